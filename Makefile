@@ -1,0 +1,41 @@
+# mechsys — set-up, demo, tests, benchmarks. Needs only python3 (3.11), cargo and pip.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.deps-stamp
+BUILD  := $(VENV)/.build-stamp
+CORE_SOURCES := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml Cargo.lock pyproject.toml
+
+.PHONY: all demo test test-rust test-python bench bench-rust build clean
+
+all: build
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm pytest
+	touch $(STAMP)
+
+# The core in release mode, installed into the venv as an editable package.
+$(BUILD): $(STAMP) $(CORE_SOURCES)
+	VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH $(VENV)/bin/maturin develop --release --quiet
+	touch $(BUILD)
+
+build: $(BUILD)
+
+demo: $(BUILD)
+	$(VENV)/bin/mechsys run examples/heavy_top.py --out results/heavy_top.h5 --plot results/heavy_top.png
+
+test: $(BUILD)
+	cargo test -p mechsys-core
+	$(PY) -m pytest -q tests
+
+bench-rust:
+	cargo bench -p mechsys-core --bench dynamics
+
+bench: $(BUILD)
+	$(PY) -m pip install --quiet pin mujoco exudyn
+	$(PY) benches/peers.py --out docs/benchmarks.md
+
+clean:
+	rm -rf $(VENV) target results

@@ -1,0 +1,99 @@
+//! The workspace: every quantity derived from a model during one evaluation, allocated once.
+//!
+//! Each field says which stage fills it and its shape. `Data::new(&model)` sizes everything; the
+//! algorithms then run without allocating.
+
+use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
+
+use crate::model::Model;
+use crate::spatial::{Force, Motion, Pose, RigidInertia};
+
+/// The state of a simulation: time, coordinates, velocities (`q̇ = H*(q) u`, eq. 2.34).
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// Time (s).
+    pub t: f64,
+    /// Generalized coordinates (nq).
+    pub q: Vec<f64>,
+    /// Generalized velocities (nu).
+    pub u: Vec<f64>,
+}
+
+/// Workspace of the recursive algorithms, one entry per body (index 0 = ground) or per joint.
+#[derive(Debug, Clone)]
+pub struct Data {
+    /// kinematics: placement of body i in its parent body (nbody).
+    pub x_rel: Vec<Pose>,
+    /// kinematics: placement of body i in the inertial frame, `a = A_IB`, `r = r_IB` (nbody).
+    pub x_abs: Vec<Pose>,
+    /// kinematics: motion subspace of the joint moving body i, body-frame twists (nbody × 6, nu used).
+    pub s: Vec<[Motion; 6]>,
+    /// kinematics: twist of body i, body frame (nbody).
+    pub v: Vec<Motion>,
+    /// kinematics: velocity-product acceleration `c_J + v_i × v_J` of body i (nbody).
+    pub c: Vec<Motion>,
+    /// dynamics: spatial acceleration of body i, body frame, without the gravity offset (nbody).
+    pub a: Vec<Motion>,
+    /// dynamics: body inertia at the current time, body frame about the body origin (nbody).
+    pub inertia: Vec<RigidInertia>,
+    /// forces: external wrench on body i, body frame about its origin (nbody).
+    pub f_ext: Vec<Force>,
+    /// forces: applied generalized forces from joint springs, dampers and joint forces (nu).
+    pub tau_applied: Vec<f64>,
+    /// dynamics: spatial force transmitted by the joint into body i, body frame (nbody).
+    pub f: Vec<Force>,
+    /// crba: composite rigid-body inertias (nbody).
+    pub ic: Vec<RigidInertia>,
+    /// crba: mass matrix M(q) (nu × nu).
+    pub mass_matrix: DMatrix<f64>,
+    /// rnea: generalized forces h(q, u, t) with M u̇ = h + τ (nu).
+    pub h: DVector<f64>,
+    /// aba: generalized accelerations (nu).
+    pub udot: Vec<f64>,
+    /// aba: articulated-body inertias (nbody).
+    pub ia: Vec<Matrix6<f64>>,
+    /// aba: articulated bias forces (nbody).
+    pub pa: Vec<Force>,
+    /// aba: `U = I^A S` per body (nbody × 6, nu used).
+    pub u_mat: Vec<[Vector6<f64>; 6]>,
+    /// aba: `D⁻¹ = (Sᵀ U)⁻¹` per body (nbody, nu × nu block used).
+    pub d_inv: Vec<Matrix6<f64>>,
+    /// aba: `τ - Sᵀ p^A` per body (nbody × 6, nu used).
+    pub u_bias: Vec<[f64; 6]>,
+    /// scratch (nu).
+    pub scratch_u: Vec<f64>,
+}
+
+impl Data {
+    /// Allocates a workspace for `model`.
+    pub fn new(model: &Model) -> Self {
+        let nb = model.nbodies();
+        let nu = model.nu;
+        let mut inertia = Vec::with_capacity(nb);
+        for b in &model.bodies {
+            inertia.push(RigidInertia::from_com(b.mass, &b.com, &b.inertia));
+        }
+        Data {
+            x_rel: vec![Pose::IDENTITY; nb],
+            x_abs: vec![Pose::IDENTITY; nb],
+            s: vec![[Motion::ZERO; 6]; nb],
+            v: vec![Motion::ZERO; nb],
+            c: vec![Motion::ZERO; nb],
+            a: vec![Motion::ZERO; nb],
+            inertia,
+            f_ext: vec![Force::ZERO; nb],
+            tau_applied: vec![0.0; nu],
+            f: vec![Force::ZERO; nb],
+            ic: vec![RigidInertia::default(); nb],
+            mass_matrix: DMatrix::zeros(nu, nu),
+            h: DVector::zeros(nu),
+            udot: vec![0.0; nu],
+            ia: vec![Matrix6::zeros(); nb],
+            pa: vec![Force::ZERO; nb],
+            u_mat: vec![[Vector6::zeros(); 6]; nb],
+            d_inv: vec![Matrix6::zeros(); nb],
+            u_bias: vec![[0.0; 6]; nb],
+            scratch_u: vec![0.0; nu],
+        }
+    }
+}

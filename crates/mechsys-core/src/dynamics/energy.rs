@@ -1,0 +1,61 @@
+//! Energies and momenta of the whole system (sections 2.3.2, 2.3.3, 2.4.2, 2.4.3):
+//! kinetic energy `T = Σ ½ v_iᵀ I_i v_i` (eq. 2.183), potential energy of gravity and springs,
+//! linear momentum `p = Σ m_i v_ci` and moment of momentum about the inertial origin.
+
+use crate::data::Data;
+use crate::forces::spring_energy;
+use crate::kinematics::point_position;
+use crate::math::Vec3;
+use crate::model::{ForceElement, Model};
+
+/// Kinetic energy of body i (requires kinematics and inertias).
+#[inline]
+pub fn body_kinetic_energy(data: &Data, i: usize) -> f64 {
+    data.inertia[i].kinetic_energy(&data.v[i])
+}
+
+/// Total kinetic energy.
+pub fn kinetic_energy(model: &Model, data: &Data) -> f64 {
+    (1..model.nbodies()).map(|i| body_kinetic_energy(data, i)).sum()
+}
+
+/// Gravitational potential energy of body i, zero at the inertial origin: `-m g · r_c`.
+#[inline]
+pub fn body_gravity_energy(model: &Model, data: &Data, i: usize) -> f64 {
+    let m = data.inertia[i].m;
+    let rc = point_position(data, i, &model.bodies[i].com);
+    -m * model.gravity.dot(&rc)
+}
+
+/// Potential energy of gravity, point-to-point springs and joint springs.
+pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
+    let mut v: f64 = (1..model.nbodies()).map(|i| body_gravity_energy(model, data, i)).sum();
+    for f in &model.forces {
+        if let ForceElement::SpringDamper { body1, point1, body2, point2, k, k3, l0, table, .. } = f {
+            let l = (point_position(data, *body2, point2) - point_position(data, *body1, point1)).norm();
+            v += spring_energy(*k, *k3, table, l - l0);
+        }
+    }
+    for j in &model.joints {
+        if let Some(s) = &j.spring {
+            for k in 0..j.nu() {
+                let d = q[j.iq + k] - s.q_free[k];
+                v += 0.5 * s.k[k] * d * d;
+            }
+        }
+    }
+    v
+}
+
+/// Linear momentum and moment of momentum about the inertial origin, both I components.
+pub fn momentum(model: &Model, data: &Data) -> (Vec3, Vec3) {
+    let mut p = Vec3::zeros();
+    let mut l = Vec3::zeros();
+    for i in 1..model.nbodies() {
+        let h_b = data.inertia[i].mul_motion(&data.v[i]);
+        let h_i = data.x_abs[i].force_to_parent(&h_b);
+        p += h_i.f;
+        l += h_i.n;
+    }
+    (p, l)
+}

@@ -1,0 +1,64 @@
+//! Model fixtures shared by tests and benchmarks: spatial chains of uniform rods.
+
+use crate::model::description::*;
+use crate::model::Model;
+
+/// A spatial chain of `n` uniform rods (mass 1 kg, length 0.5 m, radius 0.02 m) along x, hanging
+/// in gravity -z; joint `joint_type` ("revolute": axes alternating z, y, x; "spherical"; "universal").
+pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
+    let (m, l, r) = (1.0, 0.5, 0.02);
+    let ia = 0.5 * m * r * r;
+    let it = m * (3.0 * r * r + l * l) / 12.0;
+    let axes = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]];
+    let mut bodies = Vec::with_capacity(n);
+    let mut joints = Vec::with_capacity(n);
+    for i in 0..n {
+        bodies.push(BodyDescription {
+            name: format!("link{}", i + 1),
+            mass: m,
+            inertia: InertiaDescription::List(vec![ia, it, it]),
+            com: [0.5 * l, 0.0, 0.0],
+            markers: vec![],
+            mass_rate: 0.0,
+            ejection_velocity: [0.0; 3],
+            ejection_point: None,
+            mass_final: None,
+        });
+        let nq = match joint_type {
+            "spherical" => 4,
+            "universal" => 2,
+            _ => 1,
+        };
+        let q0 = match joint_type {
+            "spherical" => vec![(0.5f64).cos(), 0.0, (0.5f64).sin() * 0.6, (0.5f64).sin() * 0.8],
+            _ => (0..nq).map(|k| 0.1 + 0.05 * (i + k) as f64).collect(),
+        };
+        joints.push(JointDescription {
+            name: format!("j{}", i + 1),
+            kind: joint_type.to_string(),
+            parent: if i == 0 { "ground".into() } else { format!("link{i}") },
+            child: format!("link{}", i + 1),
+            axis: if joint_type == "revolute" { Some(axes[i % 3]) } else { None },
+            axis2: None,
+            parent_frame: FrameDescription { position: [if i == 0 { 0.0 } else { l }, 0.0, 0.0], rotation: None },
+            child_frame: FrameDescription::default(),
+            q0: Some(q0),
+            u0: None,
+            spring: None,
+            damper: None,
+        });
+    }
+    ModelDescription {
+        name: format!("chain-{n}-{joint_type}"),
+        gravity: [0.0, 0.0, -9.81],
+        bodies,
+        joints,
+        forces: vec![],
+        ground_markers: vec![],
+    }
+}
+
+/// The validated chain model.
+pub fn chain(n: usize, joint_type: &str) -> Model {
+    Model::from_description(chain_description(n, joint_type)).expect("fixture chain is valid")
+}

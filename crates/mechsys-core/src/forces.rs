@@ -1,0 +1,259 @@
+//! Force elements (section 2.1.2: active forces applied at the cuts): gravity is handled by the
+//! dynamics as a base acceleration; this stage turns every other element into body wrenches
+//! (`Data::f_ext`, body frame about the body origin) and generalized forces (`Data::tau_applied`).
+
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::kinematics::{point_position, point_velocity};
+use crate::math::Vec3;
+use crate::model::{ForceElement, ForceFrame, Model, TimeFunction};
+use crate::spatial::{Force, RigidInertia};
+
+/// User callbacks (Python callables through the bindings). Calling them is slow.
+pub trait Callbacks {
+    /// Value of time function `id` at `t`.
+    fn time_function(&self, id: usize, t: f64) -> Result<f64>;
+    /// Generalized forces of callback element `id`, added to `out` (length nu).
+    fn generalized_force(&self, id: usize, t: f64, q: &[f64], u: &[f64], out: &mut [f64]) -> Result<()>;
+}
+
+/// No callbacks: any model referring to one fails when built into a simulation.
+pub struct NoCallbacks;
+
+impl Callbacks for NoCallbacks {
+    fn time_function(&self, id: usize, _t: f64) -> Result<f64> {
+        Err(Error::Callback(format!("time function callback {id} was not provided")))
+    }
+    fn generalized_force(&self, id: usize, _t: f64, _q: &[f64], _u: &[f64], _out: &mut [f64]) -> Result<()> {
+        Err(Error::Callback(format!("force callback {id} was not provided")))
+    }
+}
+
+impl TimeFunction {
+    /// Value at time t.
+    #[inline]
+    pub fn eval(&self, t: f64, cb: &dyn Callbacks) -> Result<f64> {
+        Ok(match self {
+            TimeFunction::Constant(v) => *v,
+            TimeFunction::Ramp { slope, t0, final_value } => {
+                let v = if t <= *t0 { 0.0 } else { slope * (t - t0) };
+                match final_value {
+                    Some(f) if (*slope >= 0.0 && v > *f) || (*slope < 0.0 && v < *f) => *f,
+                    _ => v,
+                }
+            }
+            TimeFunction::Harmonic { amplitude, omega, phase, offset } => offset + amplitude * (omega * t + phase).sin(),
+            TimeFunction::Table { t: ts, values } => interp(ts, values, t),
+            TimeFunction::Callback(id) => cb.time_function(*id, t)?,
+        })
+    }
+}
+
+/// Piecewise-linear interpolation, constant outside the table.
+#[inline]
+pub fn interp(x: &[f64], y: &[f64], xi: f64) -> f64 {
+    let n = x.len();
+    if xi <= x[0] {
+        return y[0];
+    }
+    if xi >= x[n - 1] {
+        return y[n - 1];
+    }
+    let k = x.partition_point(|v| *v <= xi).clamp(1, n - 1);
+    let s = (xi - x[k - 1]) / (x[k] - x[k - 1]);
+    y[k - 1] + s * (y[k] - y[k - 1])
+}
+
+/// ∫ of the piecewise-linear table from 0 to xi (potential of a tabulated spring), extrapolating
+/// with the end values as `interp` does.
+pub fn interp_integral(x: &[f64], y: &[f64], xi: f64) -> f64 {
+    // integrate f from 0 to xi by splitting at the table's nodes
+    let mut pts: Vec<f64> = x.iter().copied().filter(|v| (*v > 0.0f64.min(xi)) && (*v < 0.0f64.max(xi))).collect();
+    let (lo, hi) = if xi >= 0.0 { (0.0, xi) } else { (xi, 0.0) };
+    pts.insert(0, lo);
+    pts.push(hi);
+    let mut s = 0.0;
+    for w in pts.windows(2) {
+        s += 0.5 * (w[1] - w[0]) * (interp(x, y, w[0]) + interp(x, y, w[1]));
+    }
+    if xi >= 0.0 {
+        s
+    } else {
+        -s
+    }
+}
+
+/// Deflection-dependent force of a spring–damper (tension positive) and its potential energy.
+#[inline]
+fn spring_force(k: f64, k3: f64, table: &(Vec<f64>, Vec<f64>), delta: f64) -> f64 {
+    let mut f = k * delta + k3 * delta * delta * delta;
+    if !table.0.is_empty() {
+        f += interp(&table.0, &table.1, delta);
+    }
+    f
+}
+
+/// Potential energy stored in a spring–damper's elastic part at deflection `delta`.
+pub fn spring_energy(k: f64, k3: f64, table: &(Vec<f64>, Vec<f64>), delta: f64) -> f64 {
+    let mut e = 0.5 * k * delta * delta + 0.25 * k3 * delta.powi(4);
+    if !table.0.is_empty() {
+        e += interp_integral(&table.0, &table.1, delta);
+    }
+    e
+}
+
+/// Updates body inertias of variable-mass bodies to time t (inertia scales with m(t)/m(0)).
+pub fn update_inertias(model: &Model, data: &mut Data, t: f64) {
+    if !model.variable_mass {
+        return;
+    }
+    for (i, b) in model.bodies.iter().enumerate().skip(1) {
+        if b.mass_rate != 0.0 {
+            let m = b.mass_at(t);
+            data.inertia[i] = RigidInertia::from_com(m, &b.com, &(b.inertia * (m / b.mass)));
+        }
+    }
+}
+
+/// Adds a force `f_i` (I components) acting at the body point `p_b` to body `b`'s wrench.
+#[inline]
+fn add_point_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) {
+    if b == 0 {
+        return;
+    }
+    let f_b = data.x_abs[b].a.transpose() * f_i;
+    data.f_ext[b] += Force::new(p_b.cross(&f_b), f_b);
+}
+
+/// Power balance of the force elements at one instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Powers {
+    /// Power dissipated by dampers (W, ≥ 0 for positive damping).
+    pub dissipated: f64,
+    /// Power of the external loads: body forces, joint forces, callbacks, thrust (W).
+    pub external: f64,
+}
+
+/// Power of a body wrench `f` (body frame, about the origin) on the body's twist.
+#[inline]
+fn wrench_power(data: &Data, b: usize, f: &Force) -> f64 {
+    data.v[b].dot(f)
+}
+
+/// Force stage: fills `f_ext` and `tau_applied`. Requires the kinematics of (q, u).
+pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<Powers> {
+    data.f_ext.iter_mut().for_each(|f| *f = Force::ZERO);
+    data.tau_applied.iter_mut().for_each(|x| *x = 0.0);
+    let mut p_diss = 0.0;
+    let mut p_ext = 0.0;
+
+    for j in &model.joints {
+        if let Some(s) = &j.spring {
+            for k in 0..j.nu() {
+                data.tau_applied[j.iu + k] -= s.k[k] * (q[j.iq + k] - s.q_free[k]);
+            }
+        }
+        for (k, d) in j.damper.iter().enumerate() {
+            let uk = u[j.iu + k];
+            data.tau_applied[j.iu + k] -= d * uk;
+            p_diss += d * uk * uk;
+        }
+    }
+
+    // variable mass: thrust ṁ w_rel at the ejection point (section 2.1.1)
+    if model.variable_mass {
+        for (i, b) in model.bodies.iter().enumerate().skip(1) {
+            let mdot = b.mass_rate_at(t);
+            if mdot != 0.0 {
+                let f_b = b.ejection_velocity * mdot;
+                let w = Force::new(b.ejection_point.cross(&f_b), f_b);
+                p_ext += wrench_power(data, i, &w);
+                data.f_ext[i] += w;
+            }
+        }
+    }
+
+    for fe in &model.forces {
+        match fe {
+            ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table } => {
+                let p1 = point_position(data, *body1, point1);
+                let p2 = point_position(data, *body2, point2);
+                let dr = p2 - p1;
+                let l = dr.norm();
+                if l < 1e-12 {
+                    if *l0 > 0.0 || !table.0.is_empty() {
+                        return Err(Error::Solver(format!(
+                            "spring-damper '{name}': its two points coincide at t = {t} s, the force direction is undefined"
+                        )));
+                    }
+                    continue;
+                }
+                let e = dr / l;
+                let ldot = e.dot(&(point_velocity(data, *body2, point2) - point_velocity(data, *body1, point1)));
+                let f = spring_force(*k, *k3, table, l - l0) + d * ldot;
+                p_diss += d * ldot * ldot;
+                let fv = e * f;
+                add_point_force(data, *body1, point1, &fv);
+                add_point_force(data, *body2, point2, &(-fv));
+            }
+            ForceElement::BodyForce { body, point, force, torque, frame, function, .. } => {
+                let s = function.eval(t, cb)?;
+                let a_bi = data.x_abs[*body].a.transpose();
+                let (f_b, n_b) = match frame {
+                    ForceFrame::Inertial => (a_bi * force * s, a_bi * torque * s),
+                    ForceFrame::Body => (force * s, torque * s),
+                };
+                let w = Force::new(n_b + point.cross(&f_b), f_b);
+                p_ext += wrench_power(data, *body, &w);
+                data.f_ext[*body] += w;
+            }
+            ForceElement::JointForce { joint, value, function, .. } => {
+                let s = function.eval(t, cb)?;
+                let j = &model.joints[*joint];
+                for (k, v) in value.iter().enumerate() {
+                    data.tau_applied[j.iu + k] += v * s;
+                    p_ext += v * s * u[j.iu + k];
+                }
+            }
+            ForceElement::Callback { name, id } => {
+                let before: f64 = data.tau_applied.iter().zip(u).map(|(a, b)| a * b).sum();
+                cb.generalized_force(*id, t, q, u, &mut data.tau_applied)
+                    .map_err(|e| Error::Callback(format!("force element '{name}': {e}")))?;
+                let after: f64 = data.tau_applied.iter().zip(u).map(|(a, b)| a * b).sum();
+                p_ext += after - before;
+            }
+        }
+    }
+    Ok(Powers { dissipated: p_diss, external: p_ext })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_interpolation_and_integral() {
+        let x = [-1.0, 0.0, 2.0];
+        let y = [-3.0, 0.0, 4.0];
+        assert!((interp(&x, &y, 1.0) - 2.0).abs() < 1e-15);
+        assert!((interp(&x, &y, -0.5) + 1.5).abs() < 1e-15);
+        assert_eq!(interp(&x, &y, 5.0), 4.0);
+        // ∫0^2 2x dx = 4; beyond the table the force stays 4: ∫2^3 4 = 4
+        assert!((interp_integral(&x, &y, 2.0) - 4.0).abs() < 1e-12);
+        assert!((interp_integral(&x, &y, 3.0) - 8.0).abs() < 1e-12);
+        // ∫0^-1 3x dx = 1.5
+        assert!((interp_integral(&x, &y, -1.0) - 1.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn time_functions() {
+        let cb = NoCallbacks;
+        let r = TimeFunction::Ramp { slope: 2.0, t0: 1.0, final_value: Some(3.0) };
+        assert_eq!(r.eval(0.5, &cb).unwrap(), 0.0);
+        assert!((r.eval(2.0, &cb).unwrap() - 2.0).abs() < 1e-15);
+        assert_eq!(r.eval(10.0, &cb).unwrap(), 3.0);
+        let h = TimeFunction::Harmonic { amplitude: 2.0, omega: 3.0, phase: 0.5, offset: 1.0 };
+        assert!((h.eval(0.7, &cb).unwrap() - (1.0 + 2.0 * (2.1f64 + 0.5).sin())).abs() < 1e-15);
+        assert!(TimeFunction::Callback(0).eval(0.0, &cb).is_err());
+    }
+}

@@ -1,0 +1,217 @@
+//! Dormand–Prince 5(4): explicit Runge–Kutta pair with local error control (the 5th-order
+//! solution is propagated, the embedded 4th-order one estimates the error), first-same-as-last,
+//! and the continuous extension of order 4 (Hairer, Nørsett, Wanner, *Solving ODEs I*, II.5–II.6)
+//! for output at any requested time without shortening steps.
+
+use super::{check_finite, Observer, OdeSystem, Stats};
+use crate::error::{Error, Result};
+
+const C2: f64 = 1.0 / 5.0;
+const C3: f64 = 3.0 / 10.0;
+const C4: f64 = 4.0 / 5.0;
+const C5: f64 = 8.0 / 9.0;
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+// error coefficients: 5th-order minus 4th-order weights
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+// dense output
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
+
+/// Adaptive integration; `max_step = 0` means unlimited, `first_step = 0` means automatic.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate<S: OdeSystem>(
+    sys: &mut S,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    rtol: f64,
+    atol: f64,
+    max_step: f64,
+    first_step: f64,
+    obs: &mut Observer<'_, S>,
+) -> Result<Stats> {
+    if !(rtol > 0.0 && rtol.is_finite() && atol > 0.0 && atol.is_finite()) {
+        return Err(Error::Settings(format!("integrator: rtol and atol must be > 0, got rtol={rtol}, atol={atol}")));
+    }
+    if !(max_step >= 0.0 && first_step >= 0.0) {
+        return Err(Error::Settings("integrator: max_step and first_step must be >= 0".into()));
+    }
+    let n = sys.dim();
+    let t_end = *t_out.last().unwrap_or(&t0);
+    let hmax = if max_step > 0.0 { max_step } else { (t_end - t0).abs().max(f64::MIN_POSITIVE) };
+    let mut stats = Stats::default();
+    let mut y = y0.to_vec();
+    let mut k = vec![vec![0.0; n]; 7];
+    let mut ynew = vec![0.0; n];
+    let mut tmp = vec![0.0; n];
+    let mut yout = vec![0.0; n];
+    let mut r = vec![vec![0.0; n]; 5]; // dense-output coefficients
+    let mut t = t0;
+    let mut next = 0usize;
+
+    sys.rhs(t, &y, &mut k[0])?;
+    stats.evaluations += 1;
+    while next < t_out.len() && t_out[next] <= t {
+        obs(sys, t, &y, true)?;
+        next += 1;
+    }
+    if next >= t_out.len() {
+        return Ok(stats);
+    }
+
+    let norm = |v: &[f64], y: &[f64]| -> f64 {
+        (v.iter().zip(y).map(|(a, b)| (a / (atol + rtol * b.abs())).powi(2)).sum::<f64>() / n.max(1) as f64).sqrt()
+    };
+    let mut h = if first_step > 0.0 {
+        first_step
+    } else {
+        // starting step from the size of y and f (Hairer's heuristic)
+        let d0 = norm(&y, &y);
+        let d1 = norm(&k[0], &y);
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+        let h0 = h0.min(hmax);
+        for i in 0..n {
+            tmp[i] = y[i] + h0 * k[0][i];
+        }
+        sys.rhs(t + h0, &tmp, &mut k[1])?;
+        stats.evaluations += 1;
+        let d2 = k[1].iter().zip(&k[0]).zip(&y).map(|((a, b), yy)| ((a - b) / (atol + rtol * yy.abs())).powi(2)).sum::<f64>();
+        let d2 = (d2 / n.max(1) as f64).sqrt() / h0;
+        let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
+        (100.0 * h0).min(h1).min(hmax)
+    };
+    let mut err_old: f64 = 1e-4;
+    let mut reject = false;
+
+    loop {
+        if t_end - t <= 1e-13 * t.abs().max(1.0) {
+            // rounding left a sliver: the remaining outputs are at the current state
+            while next < t_out.len() {
+                obs(sys, t_out[next], &y, false)?;
+                next += 1;
+            }
+            break;
+        }
+        if h < 1e-14 * t.abs().max(1.0) {
+            return Err(Error::Solver(format!(
+                "step size underflow at t = {t:.6} s (h = {h:.3e}); the system may be stiff (use radau5) or singular"
+            )));
+        }
+        if t + h > t_end {
+            h = t_end - t;
+        }
+        macro_rules! stage {
+            ($dst:expr, $c:expr, $($a:expr => $ki:expr),+) => {{
+                for i in 0..n {
+                    tmp[i] = y[i] + h * (0.0 $(+ $a * k[$ki][i])+);
+                }
+                let (head, tail) = k.split_at_mut($dst);
+                let _ = head;
+                sys.rhs(t + $c * h, &tmp, &mut tail[0])?;
+            }};
+        }
+        stage!(1, C2, A21 => 0);
+        stage!(2, C3, A31 => 0, A32 => 1);
+        stage!(3, C4, A41 => 0, A42 => 1, A43 => 2);
+        stage!(4, C5, A51 => 0, A52 => 1, A53 => 2, A54 => 3);
+        stage!(5, 1.0, A61 => 0, A62 => 1, A63 => 2, A64 => 3, A65 => 4);
+        for i in 0..n {
+            ynew[i] = y[i] + h * (A71 * k[0][i] + A73 * k[2][i] + A74 * k[3][i] + A75 * k[4][i] + A76 * k[5][i]);
+        }
+        sys.rhs(t + h, &ynew, &mut k[6])?;
+        stats.evaluations += 6;
+        let mut err = 0.0;
+        for i in 0..n {
+            let e = h * (E1 * k[0][i] + E3 * k[2][i] + E4 * k[3][i] + E5 * k[4][i] + E6 * k[5][i] + E7 * k[6][i]);
+            let sc = atol + rtol * y[i].abs().max(ynew[i].abs());
+            err += (e / sc).powi(2);
+        }
+        let err = (err / n.max(1) as f64).sqrt();
+        if !err.is_finite() {
+            // a stage produced inf/NaN: shrink hard and retry
+            stats.rejected += 1;
+            h *= 0.1;
+            reject = true;
+            continue;
+        }
+        if err <= 1.0 {
+            // dense output coefficients for the accepted step [t, t + h]
+            for i in 0..n {
+                let ydiff = ynew[i] - y[i];
+                let bspl = h * k[0][i] - ydiff;
+                r[0][i] = y[i];
+                r[1][i] = ydiff;
+                r[2][i] = bspl;
+                r[3][i] = ydiff - h * k[6][i] - bspl;
+                r[4][i] = h * (D1 * k[0][i] + D3 * k[2][i] + D4 * k[3][i] + D5 * k[4][i] + D6 * k[5][i] + D7 * k[6][i]);
+            }
+            let t_new = t + h;
+            sys.project(&mut ynew);
+            check_finite(t_new, &ynew)?;
+            while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
+                let to = t_out[next];
+                if to >= t_new {
+                    obs(sys, to, &ynew, false)?;
+                } else {
+                    let th = (to - t) / h;
+                    let th1 = 1.0 - th;
+                    for i in 0..n {
+                        yout[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
+                    }
+                    sys.project(&mut yout);
+                    obs(sys, to, &yout, false)?;
+                }
+                next += 1;
+            }
+            stats.steps += 1;
+            t = t_new;
+            std::mem::swap(&mut y, &mut ynew);
+            k.swap(0, 6); // first same as last
+            if next >= t_out.len() || t >= t_end {
+                break;
+            }
+            // PI step-size controller (β = 0.04)
+            let mut fac = 0.9 * err.max(1e-10).powf(-0.17) * err_old.powf(0.04);
+            fac = fac.clamp(0.2, 10.0);
+            if reject {
+                fac = fac.min(1.0);
+            }
+            h = (h * fac).min(hmax);
+            err_old = err.max(1e-4);
+            reject = false;
+        } else {
+            stats.rejected += 1;
+            reject = true;
+            h *= (0.9 * err.powf(-0.2)).max(0.2);
+        }
+    }
+    Ok(stats)
+}

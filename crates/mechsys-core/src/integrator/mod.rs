@@ -1,0 +1,118 @@
+//! Time integrators behind one interface, one file per scheme.
+//!
+//! An [`OdeSystem`] gives `ẏ = f(t, y)` and a projection back onto the configuration manifold
+//! (unit quaternions); a scheme advances it and calls an observer at each requested output time.
+//! - [`rk4`]: classical fixed-step Runge–Kutta of order 4;
+//! - [`dopri5`]: Dormand–Prince 5(4) with step-size control and dense output;
+//! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable), fixed step, for stiff systems.
+
+pub mod dopri5;
+pub mod radau5;
+pub mod rk4;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Result;
+
+/// A first-order system `ẏ = f(t, y)`.
+pub trait OdeSystem {
+    /// Dimension of y.
+    fn dim(&self) -> usize;
+    /// Evaluates `dy = f(t, y)`.
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()>;
+    /// Projects y back onto its manifold after a step (e.g. renormalizes quaternions).
+    fn project(&self, _y: &mut [f64]) {}
+}
+
+/// Called at each output time with the system and the state; `fresh` says the system's last `rhs`
+/// call was at exactly this (t, y), so its workspace can be read without another evaluation.
+pub type Observer<'a, S> = dyn FnMut(&mut S, f64, &[f64], bool) -> Result<()> + 'a;
+
+/// Which scheme, with its settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum IntegratorKind {
+    /// Fixed-step RK4.
+    Rk4 {
+        /// Step size (s).
+        dt: f64,
+    },
+    /// Adaptive Dormand–Prince 5(4).
+    Dopri5 {
+        /// Relative tolerance.
+        #[serde(default = "default_rtol")]
+        rtol: f64,
+        /// Absolute tolerance.
+        #[serde(default = "default_atol")]
+        atol: f64,
+        /// Largest step (s); 0 means unlimited.
+        #[serde(default)]
+        max_step: f64,
+        /// Initial step (s); 0 means automatic.
+        #[serde(default)]
+        first_step: f64,
+    },
+    /// Fixed-step Radau IIA (3 stages, order 5), implicit, for stiff systems.
+    Radau5 {
+        /// Step size (s).
+        dt: f64,
+        /// Newton tolerance on the stage increments (relative).
+        #[serde(default = "default_newton_tol")]
+        newton_tol: f64,
+    },
+}
+
+fn default_rtol() -> f64 {
+    1e-8
+}
+fn default_atol() -> f64 {
+    1e-10
+}
+fn default_newton_tol() -> f64 {
+    1e-10
+}
+
+/// Counters of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: usize,
+    /// Rejected steps (adaptive schemes).
+    pub rejected: usize,
+    /// Right-hand-side evaluations.
+    pub evaluations: usize,
+    /// Jacobian evaluations (implicit schemes).
+    pub jacobians: usize,
+}
+
+/// Runs the chosen scheme from (t0, y0) through all `t_out` (increasing, ≥ t0).
+pub fn integrate<S: OdeSystem>(
+    kind: &IntegratorKind,
+    sys: &mut S,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    obs: &mut Observer<'_, S>,
+) -> Result<Stats> {
+    match kind {
+        IntegratorKind::Rk4 { dt } => rk4::integrate(sys, t0, y0, *dt, t_out, obs),
+        IntegratorKind::Dopri5 { rtol, atol, max_step, first_step } => {
+            dopri5::integrate(sys, t0, y0, t_out, *rtol, *atol, *max_step, *first_step, obs)
+        }
+        IntegratorKind::Radau5 { dt, newton_tol } => radau5::integrate(sys, t0, y0, *dt, *newton_tol, t_out, obs),
+    }
+}
+
+/// Fails with a solver error if y holds a NaN or inf, naming the time.
+pub(crate) fn check_finite(t: f64, y: &[f64]) -> Result<()> {
+    if y.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(crate::Error::Solver(format!(
+            "the solution diverged (non-finite state) at t = {t:.6} s; reduce the step size or check the model"
+        )))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,73 @@
+//! Kinematics against finite differences.
+
+use nalgebra::DMatrix;
+
+use super::*;
+use crate::data::Data;
+use crate::fixtures;
+use crate::math::Vec3;
+
+/// The point Jacobian times u equals the recursive point velocity, and both equal the finite
+/// difference of the point position along q ⊕ u dt (eq. 2.69).
+#[test]
+fn point_jacobian_matches_velocity_and_finite_difference() {
+    for kind in ["revolute", "spherical", "universal"] {
+        let model = fixtures::chain(4, kind);
+        let mut data = Data::new(&model);
+        let q = model.q0();
+        let u: Vec<f64> = (0..model.nu).map(|i| 0.3 - 0.11 * i as f64).collect();
+        forward_kinematics(&model, &mut data, &q, &u);
+        let p_b = Vec3::new(0.4, 0.05, -0.02);
+        let body = model.nbodies() - 1;
+        let mut jt = DMatrix::zeros(3, model.nu);
+        let mut jr = DMatrix::zeros(3, model.nu);
+        point_jacobian(&model, &data, body, &p_b, &mut jt, &mut jr);
+        let uv = nalgebra::DVector::from_column_slice(&u);
+        let v_rec = point_velocity(&data, body, &p_b);
+        assert!((&jt * &uv - v_rec).norm() < 1e-12, "{kind}: J u vs recursion");
+        let w_rec = data.x_abs[body].a * data.v[body].w;
+        assert!((&jr * &uv - w_rec).norm() < 1e-12, "{kind}: J_R u vs recursion");
+        let h = 1e-6;
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        model.integrate(&q, &u, h, &mut qp);
+        model.integrate(&q, &u, -h, &mut qm);
+        let mut d2 = Data::new(&model);
+        positions(&model, &mut d2, &qp);
+        let pp = point_position(&d2, body, &p_b);
+        positions(&model, &mut d2, &qm);
+        let pm = point_position(&d2, body, &p_b);
+        assert!(((pp - pm) / (2.0 * h) - v_rec).norm() < 1e-8, "{kind}: finite difference");
+    }
+}
+
+/// The recursive acceleration of a point equals the finite difference of its velocity.
+#[test]
+fn point_acceleration_matches_finite_difference() {
+    let model = fixtures::chain(3, "universal");
+    let q = model.q0();
+    let u: Vec<f64> = (0..model.nu).map(|i| 0.5 - 0.2 * i as f64).collect();
+    let udot: Vec<f64> = (0..model.nu).map(|i| -0.3 + 0.4 * i as f64).collect();
+    let mut data = Data::new(&model);
+    forward_kinematics(&model, &mut data, &q, &u);
+    data.a[0] = crate::spatial::Motion::ZERO;
+    accelerations(&model, &mut data, &udot);
+    let p_b = Vec3::new(0.3, -0.1, 0.05);
+    let body = 3;
+    let a_rec = point_acceleration(&data, body, &p_b);
+    let h = 1e-5;
+    let vel = |s: f64| {
+        let mut qs = q.clone();
+        model.integrate(&q, &u, s, &mut qs);
+        // second-order accurate: q(t+s) ≈ q ⊕ (u s + ½ u̇ s²)
+        let du: Vec<f64> = udot.iter().map(|a| 0.5 * a * s * s).collect();
+        let q2 = qs.clone();
+        let mut q3 = qs.clone();
+        model.integrate(&q2, &du, 1.0, &mut q3);
+        let us: Vec<f64> = u.iter().zip(&udot).map(|(a, b)| a + b * s).collect();
+        let mut d = Data::new(&model);
+        forward_kinematics(&model, &mut d, &q3, &us);
+        point_velocity(&d, body, &p_b)
+    };
+    let fd = (vel(h) - vel(-h)) / (2.0 * h);
+    assert!((fd - a_rec).norm() < 1e-6, "fd {fd} vs {a_rec}");
+}

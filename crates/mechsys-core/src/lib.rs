@@ -1,0 +1,25 @@
+//! # mechsys-core
+//!
+//! The engine of mechsys: rigid multibody kinematics, dynamics and time integration, following the
+//! notation of *Fundamentals of Mechanical System Dynamics* (equation numbers are quoted in the code).
+//!
+//! Data flows one way: a [`model::ModelDescription`] (from Python or a model file) is validated
+//! into an immutable [`model::Model`]; a [`data::Data`] workspace sized from the model holds every
+//! intermediate quantity; free functions ([`kinematics::forward_kinematics`], [`dynamics::crba`],
+//! [`dynamics::rnea`], [`dynamics::aba`]) fill it; [`simulate::simulate`] runs the step loop and
+//! records signals.
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod math;
+pub mod spatial;
+pub mod model;
+pub mod data;
+pub mod kinematics;
+pub mod dynamics;
+pub mod forces;
+pub mod integrator;
+pub mod simulate;
+pub mod fixtures;
+
+pub use error::{Error, Result};

@@ -1,0 +1,353 @@
+//! The model description: the plain-data form of a model shared by model files (TOML), the Python
+//! builder (which emits the same structure as JSON) and the engine. Parsing reports the key path of
+//! any error (`bodies[2].inertia`); unknown keys are rejected so that a misspelt key never passes
+//! silently. [`super::Model::from_description`] turns it into a validated [`super::Model`].
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// A whole model as written in a model file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelDescription {
+    /// Model name.
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// Gravitational acceleration in the inertial frame (m/s²).
+    #[serde(default)]
+    pub gravity: [f64; 3],
+    /// Rigid bodies (the ground is implicit and named `ground`).
+    #[serde(default)]
+    pub bodies: Vec<BodyDescription>,
+    /// Joints; they must form a tree rooted at the ground.
+    #[serde(default)]
+    pub joints: Vec<JointDescription>,
+    /// Force elements.
+    #[serde(default)]
+    pub forces: Vec<ForceDescription>,
+    /// Markers (named frames) on the ground.
+    #[serde(default)]
+    pub ground_markers: Vec<MarkerDescription>,
+}
+
+fn default_name() -> String {
+    "model".to_string()
+}
+
+/// An inertia tensor as a full 3×3 matrix, its diagonal `[Ixx, Iyy, Izz]`, or the six independent
+/// entries `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]` (products of inertia as matrix entries, i.e. `Ixy = -∫xy dm`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum InertiaDescription {
+    /// Full matrix, rows.
+    Matrix([[f64; 3]; 3]),
+    /// Diagonal or six entries.
+    List(Vec<f64>),
+}
+
+/// A rotation: a unit quaternion `[w, x, y, z]`, a 3×3 matrix (rows of A_PB), or named angles.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum RotationDescription {
+    /// Rotation matrix rows.
+    Matrix([[f64; 3]; 3]),
+    /// Quaternion `[w, x, y, z]` (normalised when read).
+    Quaternion([f64; 4]),
+    /// Angles by name.
+    Angles(AnglesDescription),
+}
+
+/// Named rotation angles.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnglesDescription {
+    /// Cardan angles x-y-z (α, β, γ), eq. 2.19.
+    #[serde(default)]
+    pub cardan: Option<[f64; 3]>,
+    /// Euler angles z-x-z (ψ, ϑ, φ), eq. 2.15.
+    #[serde(default)]
+    pub euler: Option<[f64; 3]>,
+    /// Rotation vector (axis × angle).
+    #[serde(default)]
+    pub rotvec: Option<[f64; 3]>,
+}
+
+/// A frame placed on a body: position of its origin and orientation, both in the body frame.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameDescription {
+    /// Origin in the body frame (m).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Orientation relative to the body frame (identity if absent).
+    #[serde(default)]
+    pub rotation: Option<RotationDescription>,
+}
+
+/// A named body-fixed frame.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MarkerDescription {
+    /// Marker name, unique on its body.
+    pub name: String,
+    /// Origin in the body frame (m).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Orientation relative to the body frame.
+    #[serde(default)]
+    pub rotation: Option<RotationDescription>,
+}
+
+/// A rigid body.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyDescription {
+    /// Unique body name.
+    pub name: String,
+    /// Mass (kg), > 0. For a variable-mass body, the mass at t = 0.
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass, body-frame components (kg m²).
+    pub inertia: InertiaDescription,
+    /// Centre of mass in the body frame (m).
+    #[serde(default)]
+    pub com: [f64; 3],
+    /// Named body-fixed frames.
+    #[serde(default)]
+    pub markers: Vec<MarkerDescription>,
+    /// Variable mass (section 2.1.1): mass rate ṁ (kg/s), negative when mass is ejected.
+    #[serde(default)]
+    pub mass_rate: f64,
+    /// Velocity of the ejected (or accreted) mass relative to the body, body frame (m/s).
+    #[serde(default)]
+    pub ejection_velocity: [f64; 3],
+    /// Point (body frame) where the thrust acts; defaults to the centre of mass.
+    #[serde(default)]
+    pub ejection_point: Option<[f64; 3]>,
+    /// Mass at which the mass flow stops (burn-out), > 0; required when `mass_rate < 0`.
+    #[serde(default)]
+    pub mass_final: Option<f64>,
+}
+
+/// A linear spring on a joint coordinate: τ = -k (q - q_free).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpringDescription {
+    /// Stiffness (N/m or N m/rad), one per joint coordinate or one for all.
+    pub k: Vec<f64>,
+    /// Unloaded position, one per joint coordinate (default 0).
+    #[serde(default)]
+    pub q_free: Option<Vec<f64>>,
+}
+
+/// A linear damper on a joint velocity: τ = -d u.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointDamperDescription {
+    /// Damping coefficient (N s/m or N m s/rad), one per joint velocity or one for all.
+    pub d: Vec<f64>,
+}
+
+/// A joint between a parent and a child body.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointDescription {
+    /// Unique joint name.
+    pub name: String,
+    /// Joint type: fixed, revolute, prismatic, cylindrical, universal, spherical, planar, free.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Parent body name (`ground` for the inertial frame).
+    pub parent: String,
+    /// Child body name.
+    pub child: String,
+    /// Joint axis in the joint frame (revolute, prismatic, cylindrical; default z).
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    /// Second axis of a universal joint, in the child joint frame (default y; first axis default x).
+    #[serde(default)]
+    pub axis2: Option<[f64; 3]>,
+    /// Joint frame on the parent body.
+    #[serde(default)]
+    pub parent_frame: FrameDescription,
+    /// Joint frame on the child body.
+    #[serde(default)]
+    pub child_frame: FrameDescription,
+    /// Initial joint coordinates (length nq of the joint).
+    #[serde(default)]
+    pub q0: Option<Vec<f64>>,
+    /// Initial joint velocities (length nu of the joint).
+    #[serde(default)]
+    pub u0: Option<Vec<f64>>,
+    /// Joint spring.
+    #[serde(default)]
+    pub spring: Option<JointSpringDescription>,
+    /// Joint damper.
+    #[serde(default)]
+    pub damper: Option<JointDamperDescription>,
+}
+
+/// A scalar function of time.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TimeFunctionDescription {
+    /// f(t) = value.
+    Constant {
+        /// The value.
+        value: f64,
+    },
+    /// f(t) = 0 before `t0`, slope·(t - t0) after, held at `final_value` once reached (if given).
+    Ramp {
+        /// Slope (1/s).
+        slope: f64,
+        /// Start time (s).
+        #[serde(default)]
+        t0: f64,
+        /// Value at which the ramp stops rising.
+        #[serde(default)]
+        final_value: Option<f64>,
+    },
+    /// f(t) = offset + amplitude·sin(omega·t + phase).
+    Harmonic {
+        /// Amplitude.
+        amplitude: f64,
+        /// Circular frequency (rad/s).
+        omega: f64,
+        /// Phase (rad).
+        #[serde(default)]
+        phase: f64,
+        /// Offset.
+        #[serde(default)]
+        offset: f64,
+    },
+    /// Piecewise-linear interpolation of a table, held constant outside it.
+    Table {
+        /// Strictly increasing times (s).
+        t: Vec<f64>,
+        /// Values at those times.
+        values: Vec<f64>,
+    },
+    /// A user callback registered under an index (Python callables; slow).
+    Callback {
+        /// Index into the callback table given with the model.
+        id: usize,
+    },
+}
+
+/// A force element.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ForceDescription {
+    /// Point-to-point spring–damper between two body points:
+    /// F = k (l - l0) + k3 (l - l0)³ + d l̇ (+ a tabulated force of l - l0), pulling the points together when positive.
+    SpringDamper {
+        /// Element name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Attachment point on body1, body frame.
+        #[serde(default)]
+        point1: [f64; 3],
+        /// Second body.
+        body2: String,
+        /// Attachment point on body2, body frame.
+        #[serde(default)]
+        point2: [f64; 3],
+        /// Linear stiffness (N/m).
+        #[serde(default)]
+        k: f64,
+        /// Cubic stiffness (N/m³).
+        #[serde(default)]
+        k3: f64,
+        /// Damping (N s/m).
+        #[serde(default)]
+        d: f64,
+        /// Unstretched length (m).
+        #[serde(default)]
+        l0: f64,
+        /// Optional tabulated force–deflection curve: deflections (m), increasing.
+        #[serde(default)]
+        table_deflection: Option<Vec<f64>>,
+        /// Forces (N) at `table_deflection`.
+        #[serde(default)]
+        table_force: Option<Vec<f64>>,
+    },
+    /// A force and torque on a body, scaled by a time function.
+    BodyForce {
+        /// Element name.
+        name: String,
+        /// Body acted upon.
+        body: String,
+        /// Point of application, body frame.
+        #[serde(default)]
+        point: [f64; 3],
+        /// Force vector (N).
+        #[serde(default)]
+        force: [f64; 3],
+        /// Torque vector (N m).
+        #[serde(default)]
+        torque: [f64; 3],
+        /// Frame of `force` and `torque`: "inertial" or "body".
+        #[serde(default = "default_frame")]
+        frame: String,
+        /// Scalar time function multiplying force and torque (constant 1 if absent).
+        #[serde(default)]
+        function: Option<TimeFunctionDescription>,
+    },
+    /// Generalized forces on a joint's velocities, scaled by a time function.
+    JointForce {
+        /// Element name.
+        name: String,
+        /// Joint acted upon.
+        joint: String,
+        /// One value per joint velocity (N or N m).
+        value: Vec<f64>,
+        /// Scalar time function multiplying `value` (constant 1 if absent).
+        #[serde(default)]
+        function: Option<TimeFunctionDescription>,
+    },
+    /// A user callback computing generalized forces from (t, q, u): slow, it calls back into Python.
+    Callback {
+        /// Element name.
+        name: String,
+        /// Index into the callback table given with the model.
+        id: usize,
+    },
+}
+
+fn default_frame() -> String {
+    "inertial".to_string()
+}
+
+impl ModelDescription {
+    /// Parses a JSON description, reporting the key path of the first error.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize(de).map_err(|e| Error::Description {
+            path: display_path(&e.path().to_string()),
+            message: clean_message(&e.inner().to_string()),
+        })
+    }
+
+    /// Serializes to JSON (the form stored as an HDF5 attribute).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+}
+
+/// serde_path_to_error prints the root as "."; make it read as a key path.
+fn display_path(p: &str) -> String {
+    if p == "." || p.is_empty() {
+        "model".to_string()
+    } else {
+        p.to_string()
+    }
+}
+
+/// Drop serde_json's " at line X column Y" (meaningless for a TOML file or a Python dict).
+fn clean_message(m: &str) -> String {
+    match m.find(" at line ") {
+        Some(i) => m[..i].to_string(),
+        None => m.to_string(),
+    }
+}

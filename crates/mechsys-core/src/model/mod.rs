@@ -1,0 +1,336 @@
+//! The validated, immutable model: bodies, joints forming a kinematic tree, force elements.
+//!
+//! A [`Model`] is built once from a [`ModelDescription`] by [`Model::from_description`], which checks
+//! everything a user can get wrong and names the offending item. Bodies are stored in topological
+//! order (index 0 is the ground, each body's parent has a smaller index) and body `i > 0` is moved
+//! by joint `i - 1`, so the recursive algorithms are plain loops.
+
+pub mod description;
+pub mod joint;
+mod validate;
+
+use std::collections::HashMap;
+
+pub use description::ModelDescription;
+pub use joint::JointKind;
+
+use crate::math::{Mat3, Vec3};
+use crate::spatial::Pose;
+
+/// A named body-fixed frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    /// Name, unique on its body.
+    pub name: String,
+    /// Placement in the body frame.
+    pub pose: Pose,
+}
+
+/// A rigid body; for variable mass (section 2.1.1) the inertia scales with m(t)/m(0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Unique name (`ground` for index 0).
+    pub name: String,
+    /// Mass at t = 0 (kg).
+    pub mass: f64,
+    /// Centre of mass, body frame (m).
+    pub com: Vec3,
+    /// Inertia tensor about the centre of mass, body frame (kg m²).
+    pub inertia: Mat3,
+    /// Named frames.
+    pub markers: Vec<Marker>,
+    /// Mass rate ṁ (kg/s), 0 for constant mass.
+    pub mass_rate: f64,
+    /// Relative velocity of the ejected mass, body frame (m/s).
+    pub ejection_velocity: Vec3,
+    /// Point where the thrust acts, body frame.
+    pub ejection_point: Vec3,
+    /// Mass at which the flow stops.
+    pub mass_final: f64,
+}
+
+impl Body {
+    /// Mass at time t: m(0) + ṁ t until `mass_final` is reached (eq. of section 2.1.1, m > 0 always).
+    #[inline]
+    pub fn mass_at(&self, t: f64) -> f64 {
+        if self.mass_rate == 0.0 {
+            return self.mass;
+        }
+        let m = self.mass + self.mass_rate * t;
+        if self.mass_rate < 0.0 {
+            m.max(self.mass_final)
+        } else {
+            m.min(self.mass_final)
+        }
+    }
+    /// The mass rate at time t (zero once the flow has stopped).
+    #[inline]
+    pub fn mass_rate_at(&self, t: f64) -> f64 {
+        if self.mass_rate == 0.0 {
+            return 0.0;
+        }
+        let m = self.mass + self.mass_rate * t;
+        let flowing = if self.mass_rate < 0.0 { m > self.mass_final } else { m < self.mass_final };
+        if flowing {
+            self.mass_rate
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A joint linear spring: τ = -k (q - q_free) per coordinate (1-DOF-per-coordinate joints only).
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointSpring {
+    /// Stiffness per velocity index.
+    pub k: Vec<f64>,
+    /// Unloaded coordinates.
+    pub q_free: Vec<f64>,
+}
+
+/// A joint, moving its child body relative to its parent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Unique name.
+    pub name: String,
+    /// Type and its constants.
+    pub kind: JointKind,
+    /// Parent body index.
+    pub parent: usize,
+    /// Child body index (= joint index + 1).
+    pub child: usize,
+    /// Joint frame on the parent body.
+    pub parent_frame: Pose,
+    /// Joint frame on the child body.
+    pub child_frame: Pose,
+    /// `child_frame.inverse()`, kept because every evaluation needs it.
+    pub child_frame_inv: Pose,
+    /// Offset of this joint's coordinates in q.
+    pub iq: usize,
+    /// Offset of this joint's velocities in u.
+    pub iu: usize,
+    /// Initial coordinates.
+    pub q0: Vec<f64>,
+    /// Initial velocities.
+    pub u0: Vec<f64>,
+    /// Optional spring.
+    pub spring: Option<JointSpring>,
+    /// Damping coefficients per velocity (empty if none).
+    pub damper: Vec<f64>,
+}
+
+impl Joint {
+    /// Number of coordinates.
+    pub fn nq(&self) -> usize {
+        self.kind.nq()
+    }
+    /// Number of velocities.
+    pub fn nu(&self) -> usize {
+        self.kind.nu()
+    }
+}
+
+/// A scalar function of time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TimeFunction {
+    /// Constant.
+    Constant(f64),
+    /// Ramp from t0 with a slope, optionally saturating.
+    Ramp {
+        /// Slope.
+        slope: f64,
+        /// Start time.
+        t0: f64,
+        /// Saturation value.
+        final_value: Option<f64>,
+    },
+    /// offset + amplitude sin(ω t + phase).
+    Harmonic {
+        /// Amplitude.
+        amplitude: f64,
+        /// Circular frequency.
+        omega: f64,
+        /// Phase.
+        phase: f64,
+        /// Offset.
+        offset: f64,
+    },
+    /// Piecewise-linear table.
+    Table {
+        /// Times, increasing.
+        t: Vec<f64>,
+        /// Values.
+        values: Vec<f64>,
+    },
+    /// User callback by index.
+    Callback(usize),
+}
+
+/// The frame in which a body force is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ForceFrame {
+    /// Inertial components.
+    Inertial,
+    /// Body components.
+    Body,
+}
+
+/// A force element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ForceElement {
+    /// Point-to-point spring–damper.
+    SpringDamper {
+        /// Name.
+        name: String,
+        /// First body index.
+        body1: usize,
+        /// Point on body1, body frame.
+        point1: Vec3,
+        /// Second body index.
+        body2: usize,
+        /// Point on body2, body frame.
+        point2: Vec3,
+        /// Linear stiffness.
+        k: f64,
+        /// Cubic stiffness.
+        k3: f64,
+        /// Damping.
+        d: f64,
+        /// Unstretched length.
+        l0: f64,
+        /// Tabulated force–deflection curve (deflections, forces), possibly empty.
+        table: (Vec<f64>, Vec<f64>),
+    },
+    /// Force and torque on a body.
+    BodyForce {
+        /// Name.
+        name: String,
+        /// Body index.
+        body: usize,
+        /// Point of application, body frame.
+        point: Vec3,
+        /// Force.
+        force: Vec3,
+        /// Torque.
+        torque: Vec3,
+        /// Frame of force and torque.
+        frame: ForceFrame,
+        /// Time scaling.
+        function: TimeFunction,
+    },
+    /// Generalized force on a joint.
+    JointForce {
+        /// Name.
+        name: String,
+        /// Joint index.
+        joint: usize,
+        /// Values per joint velocity.
+        value: Vec<f64>,
+        /// Time scaling.
+        function: TimeFunction,
+    },
+    /// Generalized forces from a user callback.
+    Callback {
+        /// Name.
+        name: String,
+        /// Callback index.
+        id: usize,
+    },
+}
+
+impl ForceElement {
+    /// The element's name.
+    pub fn name(&self) -> &str {
+        match self {
+            ForceElement::SpringDamper { name, .. }
+            | ForceElement::BodyForce { name, .. }
+            | ForceElement::JointForce { name, .. }
+            | ForceElement::Callback { name, .. } => name,
+        }
+    }
+}
+
+/// The validated model.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Model name.
+    pub name: String,
+    /// Gravity, inertial frame.
+    pub gravity: Vec3,
+    /// Bodies; index 0 is the ground.
+    pub bodies: Vec<Body>,
+    /// Joints; joint `i` moves body `i + 1`.
+    pub joints: Vec<Joint>,
+    /// Force elements.
+    pub forces: Vec<ForceElement>,
+    /// Total number of coordinates.
+    pub nq: usize,
+    /// Total number of velocities (degrees of freedom).
+    pub nu: usize,
+    /// Whether any body has variable mass.
+    pub variable_mass: bool,
+    /// Number of user callbacks the model refers to.
+    pub n_callbacks: usize,
+    /// The description it was built from (stored with results).
+    pub description: ModelDescription,
+    body_index: HashMap<String, usize>,
+    joint_index: HashMap<String, usize>,
+}
+
+impl Model {
+    /// Number of bodies including the ground.
+    pub fn nbodies(&self) -> usize {
+        self.bodies.len()
+    }
+    /// Index of a body by name.
+    pub fn body_id(&self, name: &str) -> Option<usize> {
+        self.body_index.get(name).copied()
+    }
+    /// Index of a joint by name.
+    pub fn joint_id(&self, name: &str) -> Option<usize> {
+        self.joint_index.get(name).copied()
+    }
+    /// The initial coordinates given in the model (neutral where none were given).
+    pub fn q0(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.nq];
+        for j in &self.joints {
+            q[j.iq..j.iq + j.nq()].copy_from_slice(&j.q0);
+        }
+        q
+    }
+    /// The initial velocities given in the model (zero where none were given).
+    pub fn u0(&self) -> Vec<f64> {
+        let mut u = vec![0.0; self.nu];
+        for j in &self.joints {
+            u[j.iu..j.iu + j.nu()].copy_from_slice(&j.u0);
+        }
+        u
+    }
+    /// The neutral configuration.
+    pub fn neutral(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.nq];
+        for j in &self.joints {
+            j.kind.neutral(&mut q[j.iq..j.iq + j.nq()]);
+        }
+        q
+    }
+    /// Normalizes all quaternions in q.
+    pub fn normalize(&self, q: &mut [f64]) {
+        for j in &self.joints {
+            j.kind.normalize(&mut q[j.iq..j.iq + j.nq()]);
+        }
+    }
+    /// q̇ = H*(q) u for the whole model (eq. 2.34).
+    pub fn qdot(&self, q: &[f64], u: &[f64], qd: &mut [f64]) {
+        for j in &self.joints {
+            j.kind.qdot(&q[j.iq..j.iq + j.nq()], &u[j.iu..j.iu + j.nu()], &mut qd[j.iq..j.iq + j.nq()]);
+        }
+    }
+    /// q ⊕ u·dt on the configuration manifold.
+    pub fn integrate(&self, q: &[f64], u: &[f64], dt: f64, out: &mut [f64]) {
+        for j in &self.joints {
+            let (rq, ru) = (j.iq..j.iq + j.nq(), j.iu..j.iu + j.nu());
+            j.kind.integrate(&q[rq.clone()], &u[ru], dt, &mut out[rq]);
+        }
+    }
+}

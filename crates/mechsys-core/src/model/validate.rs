@@ -1,0 +1,549 @@
+//! Building a [`Model`] from a [`ModelDescription`]: every check a user's input can fail, each
+//! error naming the item and the key path (`bodies[2] 'arm': mass must be > 0, got -1`).
+
+use std::collections::{HashMap, HashSet};
+
+use nalgebra::SymmetricEigen;
+
+use super::description::*;
+use super::*;
+use crate::error::{Error, Result};
+
+
+fn err(msg: String) -> Error {
+    Error::Model(msg)
+}
+
+fn finite3(v: &[f64; 3], what: &str) -> Result<Vec3> {
+    crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: must be finite, got {v:?}");
+    Ok(Vec3::new(v[0], v[1], v[2]))
+}
+
+fn unit_axis(v: &[f64; 3], what: &str) -> Result<Vec3> {
+    let a = finite3(v, what)?;
+    let n = a.norm();
+    crate::ensure!(n > 1e-12, Model, "{what}: axis must not be zero, got {v:?}");
+    Ok(a / n)
+}
+
+fn rotation(r: &Option<RotationDescription>, what: &str) -> Result<Mat3> {
+    let Some(r) = r else { return Ok(Mat3::identity()) };
+    match r {
+        RotationDescription::Quaternion(q) => {
+            crate::ensure!(q.iter().all(|x| x.is_finite()), Model, "{what}: quaternion must be finite, got {q:?}");
+            let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+            crate::ensure!(n > 1e-12, Model, "{what}: quaternion must not be zero");
+            Ok(joint::quat_matrix(q[0] / n, q[1] / n, q[2] / n, q[3] / n))
+        }
+        RotationDescription::Matrix(m) => {
+            let a = Mat3::from_fn(|i, j| m[i][j]);
+            crate::ensure!(a.iter().all(|x| x.is_finite()), Model, "{what}: rotation matrix must be finite");
+            let e = (a.transpose() * a - Mat3::identity()).norm();
+            crate::ensure!(
+                e < 1e-6 && a.determinant() > 0.0,
+                Model,
+                "{what}: rotation matrix must be orthonormal with determinant +1 (|AᵀA - E| = {e:.2e})"
+            );
+            Ok(a)
+        }
+        RotationDescription::Angles(ang) => {
+            let given = [ang.cardan.is_some(), ang.euler.is_some(), ang.rotvec.is_some()];
+            crate::ensure!(
+                given.iter().filter(|g| **g).count() == 1,
+                Model,
+                "{what}: give exactly one of cardan, euler, rotvec"
+            );
+            if let Some(c) = ang.cardan {
+                let c = finite3(&c, what)?;
+                let (x, y, z) = (Vec3::x(), Vec3::y(), Vec3::z());
+                // eq. 2.19: A_IB = A_α A_β A_γ
+                Ok(joint::axis_rotation(&x, c[0]) * joint::axis_rotation(&y, c[1]) * joint::axis_rotation(&z, c[2]))
+            } else if let Some(e) = ang.euler {
+                let e = finite3(&e, what)?;
+                let (x, z) = (Vec3::x(), Vec3::z());
+                // eq. 2.15: A_IB = A_ψ A_ϑ A_φ
+                Ok(joint::axis_rotation(&z, e[0]) * joint::axis_rotation(&x, e[1]) * joint::axis_rotation(&z, e[2]))
+            } else {
+                let r = finite3(&ang.rotvec.unwrap_or_default(), what)?;
+                let n = r.norm();
+                if n < 1e-300 {
+                    Ok(Mat3::identity())
+                } else {
+                    Ok(joint::axis_rotation(&(r / n), n))
+                }
+            }
+        }
+    }
+}
+
+fn frame(f: &FrameDescription, what: &str) -> Result<Pose> {
+    Ok(Pose::new(rotation(&f.rotation, what)?, finite3(&f.position, &format!("{what}.position"))?))
+}
+
+/// Checks and returns an inertia tensor about the centre of mass.
+pub(crate) fn inertia(desc: &InertiaDescription, what: &str) -> Result<Mat3> {
+    let m = match desc {
+        InertiaDescription::Matrix(m) => Mat3::from_fn(|i, j| m[i][j]),
+        InertiaDescription::List(v) => match v.len() {
+            3 => Mat3::from_diagonal(&Vec3::new(v[0], v[1], v[2])),
+            6 => Mat3::new(v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2]),
+            n => return Err(err(format!("{what}: give 3 (diagonal), 6 (Ixx Iyy Izz Ixy Ixz Iyz) or 3×3 values, got {n}"))),
+        },
+    };
+    crate::ensure!(m.iter().all(|x| x.is_finite()), Model, "{what}: must be finite, got {m:?}");
+    let scale = m.abs().max().max(f64::MIN_POSITIVE);
+    crate::ensure!(
+        (m - m.transpose()).abs().max() <= 1e-9 * scale,
+        Model,
+        "{what}: inertia tensor must be symmetric"
+    );
+    let eig = SymmetricEigen::new(m).eigenvalues;
+    let (a, b, c) = (eig[0], eig[1], eig[2]);
+    crate::ensure!(
+        a > 0.0 && b > 0.0 && c > 0.0,
+        Model,
+        "{what}: inertia tensor is not positive definite (principal moments {a:.6e}, {b:.6e}, {c:.6e})"
+    );
+    // triangle inequalities of the principal moments: each ≤ sum of the other two
+    let tol = 1e-9 * (a + b + c);
+    crate::ensure!(
+        a <= b + c + tol && b <= a + c + tol && c <= a + b + tol,
+        Model,
+        "{what}: principal moments {a:.6e}, {b:.6e}, {c:.6e} violate the triangle inequality (no mass distribution has them)"
+    );
+    Ok(m)
+}
+
+fn time_function(f: &Option<TimeFunctionDescription>, what: &str, n_cb: &mut usize) -> Result<TimeFunction> {
+    let Some(f) = f else { return Ok(TimeFunction::Constant(1.0)) };
+    let check = |x: f64, k: &str| -> Result<()> {
+        crate::ensure!(x.is_finite(), Model, "{what}.{k}: must be finite, got {x}");
+        Ok(())
+    };
+    Ok(match f {
+        TimeFunctionDescription::Constant { value } => {
+            check(*value, "value")?;
+            TimeFunction::Constant(*value)
+        }
+        TimeFunctionDescription::Ramp { slope, t0, final_value } => {
+            check(*slope, "slope")?;
+            check(*t0, "t0")?;
+            if let Some(v) = final_value {
+                check(*v, "final_value")?;
+            }
+            TimeFunction::Ramp { slope: *slope, t0: *t0, final_value: *final_value }
+        }
+        TimeFunctionDescription::Harmonic { amplitude, omega, phase, offset } => {
+            for (x, k) in [(amplitude, "amplitude"), (omega, "omega"), (phase, "phase"), (offset, "offset")] {
+                check(*x, k)?;
+            }
+            TimeFunction::Harmonic { amplitude: *amplitude, omega: *omega, phase: *phase, offset: *offset }
+        }
+        TimeFunctionDescription::Table { t, values } => {
+            table(t, values, what, "t", "values")?;
+            TimeFunction::Table { t: t.clone(), values: values.clone() }
+        }
+        TimeFunctionDescription::Callback { id } => {
+            *n_cb = (*n_cb).max(id + 1);
+            TimeFunction::Callback(*id)
+        }
+    })
+}
+
+fn table(x: &[f64], y: &[f64], what: &str, kx: &str, ky: &str) -> Result<()> {
+    crate::ensure!(!x.is_empty(), Model, "{what}.{kx}: table must not be empty");
+    crate::ensure!(
+        x.len() == y.len(),
+        Model,
+        "{what}: {kx} has {} entries but {ky} has {}",
+        x.len(),
+        y.len()
+    );
+    crate::ensure!(x.iter().chain(y).all(|v| v.is_finite()), Model, "{what}: table entries must be finite");
+    crate::ensure!(x.windows(2).all(|w| w[1] > w[0]), Model, "{what}.{kx}: must be strictly increasing");
+    Ok(())
+}
+
+fn per_dof(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>> {
+    crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: must be finite, got {v:?}");
+    if v.len() == 1 {
+        Ok(vec![v[0]; n])
+    } else {
+        crate::ensure!(v.len() == n, Model, "{what}: expected 1 or {n} values (one per joint velocity), got {}", v.len());
+        Ok(v.to_vec())
+    }
+}
+
+impl Model {
+    /// Parses a JSON model description and validates it.
+    pub fn from_json(text: &str) -> Result<Model> {
+        Model::from_description(ModelDescription::from_json(text)?)
+    }
+
+    /// Validates a description and builds the model.
+    pub fn from_description(desc: ModelDescription) -> Result<Model> {
+        let g = finite3(&desc.gravity, "gravity")?;
+
+        // ---- bodies ----------------------------------------------------------------------------
+        let mut names: HashMap<String, usize> = HashMap::new();
+        names.insert("ground".to_string(), 0);
+        for (i, b) in desc.bodies.iter().enumerate() {
+            let what = format!("bodies[{i}] '{}'", b.name);
+            crate::ensure!(!b.name.trim().is_empty(), Model, "bodies[{i}]: name must not be empty");
+            crate::ensure!(b.name != "ground", Model, "{what}: the name 'ground' is reserved for the inertial frame");
+            crate::ensure!(
+                names.insert(b.name.clone(), i + 1).is_none(),
+                Model,
+                "{what}: duplicate body name '{}'",
+                b.name
+            );
+        }
+
+        // ---- joints: tree structure ---------------------------------------------------------------
+        let mut joint_names = HashSet::new();
+        let mut parent_joint: HashMap<usize, usize> = HashMap::new(); // desc body idx -> desc joint idx
+        for (i, j) in desc.joints.iter().enumerate() {
+            let what = format!("joints[{i}] '{}'", j.name);
+            crate::ensure!(!j.name.trim().is_empty(), Model, "joints[{i}]: name must not be empty");
+            crate::ensure!(joint_names.insert(j.name.clone()), Model, "{what}: duplicate joint name '{}'", j.name);
+            let p = *names
+                .get(&j.parent)
+                .ok_or_else(|| err(format!("{what}.parent: unknown body '{}'", j.parent)))?;
+            let c = *names
+                .get(&j.child)
+                .ok_or_else(|| err(format!("{what}.child: unknown body '{}'", j.child)))?;
+            crate::ensure!(c != 0, Model, "{what}.child: the ground cannot be a child");
+            crate::ensure!(p != c, Model, "{what}: parent and child are the same body '{}'", j.child);
+            if let Some(other) = parent_joint.insert(c, i) {
+                return Err(err(format!(
+                    "{what}: body '{}' already has parent joint '{}'; a second one closes a loop (use a constraint)",
+                    j.child, desc.joints[other].name
+                )));
+            }
+        }
+        for (i, b) in desc.bodies.iter().enumerate() {
+            crate::ensure!(
+                parent_joint.contains_key(&(i + 1)),
+                Model,
+                "bodies[{i}] '{}': no joint connects it (add a joint with child = '{}'; use type 'free' for a floating body)",
+                b.name,
+                b.name
+            );
+        }
+        // topological order from the ground, keeping the user's order among siblings
+        let mut order: Vec<usize> = Vec::with_capacity(desc.joints.len()); // desc joint indices
+        let mut placed = vec![false; desc.bodies.len() + 1];
+        placed[0] = true;
+        while order.len() < desc.joints.len() {
+            let before = order.len();
+            for (i, j) in desc.joints.iter().enumerate() {
+                let (p, c) = (names[&j.parent], names[&j.child]);
+                if !placed[c] && placed[p] {
+                    placed[c] = true;
+                    order.push(i);
+                }
+            }
+            if order.len() == before {
+                let stuck: Vec<&str> = desc
+                    .joints
+                    .iter()
+                    .filter(|j| !placed[names[&j.child]])
+                    .map(|j| j.name.as_str())
+                    .collect();
+                return Err(err(format!(
+                    "joints {stuck:?} form a cycle not connected to the ground; joints must form a tree rooted at 'ground'"
+                )));
+            }
+        }
+        // new body index of each description body
+        let mut new_index = vec![0usize; desc.bodies.len() + 1];
+        for (k, &ji) in order.iter().enumerate() {
+            new_index[names[&desc.joints[ji].child]] = k + 1;
+        }
+
+        // ---- bodies, checked -----------------------------------------------------------------------
+        let mut bodies = vec![Body {
+            name: "ground".into(),
+            mass: 0.0,
+            com: Vec3::zeros(),
+            inertia: Mat3::zeros(),
+            markers: markers(&desc.ground_markers, "ground_markers")?,
+            mass_rate: 0.0,
+            ejection_velocity: Vec3::zeros(),
+            ejection_point: Vec3::zeros(),
+            mass_final: 0.0,
+        }];
+        let mut variable_mass = false;
+        for &ji in &order {
+            let bi = names[&desc.joints[ji].child] - 1;
+            let b = &desc.bodies[bi];
+            let what = format!("bodies[{bi}] '{}'", b.name);
+            crate::ensure!(
+                b.mass.is_finite() && b.mass > 0.0,
+                Model,
+                "{what}.mass: must be > 0, got {}",
+                b.mass
+            );
+            let com = finite3(&b.com, &format!("{what}.com"))?;
+            let i_c = inertia(&b.inertia, &format!("{what}.inertia"))?;
+            crate::ensure!(b.mass_rate.is_finite(), Model, "{what}.mass_rate: must be finite");
+            let mass_final = if b.mass_rate != 0.0 {
+                variable_mass = true;
+                let mf = b.mass_final.ok_or_else(|| {
+                    err(format!("{what}.mass_final: required with a mass_rate (the mass at which the flow stops)"))
+                })?;
+                crate::ensure!(mf.is_finite() && mf > 0.0, Model, "{what}.mass_final: must be > 0, got {mf}");
+                crate::ensure!(
+                    (b.mass_rate < 0.0 && mf < b.mass) || (b.mass_rate > 0.0 && mf > b.mass),
+                    Model,
+                    "{what}.mass_final: {mf} is not reached from mass {} with mass_rate {}",
+                    b.mass,
+                    b.mass_rate
+                );
+                mf
+            } else {
+                b.mass
+            };
+            bodies.push(Body {
+                name: b.name.clone(),
+                mass: b.mass,
+                com,
+                inertia: i_c,
+                markers: markers(&b.markers, &format!("{what}.markers"))?,
+                mass_rate: b.mass_rate,
+                ejection_velocity: finite3(&b.ejection_velocity, &format!("{what}.ejection_velocity"))?,
+                ejection_point: match &b.ejection_point {
+                    Some(p) => finite3(p, &format!("{what}.ejection_point"))?,
+                    None => com,
+                },
+                mass_final,
+            });
+        }
+
+        // ---- joints, checked -------------------------------------------------------------------------
+        let mut joints = Vec::with_capacity(order.len());
+        let (mut iq, mut iu) = (0usize, 0usize);
+        for &ji in &order {
+            let j = &desc.joints[ji];
+            let what = format!("joints[{ji}] '{}'", j.name);
+            let axis = |a: &Option<[f64; 3]>, d: [f64; 3], k: &str| unit_axis(&a.unwrap_or(d), &format!("{what}.{k}"));
+            let kind = match j.kind.to_ascii_lowercase().as_str() {
+                "fixed" => JointKind::Fixed,
+                "revolute" => JointKind::Revolute { axis: axis(&j.axis, [0.0, 0.0, 1.0], "axis")? },
+                "prismatic" => JointKind::Prismatic { axis: axis(&j.axis, [0.0, 0.0, 1.0], "axis")? },
+                "cylindrical" => JointKind::Cylindrical { axis: axis(&j.axis, [0.0, 0.0, 1.0], "axis")? },
+                "universal" => {
+                    let a1 = axis(&j.axis, [1.0, 0.0, 0.0], "axis")?;
+                    let a2 = axis(&j.axis2, [0.0, 1.0, 0.0], "axis2")?;
+                    crate::ensure!(
+                        a1.cross(&a2).norm() > 1e-6,
+                        Model,
+                        "{what}: axis and axis2 of a universal joint must not be parallel"
+                    );
+                    JointKind::Universal { axis1: a1, axis2: a2 }
+                }
+                "spherical" | "ball" => JointKind::Spherical,
+                "planar" => JointKind::Planar,
+                "free" | "floating" => JointKind::Free,
+                other => {
+                    return Err(err(format!(
+                        "{what}.type: unknown joint type '{other}' (expected fixed, revolute, prismatic, cylindrical, universal, spherical, planar or free)"
+                    )))
+                }
+            };
+            if !matches!(kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. } | JointKind::Cylindrical { .. } | JointKind::Universal { .. }) {
+                crate::ensure!(j.axis.is_none(), Model, "{what}.axis: a {} joint has no axis", kind.type_name());
+            }
+            if !matches!(kind, JointKind::Universal { .. }) {
+                crate::ensure!(j.axis2.is_none(), Model, "{what}.axis2: only universal joints have a second axis");
+            }
+            let (nq, nu) = (kind.nq(), kind.nu());
+            let mut q0 = vec![0.0; nq];
+            kind.neutral(&mut q0);
+            if let Some(v) = &j.q0 {
+                crate::ensure!(v.len() == nq, Model, "{what}.q0: a {} joint has {nq} coordinates, got {}", kind.type_name(), v.len());
+                crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}.q0: must be finite, got {v:?}");
+                q0.copy_from_slice(v);
+                if kind.has_quaternion() {
+                    let r = if matches!(kind, JointKind::Free) { 3..7 } else { 0..4 };
+                    let n: f64 = q0[r].iter().map(|x| x * x).sum::<f64>().sqrt();
+                    crate::ensure!(n > 1e-12, Model, "{what}.q0: the quaternion part must not be zero");
+                    kind.normalize(&mut q0);
+                }
+            }
+            let u0 = match &j.u0 {
+                Some(v) => {
+                    crate::ensure!(v.len() == nu, Model, "{what}.u0: a {} joint has {nu} velocities, got {}", kind.type_name(), v.len());
+                    crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}.u0: must be finite, got {v:?}");
+                    v.clone()
+                }
+                None => vec![0.0; nu],
+            };
+            let spring = match &j.spring {
+                Some(s) => {
+                    crate::ensure!(
+                        !kind.has_quaternion() && nu > 0,
+                        Model,
+                        "{what}.spring: joint springs need coordinate-per-velocity joints (not {})",
+                        kind.type_name()
+                    );
+                    let k = per_dof(&s.k, nu, &format!("{what}.spring.k"))?;
+                    let q_free = match &s.q_free {
+                        Some(q) => per_dof(q, nq, &format!("{what}.spring.q_free"))?,
+                        None => vec![0.0; nq],
+                    };
+                    Some(JointSpring { k, q_free })
+                }
+                None => None,
+            };
+            let damper = match &j.damper {
+                Some(d) => {
+                    crate::ensure!(nu > 0, Model, "{what}.damper: a fixed joint cannot have a damper");
+                    per_dof(&d.d, nu, &format!("{what}.damper.d"))?
+                }
+                None => vec![],
+            };
+            let child_frame = frame(&j.child_frame, &format!("{what}.child_frame"))?;
+            joints.push(Joint {
+                name: j.name.clone(),
+                kind,
+                parent: new_index[names[&j.parent]],
+                child: new_index[names[&j.child]],
+                parent_frame: frame(&j.parent_frame, &format!("{what}.parent_frame"))?,
+                child_frame,
+                child_frame_inv: child_frame.inverse(),
+                iq,
+                iu,
+                q0,
+                u0,
+                spring,
+                damper,
+            });
+            iq += nq;
+            iu += nu;
+        }
+
+        // ---- force elements ------------------------------------------------------------------------
+        let body = |n: &str, what: &str| -> Result<usize> {
+            names
+                .get(n)
+                .map(|&i| new_index[i])
+                .ok_or_else(|| err(format!("{what}: unknown body '{n}'")))
+        };
+        let joint_index: HashMap<String, usize> =
+            joints.iter().enumerate().map(|(i, j)| (j.name.clone(), i)).collect();
+        let mut n_callbacks = 0usize;
+        let mut force_names = HashSet::new();
+        let mut forces = Vec::with_capacity(desc.forces.len());
+        for (i, f) in desc.forces.iter().enumerate() {
+            let name = match f {
+                ForceDescription::SpringDamper { name, .. }
+                | ForceDescription::BodyForce { name, .. }
+                | ForceDescription::JointForce { name, .. }
+                | ForceDescription::Callback { name, .. } => name.clone(),
+            };
+            let what = format!("forces[{i}] '{name}'");
+            crate::ensure!(force_names.insert(name.clone()), Model, "{what}: duplicate force element name");
+            forces.push(match f {
+                ForceDescription::SpringDamper {
+                    body1, point1, body2, point2, k, k3, d, l0, table_deflection, table_force, ..
+                } => {
+                    for (x, key) in [(k, "k"), (k3, "k3"), (d, "d"), (l0, "l0")] {
+                        crate::ensure!(x.is_finite(), Model, "{what}.{key}: must be finite, got {x}");
+                    }
+                    crate::ensure!(*l0 >= 0.0, Model, "{what}.l0: must be >= 0, got {l0}");
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    let tab = match (table_deflection, table_force) {
+                        (None, None) => (vec![], vec![]),
+                        (Some(x), Some(y)) => {
+                            table(x, y, &what, "table_deflection", "table_force")?;
+                            (x.clone(), y.clone())
+                        }
+                        _ => return Err(err(format!("{what}: give both table_deflection and table_force"))),
+                    };
+                    ForceElement::SpringDamper {
+                        name,
+                        body1: b1,
+                        point1: finite3(point1, &format!("{what}.point1"))?,
+                        body2: b2,
+                        point2: finite3(point2, &format!("{what}.point2"))?,
+                        k: *k,
+                        k3: *k3,
+                        d: *d,
+                        l0: *l0,
+                        table: tab,
+                    }
+                }
+                ForceDescription::BodyForce { body: b, point, force, torque, frame, function, .. } => {
+                    let bi = body(b, &format!("{what}.body"))?;
+                    crate::ensure!(bi != 0, Model, "{what}.body: forces on the ground have no effect");
+                    let frame = match frame.as_str() {
+                        "inertial" | "world" => ForceFrame::Inertial,
+                        "body" => ForceFrame::Body,
+                        o => return Err(err(format!("{what}.frame: expected 'inertial' or 'body', got '{o}'"))),
+                    };
+                    ForceElement::BodyForce {
+                        name,
+                        body: bi,
+                        point: finite3(point, &format!("{what}.point"))?,
+                        force: finite3(force, &format!("{what}.force"))?,
+                        torque: finite3(torque, &format!("{what}.torque"))?,
+                        frame,
+                        function: time_function(function, &format!("{what}.function"), &mut n_callbacks)?,
+                    }
+                }
+                ForceDescription::JointForce { joint, value, function, .. } => {
+                    let ji = *joint_index
+                        .get(joint)
+                        .ok_or_else(|| err(format!("{what}.joint: unknown joint '{joint}'")))?;
+                    let n = joints[ji].nu();
+                    crate::ensure!(n > 0, Model, "{what}.joint: joint '{joint}' has no degrees of freedom");
+                    ForceElement::JointForce {
+                        name,
+                        joint: ji,
+                        value: per_dof(value, n, &format!("{what}.value"))?,
+                        function: time_function(function, &format!("{what}.function"), &mut n_callbacks)?,
+                    }
+                }
+                ForceDescription::Callback { id, .. } => {
+                    n_callbacks = n_callbacks.max(id + 1);
+                    ForceElement::Callback { name, id: *id }
+                }
+            });
+        }
+
+        let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
+        Ok(Model {
+            name: desc.name.clone(),
+            gravity: g,
+            bodies,
+            joints,
+            forces,
+            nq: iq,
+            nu: iu,
+            variable_mass,
+            n_callbacks,
+            description: desc,
+            body_index,
+            joint_index,
+        })
+    }
+}
+
+fn markers(list: &[MarkerDescription], what: &str) -> Result<Vec<Marker>> {
+    let mut seen = HashSet::new();
+    list.iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let w = format!("{what}[{i}] '{}'", m.name);
+            crate::ensure!(seen.insert(m.name.clone()), Model, "{w}: duplicate marker name");
+            Ok(Marker {
+                name: m.name.clone(),
+                pose: Pose::new(rotation(&m.rotation, &w)?, finite3(&m.position, &format!("{w}.position"))?),
+            })
+        })
+        .collect()
+}
+

@@ -1,0 +1,305 @@
+//! The simulation loop: the model's equations of motion as a first-order system, one integrator,
+//! and the record stage, which samples every signal at the output times into preallocated arrays.
+//!
+//! The integrated state is `y = [q, u, E_diss, W_ext]`: besides coordinates and velocities it
+//! carries the energy dissipated by dampers and the work of external loads, so that the energy
+//! balance `T + V + E_diss - W_ext = const` can be checked on any result.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+use serde::{Deserialize, Serialize};
+
+use crate::data::Data;
+use crate::dynamics::{self, energy};
+use crate::error::{Error, Result};
+use crate::forces::Callbacks;
+use crate::integrator::{self, IntegratorKind, OdeSystem, Stats};
+use crate::model::Model;
+
+/// Settings of one simulation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Settings {
+    /// Start time (s).
+    #[serde(default)]
+    pub t0: f64,
+    /// End time (s).
+    pub t_end: f64,
+    /// Interval between recorded samples (s).
+    pub output_dt: f64,
+    /// The integration scheme.
+    pub integrator: IntegratorKind,
+    /// Initial coordinates (nq); the model's q0 if absent.
+    #[serde(default)]
+    pub q0: Option<Vec<f64>>,
+    /// Initial velocities (nu); the model's u0 if absent.
+    #[serde(default)]
+    pub u0: Option<Vec<f64>>,
+}
+
+/// Recorded signals, sample-major flat arrays (`n_out` samples).
+#[derive(Debug, Clone, Default)]
+pub struct Recording {
+    /// Number of samples.
+    pub n_out: usize,
+    /// Number of bodies recorded (the model's bodies without the ground).
+    pub n_bodies: usize,
+    /// Sample times (n_out), s.
+    pub t: Vec<f64>,
+    /// Coordinates (n_out × nq).
+    pub q: Vec<f64>,
+    /// Velocities (n_out × nu).
+    pub u: Vec<f64>,
+    /// Accelerations (n_out × nu).
+    pub udot: Vec<f64>,
+    /// Body-frame origin positions, I components (n_out × n_bodies × 3), m.
+    pub body_position: Vec<f64>,
+    /// Body orientations as unit quaternions [w, x, y, z] of A_IB (n_out × n_bodies × 4).
+    pub body_orientation: Vec<f64>,
+    /// Velocities of body-frame origins, I components (n_out × n_bodies × 3), m/s.
+    pub body_velocity: Vec<f64>,
+    /// Angular velocities, I components (n_out × n_bodies × 3), rad/s.
+    pub body_angular_velocity: Vec<f64>,
+    /// Accelerations of body-frame origins, I components (n_out × n_bodies × 3), m/s².
+    pub body_acceleration: Vec<f64>,
+    /// Body masses (n_out × n_bodies), kg.
+    pub body_mass: Vec<f64>,
+    /// Kinetic energy (n_out), J.
+    pub kinetic: Vec<f64>,
+    /// Potential energy of gravity and springs (n_out), J.
+    pub potential: Vec<f64>,
+    /// Energy dissipated by dampers since t0 (n_out), J.
+    pub dissipated: Vec<f64>,
+    /// Work of external loads since t0 (n_out), J.
+    pub external_work: Vec<f64>,
+    /// Linear momentum, I components (n_out × 3), N s.
+    pub momentum_linear: Vec<f64>,
+    /// Moment of momentum about the inertial origin, I components (n_out × 3), N m s.
+    pub momentum_angular: Vec<f64>,
+    /// Integrator counters.
+    pub stats: Stats,
+}
+
+/// Progress and cancellation shared with another thread (the Python progress bar).
+#[derive(Debug, Default)]
+pub struct Progress {
+    /// Samples recorded so far.
+    pub samples: AtomicU64,
+    /// Set to stop the run early with an error.
+    pub cancel: AtomicBool,
+}
+
+/// The equations of motion of a model as a first-order system.
+pub struct MultibodySystem<'a> {
+    model: &'a Model,
+    /// The workspace (public so that observers can read the last evaluation).
+    pub data: Data,
+    cb: &'a dyn Callbacks,
+}
+
+impl<'a> MultibodySystem<'a> {
+    /// Wraps a model with a fresh workspace.
+    pub fn new(model: &'a Model, cb: &'a dyn Callbacks) -> Self {
+        MultibodySystem { model, data: Data::new(model), cb }
+    }
+}
+
+impl OdeSystem for MultibodySystem<'_> {
+    fn dim(&self) -> usize {
+        self.model.nq + self.model.nu + 2
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        let (q, rest) = y.split_at(nq);
+        let u = &rest[..nu];
+        let p = dynamics::forward_dynamics(self.model, &mut self.data, t, q, u, None, self.cb)?;
+        self.model.qdot(q, u, &mut dy[..nq]);
+        dy[nq..nq + nu].copy_from_slice(&self.data.udot);
+        dy[nq + nu] = p.dissipated;
+        dy[nq + nu + 1] = p.external;
+        Ok(())
+    }
+    fn project(&self, y: &mut [f64]) {
+        self.model.normalize(&mut y[..self.model.nq]);
+    }
+}
+
+/// Quaternion [w, x, y, z] of a rotation matrix (Shepperd's method, robust for all rotations).
+pub fn matrix_to_quaternion(a: &crate::math::Mat3) -> [f64; 4] {
+    let tr = a[(0, 0)] + a[(1, 1)] + a[(2, 2)];
+    let q = if tr > a[(0, 0)].max(a[(1, 1)]).max(a[(2, 2)]) {
+        let s = 2.0 * (1.0 + tr).sqrt();
+        [0.25 * s, (a[(2, 1)] - a[(1, 2)]) / s, (a[(0, 2)] - a[(2, 0)]) / s, (a[(1, 0)] - a[(0, 1)]) / s]
+    } else if a[(0, 0)] >= a[(1, 1)] && a[(0, 0)] >= a[(2, 2)] {
+        let s = 2.0 * (1.0 + a[(0, 0)] - a[(1, 1)] - a[(2, 2)]).sqrt();
+        [(a[(2, 1)] - a[(1, 2)]) / s, 0.25 * s, (a[(0, 1)] + a[(1, 0)]) / s, (a[(0, 2)] + a[(2, 0)]) / s]
+    } else if a[(1, 1)] >= a[(2, 2)] {
+        let s = 2.0 * (1.0 + a[(1, 1)] - a[(0, 0)] - a[(2, 2)]).sqrt();
+        [(a[(0, 2)] - a[(2, 0)]) / s, (a[(0, 1)] + a[(1, 0)]) / s, 0.25 * s, (a[(1, 2)] + a[(2, 1)]) / s]
+    } else {
+        let s = 2.0 * (1.0 + a[(2, 2)] - a[(0, 0)] - a[(1, 1)]).sqrt();
+        [(a[(1, 0)] - a[(0, 1)]) / s, (a[(0, 2)] + a[(2, 0)]) / s, (a[(1, 2)] + a[(2, 1)]) / s, 0.25 * s]
+    };
+    // keep w ≥ 0 so recorded orientations are continuous for rotations below π
+    if q[0] < 0.0 {
+        [-q[0], -q[1], -q[2], -q[3]]
+    } else {
+        q
+    }
+}
+
+/// Checks settings and returns the output times and the initial state.
+pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
+    crate::ensure!(s.t0.is_finite(), Settings, "t0: must be finite, got {}", s.t0);
+    crate::ensure!(
+        s.t_end.is_finite() && s.t_end > s.t0,
+        Settings,
+        "t_end: must be finite and > t0 = {}, got {}",
+        s.t0,
+        s.t_end
+    );
+    crate::ensure!(
+        s.output_dt.is_finite() && s.output_dt > 0.0,
+        Settings,
+        "output_dt: must be > 0, got {}",
+        s.output_dt
+    );
+    let span = s.t_end - s.t0;
+    let n_out = ((span / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() as usize + 1;
+    let width = 1 + 2 * model.nq + 3 * model.nu + 17 * model.nbodies() + 10;
+    crate::ensure!(
+        (n_out as f64) * (width as f64) * 8.0 < 16e9,
+        Settings,
+        "output_dt: {} s over {} s gives {n_out} samples, more than 16 GB of results; choose a larger output_dt",
+        s.output_dt,
+        span
+    );
+    if let IntegratorKind::Rk4 { dt } | IntegratorKind::Radau5 { dt, .. } = s.integrator {
+        crate::ensure!(dt.is_finite() && dt > 0.0, Settings, "integrator.dt: must be > 0, got {dt}");
+        let ratio = s.output_dt / dt;
+        crate::ensure!(
+            (ratio - ratio.round()).abs() < 1e-9 * ratio.max(1.0) && ratio.round() >= 1.0,
+            Settings,
+            "output_dt: must be a whole multiple of the fixed step dt = {dt} s, got {}",
+            s.output_dt
+        );
+    }
+    let t_out: Vec<f64> = (0..n_out).map(|k| (s.t0 + k as f64 * s.output_dt).min(s.t_end)).collect();
+
+    let mut y = vec![0.0; model.nq + model.nu + 2];
+    match &s.q0 {
+        Some(q) => {
+            crate::ensure!(
+                q.len() == model.nq,
+                Settings,
+                "q0: the model has {} coordinates, got {}",
+                model.nq,
+                q.len()
+            );
+            for (i, v) in q.iter().enumerate() {
+                crate::ensure!(v.is_finite(), Settings, "q0[{i}]: must be finite, got {v}");
+            }
+            y[..model.nq].copy_from_slice(q);
+            for j in &model.joints {
+                if j.kind.has_quaternion() {
+                    let r = if j.nq() == 7 { j.iq + 3..j.iq + 7 } else { j.iq..j.iq + 4 };
+                    let n: f64 = y[r].iter().map(|x| x * x).sum::<f64>().sqrt();
+                    crate::ensure!(n > 1e-12, Settings, "q0: the quaternion of joint '{}' must not be zero", j.name);
+                }
+            }
+            model.normalize(&mut y[..model.nq]);
+        }
+        None => y[..model.nq].copy_from_slice(&model.q0()),
+    }
+    match &s.u0 {
+        Some(u) => {
+            crate::ensure!(
+                u.len() == model.nu,
+                Settings,
+                "u0: the model has {} velocities, got {}",
+                model.nu,
+                u.len()
+            );
+            for (i, v) in u.iter().enumerate() {
+                crate::ensure!(v.is_finite(), Settings, "u0[{i}]: must be finite, got {v}");
+            }
+            y[model.nq..model.nq + model.nu].copy_from_slice(u);
+        }
+        None => y[model.nq..model.nq + model.nu].copy_from_slice(&model.u0()),
+    }
+    Ok((t_out, y))
+}
+
+/// Runs a simulation and records all signals.
+pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress: Option<&Progress>) -> Result<Recording> {
+    let (t_out, y0) = prepare(model, settings)?;
+    let n_out = t_out.len();
+    let nb = model.nbodies() - 1;
+    let (nq, nu) = (model.nq, model.nu);
+    let mut rec = Recording {
+        n_out,
+        n_bodies: nb,
+        t: Vec::with_capacity(n_out),
+        q: Vec::with_capacity(n_out * nq),
+        u: Vec::with_capacity(n_out * nu),
+        udot: Vec::with_capacity(n_out * nu),
+        body_position: Vec::with_capacity(n_out * nb * 3),
+        body_orientation: Vec::with_capacity(n_out * nb * 4),
+        body_velocity: Vec::with_capacity(n_out * nb * 3),
+        body_angular_velocity: Vec::with_capacity(n_out * nb * 3),
+        body_acceleration: Vec::with_capacity(n_out * nb * 3),
+        body_mass: Vec::with_capacity(n_out * nb),
+        kinetic: Vec::with_capacity(n_out),
+        potential: Vec::with_capacity(n_out),
+        dissipated: Vec::with_capacity(n_out),
+        external_work: Vec::with_capacity(n_out),
+        momentum_linear: Vec::with_capacity(n_out * 3),
+        momentum_angular: Vec::with_capacity(n_out * 3),
+        stats: Stats::default(),
+    };
+    let mut sys = MultibodySystem::new(model, cb);
+    let mut scratch = vec![0.0; sys.dim()];
+    let mut observer = |sys: &mut MultibodySystem, t: f64, y: &[f64], fresh: bool| -> Result<()> {
+        if !fresh {
+            sys.rhs(t, y, &mut scratch)?;
+        }
+        record(model, &sys.data, t, y, &mut rec);
+        if let Some(p) = progress {
+            p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
+            if p.cancel.load(Ordering::Relaxed) {
+                return Err(Error::Solver(format!("simulation cancelled at t = {t:.6} s")));
+            }
+        }
+        Ok(())
+    };
+    let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
+    rec.stats = stats;
+    Ok(rec)
+}
+
+/// The record stage: appends one sample of every signal from an evaluated workspace.
+fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
+    let (nq, nu) = (model.nq, model.nu);
+    rec.t.push(t);
+    rec.q.extend_from_slice(&y[..nq]);
+    rec.u.extend_from_slice(&y[nq..nq + nu]);
+    rec.udot.extend_from_slice(&data.udot);
+    for i in 1..model.nbodies() {
+        let x = &data.x_abs[i];
+        rec.body_position.extend_from_slice(x.r.as_slice());
+        rec.body_orientation.extend_from_slice(&matrix_to_quaternion(&x.a));
+        let v = &data.v[i];
+        rec.body_velocity.extend_from_slice((x.a * v.v).as_slice());
+        rec.body_angular_velocity.extend_from_slice((x.a * v.w).as_slice());
+        let a = &data.a[i];
+        rec.body_acceleration.extend_from_slice((x.a * (a.v + v.w.cross(&v.v))).as_slice());
+        rec.body_mass.push(data.inertia[i].m);
+    }
+    rec.kinetic.push(energy::kinetic_energy(model, data));
+    rec.potential.push(energy::potential_energy(model, data, &y[..nq]));
+    rec.dissipated.push(y[nq + nu]);
+    rec.external_work.push(y[nq + nu + 1]);
+    let (p, l) = energy::momentum(model, data);
+    rec.momentum_linear.extend_from_slice(p.as_slice());
+    rec.momentum_angular.extend_from_slice(l.as_slice());
+}

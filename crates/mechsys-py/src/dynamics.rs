@@ -1,0 +1,144 @@
+//! Bindings of the dynamics algorithms for single evaluations: CRBA, RNEA, ABA, h, energies.
+
+use mechsys_core::dynamics::{self, energy};
+use mechsys_core::forces::Callbacks;
+use mechsys_core::kinematics;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{settings, PyMechsysError};
+use crate::model::{check_len, PyModel};
+use crate::simulate::PyCallbacks;
+
+fn callbacks(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<PyCallbacks> {
+    let cb = PyCallbacks { funcs: cbs.unwrap_or_default(), nu: model.model.nu };
+    if cb.funcs.len() < model.model.n_callbacks {
+        return Err(settings(format!(
+            "callbacks: the model refers to {} callbacks, {} given",
+            model.model.n_callbacks,
+            cb.funcs.len()
+        )));
+    }
+    Ok(cb)
+}
+
+/// Mass matrix M(q) by the composite-rigid-body algorithm.
+#[pyfunction]
+#[pyo3(signature = (model, q, t = 0.0))]
+fn crba<'py>(py: Python<'py>, model: &PyModel, q: PyReadonlyArray1<'py, f64>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let q = check_len(&q, model.model.nq, "q")?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    dynamics::crba::mass_matrix(&model.model, &mut data, t, q);
+    let n = model.model.nu;
+    let rows: Vec<Vec<f64>> = (0..n).map(|r| (0..n).map(|c| data.mass_matrix[(r, c)]).collect()).collect();
+    PyArray2::from_vec2(py, &rows).map_err(|e| settings(e.to_string()))
+}
+
+/// Forward dynamics u̇ = M⁻¹(h + τ) by the articulated-body algorithm.
+#[pyfunction]
+#[pyo3(signature = (model, q, u, tau = None, t = 0.0, callbacks = None))]
+fn aba<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    tau: Option<PyReadonlyArray1<'py, f64>>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let u = check_len(&u, m.nu, "u")?;
+    let tau = match &tau {
+        Some(a) => Some(check_len(a, m.nu, "tau")?),
+        None => None,
+    };
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    if m.n_callbacks == 0 && callbacks.is_none() {
+        dynamics::aba(m, &mut data, t, q, u, tau, &mechsys_core::forces::NoCallbacks).map_err(PyMechsysError::from)?;
+    } else {
+        let cb = self::callbacks(model, callbacks)?;
+        dynamics::aba(m, &mut data, t, q, u, tau, &cb).map_err(PyMechsysError::from)?;
+    }
+    Ok(PyArray1::from_slice(py, &data.udot))
+}
+
+/// Inverse dynamics τ = M u̇ - h by the recursive Newton–Euler algorithm.
+#[pyfunction]
+#[pyo3(signature = (model, q, u, udot, t = 0.0, callbacks = None))]
+fn rnea<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    udot: PyReadonlyArray1<'py, f64>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let u = check_len(&u, m.nu, "u")?;
+    let ud = check_len(&udot, m.nu, "udot")?;
+    let cb = self::callbacks(model, callbacks)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let mut tau = vec![0.0; m.nu];
+    dynamics::inverse_dynamics(m, &mut data, t, q, u, ud, &cb as &dyn Callbacks, &mut tau).map_err(PyMechsysError::from)?;
+    Ok(PyArray1::from_vec(py, tau))
+}
+
+/// h(q, u, t): all model forces in generalized components, so that M u̇ = h + τ.
+#[pyfunction]
+#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None))]
+fn nonlinear_effects<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let u = check_len(&u, m.nu, "u")?;
+    let cb = self::callbacks(model, callbacks)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    dynamics::nonlinear_effects(m, &mut data, t, q, u, &cb).map_err(PyMechsysError::from)?;
+    Ok(PyArray1::from_slice(py, data.h.as_slice()))
+}
+
+/// Energies and momenta at (q, u, t): kinetic, potential, per-body kinetic, linear and angular momentum.
+#[pyfunction]
+#[pyo3(signature = (model, q, u, t = 0.0))]
+fn energies<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    t: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let u = check_len(&u, m.nu, "u")?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    kinematics::forward_kinematics(m, &mut data, q, u);
+    mechsys_core::forces::update_inertias(m, &mut data, t);
+    let d = PyDict::new(py);
+    d.set_item("kinetic", energy::kinetic_energy(m, &data))?;
+    d.set_item("potential", energy::potential_energy(m, &data, q))?;
+    let per_body: Vec<f64> = (1..m.nbodies()).map(|i| energy::body_kinetic_energy(&data, i)).collect();
+    d.set_item("kinetic_per_body", PyArray1::from_vec(py, per_body))?;
+    let (p, l) = energy::momentum(m, &data);
+    d.set_item("momentum_linear", PyArray1::from_slice(py, p.as_slice()))?;
+    d.set_item("momentum_angular", PyArray1::from_slice(py, l.as_slice()))?;
+    Ok(d)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(crba, m)?)?;
+    m.add_function(wrap_pyfunction!(aba, m)?)?;
+    m.add_function(wrap_pyfunction!(rnea, m)?)?;
+    m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
+    m.add_function(wrap_pyfunction!(energies, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,106 @@
+//! Bindings of the recursive kinematics: body placements, twists and point Jacobians.
+
+use mechsys_core::kinematics;
+use mechsys_core::math::Vec3;
+use nalgebra::DMatrix;
+use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::settings;
+use crate::model::{check_len, PyModel};
+
+fn body_index(model: &PyModel, body: &str) -> PyResult<usize> {
+    model.model.body_id(body).ok_or_else(|| settings(format!("body: unknown body '{body}'")))
+}
+
+/// Positions (nbody × 3), rotation matrices A_IB (nbody × 3 × 3), velocities and angular velocities
+/// (I components) of all bodies including the ground (row 0).
+#[pyfunction]
+#[pyo3(signature = (model, q, u = None))]
+fn body_states<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let zero = vec![0.0; m.nu];
+    let u = match &u {
+        Some(a) => check_len(a, m.nu, "u")?,
+        None => &zero,
+    };
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    kinematics::forward_kinematics(m, &mut data, q, u);
+    let nb = m.nbodies();
+    let mut pos = Vec::with_capacity(nb);
+    let mut rot = Vec::with_capacity(nb);
+    let mut vel = Vec::with_capacity(nb);
+    let mut omg = Vec::with_capacity(nb);
+    for i in 0..nb {
+        let x = &data.x_abs[i];
+        pos.push(x.r.as_slice().to_vec());
+        rot.push((0..3).map(|r| (0..3).map(|c| x.a[(r, c)]).collect::<Vec<f64>>()).collect::<Vec<_>>());
+        let v = &data.v[i];
+        vel.push((x.a * v.v).as_slice().to_vec());
+        omg.push((x.a * v.w).as_slice().to_vec());
+    }
+    let d = PyDict::new(py);
+    let e = |e: numpy::FromVecError| settings(e.to_string());
+    d.set_item("position", PyArray2::from_vec2(py, &pos).map_err(e)?)?;
+    d.set_item("rotation", PyArray3::from_vec3(py, &rot).map_err(|e| settings(e.to_string()))?)?;
+    d.set_item("velocity", PyArray2::from_vec2(py, &vel).map_err(|e| settings(e.to_string()))?)?;
+    d.set_item("angular_velocity", PyArray2::from_vec2(py, &omg).map_err(|e| settings(e.to_string()))?)?;
+    Ok(d)
+}
+
+/// Jacobians of a body-fixed point: translational (3 × nu) and rotational (3 × nu), I components.
+#[pyfunction]
+#[pyo3(signature = (model, q, body, point = [0.0, 0.0, 0.0]))]
+fn point_jacobian<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    body: &str,
+    point: [f64; 3],
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let b = body_index(model, body)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    kinematics::positions(m, &mut data, q);
+    let mut jt = DMatrix::zeros(3, m.nu);
+    let mut jr = DMatrix::zeros(3, m.nu);
+    kinematics::point_jacobian(m, &data, b, &Vec3::from(point), &mut jt, &mut jr);
+    let to_rows = |j: &DMatrix<f64>| -> Vec<Vec<f64>> { (0..3).map(|r| (0..m.nu).map(|c| j[(r, c)]).collect()).collect() };
+    let a = PyArray2::from_vec2(py, &to_rows(&jt)).map_err(|e| settings(e.to_string()))?;
+    let b = PyArray2::from_vec2(py, &to_rows(&jr)).map_err(|e| settings(e.to_string()))?;
+    Ok((a, b))
+}
+
+/// Position of a body-fixed point, I components.
+#[pyfunction]
+#[pyo3(signature = (model, q, body, point = [0.0, 0.0, 0.0]))]
+fn point_position<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    body: &str,
+    point: [f64; 3],
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let q = check_len(&q, m.nq, "q")?;
+    let b = body_index(model, body)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    kinematics::positions(m, &mut data, q);
+    let p = kinematics::point_position(&data, b, &Vec3::from(point));
+    Ok(PyArray1::from_slice(py, p.as_slice()))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(body_states, m)?)?;
+    m.add_function(wrap_pyfunction!(point_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(point_position, m)?)?;
+    Ok(())
+}

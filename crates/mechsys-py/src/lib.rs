@@ -1,0 +1,20 @@
+//! `mechsys._core`: thin PyO3 bindings of the engine. Type conversion and error mapping only;
+//! the GIL is released while a simulation runs.
+
+mod dynamics;
+mod errors;
+mod kinematics;
+mod model;
+mod simulate;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    model::register(m)?;
+    dynamics::register(m)?;
+    kinematics::register(m)?;
+    simulate::register(m)?;
+    Ok(())
+}

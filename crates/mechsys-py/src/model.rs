@@ -1,0 +1,166 @@
+//! The validated model as a Python object, with a workspace for single evaluations.
+
+use std::sync::Mutex;
+
+use mechsys_core::data::Data;
+use mechsys_core::model::Model;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{settings, PyMechsysError};
+
+/// A validated, immutable model (built from a JSON description).
+#[pyclass(name = "Model", module = "mechsys._core", frozen)]
+pub struct PyModel {
+    pub model: Model,
+    /// Workspace for single calls (aba, crba, ...); simulations use their own.
+    pub data: Mutex<Data>,
+}
+
+#[pymethods]
+impl PyModel {
+    #[new]
+    fn new(description_json: &str) -> PyResult<Self> {
+        let model = Model::from_json(description_json).map_err(PyMechsysError::from)?;
+        let data = Mutex::new(Data::new(&model));
+        Ok(PyModel { model, data })
+    }
+    #[getter]
+    fn name(&self) -> &str {
+        &self.model.name
+    }
+    #[getter]
+    fn nq(&self) -> usize {
+        self.model.nq
+    }
+    #[getter]
+    fn nu(&self) -> usize {
+        self.model.nu
+    }
+    #[getter]
+    fn n_callbacks(&self) -> usize {
+        self.model.n_callbacks
+    }
+    #[getter]
+    fn gravity(&self) -> [f64; 3] {
+        [self.model.gravity.x, self.model.gravity.y, self.model.gravity.z]
+    }
+    /// Body names in the engine's order, ground first.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.model.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+    /// One dict per body (ground excluded): name, mass, com, inertia, parent_joint, markers.
+    fn bodies<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut out = vec![];
+        for (i, b) in self.model.bodies.iter().enumerate().skip(1) {
+            let d = PyDict::new(py);
+            d.set_item("name", &b.name)?;
+            d.set_item("index", i)?;
+            d.set_item("mass", b.mass)?;
+            d.set_item("com", b.com.as_slice().to_vec())?;
+            let rows: Vec<Vec<f64>> = (0..3).map(|r| (0..3).map(|c| b.inertia[(r, c)]).collect()).collect();
+            d.set_item("inertia", rows)?;
+            d.set_item("parent_joint", &self.model.joints[i - 1].name)?;
+            d.set_item("variable_mass", b.mass_rate != 0.0)?;
+            let markers: Vec<(String, Vec<f64>)> =
+                b.markers.iter().map(|m| (m.name.clone(), m.pose.r.as_slice().to_vec())).collect();
+            d.set_item("markers", markers)?;
+            out.push(d);
+        }
+        Ok(out)
+    }
+    /// One dict per joint in the engine's (topological) order: name, type, parent, child, iq, nq, iu, nu.
+    fn joints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut out = vec![];
+        for j in &self.model.joints {
+            let d = PyDict::new(py);
+            d.set_item("name", &j.name)?;
+            d.set_item("type", j.kind.type_name())?;
+            d.set_item("parent", &self.model.bodies[j.parent].name)?;
+            d.set_item("child", &self.model.bodies[j.child].name)?;
+            d.set_item("iq", j.iq)?;
+            d.set_item("nq", j.nq())?;
+            d.set_item("iu", j.iu)?;
+            d.set_item("nu", j.nu())?;
+            d.set_item("q0", j.q0.clone())?;
+            d.set_item("u0", j.u0.clone())?;
+            out.push(d);
+        }
+        Ok(out)
+    }
+    /// Force element (name, type) pairs.
+    fn forces(&self) -> Vec<(String, String)> {
+        use mechsys_core::model::ForceElement as F;
+        self.model
+            .forces
+            .iter()
+            .map(|f| {
+                let t = match f {
+                    F::SpringDamper { .. } => "spring_damper",
+                    F::BodyForce { .. } => "body_force",
+                    F::JointForce { .. } => "joint_force",
+                    F::Callback { .. } => "callback",
+                };
+                (f.name().to_string(), t.to_string())
+            })
+            .collect()
+    }
+    /// The model's initial coordinates.
+    fn q0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.q0())
+    }
+    /// The model's initial velocities.
+    fn u0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.u0())
+    }
+    /// The neutral configuration.
+    fn neutral<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.neutral())
+    }
+    /// q ⊕ u dt on the configuration manifold.
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray1<'py, f64>,
+        u: PyReadonlyArray1<'py, f64>,
+        dt: f64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let q = check_len(&q, self.model.nq, "q")?;
+        let u = check_len(&u, self.model.nu, "u")?;
+        let mut out = vec![0.0; self.model.nq];
+        self.model.integrate(q, u, dt, &mut out);
+        Ok(PyArray1::from_vec(py, out))
+    }
+    /// The description as JSON (what results files store).
+    fn description_json(&self) -> String {
+        self.model.description.to_json()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Model('{}', bodies={}, joints={}, nq={}, nu={})",
+            self.model.name,
+            self.model.nbodies() - 1,
+            self.model.joints.len(),
+            self.model.nq,
+            self.model.nu
+        )
+    }
+}
+
+/// A contiguous, finite f64 slice of the expected length, or a SettingsError naming the argument.
+pub fn check_len<'a>(a: &'a PyReadonlyArray1<'_, f64>, n: usize, what: &str) -> PyResult<&'a [f64]> {
+    let s = a.as_slice().map_err(|_| settings(format!("{what}: must be a contiguous float64 array")))?;
+    if s.len() != n {
+        return Err(settings(format!("{what}: expected length {n}, got {}", s.len())));
+    }
+    if let Some(i) = s.iter().position(|v| !v.is_finite()) {
+        return Err(settings(format!("{what}[{i}]: must be finite, got {}", s[i])));
+    }
+    Ok(s)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyModel>()
+}

@@ -1,0 +1,173 @@
+//! The simulation binding: runs the loop in Rust with the GIL released, hands the recorded arrays
+//! to numpy without copying, and calls Python callables back (slowly) where a model asks for it.
+
+use std::sync::atomic::Ordering;
+use std::sync::Arc;
+
+use mechsys_core::error::Error;
+use mechsys_core::forces::Callbacks;
+use mechsys_core::simulate::{Progress, Settings};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{settings, PyMechsysError};
+use crate::model::PyModel;
+
+/// Python callables: time functions `f(t) -> float` and force laws `f(t, q, u) -> array(nu)`.
+pub struct PyCallbacks {
+    pub funcs: Vec<PyObject>,
+    pub nu: usize,
+}
+
+impl PyCallbacks {
+    fn get(&self, id: usize) -> Result<&PyObject, Error> {
+        self.funcs.get(id).ok_or_else(|| Error::Callback(format!("callback {id} was not provided")))
+    }
+}
+
+fn py_err(e: PyErr) -> Error {
+    Python::with_gil(|py| {
+        let tb = e.traceback(py).and_then(|t| t.format().ok()).unwrap_or_default();
+        Error::Callback(format!("{e}{}", if tb.is_empty() { String::new() } else { format!("\n{tb}") }))
+    })
+}
+
+impl Callbacks for PyCallbacks {
+    fn time_function(&self, id: usize, t: f64) -> Result<f64, Error> {
+        let f = self.get(id)?;
+        Python::with_gil(|py| {
+            let v: f64 = f.call1(py, (t,)).and_then(|r| r.extract(py)).map_err(py_err)?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(Error::Callback(format!("time function callback {id} returned {v} at t = {t}")))
+            }
+        })
+    }
+    fn generalized_force(&self, id: usize, t: f64, q: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), Error> {
+        let f = self.get(id)?;
+        Python::with_gil(|py| {
+            let qa = PyArray1::from_slice(py, q);
+            let ua = PyArray1::from_slice(py, u);
+            let r = f.call1(py, (t, qa, ua)).map_err(py_err)?;
+            let v: Vec<f64> = r.extract(py).map_err(py_err)?;
+            if v.len() != self.nu {
+                return Err(Error::Callback(format!("force callback returned {} values, expected nu = {}", v.len(), self.nu)));
+            }
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(Error::Callback(format!("force callback returned {} at index {i}, t = {t}", v[i])));
+            }
+            out.iter_mut().zip(&v).for_each(|(o, x)| *o += x);
+            Ok(())
+        })
+    }
+}
+
+/// Progress of a running simulation, readable from another Python thread.
+#[pyclass(name = "Progress", module = "mechsys._core", frozen)]
+pub struct PyProgress {
+    inner: Arc<Progress>,
+}
+
+#[pymethods]
+impl PyProgress {
+    #[new]
+    fn new() -> Self {
+        PyProgress { inner: Arc::new(Progress::default()) }
+    }
+    /// Samples recorded so far.
+    #[getter]
+    fn samples(&self) -> u64 {
+        self.inner.samples.load(Ordering::Relaxed)
+    }
+    /// Ask the running simulation to stop (it raises SolverError).
+    fn cancel(&self) {
+        self.inner.cancel.store(true, Ordering::Relaxed);
+    }
+}
+
+/// Runs a simulation; `settings_json` holds t0, t_end, output_dt, integrator, q0, u0.
+/// Returns a dict of numpy arrays and the integrator statistics.
+#[pyfunction]
+#[pyo3(signature = (model, settings_json, callbacks = None, progress = None))]
+fn simulate<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    settings_json: &str,
+    callbacks: Option<Vec<PyObject>>,
+    progress: Option<&PyProgress>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let de = &mut serde_json::Deserializer::from_str(settings_json);
+    let s: Settings = serde_path_to_error::deserialize(de).map_err(|e| {
+        let m = e.inner().to_string();
+        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
+        settings(format!("settings.{}: {m}", e.path()))
+    })?;
+    let cb = PyCallbacks { funcs: callbacks.unwrap_or_default(), nu: model.model.nu };
+    if cb.funcs.len() < model.model.n_callbacks {
+        return Err(settings(format!(
+            "callbacks: the model refers to {} callbacks, {} given",
+            model.model.n_callbacks,
+            cb.funcs.len()
+        )));
+    }
+    let prog = progress.map(|p| p.inner.clone());
+    let m = &model.model;
+    let rec = py
+        .allow_threads(|| mechsys_core::simulate::simulate(m, &s, &cb, prog.as_deref()))
+        .map_err(PyMechsysError::from)?;
+    let n = rec.n_out;
+    let nb = rec.n_bodies;
+    let d = PyDict::new(py);
+    let put = |name: &str, v: Vec<f64>, shape: &[usize]| -> PyResult<()> {
+        let a = PyArray1::from_vec(py, v);
+        let a = a.reshape(shape.to_vec())?;
+        d.set_item(name, a)
+    };
+    put("t", rec.t, &[n])?;
+    put("q", rec.q, &[n, m.nq])?;
+    put("u", rec.u, &[n, m.nu])?;
+    put("udot", rec.udot, &[n, m.nu])?;
+    put("body_position", rec.body_position, &[n, nb, 3])?;
+    put("body_orientation", rec.body_orientation, &[n, nb, 4])?;
+    put("body_velocity", rec.body_velocity, &[n, nb, 3])?;
+    put("body_angular_velocity", rec.body_angular_velocity, &[n, nb, 3])?;
+    put("body_acceleration", rec.body_acceleration, &[n, nb, 3])?;
+    put("body_mass", rec.body_mass, &[n, nb])?;
+    put("kinetic", rec.kinetic, &[n])?;
+    put("potential", rec.potential, &[n])?;
+    put("dissipated", rec.dissipated, &[n])?;
+    put("external_work", rec.external_work, &[n])?;
+    put("momentum_linear", rec.momentum_linear, &[n, 3])?;
+    put("momentum_angular", rec.momentum_angular, &[n, 3])?;
+    let st = PyDict::new(py);
+    st.set_item("steps", rec.stats.steps)?;
+    st.set_item("rejected", rec.stats.rejected)?;
+    st.set_item("evaluations", rec.stats.evaluations)?;
+    st.set_item("jacobians", rec.stats.jacobians)?;
+    d.set_item("stats", st)?;
+    Ok(d)
+}
+
+/// Coordinate rates q̇ = H*(q) u (eq. 2.34).
+#[pyfunction]
+fn qdot<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let q = crate::model::check_len(&q, model.model.nq, "q")?;
+    let u = crate::model::check_len(&u, model.model.nu, "u")?;
+    let mut out = vec![0.0; model.model.nq];
+    model.model.qdot(q, u, &mut out);
+    Ok(PyArray1::from_vec(py, out))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyProgress>()?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(qdot, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,57 @@
+"""mechsys — mechanical system dynamics.
+
+Build a model (:class:`Model`, :mod:`joints`, :mod:`forces`, :mod:`inertia`), simulate it in the
+Rust engine (:func:`simulate`), read named signals with units (:class:`Results`), plot them
+(:func:`plot`) and save them to HDF5.
+"""
+
+from . import dynamics, forces, functions, inertia, joints
+from ._core import __version__
+from .errors import (
+    CallbackError,
+    MechsysError,
+    ModelError,
+    ResultsError,
+    SettingsError,
+    SingularityError,
+    SolverError,
+)
+from .integrators import DOPRI5, RK4, Radau5
+from .joints import Frame
+from .model import Body, Model
+from .results import Results, load
+from .simulate import simulate
+
+
+def plot(results, signals, out=None, **kwargs):
+    """Plots signals of a :class:`Results` against time (see :func:`mechsys.plotting.plot`)."""
+    from .plotting import plot as _plot
+
+    return _plot(results, signals, out=out, **kwargs)
+
+
+__all__ = [
+    "__version__",
+    "Model",
+    "Body",
+    "Frame",
+    "simulate",
+    "Results",
+    "load",
+    "plot",
+    "RK4",
+    "DOPRI5",
+    "Radau5",
+    "joints",
+    "forces",
+    "functions",
+    "inertia",
+    "dynamics",
+    "MechsysError",
+    "ModelError",
+    "SettingsError",
+    "SolverError",
+    "SingularityError",
+    "CallbackError",
+    "ResultsError",
+]

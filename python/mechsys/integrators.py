@@ -1,0 +1,68 @@
+"""Integration schemes for smooth dynamics.
+
+- :class:`RK4` — classical Runge-Kutta, fixed step: cheap, predictable, 4th order.
+- :class:`DOPRI5` — Dormand-Prince 5(4), adaptive with error control and dense output (the default).
+- :class:`Radau5` — Radau IIA (3 stages, order 5, L-stable), fixed step, implicit: for stiff
+  spring-damper systems where explicit schemes need tiny steps. L-stability damps parasitic stiff
+  modes instead of letting them ring, and as a collocation method on the first-order form it
+  needs no special handling of quaternion kinematics (generalized-alpha would).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+
+@dataclass(frozen=True)
+class RK4:
+    """Fixed-step classical Runge-Kutta of order 4 with step ``dt`` (s)."""
+
+    dt: float
+
+    def describe(self) -> dict:
+        return {"type": "rk4", "dt": float(self.dt)}
+
+
+@dataclass(frozen=True)
+class DOPRI5:
+    """Adaptive Dormand-Prince 5(4) with relative/absolute tolerances, optional step limits."""
+
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_step: float = 0.0
+    first_step: float = 0.0
+
+    def describe(self) -> dict:
+        return {"type": "dopri5", **{k: float(v) for k, v in asdict(self).items()}}
+
+
+@dataclass(frozen=True)
+class Radau5:
+    """Implicit Radau IIA (order 5) with fixed step ``dt``; Newton tolerance ``newton_tol``."""
+
+    dt: float
+    newton_tol: float = 1e-10
+
+    def describe(self) -> dict:
+        return {"type": "radau5", "dt": float(self.dt), "newton_tol": float(self.newton_tol)}
+
+
+def from_name(name: str, dt: float | None = None, rtol: float | None = None, atol: float | None = None):
+    """An integrator from its name (command line): rk4, dopri5, radau5."""
+    from .errors import SettingsError
+
+    n = name.lower()
+    if n == "rk4":
+        if dt is None:
+            raise SettingsError("integrator rk4 needs a step: give --dt")
+        return RK4(dt)
+    if n == "dopri5":
+        return DOPRI5(rtol=rtol or 1e-8, atol=atol or 1e-10)
+    if n == "radau5":
+        if dt is None:
+            raise SettingsError("integrator radau5 needs a step: give --dt")
+        return Radau5(dt)
+    raise SettingsError(f"integrator: unknown name '{name}' (expected rk4, dopri5 or radau5)")
+
+
+__all__ = ["RK4", "DOPRI5", "Radau5"]

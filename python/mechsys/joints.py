@@ -1,0 +1,251 @@
+"""Joints of the kinematic tree.
+
+Each joint connects a parent body (``model.ground`` for the inertial frame) to a child body; the
+joint frame sits at ``parent_frame`` on the parent and at ``child_frame`` on the child (both
+:class:`mechsys.Frame` or a position tuple). Coordinates and velocities per type:
+
+============  ==  ==  =====================================================  ==========================
+type          nq  nu  q                                                      u
+============  ==  ==  =====================================================  ==========================
+Fixed         0   0   -                                                      -
+Revolute      1   1   angle about ``axis`` (rad)                             rate
+Prismatic     1   1   displacement along ``axis`` (m)                        rate
+Cylindrical   2   2   angle, displacement about/along ``axis``               rates
+Universal     2   2   angle about ``axis`` (parent), then ``axis2`` (child)  rates
+Spherical     4   3   unit quaternion [w, x, y, z]                           angular velocity, child frame
+Planar        3   3   x, y in the joint frame's x-y plane, angle about z     rates
+Free          7   6   position (parent frame), quaternion                    velocity, angular velocity, child frame
+============  ==  ==  =====================================================  ==========================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from .errors import ModelError
+
+
+@dataclass
+class Frame:
+    """A frame on a body: origin ``position`` and orientation, all relative to the body frame.
+
+    Give at most one of ``rotation`` (3x3 matrix A_BF or quaternion [w, x, y, z]),
+    ``cardan`` (x-y-z angles), ``euler`` (z-x-z angles) or ``rotvec`` (axis times angle).
+    """
+
+    position: Sequence[float] = (0.0, 0.0, 0.0)
+    rotation: Any = None
+    cardan: Sequence[float] | None = None
+    euler: Sequence[float] | None = None
+    rotvec: Sequence[float] | None = None
+
+    def describe(self) -> dict:
+        d: dict = {"position": [float(x) for x in np.asarray(self.position, dtype=float).reshape(3)]}
+        given = [k for k in ("rotation", "cardan", "euler", "rotvec") if getattr(self, k) is not None]
+        if len(given) > 1:
+            raise ModelError(f"Frame: give only one of rotation, cardan, euler, rotvec (got {given})")
+        if self.rotation is not None:
+            r = np.asarray(self.rotation, dtype=float)
+            d["rotation"] = r.tolist()
+        elif given:
+            k = given[0]
+            d["rotation"] = {k: [float(x) for x in getattr(self, k)]}
+        return d
+
+
+def _frame(f, what: str) -> dict:
+    if f is None:
+        return Frame().describe()
+    if isinstance(f, Frame):
+        return f.describe()
+    if isinstance(f, dict):
+        return f
+    try:
+        return Frame(position=tuple(float(x) for x in f)).describe()
+    except Exception:  # noqa: BLE001 - any malformed value gets the same clear message
+        raise ModelError(f"{what}: expected a mechsys.Frame or a position (x, y, z), got {f!r}") from None
+
+
+def _name(x) -> str:
+    return x if isinstance(x, str) else getattr(x, "name", str(x))
+
+
+@dataclass
+class JointSpring:
+    """Linear spring on each joint coordinate: tau = -k (q - q_free)."""
+
+    k: float | Sequence[float]
+    q_free: float | Sequence[float] | None = None
+
+    def describe(self) -> dict:
+        d = {"k": [float(x) for x in np.atleast_1d(self.k)]}
+        if self.q_free is not None:
+            d["q_free"] = [float(x) for x in np.atleast_1d(self.q_free)]
+        return d
+
+
+@dataclass
+class JointDamper:
+    """Linear viscous damper on each joint velocity: tau = -d u."""
+
+    d: float | Sequence[float]
+
+    def describe(self) -> dict:
+        return {"d": [float(x) for x in np.atleast_1d(self.d)]}
+
+
+@dataclass
+class Joint:
+    """Base of all joint types; use the subclasses."""
+
+    name: str
+    parent: Any
+    child: Any
+    parent_frame: Any = None
+    child_frame: Any = None
+    q0: Any = None
+    u0: Any = None
+    spring: JointSpring | None = None
+    damper: JointDamper | None = None
+    type: str = field(default="", init=False)
+
+    def _extra(self) -> dict:
+        return {}
+
+    def describe(self) -> dict:
+        d = {
+            "name": self.name,
+            "type": self.type,
+            "parent": _name(self.parent),
+            "child": _name(self.child),
+            "parent_frame": _frame(self.parent_frame, f"joint '{self.name}'.parent_frame"),
+            "child_frame": _frame(self.child_frame, f"joint '{self.name}'.child_frame"),
+        }
+        d.update(self._extra())
+        if self.q0 is not None:
+            d["q0"] = [float(x) for x in np.atleast_1d(np.asarray(self.q0, dtype=float))]
+        if self.u0 is not None:
+            d["u0"] = [float(x) for x in np.atleast_1d(np.asarray(self.u0, dtype=float))]
+        if self.spring is not None:
+            d["spring"] = self.spring.describe()
+        if self.damper is not None:
+            d["damper"] = self.damper.describe()
+        return d
+
+
+def _axis(a) -> list[float]:
+    return [float(x) for x in np.asarray(a, dtype=float).reshape(3)]
+
+
+@dataclass
+class Fixed(Joint):
+    """Rigid connection (0 DOF)."""
+
+    def __post_init__(self):
+        self.type = "fixed"
+
+
+@dataclass
+class Revolute(Joint):
+    """Rotation about ``axis`` (joint frame), 1 DOF."""
+
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        self.type = "revolute"
+
+    def _extra(self):
+        return {"axis": _axis(self.axis)}
+
+
+@dataclass
+class Prismatic(Joint):
+    """Translation along ``axis`` (joint frame), 1 DOF."""
+
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        self.type = "prismatic"
+
+    def _extra(self):
+        return {"axis": _axis(self.axis)}
+
+
+@dataclass
+class Cylindrical(Joint):
+    """Rotation about and translation along ``axis``, 2 DOF (q = [angle, displacement])."""
+
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        self.type = "cylindrical"
+
+    def _extra(self):
+        return {"axis": _axis(self.axis)}
+
+
+@dataclass
+class Universal(Joint):
+    """Cardan joint: rotation about ``axis`` (parent), then about ``axis2`` (child), 2 DOF."""
+
+    axis: Sequence[float] = (1.0, 0.0, 0.0)
+    axis2: Sequence[float] = (0.0, 1.0, 0.0)
+
+    def __post_init__(self):
+        self.type = "universal"
+
+    def _extra(self):
+        return {"axis": _axis(self.axis), "axis2": _axis(self.axis2)}
+
+
+@dataclass
+class Spherical(Joint):
+    """Ball joint, 3 DOF; q is a unit quaternion [w, x, y, z], u the child's angular velocity."""
+
+    def __post_init__(self):
+        self.type = "spherical"
+
+
+@dataclass
+class Planar(Joint):
+    """Planar joint in the joint frame's x-y plane, 3 DOF (q = [x, y, angle])."""
+
+    def __post_init__(self):
+        self.type = "planar"
+
+
+@dataclass
+class Free(Joint):
+    """Six degrees of freedom; q = [x, y, z, qw, qx, qy, qz], u = [v_B, omega_B] (child frame)."""
+
+    def __post_init__(self):
+        self.type = "free"
+
+
+# Aliases engineers coming from other tools look for.
+RotaryDamper = JointDamper
+RotarySpring = JointSpring
+LinearDamper = JointDamper
+LinearSpring = JointSpring
+
+__all__ = [
+    "Frame",
+    "Joint",
+    "JointSpring",
+    "JointDamper",
+    "Fixed",
+    "Revolute",
+    "Prismatic",
+    "Cylindrical",
+    "Universal",
+    "Spherical",
+    "Planar",
+    "Free",
+    "RotaryDamper",
+    "RotarySpring",
+    "LinearDamper",
+    "LinearSpring",
+]

@@ -1,0 +1,239 @@
+"""The model builder: bodies, joints, force elements and gravity, validated by the engine.
+
+A :class:`Model` collects the description; :meth:`Model.build` (called by ``simulate`` and the
+analysis functions) hands it to the Rust engine, which validates everything and names the
+offending item in any error. The description is plain data, the same as a TOML model file.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from . import _core
+from .errors import ModelError
+from .joints import Frame, Joint
+
+
+@dataclass
+class Body:
+    """Handle of a body in a model (returned by :meth:`Model.add_body`; ``model.ground`` too)."""
+
+    name: str
+    model: "Model" = field(repr=False)
+
+    def add_marker(self, name: str, position: Sequence[float] = (0.0, 0.0, 0.0), **rotation) -> "Body":
+        """Adds a named body-fixed frame (``rotation=``, ``cardan=``, ``euler=`` or ``rotvec=``)."""
+        self.model.add_marker(self.name, name, position, **rotation)
+        return self
+
+
+def _vec3(v, what: str) -> list[float]:
+    try:
+        a = np.asarray(v, dtype=float).reshape(3)
+    except Exception:  # noqa: BLE001
+        raise ModelError(f"{what}: expected 3 numbers, got {v!r}") from None
+    return [float(x) for x in a]
+
+
+class Model:
+    """A multibody model under construction.
+
+    >>> m = Model("pendulum", gravity=(0, -9.81, 0))
+    >>> rod = m.add_body("rod", mass=1.0, inertia=[1e-4, 0.0833, 0.0833], com=(0.5, 0, 0))
+    """
+
+    def __init__(self, name: str = "model", gravity: Sequence[float] = (0.0, 0.0, 0.0)):
+        self.name = name
+        self.gravity = _vec3(gravity, "gravity")
+        self._bodies: list[dict] = []
+        self._joints: list[Joint | dict] = []
+        self._forces: list[Any] = []
+        self._ground_markers: list[dict] = []
+        self._built: tuple[str, Any, list] | None = None
+        self._extra_callbacks: list = []
+        self.ground = Body("ground", self)
+
+    # ---- building ------------------------------------------------------------------------------
+    def add_body(
+        self,
+        name: str,
+        mass: float,
+        inertia,
+        com: Sequence[float] = (0.0, 0.0, 0.0),
+        *,
+        mass_rate: float = 0.0,
+        ejection_velocity: Sequence[float] = (0.0, 0.0, 0.0),
+        ejection_point: Sequence[float] | None = None,
+        mass_final: float | None = None,
+    ) -> Body:
+        """Adds a rigid body. ``inertia`` about the centre of mass in body components: a 3x3
+        matrix, its diagonal, or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. A variable-mass body (section
+        2.1.1) has ``mass_rate`` (kg/s, negative when ejecting), the ``ejection_velocity`` of the
+        ejected mass relative to the body (body frame), and the ``mass_final`` at which the flow stops."""
+        inert = np.asarray(inertia, dtype=float)
+        body = {
+            "name": name,
+            "mass": float(mass),
+            "inertia": inert.tolist(),
+            "com": _vec3(com, f"body '{name}'.com"),
+            "markers": [],
+        }
+        if mass_rate:
+            body["mass_rate"] = float(mass_rate)
+            body["ejection_velocity"] = _vec3(ejection_velocity, f"body '{name}'.ejection_velocity")
+            if ejection_point is not None:
+                body["ejection_point"] = _vec3(ejection_point, f"body '{name}'.ejection_point")
+            if mass_final is not None:
+                body["mass_final"] = float(mass_final)
+        self._bodies.append(body)
+        self._built = None
+        return Body(name, self)
+
+    def add_marker(self, body: str | Body, name: str, position: Sequence[float] = (0.0, 0.0, 0.0), **rotation) -> None:
+        """Adds a named frame to a body (or to the ground)."""
+        bname = body if isinstance(body, str) else body.name
+        f = Frame(position=position, **rotation).describe()
+        marker = {"name": name, **f}
+        if bname == "ground":
+            self._ground_markers.append(marker)
+        else:
+            for b in self._bodies:
+                if b["name"] == bname:
+                    b["markers"].append(marker)
+                    break
+            else:
+                raise ModelError(f"add_marker: unknown body '{bname}'")
+        self._built = None
+
+    def add_joint(self, joint: Joint | dict) -> Joint | dict:
+        """Adds a joint (see :mod:`mechsys.joints`)."""
+        if not isinstance(joint, (Joint, dict)):
+            raise ModelError(f"add_joint: expected a mechsys.joints joint, got {type(joint).__name__}")
+        self._joints.append(joint)
+        self._built = None
+        return joint
+
+    def add_force(self, force) -> Any:
+        """Adds a force element (see :mod:`mechsys.forces`)."""
+        if not (hasattr(force, "describe") or isinstance(force, dict)):
+            raise ModelError(f"add_force: expected a mechsys.forces element, got {type(force).__name__}")
+        self._forces.append(force)
+        self._built = None
+        return force
+
+    # ---- description and engine model -----------------------------------------------------------
+    def describe(self) -> tuple[dict, list]:
+        """The plain-data description (as in a model file) and the Python callbacks it refers to."""
+        callbacks: list = list(self._extra_callbacks)
+        forces = [f if isinstance(f, dict) else f.describe(callbacks) for f in self._forces]
+        desc = {
+            "name": self.name,
+            "gravity": list(self.gravity),
+            "bodies": copy.deepcopy(self._bodies),
+            "joints": [j if isinstance(j, dict) else j.describe() for j in self._joints],
+            "forces": forces,
+            "ground_markers": copy.deepcopy(self._ground_markers),
+        }
+        return desc, callbacks
+
+    def to_dict(self) -> dict:
+        """The description as plain data (Python callables appear as callback ids)."""
+        return self.describe()[0]
+
+    def build(self) -> "_core.Model":
+        """Validates the model in the engine (cached until the model changes)."""
+        if self._built is None:
+            desc, callbacks = self.describe()
+            text = json.dumps(desc, allow_nan=True)
+            self._built = (text, _core.Model(text), callbacks)
+        return self._built[1]
+
+    @property
+    def callbacks(self) -> list:
+        """Python callables referred to by the description."""
+        self.build()
+        return self._built[2]  # type: ignore[index]
+
+    @classmethod
+    def from_dict(cls, desc: dict, callbacks: list | None = None) -> "Model":
+        """A model from a plain-data description (e.g. a parsed TOML model file)."""
+        if not isinstance(desc, dict):
+            raise ModelError(f"model: expected a table/dict, got {type(desc).__name__}")
+        m = cls(desc.get("name", "model"), desc.get("gravity", (0.0, 0.0, 0.0)))
+        m._bodies = copy.deepcopy(list(desc.get("bodies", [])))
+        m._joints = copy.deepcopy(list(desc.get("joints", [])))
+        m._forces = copy.deepcopy(list(desc.get("forces", [])))
+        m._ground_markers = copy.deepcopy(list(desc.get("ground_markers", [])))
+        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers"}
+        extra = set(desc) - known
+        if extra:
+            # let the engine produce the canonical message for a misspelt top-level key
+            _core.Model(json.dumps(desc))
+        m._extra_callbacks = list(callbacks or [])
+        return m
+
+    # ---- information ----------------------------------------------------------------------------
+    @property
+    def nq(self) -> int:
+        """Number of generalized coordinates."""
+        return self.build().nq
+
+    @property
+    def nu(self) -> int:
+        """Number of generalized velocities (degrees of freedom of the tree)."""
+        return self.build().nu
+
+    def joint_info(self) -> list[dict]:
+        """Per joint: name, type, parent, child, index ranges in q (iq, nq) and u (iu, nu)."""
+        return self.build().joints()
+
+    def body_info(self) -> list[dict]:
+        """Per body: name, mass, com, inertia, parent joint, markers."""
+        return self.build().bodies()
+
+    def q0(self) -> np.ndarray:
+        """Initial coordinates from the joints' q0 (neutral where none was given)."""
+        return self.build().q0()
+
+    def u0(self) -> np.ndarray:
+        """Initial velocities from the joints' u0 (zero where none was given)."""
+        return self.build().u0()
+
+    def state_vector(self, values, which: str) -> np.ndarray:
+        """A full q (``which='q'``) or u vector from an array or a {joint name: value} dict,
+        starting from the model's own initial values."""
+        core = self.build()
+        base = core.q0() if which == "q" else core.u0()
+        n = core.nq if which == "q" else core.nu
+        if values is None:
+            return base
+        if isinstance(values, dict):
+            info = {j["name"]: j for j in core.joints()}
+            out = np.array(base, dtype=float)
+            for name, v in values.items():
+                if name not in info:
+                    raise ModelError(f"{which}0: unknown joint '{name}' (joints: {', '.join(info)})")
+                j = info[name]
+                start, cnt = (j["iq"], j["nq"]) if which == "q" else (j["iu"], j["nu"])
+                arr = np.atleast_1d(np.asarray(v, dtype=float))
+                if arr.size != cnt:
+                    raise ModelError(
+                        f"{which}0['{name}']: a {j['type']} joint has {cnt} {'coordinates' if which == 'q' else 'velocities'}, got {arr.size}"
+                    )
+                out[start : start + cnt] = arr
+            return out
+        arr = np.asarray(values, dtype=float).reshape(-1)
+        if arr.size != n:
+            raise ModelError(f"{which}0: the model has {n} {'coordinates' if which == 'q' else 'velocities'}, got {arr.size}")
+        return arr
+
+    def __repr__(self) -> str:
+        return f"Model('{self.name}', bodies={len(self._bodies)}, joints={len(self._joints)}, forces={len(self._forces)})"
+
+
+__all__ = ["Model", "Body"]

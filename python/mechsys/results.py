@@ -1,0 +1,217 @@
+"""Simulation results: named signals with units, as numpy arrays, saved to and loaded from HDF5.
+
+Signal names (``res.names()`` lists those present):
+
+==============================  ===========  =============================================
+name                            unit         shape
+==============================  ===========  =============================================
+t                               s            (n,)
+q, u, udot                      mixed        (n, nq), (n, nu), (n, nu)
+joint/<j>/q, /u, /udot          rad, m, ...  (n,) for 1-DOF joints, else (n, k)
+body/<b>/position               m            (n, 3)  body-frame origin, inertial components
+body/<b>/orientation            1            (n, 4)  quaternion [w, x, y, z] of A_IB
+body/<b>/velocity               m/s          (n, 3)
+body/<b>/angular_velocity       rad/s        (n, 3)  inertial components
+body/<b>/acceleration           m/s^2        (n, 3)
+body/<b>/mass                   kg           (n,)
+energy/kinetic, potential,      J            (n,)
+  total, dissipated,
+  external_work
+momentum/linear                 N s          (n, 3)
+momentum/angular                N m s        (n, 3)  about the inertial origin
+==============================  ===========  =============================================
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+
+from .errors import ResultsError
+
+_JOINT_UNITS = {
+    "revolute": ("rad", "rad/s", "rad/s^2"),
+    "prismatic": ("m", "m/s", "m/s^2"),
+    "cylindrical": ("rad, m", "rad/s, m/s", "rad/s^2, m/s^2"),
+    "universal": ("rad", "rad/s", "rad/s^2"),
+    "spherical": ("1 (quaternion)", "rad/s", "rad/s^2"),
+    "planar": ("m, m, rad", "m/s, m/s, rad/s", "m/s^2, m/s^2, rad/s^2"),
+    "free": ("m, 1 (quaternion)", "m/s, rad/s", "m/s^2, rad/s^2"),
+    "fixed": ("", "", ""),
+}
+
+
+class Results:
+    """Named signals of one simulation. ``res["joint/hinge/q"]`` is a numpy array (a view into the
+    recorded block, no copy); ``res.unit(name)`` its unit; ``res.model`` the model description."""
+
+    def __init__(self, signals: dict[str, np.ndarray], units: dict[str, str], attrs: dict | None = None):
+        self._signals = signals
+        self._units = units
+        self.attrs = dict(attrs or {})
+
+    # ---- construction from a simulation --------------------------------------------------------
+    @classmethod
+    def from_raw(cls, raw: dict, joints: list[dict], body_names: list[str], attrs: dict) -> "Results":
+        s: dict[str, np.ndarray] = {}
+        u: dict[str, str] = {}
+
+        def put(name, arr, unit):
+            s[name] = arr
+            u[name] = unit
+
+        put("t", raw["t"], "s")
+        put("q", raw["q"], "mixed")
+        put("u", raw["u"], "mixed")
+        put("udot", raw["udot"], "mixed")
+        for j in joints:
+            uq, uu, ua = _JOINT_UNITS.get(j["type"], ("", "", ""))
+            if j["nq"] == 0:
+                continue
+            sq = slice(j["iq"], j["iq"] + j["nq"])
+            su = slice(j["iu"], j["iu"] + j["nu"])
+            one = j["nq"] == 1
+            put(f"joint/{j['name']}/q", raw["q"][:, j["iq"]] if one else raw["q"][:, sq], uq)
+            put(f"joint/{j['name']}/u", raw["u"][:, j["iu"]] if one else raw["u"][:, su], uu)
+            put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua)
+        for k, b in enumerate(body_names):
+            put(f"body/{b}/position", raw["body_position"][:, k, :], "m")
+            put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1")
+            put(f"body/{b}/velocity", raw["body_velocity"][:, k, :], "m/s")
+            put(f"body/{b}/angular_velocity", raw["body_angular_velocity"][:, k, :], "rad/s")
+            put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2")
+            put(f"body/{b}/mass", raw["body_mass"][:, k], "kg")
+        put("energy/kinetic", raw["kinetic"], "J")
+        put("energy/potential", raw["potential"], "J")
+        put("energy/total", raw["kinetic"] + raw["potential"], "J")
+        put("energy/dissipated", raw["dissipated"], "J")
+        put("energy/external_work", raw["external_work"], "J")
+        put("momentum/linear", raw["momentum_linear"], "N s")
+        put("momentum/angular", raw["momentum_angular"], "N m s")
+        return cls(s, u, attrs)
+
+    # ---- access --------------------------------------------------------------------------------
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self._signals[name]
+        except KeyError:
+            close = [n for n in self._signals if name.split("/")[-1] in n][:8]
+            hint = f"; similar: {', '.join(close)}" if close else ""
+            raise ResultsError(f"unknown signal '{name}'{hint} (res.names() lists all)") from None
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._signals
+
+    def names(self) -> list[str]:
+        """All signal names."""
+        return list(self._signals)
+
+    def unit(self, name: str) -> str:
+        """The unit of a signal."""
+        self[name]
+        return self._units.get(name, "")
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample times (s)."""
+        return self._signals["t"]
+
+    @property
+    def model(self) -> dict:
+        """The model description the results came from."""
+        return json.loads(self.attrs.get("model", "{}"))
+
+    @property
+    def settings(self) -> dict:
+        """The simulation settings."""
+        return json.loads(self.attrs.get("settings", "{}"))
+
+    @property
+    def stats(self) -> dict:
+        """Integrator statistics (steps, rejected, evaluations, jacobians)."""
+        return json.loads(self.attrs.get("stats", "{}"))
+
+    def __repr__(self) -> str:
+        n = len(self.t)
+        span = f"{self.t[0]:g}..{self.t[-1]:g} s" if n else "empty"
+        return f"Results({len(self._signals)} signals, {n} samples, t = {span})"
+
+    # ---- files ---------------------------------------------------------------------------------
+    def save(self, path: str | Path) -> Path:
+        """Writes all signals to HDF5 (one dataset per signal with a ``unit`` attribute; the model
+        description, settings and statistics as file attributes)."""
+        import h5py
+
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(path, "w") as f:
+            f.attrs["format"] = "mechsys-results"
+            f.attrs["format_version"] = 1
+            for k, v in self.attrs.items():
+                f.attrs[k] = v
+            for name, arr in self._signals.items():
+                ds = f.create_dataset(name, data=np.ascontiguousarray(arr))
+                ds.attrs["unit"] = self._units.get(name, "")
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Results":
+        """Reads a results file written by :meth:`save`."""
+        import h5py
+
+        path = Path(path)
+        if not path.exists():
+            raise ResultsError(f"results file '{path}' does not exist")
+        try:
+            f = h5py.File(path, "r")
+        except OSError as e:
+            raise ResultsError(f"'{path}' is not an HDF5 results file ({e})") from None
+        with f:
+            if f.attrs.get("format") != "mechsys-results":
+                raise ResultsError(f"'{path}' is an HDF5 file but not mechsys results (no 'format' attribute)")
+            signals: dict[str, np.ndarray] = {}
+            units: dict[str, str] = {}
+
+            def visit(name, obj):
+                if isinstance(obj, h5py.Dataset):
+                    signals[name] = obj[()]
+                    units[name] = str(obj.attrs.get("unit", ""))
+
+            f.visititems(visit)
+            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        # keep the canonical order: t first
+        order = sorted(signals, key=lambda n: (n != "t", n))
+        return cls({n: signals[n] for n in order}, units, attrs)
+
+    def to_csv(self, path: str | Path, signals: Iterable[str] | None = None) -> Path:
+        """Writes chosen signals (all scalar and vector ones if None) as CSV with a header row
+        ``t [s], name[i] [unit], ...``."""
+        names = list(signals) if signals is not None else [n for n in self.names() if n not in ("t", "q", "u", "udot")]
+        cols = [self.t.reshape(-1, 1)]
+        header = ["t [s]"]
+        for n in names:
+            a = np.asarray(self[n])
+            if a.shape[0] != len(self.t):
+                raise ResultsError(f"signal '{n}' does not have one row per sample")
+            a2 = a.reshape(len(self.t), -1)
+            cols.append(a2)
+            unit = self.unit(n)
+            if a2.shape[1] == 1:
+                header.append(f"{n} [{unit}]")
+            else:
+                header.extend(f"{n}[{i}] [{unit}]" for i in range(a2.shape[1]))
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
+        return path
+
+
+def load(path: str | Path) -> Results:
+    """Reads a results file (see :meth:`Results.load`)."""
+    return Results.load(path)
+
+
+__all__ = ["Results", "load"]

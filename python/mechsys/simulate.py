@@ -1,0 +1,127 @@
+"""``simulate``: runs the step loop in Rust (GIL released) and returns :class:`Results`."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from .errors import SettingsError
+from .integrators import DOPRI5, RK4, Radau5
+from .model import Model
+from .results import Results
+
+
+def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0) -> dict:
+    if integrator is None:
+        integrator = DOPRI5()
+    if not hasattr(integrator, "describe"):
+        raise SettingsError(f"integrator: expected mechsys.RK4, DOPRI5 or Radau5, got {type(integrator).__name__}")
+    try:
+        t_end = float(t_end)
+        t0 = float(t0)
+    except (TypeError, ValueError):
+        raise SettingsError(f"t_end and t0 must be numbers, got {t_end!r}, {t0!r}") from None
+    if output_dt is None:
+        if isinstance(integrator, (RK4, Radau5)):
+            output_dt = integrator.dt
+        else:
+            output_dt = (t_end - t0) / 1000.0 if t_end > t0 else 1.0
+    return {
+        "t0": t0,
+        "t_end": t_end,
+        "output_dt": float(output_dt),
+        "integrator": integrator.describe(),
+        "q0": model.state_vector(q0, "q").tolist(),
+        "u0": model.state_vector(u0, "u").tolist(),
+    }
+
+
+def simulate(
+    model: Model,
+    t_end: float,
+    integrator: Any = None,
+    output_dt: float | None = None,
+    q0: Any = None,
+    u0: Any = None,
+    t0: float = 0.0,
+    progress: bool | None = None,
+) -> Results:
+    """Simulates ``model`` from ``t0`` to ``t_end``.
+
+    ``integrator``: :class:`mechsys.RK4`, :class:`mechsys.DOPRI5` (default) or :class:`mechsys.Radau5`.
+    ``output_dt``: sampling interval of the results (default: the step of a fixed-step scheme,
+    else 1/1000 of the span). ``q0``/``u0``: full vectors or ``{joint name: value}`` dicts
+    (the joints' own q0/u0 elsewhere). ``progress``: show a progress bar (default: only when
+    the run takes longer than about a second and stderr is a terminal).
+    """
+    if not isinstance(model, Model):
+        raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
+    core = model.build()
+    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0)
+    text = json.dumps(settings)
+    callbacks = model.callbacks or None
+    prog = _core.Progress()
+    n_expected = int(np.floor((settings["t_end"] - settings["t0"]) / settings["output_dt"] * (1 + 1e-12) + 1e-9)) + 1
+
+    raw: dict = {}
+    error: list[BaseException] = []
+
+    def run():
+        try:
+            raw.update(_core.simulate(core, text, callbacks, prog))
+        except BaseException as e:  # noqa: BLE001 - re-raised in the calling thread
+            error.append(e)
+
+    if callbacks:
+        # callbacks need the interpreter; running in this thread keeps tracebacks simple
+        run()
+    else:
+        worker = threading.Thread(target=run, name="mechsys-simulate", daemon=True)
+        worker.start()
+        _wait(worker, prog, n_expected, progress)
+    if error:
+        raise error[0]
+    attrs = {
+        "model": core.description_json(),
+        "settings": text,
+        "stats": json.dumps(raw.pop("stats")),
+        "mechsys_version": _core.__version__,
+    }
+    body_names = core.body_names[1:]
+    return Results.from_raw(raw, core.joints(), body_names, attrs)
+
+
+def _wait(worker: threading.Thread, prog, n_expected: int, progress: bool | None) -> None:
+    """Waits for the simulation thread, showing a bar after ~1 s; Ctrl-C cancels the run."""
+    import sys
+
+    start = time.perf_counter()
+    bar = None
+    try:
+        while worker.is_alive():
+            worker.join(0.05)
+            if bar is None and worker.is_alive():
+                show = progress if progress is not None else sys.stderr.isatty()
+                if show and time.perf_counter() - start > 1.0:
+                    from tqdm import tqdm
+
+                    bar = tqdm(total=n_expected, unit="sample", desc="simulating", leave=False)
+            if bar is not None:
+                bar.n = prog.samples
+                bar.refresh()
+    except KeyboardInterrupt:
+        prog.cancel()
+        worker.join()
+        raise
+    finally:
+        if bar is not None:
+            bar.n = prog.samples
+            bar.close()
+
+
+__all__ = ["simulate"]
