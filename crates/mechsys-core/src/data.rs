@@ -22,21 +22,21 @@ pub struct State {
 /// Workspace of the recursive algorithms, one entry per body (index 0 = ground) or per joint.
 #[derive(Debug, Clone)]
 pub struct Data {
-    /// kinematics: placement of body i in its parent body (nbody).
-    pub x_rel: Vec<Pose>,
     /// kinematics: placement of body i in the inertial frame, `a = A_IB`, `r = r_IB` (nbody).
     pub x_abs: Vec<Pose>,
-    /// kinematics: motion subspace of the joint moving body i, body-frame twists (nbody × 6, nu used).
+    /// kinematics: placement of the child joint frame of the joint moving body i, in I (nbody).
+    pub x_joint: Vec<Pose>,
+    /// kinematics: motion subspace of the joint moving body i, world twists (nbody × 6, nu used).
     pub s: Vec<[Motion; 6]>,
-    /// kinematics: twist of body i, body frame (nbody).
+    /// kinematics: twist of body i, world components about the origin (nbody).
     pub v: Vec<Motion>,
-    /// kinematics: velocity-product acceleration `c_J + v_i × v_J` of body i (nbody).
+    /// kinematics: velocity-product acceleration `v_i × v_J + c_J` of body i, world (nbody).
     pub c: Vec<Motion>,
-    /// dynamics: spatial acceleration of body i, body frame, without the gravity offset (nbody).
+    /// dynamics: spatial acceleration of body i, world, without the gravity offset (nbody).
     pub a: Vec<Motion>,
-    /// dynamics: body inertia at the current time, body frame about the body origin (nbody).
+    /// kinematics: body inertia at the current time, world components about the origin (nbody).
     pub inertia: Vec<RigidInertia>,
-    /// forces: external wrench on body i, body frame about its origin (nbody).
+    /// forces: external wrench on body i, world components about the origin (nbody).
     pub f_ext: Vec<Force>,
     /// forces: applied generalized forces from joint springs, dampers and joint forces (nu).
     pub tau_applied: Vec<f64>,
@@ -62,6 +62,8 @@ pub struct Data {
     pub u_bias: Vec<[f64; 6]>,
     /// scratch (nu).
     pub scratch_u: Vec<f64>,
+    /// zeros (nu), for h = -rnea(u̇ = 0).
+    pub zero_u: Vec<f64>,
 }
 
 impl Data {
@@ -69,18 +71,14 @@ impl Data {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbodies();
         let nu = model.nu;
-        let mut inertia = Vec::with_capacity(nb);
-        for b in &model.bodies {
-            inertia.push(RigidInertia::from_com(b.mass, &b.com, &b.inertia));
-        }
         Data {
-            x_rel: vec![Pose::IDENTITY; nb],
             x_abs: vec![Pose::IDENTITY; nb],
+            x_joint: vec![Pose::IDENTITY; nb],
             s: vec![[Motion::ZERO; 6]; nb],
             v: vec![Motion::ZERO; nb],
             c: vec![Motion::ZERO; nb],
             a: vec![Motion::ZERO; nb],
-            inertia,
+            inertia: vec![RigidInertia::default(); nb],
             f_ext: vec![Force::ZERO; nb],
             tau_applied: vec![0.0; nu],
             f: vec![Force::ZERO; nb],
@@ -94,6 +92,7 @@ impl Data {
             d_inv: vec![Matrix6::zeros(); nb],
             u_bias: vec![[0.0; 6]; nb],
             scratch_u: vec![0.0; nu],
+            zero_u: vec![0.0; nu],
         }
     }
 }

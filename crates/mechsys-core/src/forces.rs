@@ -1,13 +1,13 @@
 //! Force elements (section 2.1.2: active forces applied at the cuts): gravity is handled by the
 //! dynamics as a base acceleration; this stage turns every other element into body wrenches
-//! (`Data::f_ext`, body frame about the body origin) and generalized forces (`Data::tau_applied`).
+//! (`Data::f_ext`, world components about the inertial origin) and generalized forces (`Data::tau_applied`).
 
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::kinematics::{point_position, point_velocity};
 use crate::math::Vec3;
 use crate::model::{ForceElement, ForceFrame, Model, TimeFunction};
-use crate::spatial::{Force, RigidInertia};
+use crate::spatial::Force;
 
 /// User callbacks (Python callables through the bindings). Calling them is slow.
 pub trait Callbacks {
@@ -102,27 +102,14 @@ pub fn spring_energy(k: f64, k3: f64, table: &(Vec<f64>, Vec<f64>), delta: f64) 
     e
 }
 
-/// Updates body inertias of variable-mass bodies to time t (inertia scales with m(t)/m(0)).
-pub fn update_inertias(model: &Model, data: &mut Data, t: f64) {
-    if !model.variable_mass {
-        return;
-    }
-    for (i, b) in model.bodies.iter().enumerate().skip(1) {
-        if b.mass_rate != 0.0 {
-            let m = b.mass_at(t);
-            data.inertia[i] = RigidInertia::from_com(m, &b.com, &(b.inertia * (m / b.mass)));
-        }
-    }
-}
-
 /// Adds a force `f_i` (I components) acting at the body point `p_b` to body `b`'s wrench.
 #[inline]
 fn add_point_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) {
     if b == 0 {
         return;
     }
-    let f_b = data.x_abs[b].a.transpose() * f_i;
-    data.f_ext[b] += Force::new(p_b.cross(&f_b), f_b);
+    let p = point_position(data, b, p_b);
+    data.f_ext[b] += Force::new(p.cross(f_i), *f_i);
 }
 
 /// Power balance of the force elements at one instant.
@@ -134,7 +121,7 @@ pub struct Powers {
     pub external: f64,
 }
 
-/// Power of a body wrench `f` (body frame, about the origin) on the body's twist.
+/// Power of a wrench `f` on body b's twist (both world components about the origin).
 #[inline]
 fn wrench_power(data: &Data, b: usize, f: &Force) -> f64 {
     data.v[b].dot(f)
@@ -165,8 +152,9 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
         for (i, b) in model.bodies.iter().enumerate().skip(1) {
             let mdot = b.mass_rate_at(t);
             if mdot != 0.0 {
-                let f_b = b.ejection_velocity * mdot;
-                let w = Force::new(b.ejection_point.cross(&f_b), f_b);
+                let x = &data.x_abs[i];
+                let f = x.a * (b.ejection_velocity * mdot);
+                let w = Force::new(x.point_to_parent(&b.ejection_point).cross(&f), f);
                 p_ext += wrench_power(data, i, &w);
                 data.f_ext[i] += w;
             }
@@ -198,12 +186,12 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
             }
             ForceElement::BodyForce { body, point, force, torque, frame, function, .. } => {
                 let s = function.eval(t, cb)?;
-                let a_bi = data.x_abs[*body].a.transpose();
-                let (f_b, n_b) = match frame {
-                    ForceFrame::Inertial => (a_bi * force * s, a_bi * torque * s),
-                    ForceFrame::Body => (force * s, torque * s),
+                let x = &data.x_abs[*body];
+                let (f, n) = match frame {
+                    ForceFrame::Inertial => (force * s, torque * s),
+                    ForceFrame::Body => (x.a * force * s, x.a * torque * s),
                 };
-                let w = Force::new(n_b + point.cross(&f_b), f_b);
+                let w = Force::new(n + x.point_to_parent(point).cross(&f), f);
                 p_ext += wrench_power(data, *body, &w);
                 data.f_ext[*body] += w;
             }

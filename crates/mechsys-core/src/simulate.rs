@@ -14,6 +14,7 @@ use crate::dynamics::{self, energy};
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::integrator::{self, IntegratorKind, OdeSystem, Stats};
+use crate::kinematics::{point_acceleration, point_velocity};
 use crate::model::Model;
 
 /// Settings of one simulation.
@@ -288,11 +289,10 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
         let x = &data.x_abs[i];
         rec.body_position.extend_from_slice(x.r.as_slice());
         rec.body_orientation.extend_from_slice(&matrix_to_quaternion(&x.a));
-        let v = &data.v[i];
-        rec.body_velocity.extend_from_slice((x.a * v.v).as_slice());
-        rec.body_angular_velocity.extend_from_slice((x.a * v.w).as_slice());
-        let a = &data.a[i];
-        rec.body_acceleration.extend_from_slice((x.a * (a.v + v.w.cross(&v.v))).as_slice());
+        let origin = crate::math::Vec3::zeros();
+        rec.body_velocity.extend_from_slice(point_velocity(data, i, &origin).as_slice());
+        rec.body_angular_velocity.extend_from_slice(data.v[i].w.as_slice());
+        rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
         rec.body_mass.push(data.inertia[i].m);
     }
     rec.kinetic.push(energy::kinetic_energy(model, data));

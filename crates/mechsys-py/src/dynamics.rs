@@ -122,7 +122,7 @@ fn energies<'py>(
     let u = check_len(&u, m.nu, "u")?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     kinematics::forward_kinematics(m, &mut data, q, u);
-    mechsys_core::forces::update_inertias(m, &mut data, t);
+    kinematics::inertias(m, &mut data, t);
     let d = PyDict::new(py);
     d.set_item("kinetic", energy::kinetic_energy(m, &data))?;
     d.set_item("potential", energy::potential_energy(m, &data, q))?;

@@ -4,6 +4,7 @@
 mod dynamics;
 mod errors;
 mod kinematics;
+mod math;
 mod model;
 mod simulate;
 
@@ -15,6 +16,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     model::register(m)?;
     dynamics::register(m)?;
     kinematics::register(m)?;
+    math::register(m)?;
     simulate::register(m)?;
     Ok(())
 }

@@ -22,9 +22,8 @@ pub fn kinetic_energy(model: &Model, data: &Data) -> f64 {
 /// Gravitational potential energy of body i, zero at the inertial origin: `-m g · r_c`.
 #[inline]
 pub fn body_gravity_energy(model: &Model, data: &Data, i: usize) -> f64 {
-    let m = data.inertia[i].m;
-    let rc = point_position(data, i, &model.bodies[i].com);
-    -m * model.gravity.dot(&rc)
+    // h = m r_c in world components
+    -model.gravity.dot(&data.inertia[i].h)
 }
 
 /// Potential energy of gravity, point-to-point springs and joint springs.
@@ -52,10 +51,10 @@ pub fn momentum(model: &Model, data: &Data) -> (Vec3, Vec3) {
     let mut p = Vec3::zeros();
     let mut l = Vec3::zeros();
     for i in 1..model.nbodies() {
-        let h_b = data.inertia[i].mul_motion(&data.v[i]);
-        let h_i = data.x_abs[i].force_to_parent(&h_b);
-        p += h_i.f;
-        l += h_i.n;
+        // world convention: I v is (moment of momentum about the origin, momentum) directly
+        let h = data.inertia[i].mul_motion(&data.v[i]);
+        p += h.f;
+        l += h.n;
     }
     (p, l)
 }

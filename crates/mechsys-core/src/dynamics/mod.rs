@@ -17,6 +17,9 @@ pub use aba::aba;
 pub use crba::crba;
 pub use rnea::{inverse_dynamics, nonlinear_effects, rnea};
 
+#[cfg(test)]
+mod tests;
+
 use crate::data::Data;
 use crate::error::Result;
 use crate::forces::{self, Callbacks, Powers};
@@ -27,7 +30,7 @@ use crate::model::Model;
 /// Returns the power balance of the force elements.
 pub fn prepare(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<Powers> {
     kinematics::forward_kinematics(model, data, q, u);
-    forces::update_inertias(model, data, t);
+    kinematics::inertias(model, data, t);
     forces::evaluate(model, data, t, q, u, cb)
 }
 

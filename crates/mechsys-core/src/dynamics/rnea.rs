@@ -1,9 +1,9 @@
 //! Recursive Newton–Euler algorithm: inverse dynamics in O(n).
 //!
 //! Outward pass: body accelerations from the joint accelerations (eqs. 2.56–2.58); per body the
-//! Newton–Euler equations in the body frame, `f_i = I_i a_i + v_i ×* I_i v_i - f_ext,i`
-//! (momentum and moment of momentum, section 2.3); inward pass: cut forces summed towards the root
-//! (cut principle, section 2.1.2) and projected on the joint subspaces, `τ_i = S_iᵀ f_i`.
+//! Newton–Euler equations (momentum and moment of momentum, section 2.3), here in world components
+//! about the origin, `f_i = I_i a_i + v_i ×* I_i v_i - f_ext,i`; inward pass: cut forces summed
+//! towards the root (cut principle, section 2.1.2) and projected on the joint axes, `τ_i = S_iᵀ f_i`.
 
 use crate::data::Data;
 use crate::error::Result;
@@ -27,20 +27,19 @@ pub fn rnea_prepared(model: &Model, data: &mut Data, udot: &[f64], out: &mut [f6
             out[j.iu + k] = data.s[i][k].dot(&data.f[i]) - data.tau_applied[j.iu + k];
         }
         if j.parent != 0 {
-            let fp = data.x_rel[i].force_to_parent(&data.f[i]);
-            data.f[j.parent] += fp;
+            let fi = data.f[i];
+            data.f[j.parent] += fi;
         }
     }
-    // the body accelerations were computed with the gravity offset; remove it for reporting
     data.a[0] = Motion::ZERO;
     for i in 1..model.nbodies() {
-        let g_b = data.x_abs[i].a.transpose() * model.gravity;
-        data.a[i].v += g_b;
+        data.a[i].v += model.gravity;
     }
 }
 
 /// Inverse dynamics: the generalized forces τ, beyond those of the model's force elements, that
 /// produce the accelerations `udot` in state (t, q, u): `τ = M u̇ - h`.
+#[allow(clippy::too_many_arguments)]
 pub fn inverse_dynamics(
     model: &Model,
     data: &mut Data,
@@ -64,12 +63,12 @@ pub use inverse_dynamics as rnea;
 pub fn nonlinear_effects(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
     super::prepare(model, data, t, q, u, cb)?;
     let mut tmp = std::mem::take(&mut data.scratch_u);
-    tmp.iter_mut().for_each(|x| *x = 0.0);
-    let zero = vec![0.0; model.nu];
+    let zero = std::mem::take(&mut data.zero_u);
     rnea_prepared(model, data, &zero, &mut tmp);
     for (h, x) in data.h.iter_mut().zip(&tmp) {
         *h = -x;
     }
     data.scratch_u = tmp;
+    data.zero_u = zero;
     Ok(())
 }

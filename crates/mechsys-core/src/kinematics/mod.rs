@@ -1,15 +1,29 @@
 //! Recursive kinematics of the tree (eqs. 2.45–2.62): placements, twists and velocity-product
 //! accelerations of every body from the root outwards, and the Jacobians of body points and body
 //! twists with respect to the generalized velocities (J and j of eqs. 2.63–2.69).
+//!
+//! Spatial quantities are kept in inertial components about the inertial origin ("world"
+//! convention): a twist `(ω_I, v_O)` holds the angular velocity and the velocity of the body-fixed
+//! point that momentarily coincides with the origin. Then the recurrences need no frame changes at
+//! all — eq. 2.45 becomes `v_i = v_p(i) + S_i u_i` literally — and the dynamics passes add inertias
+//! and forces of children to parents directly.
 
 use nalgebra::DMatrix;
 
 use crate::data::Data;
 use crate::math::Vec3;
 use crate::model::Model;
-use crate::spatial::Motion;
+use crate::spatial::{Motion, Pose};
 
-/// Position stage: placements `x_rel`, `x_abs` and motion subspaces `s` of all bodies.
+/// A twist or acceleration given in the components of frame `x` about its origin, expressed in
+/// inertial components about the inertial origin (`x` placed in I).
+#[inline]
+pub fn motion_to_world(x: &Pose, m: &Motion) -> Motion {
+    let w = x.a * m.w;
+    Motion::new(w, x.a * m.v + x.r.cross(&w))
+}
+
+/// Position stage: placements `x_abs`, `x_joint` and motion subspaces `s` (world) of all bodies.
 ///
 /// eq. 2.46: A_IBi = A_IBi-1 · A_Bi-1Bi; eq. 2.51: r_IBi = r_IBi-1 + A_IBi-1 r_Bi-1Bi.
 pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
@@ -17,19 +31,21 @@ pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
         let i = ji + 1;
         let qj = &q[j.iq..j.iq + j.nq()];
         let xj = j.kind.placement(qj);
-        data.x_rel[i] = j.parent_frame.compose(&xj).compose(&j.child_frame_inv);
-        data.x_abs[i] = data.x_abs[j.parent].compose(&data.x_rel[i]);
+        // pose of the child joint frame in I, then of the child body frame
+        let x_pj = data.x_abs[j.parent].compose(&j.parent_frame);
+        let x_cj = x_pj.compose(&xj);
+        data.x_abs[i] = x_cj.compose(&j.child_frame_inv);
+        data.x_joint[i] = x_cj;
         let mut s = [Motion::ZERO; 6];
         j.kind.subspace(qj, &mut s);
         for k in 0..j.nu() {
-            // joint-frame twist → body-frame twist (constant placement of the joint frame)
-            data.s[i][k] = j.child_frame.motion_to_parent(&s[k]);
+            data.s[i][k] = motion_to_world(&x_cj, &s[k]);
         }
     }
 }
 
-/// Velocity stage: body twists `v` (eqs. 2.49, 2.52) and velocity-product terms `c`.
-/// Requires [`positions`].
+/// Velocity stage: body twists `v` (eqs. 2.49, 2.52, 2.54, 2.55) and velocity-product terms `c`
+/// (the ω̃ ω_rel and Coriolis terms of eqs. 2.56, 2.57). Requires [`positions`].
 pub fn velocities(model: &Model, data: &mut Data, q: &[f64], u: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
         let i = ji + 1;
@@ -38,26 +54,47 @@ pub fn velocities(model: &Model, data: &mut Data, q: &[f64], u: &[f64]) {
         for (k, uk) in uj.iter().enumerate() {
             vj += data.s[i][k] * *uk;
         }
-        let vi = data.x_rel[i].motion_to_child(&data.v[j.parent]) + vj;
+        let vi = data.v[j.parent] + vj;
         data.v[i] = vi;
-        let cj = j.kind.bias(&q[j.iq..j.iq + j.nq()], uj);
-        // eq. 2.57 / 2.56: ω̃ ω_rel and the centripetal/Coriolis terms of the chain
-        data.c[i] = j.child_frame.motion_to_parent(&cj) + vi.cross_motion(&vj);
+        // d/dt of world-frame S: the frame carrying S moves with v_i, plus the joint's own Ṡ u
+        let mut c = vi.cross_motion(&vj);
+        if j.kind.has_bias() {
+            let cj = j.kind.bias(&q[j.iq..j.iq + j.nq()], uj);
+            c += motion_to_world(&data.x_joint[i], &cj);
+        }
+        data.c[i] = c;
     }
 }
 
-/// Both stages.
+/// Body inertias at time t in world components about the origin (variable masses scaled).
+/// Requires [`positions`].
+pub fn inertias(model: &Model, data: &mut Data, t: f64) {
+    for (i, b) in model.bodies.iter().enumerate().skip(1) {
+        let x = &data.x_abs[i];
+        let c = x.r + x.a * b.com;
+        let (m, i_c) = if b.mass_rate == 0.0 {
+            (b.mass, b.inertia)
+        } else {
+            let m = b.mass_at(t);
+            (m, b.inertia * (m / b.mass))
+        };
+        let i_c_w = x.a * i_c * x.a.transpose();
+        data.inertia[i] = crate::spatial::RigidInertia::from_com(m, &c, &i_c_w);
+    }
+}
+
+/// Both kinematic stages.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64], u: &[f64]) {
     positions(model, data, q);
     velocities(model, data, q, u);
 }
 
-/// Acceleration stage for given `udot`: spatial accelerations `a` (eqs. 2.56–2.58), without gravity.
-/// Requires [`forward_kinematics`].
+/// Acceleration stage for given `udot`: spatial accelerations `a` (eqs. 2.56–2.58), starting from
+/// `data.a[0]` (zero, or the gravity offset). Requires [`forward_kinematics`].
 pub fn accelerations(model: &Model, data: &mut Data, udot: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
         let i = ji + 1;
-        let mut a = data.x_rel[i].motion_to_child(&data.a[j.parent]) + data.c[i];
+        let mut a = data.a[j.parent] + data.c[i];
         for k in 0..j.nu() {
             a += data.s[i][k] * udot[j.iu + k];
         }
@@ -66,23 +103,33 @@ pub fn accelerations(model: &Model, data: &mut Data, udot: &[f64]) {
 }
 
 /// Absolute position (I components) of a point `p_b` fixed on body `body`.
+#[inline]
 pub fn point_position(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     data.x_abs[body].point_to_parent(p_b)
 }
 
 /// Absolute velocity (I components) of a body-fixed point (eq. 2.28 with ṙ = 0).
+#[inline]
 pub fn point_velocity(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     let v = &data.v[body];
-    data.x_abs[body].a * (v.v + v.w.cross(p_b))
+    v.v + v.w.cross(&point_position(data, body, p_b))
 }
 
-/// Absolute (classical) acceleration, I components, of a body-fixed point (eq. 2.41 with ṙ = r̈ = 0).
-/// Requires [`accelerations`].
+/// Absolute (classical) acceleration, I components, of a body-fixed point (eq. 2.41 with
+/// ṙ = r̈ = 0). Requires [`accelerations`] without the gravity offset.
+#[inline]
 pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     let (v, a) = (&data.v[body], &data.a[body]);
-    let vp = v.v + v.w.cross(p_b);
-    // spatial → classical: a_P = v̇ + ω̇ × p + ω × (v + ω × p)
-    data.x_abs[body].a * (a.v + a.w.cross(p_b) + v.w.cross(&vp))
+    let p = point_position(data, body, p_b);
+    let vp = v.v + v.w.cross(&p);
+    // spatial → classical: a_P = a_O + ω̇ × p + ω × v_P
+    a.v + a.w.cross(&p) + v.w.cross(&vp)
+}
+
+/// Angular velocity of a body in its own frame, `Bω` (eq. 2.31/2.33 left-hand side).
+#[inline]
+pub fn angular_velocity_body(data: &Data, body: usize) -> Vec3 {
+    data.x_abs[body].a.transpose() * data.v[body].w
 }
 
 /// Jacobians of a body-fixed point (translational `jt`, 3 × nu) and of the body's angular velocity
@@ -91,19 +138,16 @@ pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
 pub fn point_jacobian(model: &Model, data: &Data, body: usize, p_b: &Vec3, jt: &mut DMatrix<f64>, jr: &mut DMatrix<f64>) {
     jt.fill(0.0);
     jr.fill(0.0);
-    let p_i = point_position(data, body, p_b);
+    let p = point_position(data, body, p_b);
     let mut b = body;
     while b != 0 {
         let j = &model.joints[b - 1];
-        let x = &data.x_abs[b];
         for k in 0..j.nu() {
             let s = &data.s[b][k];
-            let w_i = x.a * s.w;
-            // velocity of the body-b origin due to this column, then carried to the point
-            let v_i = x.a * s.v + w_i.cross(&(p_i - x.r));
+            let v = s.v + s.w.cross(&p);
             for r in 0..3 {
-                jt[(r, j.iu + k)] = v_i[r];
-                jr[(r, j.iu + k)] = w_i[r];
+                jt[(r, j.iu + k)] = v[r];
+                jr[(r, j.iu + k)] = s.w[r];
             }
         }
         b = j.parent;

@@ -89,6 +89,11 @@ impl JointKind {
             JointKind::Free => "free",
         }
     }
+    /// Whether the motion subspace depends on q (so `c_J = Ṡ u ≠ 0`).
+    #[inline]
+    pub fn has_bias(&self) -> bool {
+        matches!(self, JointKind::Universal { .. } | JointKind::Planar)
+    }
     /// Whether the coordinates contain a quaternion (and so `q̇ ≠ u`).
     pub fn has_quaternion(&self) -> bool {
         matches!(self, JointKind::Spherical | JointKind::Free)
@@ -114,9 +119,9 @@ impl JointKind {
             JointKind::Universal { axis1, axis2 } => {
                 Pose::new(axis_rotation(axis1, q[0]) * axis_rotation(axis2, q[1]), Vec3::zeros())
             }
-            JointKind::Spherical => Pose::new(quat_matrix(q[0], q[1], q[2], q[3]), Vec3::zeros()),
+            JointKind::Spherical => Pose::new(unit_quat_matrix(&q[0..4]), Vec3::zeros()),
             JointKind::Planar => Pose::new(axis_rotation(&Vec3::z(), q[2]), Vec3::new(q[0], q[1], 0.0)),
-            JointKind::Free => Pose::new(quat_matrix(q[3], q[4], q[5], q[6]), Vec3::new(q[0], q[1], q[2])),
+            JointKind::Free => Pose::new(unit_quat_matrix(&q[3..7]), Vec3::new(q[0], q[1], q[2])),
         }
     }
 
@@ -254,6 +259,15 @@ pub fn quat_matrix(w: f64, x: f64, y: f64, z: f64) -> Mat3 {
         2.0 * (y * z + w * x),
         1.0 - 2.0 * (x * x + y * y),
     )
+}
+
+/// Rotation matrix of a quaternion after normalization, so that a quaternion slightly off the unit
+/// sphere between projections (inside a Runge–Kutta step) still gives an orthogonal matrix.
+#[inline]
+fn unit_quat_matrix(q: &[f64]) -> Mat3 {
+    let n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    let s = if n2 > 0.0 { 1.0 / n2.sqrt() } else { 1.0 };
+    quat_matrix(q[0] * s, q[1] * s, q[2] * s, q[3] * s)
 }
 
 /// q̇ = ½ q ⊗ (0, ω_C) with ω in the rotated (child) frame.

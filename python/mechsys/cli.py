@@ -1,0 +1,309 @@
+"""The ``mechsys`` command line: run model files, inspect models and results, plot signals.
+
+::
+
+    mechsys run model.toml --t-end 2 --out results.h5 --plot q.png
+    mechsys info model.toml
+    mechsys signals results.h5
+    mechsys plot results.h5 joint/hinge/q energy/total --out q.svg
+
+Errors in the input (model files, settings, results files) are printed as one line
+``error: <message>`` on stderr with exit status 2.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import time
+from pathlib import Path
+from typing import Any, Sequence
+
+import click
+
+from ._core import __version__
+from .errors import MechsysError
+
+#: Exit status for errors in the user's input (the same as click's usage errors).
+EXIT_INPUT_ERROR = 2
+
+
+class CliError(click.ClickException):
+    """An input error shown as ``error: <message>`` with exit status 2."""
+
+    exit_code = EXIT_INPUT_ERROR
+
+    def show(self, file: Any = None) -> None:
+        click.echo(f"error: {self.format_message()}", err=True)
+
+
+def _message(e: BaseException) -> str:
+    if isinstance(e, OSError) and not isinstance(e, MechsysError) and e.filename is not None:
+        reason = e.strerror or str(e)
+        return f"{e.filename}: {reason}"
+    msg = str(e).strip()
+    return " ".join(msg.splitlines()) or type(e).__name__
+
+
+class _Group(click.Group):
+    """A command group that turns mechsys errors and file errors into :class:`CliError`."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except (MechsysError, OSError) as e:
+            raise CliError(_message(e)) from e
+
+
+CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+
+@click.group(cls=_Group, context_settings=CONTEXT)
+@click.version_option(__version__, "-V", "--version", prog_name="mechsys", message="%(prog)s %(version)s")
+def cli() -> None:
+    """mechsys: mechanical system dynamics from the command line.
+
+    Model files are TOML (the model description plus an optional [simulation] table) or Python
+    (a module-level `model` and an optional `simulation` dict).
+    """
+
+
+# ---- helpers -------------------------------------------------------------------------------------
+
+
+def _table(headers: Sequence[str], rows: Sequence[Sequence[Any]], indent: str = "  ") -> str:
+    """A plain-text table with left-aligned columns."""
+    cells = [[str(h) for h in headers]] + [[str(c) for c in r] for r in rows]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(headers))]
+    lines = []
+    for k, r in enumerate(cells):
+        lines.append(indent + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
+        if k == 0:
+            lines.append(indent + "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def _fmt_vec(v: Sequence[float]) -> str:
+    return "(" + ", ".join(f"{x:g}" for x in v) + ")"
+
+
+def _safe_name(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "model"
+
+
+def _split_signals(values: Sequence[str]) -> list[str]:
+    out: list[str] = []
+    for v in values:
+        out.extend(s for s in (p.strip() for p in v.split(",")) if s)
+    return out
+
+
+def _describe_integrator(settings: dict) -> str:
+    integ = dict(settings.get("integrator") or {})
+    kind = integ.pop("type", "?")
+    params = ", ".join(f"{k}={v:g}" for k, v in integ.items() if isinstance(v, (int, float)) and v)
+    return f"{kind}({params})" if params else str(kind)
+
+
+def _default_signals(results: Any, joints: list[dict]) -> list[str]:
+    names = []
+    for j in joints:
+        n = f"joint/{j['name']}/q"
+        if j["nq"] > 0 and n in results:
+            names.append(n)
+            break
+    names.append("energy/total")
+    return names
+
+
+# ---- commands ------------------------------------------------------------------------------------
+
+
+@cli.command()
+@click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
+@click.option("--t-end", type=float, help="End time (s); overrides simulation.t_end.")
+@click.option("--t0", type=float, help="Start time (s); overrides simulation.t0.")
+@click.option("--dt", type=float, help="Step of rk4/radau5 (s); alone it selects rk4.")
+@click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5"], case_sensitive=False), help="Integration scheme.")
+@click.option("--rtol", type=float, help="Relative tolerance of dopri5.")
+@click.option("--atol", type=float, help="Absolute tolerance of dopri5.")
+@click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
+@click.option("--out", "out", type=click.Path(path_type=Path, dir_okay=False), help="HDF5 results file [default: results/<model name>.h5].")
+@click.option("--plot", "plot_out", type=click.Path(path_type=Path, dir_okay=False), help="Write a plot (.png, .svg or .pdf).")
+@click.option(
+    "--signals",
+    "signals",
+    multiple=True,
+    metavar="NAME[,NAME...]",
+    help="Signals for --plot and --csv; repeat or separate by commas [default plot: first joint's q, energy/total].",
+)
+@click.option("--csv", "csv_out", type=click.Path(path_type=Path, dir_okay=False), help="Also write signals as CSV (all if no --signals).")
+@click.option("-q", "--quiet", is_flag=True, help="Print nothing on success.")
+def run(
+    model_file: Path,
+    t_end: float | None,
+    t0: float | None,
+    dt: float | None,
+    integrator: str | None,
+    rtol: float | None,
+    atol: float | None,
+    output_dt: float | None,
+    out: Path | None,
+    plot_out: Path | None,
+    signals: tuple[str, ...],
+    csv_out: Path | None,
+    quiet: bool,
+) -> None:
+    """Simulate a model file (.toml or .py) and save the results to HDF5."""
+    from . import simulate
+    from .errors import ResultsError
+    from .modelfile import load_model, simulation_kwargs
+
+    model, defaults = load_model(model_file)
+    kwargs = simulation_kwargs(
+        defaults,
+        t_end=t_end,
+        t0=t0,
+        output_dt=output_dt,
+        integrator=integrator,
+        dt=dt,
+        rtol=rtol,
+        atol=atol,
+    )
+    start = time.perf_counter()
+    res = simulate(model, **kwargs)
+    wall = time.perf_counter() - start
+
+    out_path = out if out is not None else Path("results") / f"{_safe_name(model.name)}.h5"
+    try:
+        res.save(out_path)
+    except OSError as e:
+        raise ResultsError(f"cannot write results file {out_path}: {e.strerror or e}") from None
+
+    chosen = _split_signals(signals)
+    unknown = [s for s in chosen if s not in res]
+    if unknown:
+        which = ", ".join(f"'{s}'" for s in unknown)
+        raise ResultsError(
+            f"unknown signal{'s' if len(unknown) > 1 else ''} {which} (results saved to {out_path}; "
+            f"`mechsys signals {out_path}` lists the names)"
+        )
+    if plot_out is not None:
+        from .plotting import plot
+
+        plot(res, chosen or _default_signals(res, model.joint_info()), out=plot_out)
+    if csv_out is not None:
+        res.to_csv(csv_out, chosen or None)
+
+    if quiet:
+        return
+    settings, stats = res.settings, res.stats
+    t = res.t
+    span = f"t = {t[0]:g} .. {t[-1]:g} s" if len(t) else "no samples"
+    rows = [
+        ("model", f"{model.name} ({model_file}), nq = {model.nq}, nu = {model.nu}"),
+        ("simulated", f"{span}, {len(t)} samples, {_describe_integrator(settings)}"),
+        (
+            "integrator",
+            ", ".join(f"{v} {k}" for k, v in stats.items()) if stats else "no statistics",
+        ),
+        ("wall time", f"{wall:.3g} s"),
+        ("results", str(out_path)),
+    ]
+    if plot_out is not None:
+        rows.append(("plot", str(plot_out)))
+    if csv_out is not None:
+        rows.append(("csv", str(csv_out)))
+    width = max(len(k) for k, _ in rows)
+    for k, v in rows:
+        click.echo(f"{k.ljust(width)}  {v}")
+
+
+@cli.command("plot")
+@click.argument("results_file", metavar="RESULTS.h5", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("signals", metavar="SIGNAL...", nargs=-1, required=True)
+@click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False), help="Image file (.png, .svg or .pdf) [default: RESULTS.png].")
+@click.option("--title", help="Figure title [default: the model name].")
+def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, title: str | None) -> None:
+    """Plot signals of a results file against time, one subplot per signal."""
+    from .plotting import plot
+    from .results import load
+
+    res = load(results_file)
+    out_path = out if out is not None else results_file.with_suffix(".png")
+    plot(res, _split_signals(signals), out=out_path, title=title)
+    click.echo(f"plot  {out_path}")
+
+
+@cli.command()
+@click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
+def info(model_file: Path) -> None:
+    """Describe a model file: bodies, joints, force elements, degrees of freedom."""
+    from .modelfile import load_model
+
+    model, sim = load_model(model_file)
+    core = model.build()
+    bodies = model.body_info()
+    joints = model.joint_info()
+    forces = core.forces()
+
+    click.echo(f"model    {model.name} ({model_file})")
+    click.echo(f"gravity  {_fmt_vec(core.gravity)} m/s^2")
+    click.echo(f"DOF      {model.nu} (nu), nq = {model.nq}")
+    click.echo("")
+    click.echo(f"bodies ({len(bodies)}):")
+    if bodies:
+        rows = [(b["name"], f"{b['mass']:g}", b["parent_joint"]) for b in bodies]
+        click.echo(_table(["name", "mass [kg]", "parent joint"], rows))
+    click.echo("")
+    click.echo(f"joints ({len(joints)}):")
+    if joints:
+        rows = [
+            (j["name"], j["type"], f"{j['parent']} -> {j['child']}", f"{j['nq']}/{j['nu']}", f"{j['iq']}/{j['iu']}")
+            for j in joints
+        ]
+        click.echo(_table(["name", "type", "parent -> child", "nq/nu", "iq/iu"], rows))
+    click.echo("")
+    click.echo(f"force elements ({len(forces)}):")
+    if forces:
+        click.echo(_table(["name", "type"], [(n, t) for n, t in forces]))
+    if sim:
+        click.echo("")
+        click.echo("simulation defaults:")
+        for k, v in sim.items():
+            if isinstance(v, dict) and "type" in v:
+                v = _describe_integrator({"integrator": v})
+            click.echo(f"  {k} = {v}")
+
+
+@cli.command()
+@click.argument("results_file", metavar="RESULTS.h5", type=click.Path(path_type=Path, dir_okay=False))
+def signals(results_file: Path) -> None:
+    """List the signals of a results file with their units and shapes."""
+    from .results import load
+
+    res = load(results_file)
+    rows = []
+    for n in res.names():
+        shape = "(" + ", ".join(str(s) for s in res[n].shape) + ("," if res[n].ndim == 1 else "") + ")"
+        rows.append((n, res.unit(n) or "-", shape))
+    click.echo(_table(["signal", "unit", "shape"], rows, indent=""))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``mechsys`` console script; returns the exit status."""
+    try:
+        cli.main(args=list(argv) if argv is not None else None, prog_name="mechsys", standalone_mode=True)
+    except SystemExit as e:
+        code = e.code
+        if code is None:
+            return 0
+        if isinstance(code, int):
+            return code
+        click.echo(str(code), err=True)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,344 @@
+"""Model files: a model and its simulation defaults in TOML or Python.
+
+A **TOML** model file holds the model description at the top level, with exactly the keys of the
+engine's schema (``name``, ``gravity``, ``[[bodies]]``, ``[[joints]]``, ``[[forces]]``,
+``[[ground_markers]]``), plus an optional ``[simulation]`` table::
+
+    name = "pendulum"
+    gravity = [0.0, -9.81, 0.0]
+
+    [[bodies]]
+    name = "rod"
+    mass = 1.0
+    inertia = [1e-4, 0.0833, 0.0833]
+    com = [0.5, 0.0, 0.0]
+
+    [[joints]]
+    name = "hinge"
+    type = "revolute"
+    parent = "ground"
+    child = "rod"
+    axis = [0.0, 0.0, 1.0]
+
+    [simulation]
+    t_end = 2.0
+    integrator = { type = "rk4", dt = 1e-3 }
+    q0 = { hinge = 0.5 }
+
+A **Python** model file is executed and must define a module-level ``model`` (a
+:class:`mechsys.Model`); an optional ``simulation`` dict has the same keys as the TOML table, and
+its ``integrator`` may also be an integrator object such as ``ms.RK4(dt=1e-3)``. The file runs with
+``__name__ == "__mechsys_model__"``, so an ``if __name__ == "__main__":`` block is skipped, and
+with its folder on ``sys.path``, so it can import modules next to it.
+
+:func:`load_model` validates everything when the file is read, so a bad file fails at load time
+with the file name and the key path in the message; :func:`simulation_kwargs` turns the defaults
+and any command-line overrides into keyword arguments for :func:`mechsys.simulate`.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import runpy
+import sys
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from .errors import MechsysError, ModelError, SettingsError
+from .integrators import DOPRI5, RK4, Radau5
+from .model import Model
+
+#: Keys of the ``[simulation]`` table.
+SIMULATION_KEYS: tuple[str, ...] = ("t_end", "t0", "output_dt", "integrator", "q0", "u0")
+
+#: Keys allowed in an integrator table, per integrator type (besides ``type``).
+INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
+    "rk4": ("dt",),
+    "dopri5": ("rtol", "atol", "max_step", "first_step"),
+    "radau5": ("dt", "newton_tol"),
+}
+
+_INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5}
+
+# top-level keys of the description that must be arrays of tables
+_LIST_KEYS = ("bodies", "joints", "forces", "ground_markers")
+
+
+class ModelFileNotFoundError(ModelError, FileNotFoundError):
+    """The model file does not exist (both a :class:`ModelError` and a :class:`FileNotFoundError`)."""
+
+
+def load_model(path: str | Path) -> tuple[Model, dict]:
+    """Reads a model file (``.toml`` or ``.py``) and validates it in the engine.
+
+    Returns the :class:`mechsys.Model` and the simulation defaults (the ``[simulation]`` table or
+    the Python file's ``simulation`` dict; empty if absent), checked for unknown keys and, for
+    ``q0``/``u0``, against the model's joints. Any error is raised with the file name prepended,
+    keeping its class (``ModelError``, ``SettingsError``, ...); the engine's key paths
+    (``bodies[0].mas: unknown field ...``) are kept in the message.
+
+    >>> model, sim = load_model("pendulum.toml")  # doctest: +SKIP
+    >>> res = mechsys.simulate(model, **simulation_kwargs(sim))  # doctest: +SKIP
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".toml", ".py"):
+        shown = f"'{path.suffix}'" if path.suffix else "no extension"
+        raise ModelError(f"{path}: unsupported model file type ({shown}); expected a .toml or .py file")
+    if not path.exists():
+        raise ModelFileNotFoundError(f"{path}: no such model file")
+    if path.is_dir():
+        raise ModelError(f"{path}: is a directory, not a model file")
+    try:
+        if suffix == ".toml":
+            model, sim = _load_toml(path)
+        else:
+            model, sim = _load_python(path)
+        model.build()
+        sim = _check_simulation(sim, model, allow_objects=suffix == ".py")
+    except MechsysError as e:
+        raise _with_path(e, path) from None
+    return model, sim
+
+
+def _with_path(e: MechsysError, path: Path) -> MechsysError:
+    """The same exception class with the file name in front of the message."""
+    msg = str(e)
+    prefix = f"{path}: "
+    if msg.startswith(prefix):
+        return e
+    try:
+        return type(e)(prefix + msg)
+    except Exception:  # noqa: BLE001 - an exotic subclass signature: fall back to ModelError
+        return ModelError(prefix + msg)
+
+
+def _load_toml(path: Path) -> tuple[Model, Any]:
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except tomllib.TOMLDecodeError as e:
+        # the message ends with "(at line L, column C)"
+        raise ModelError(f"invalid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise ModelError(f"not a UTF-8 text file ({e.reason} at byte {e.start})") from None
+    sim = data.pop("simulation", {})
+    if not isinstance(sim, dict):
+        raise ModelError(f"simulation: expected a table, got {_tname(sim)}")
+    for key in _LIST_KEYS:
+        if key in data and not isinstance(data[key], list):
+            raise ModelError(f"{key}: expected an array of tables ([[{key}]]), got {_tname(data[key])}")
+    return Model.from_dict(data), sim
+
+
+def _load_python(path: Path) -> tuple[Model, Any]:
+    # like `python model.py`: modules next to the model file can be imported
+    folder = str(path.resolve().parent)
+    sys.path.insert(0, folder)
+    try:
+        namespace = runpy.run_path(str(path), run_name="__mechsys_model__")
+    finally:
+        try:
+            sys.path.remove(folder)
+        except ValueError:
+            pass
+    if "model" not in namespace:
+        raise ModelError("defines no module-level 'model' (a mechsys.Model)")
+    model = namespace["model"]
+    if not isinstance(model, Model):
+        raise ModelError(f"'model' must be a mechsys.Model, got {_tname(model)}")
+    sim = namespace.get("simulation", {})
+    if sim is None:
+        sim = {}
+    if not isinstance(sim, dict):
+        raise ModelError(f"simulation: expected a dict, got {_tname(sim)}")
+    return model, sim
+
+
+def _tname(v: Any) -> str:
+    names = {dict: "a table", list: "an array", str: "a string", bool: "a boolean", int: "an integer", float: "a number"}
+    return names.get(type(v), type(v).__name__)
+
+
+def _number(v: Any, where: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise ModelError(f"{where}: expected a number, got {_tname(v)} {v!r}")
+    x = float(v)
+    if not math.isfinite(x):
+        raise ModelError(f"{where}: must be finite, got {x}")
+    return x
+
+
+def _check_integrator(spec: Any, allow_objects: bool) -> Any:
+    where = "simulation.integrator"
+    if allow_objects and hasattr(spec, "describe") and not isinstance(spec, dict):
+        if not isinstance(spec, (RK4, DOPRI5, Radau5)):
+            raise ModelError(f"{where}: expected mechsys.RK4, DOPRI5 or Radau5, got {_tname(spec)}")
+        return spec
+    if isinstance(spec, str):
+        spec = {"type": spec}
+    if not isinstance(spec, dict):
+        raise ModelError(f"{where}: expected a table like {{ type = \"rk4\", dt = 1e-3 }}, got {_tname(spec)}")
+    if "type" not in spec:
+        raise ModelError(f"{where}.type: missing; expected one of {', '.join(INTEGRATOR_KEYS)}")
+    kind = spec["type"]
+    if not isinstance(kind, str) or kind.lower() not in INTEGRATOR_KEYS:
+        raise ModelError(f"{where}.type: unknown integrator {kind!r}; expected one of {', '.join(INTEGRATOR_KEYS)}")
+    kind = kind.lower()
+    allowed = INTEGRATOR_KEYS[kind]
+    out: dict[str, Any] = {"type": kind}
+    for key, value in spec.items():
+        if key == "type":
+            continue
+        if key not in allowed:
+            raise ModelError(f"{where}.{key}: unknown key for {kind}; expected one of type, {', '.join(allowed)}")
+        x = _number(value, f"{where}.{key}")
+        if x < 0 or (x == 0 and key in ("dt", "rtol", "newton_tol")):
+            raise ModelError(f"{where}.{key}: must be > 0, got {x:g}")
+        out[key] = x
+    return out
+
+
+def _check_state(values: Any, key: str, model: Model) -> Any:
+    where = f"simulation.{key}"
+    joints = {j["name"]: j for j in model.joint_info()}
+    count = "nq" if key == "q0" else "nu"
+    if isinstance(values, dict):
+        out: dict[str, Any] = {}
+        for name, v in values.items():
+            if name not in joints:
+                raise ModelError(f"{where}.{name}: unknown joint; joints are {', '.join(joints) or '(none)'}")
+            items = list(v) if isinstance(v, (list, tuple)) else [v]
+            nums = [_number(x, f"{where}.{name}" + (f"[{i}]" if len(items) > 1 else "")) for i, x in enumerate(items)]
+            n = joints[name][count]
+            if len(nums) != n:
+                what = "coordinates" if key == "q0" else "velocities"
+                raise ModelError(f"{where}.{name}: a {joints[name]['type']} joint has {n} {what}, got {len(nums)}")
+            out[name] = nums[0] if n == 1 and not isinstance(v, (list, tuple)) else nums
+        return out
+    # a full vector (allowed too, as for mechsys.simulate)
+    try:
+        items = list(values)
+    except TypeError:
+        raise ModelError(f"{where}: expected a table joint name -> value(s), got {_tname(values)}") from None
+    nums = [_number(x, f"{where}[{i}]") for i, x in enumerate(items)]
+    n = model.nq if key == "q0" else model.nu
+    if len(nums) != n:
+        raise ModelError(f"{where}: the model has {n} {'coordinates' if key == 'q0' else 'velocities'}, got {len(nums)}")
+    return nums
+
+
+def _check_simulation(sim: dict, model: Model, allow_objects: bool) -> dict:
+    """Checks a simulation table/dict; returns a normalised copy (numbers as floats)."""
+    out: dict[str, Any] = {}
+    for key, value in sim.items():
+        if key not in SIMULATION_KEYS:
+            raise ModelError(f"simulation.{key}: unknown key; expected one of {', '.join(SIMULATION_KEYS)}")
+        if value is None:
+            continue
+        if key in ("t_end", "t0", "output_dt"):
+            x = _number(value, f"simulation.{key}")
+            if key == "output_dt" and x <= 0:
+                raise ModelError(f"simulation.output_dt: must be > 0, got {x:g}")
+            out[key] = x
+        elif key == "integrator":
+            out[key] = _check_integrator(value, allow_objects)
+        else:
+            out[key] = _check_state(value, key, model)
+    if "t_end" in out and out["t_end"] <= out.get("t0", 0.0):
+        raise ModelError(f"simulation.t_end: must be > t0 = {out.get('t0', 0.0):g}, got {out['t_end']:g}")
+    return out
+
+
+def _integrator_dict(spec: Any) -> dict | None:
+    if spec is None:
+        return None
+    if isinstance(spec, dict):
+        return dict(spec)
+    if isinstance(spec, str):
+        return {"type": spec.lower()}
+    if hasattr(spec, "describe"):
+        return spec.describe()
+    raise SettingsError(f"integrator: expected rk4, dopri5, radau5 or an integrator object, got {_tname(spec)}")
+
+
+def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
+    """Keyword arguments for :func:`mechsys.simulate` from simulation defaults plus overrides.
+
+    ``defaults`` is the dict returned by :func:`load_model`. ``overrides`` (None values are
+    ignored) may be ``t_end``, ``t0``, ``output_dt``, ``q0``, ``u0``, ``integrator`` (a name
+    ``"rk4"``/``"dopri5"``/``"radau5"``, a table or an integrator object) and the integrator
+    parameters ``dt``, ``rtol``, ``atol``. Changing the integrator type keeps the parameters that
+    still apply (a file's ``dt`` carries over from rk4 to radau5). Without any integrator the
+    engine's default (DOPRI5) is used, or RK4 when only ``dt`` is given.
+
+    Raises :class:`mechsys.SettingsError` when ``t_end`` is missing, a fixed-step scheme has no
+    step, or a parameter does not apply to the chosen scheme.
+
+    >>> simulation_kwargs({"t_end": 1.0, "integrator": {"type": "rk4", "dt": 1e-3}}, t_end=2.0)
+    {'t_end': 2.0, 'integrator': RK4(dt=0.001)}
+    """
+    defaults = dict(defaults or {})
+    over = {k: v for k, v in overrides.items() if v is not None}
+    known = set(SIMULATION_KEYS) | {"dt", "rtol", "atol"}
+    unknown = sorted(set(over) - known)
+    if unknown:
+        raise SettingsError(f"simulation_kwargs: unknown override {', '.join(unknown)}; expected one of {', '.join(sorted(known))}")
+    unknown = sorted(set(defaults) - set(SIMULATION_KEYS))
+    if unknown:
+        raise SettingsError(f"simulation.{unknown[0]}: unknown key; expected one of {', '.join(SIMULATION_KEYS)}")
+
+    kwargs: dict[str, Any] = {}
+    for key in ("t_end", "t0", "output_dt", "q0", "u0"):
+        value = over.get(key, defaults.get(key))
+        if value is not None:
+            kwargs[key] = value
+    if "t_end" not in kwargs:
+        raise SettingsError("t_end: not given; set simulation.t_end in the model file or pass --t-end")
+    for key in ("t_end", "t0", "output_dt"):
+        if key in kwargs:
+            try:
+                kwargs[key] = float(kwargs[key])
+            except (TypeError, ValueError):
+                raise SettingsError(f"{key}: expected a number, got {kwargs[key]!r}") from None
+            if not math.isfinite(kwargs[key]):
+                raise SettingsError(f"{key}: must be finite, got {kwargs[key]}")
+    if "output_dt" in kwargs and kwargs["output_dt"] <= 0:
+        raise SettingsError(f"output_dt: must be > 0, got {kwargs['output_dt']:g}")
+
+    base = _integrator_dict(defaults.get("integrator"))
+    chosen = _integrator_dict(over.get("integrator"))
+    params = {k: over[k] for k in ("dt", "rtol", "atol") if k in over}
+    if chosen is None and base is None and not params:
+        return kwargs  # the engine's default integrator
+    if chosen is None:
+        spec = base if base is not None else {"type": "rk4" if "dt" in params else "dopri5"}
+    elif base is not None and base.get("type") == chosen.get("type"):
+        spec = {**base, **chosen}
+    else:
+        spec = dict(chosen)
+        if base is not None:
+            allowed = INTEGRATOR_KEYS.get(str(spec.get("type")), ())
+            spec = {**{k: v for k, v in base.items() if k in allowed}, **spec}
+    kind = str(spec.get("type", "")).lower()
+    if kind not in INTEGRATOR_KEYS:
+        raise SettingsError(f"integrator: unknown type {spec.get('type')!r}; expected one of {', '.join(INTEGRATOR_KEYS)}")
+    allowed = INTEGRATOR_KEYS[kind]
+    for key, value in params.items():
+        if key not in allowed:
+            hint = " (it is adaptive: use --rtol/--atol)" if kind == "dopri5" else " (it has a fixed step: use --dt)"
+            raise SettingsError(f"--{key} does not apply to integrator {kind}{hint}")
+        spec[key] = value
+    if "dt" in allowed and spec.get("dt") is None:
+        raise SettingsError(f"integrator {kind} needs a step: set simulation.integrator.dt or pass --dt")
+    args = {k: float(v) for k, v in spec.items() if k in allowed}
+    try:
+        kwargs["integrator"] = _INTEGRATOR_CLASSES[kind](**args)
+    except (TypeError, ValueError) as e:
+        raise SettingsError(f"integrator {kind}: {e}") from None
+    return kwargs
+
+
+__all__ = ["load_model", "simulation_kwargs", "ModelFileNotFoundError", "SIMULATION_KEYS", "INTEGRATOR_KEYS"]
