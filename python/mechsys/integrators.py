@@ -57,7 +57,7 @@ def from_name(name: str, dt: float | None = None, rtol: float | None = None, ato
             raise SettingsError("integrator rk4 needs a step: give --dt")
         return RK4(dt)
     if n == "dopri5":
-        return DOPRI5(rtol=rtol or 1e-8, atol=atol or 1e-10)
+        return DOPRI5(rtol=1e-8 if rtol is None else rtol, atol=1e-10 if atol is None else atol)
     if n == "radau5":
         if dt is None:
             raise SettingsError("integrator radau5 needs a step: give --dt")

@@ -165,10 +165,15 @@ class Model:
         if not isinstance(desc, dict):
             raise ModelError(f"model: expected a table/dict, got {type(desc).__name__}")
         m = cls(desc.get("name", "model"), desc.get("gravity", (0.0, 0.0, 0.0)))
-        m._bodies = copy.deepcopy(list(desc.get("bodies", [])))
-        m._joints = copy.deepcopy(list(desc.get("joints", [])))
-        m._forces = copy.deepcopy(list(desc.get("forces", [])))
-        m._ground_markers = copy.deepcopy(list(desc.get("ground_markers", [])))
+        # non-list values are passed on unchanged so the engine reports "expected a sequence"
+        def seq(key):
+            v = desc.get(key, [])
+            return copy.deepcopy(list(v) if isinstance(v, (list, tuple)) else v)
+
+        m._bodies = seq("bodies")
+        m._joints = seq("joints")
+        m._forces = seq("forces")
+        m._ground_markers = seq("ground_markers")
         known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers"}
         extra = set(desc) - known
         if extra:

@@ -98,7 +98,9 @@ class Results:
         try:
             return self._signals[name]
         except KeyError:
-            close = [n for n in self._signals if name.split("/")[-1] in n][:8]
+            import difflib
+
+            close = difflib.get_close_matches(name, list(self._signals), n=6, cutoff=0.6)
             hint = f"; similar: {', '.join(close)}" if close else ""
             raise ResultsError(f"unknown signal '{name}'{hint} (res.names() lists all)") from None
 
@@ -147,11 +149,13 @@ class Results:
 
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        with h5py.File(path, "w") as f:
+        with h5py.File(path, "w", track_order=True) as f:
             f.attrs["format"] = "mechsys-results"
             f.attrs["format_version"] = 1
             for k, v in self.attrs.items():
-                f.attrs[k] = v
+                if k != "signal_order":
+                    f.attrs[k] = v
+            f.attrs["signal_order"] = json.dumps(list(self._signals))
             for name, arr in self._signals.items():
                 ds = f.create_dataset(name, data=np.ascontiguousarray(arr))
                 ds.attrs["unit"] = self._units.get(name, "")
@@ -182,8 +186,8 @@ class Results:
 
             f.visititems(visit)
             attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-        # keep the canonical order: t first
-        order = sorted(signals, key=lambda n: (n != "t", n))
+        order = json.loads(attrs.pop("signal_order", "[]"))
+        order = [n for n in order if n in signals] + [n for n in signals if n not in order]
         return cls({n: signals[n] for n in order}, units, attrs)
 
     def to_csv(self, path: str | Path, signals: Iterable[str] | None = None) -> Path:

@@ -31,6 +31,14 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0) -> dict:
             output_dt = integrator.dt
         else:
             output_dt = (t_end - t0) / 1000.0 if t_end > t0 else 1.0
+    try:
+        output_dt = float(output_dt)
+    except (TypeError, ValueError):
+        raise SettingsError(f"output_dt: must be a number, got {output_dt!r}") from None
+    if not (np.isfinite(output_dt) and output_dt > 0):
+        raise SettingsError(f"output_dt: must be > 0, got {output_dt}")
+    if not (np.isfinite(t_end) and np.isfinite(t0) and t_end > t0):
+        raise SettingsError(f"t_end: must be finite and > t0 = {t0}, got {t_end}")
     return {
         "t0": t0,
         "t_end": t_end,

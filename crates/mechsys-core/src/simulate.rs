@@ -281,6 +281,7 @@ pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress
 /// The record stage: appends one sample of every signal from an evaluated workspace.
 fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
     let (nq, nu) = (model.nq, model.nu);
+    let nb_rec = model.nbodies() - 1;
     rec.t.push(t);
     rec.q.extend_from_slice(&y[..nq]);
     rec.u.extend_from_slice(&y[nq..nq + nu]);
@@ -288,7 +289,17 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
     for i in 1..model.nbodies() {
         let x = &data.x_abs[i];
         rec.body_position.extend_from_slice(x.r.as_slice());
-        rec.body_orientation.extend_from_slice(&matrix_to_quaternion(&x.a));
+        let mut qb = matrix_to_quaternion(&x.a);
+        // q and -q are the same rotation: keep the sign closest to the previous sample so that
+        // recorded orientations stay continuous through rotations past π
+        let k = rec.body_orientation.len();
+        if k >= 4 * nb_rec {
+            let prev = &rec.body_orientation[k - 4 * nb_rec..k - 4 * nb_rec + 4];
+            if prev.iter().zip(&qb).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
+                qb = [-qb[0], -qb[1], -qb[2], -qb[3]];
+            }
+        }
+        rec.body_orientation.extend_from_slice(&qb);
         let origin = crate::math::Vec3::zeros();
         rec.body_velocity.extend_from_slice(point_velocity(data, i, &origin).as_slice());
         rec.body_angular_velocity.extend_from_slice(data.v[i].w.as_slice());

@@ -42,9 +42,9 @@ fn body_states<'py>(
         let x = &data.x_abs[i];
         pos.push(x.r.as_slice().to_vec());
         rot.push((0..3).map(|r| (0..3).map(|c| x.a[(r, c)]).collect::<Vec<f64>>()).collect::<Vec<_>>());
-        let v = &data.v[i];
-        vel.push((x.a * v.v).as_slice().to_vec());
-        omg.push((x.a * v.w).as_slice().to_vec());
+        // world-convention twists: the origin's velocity is that of the body point at r_IB
+        vel.push(kinematics::point_velocity(&data, i, &Vec3::zeros()).as_slice().to_vec());
+        omg.push(data.v[i].w.as_slice().to_vec());
     }
     let d = PyDict::new(py);
     let e = |e: numpy::FromVecError| settings(e.to_string());

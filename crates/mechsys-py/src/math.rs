@@ -64,7 +64,10 @@ fn fixed<const N: usize>(obj: &Bound<'_, PyAny>, name: &str, expected: &str) -> 
     let a = as_array(obj, name, expected)?;
     let view = a.as_array();
     if view.shape() != [N] {
-        return Err(settings(format!("{name}: expected {expected}, got an array of shape {}", shape_str(view.shape()))));
+        return Err(settings(format!(
+            "{name}: expected {expected}, got an array of shape {}",
+            shape_str(view.shape())
+        )));
     }
     let mut out = [0.0; N];
     for (i, (o, v)) in out.iter_mut().zip(view.iter()).enumerate() {
@@ -128,7 +131,10 @@ fn mat3_with(obj: &Bound<'_, PyAny>, name: &str, allow_nonfinite: bool) -> PyRes
     let a = as_array(obj, name, "a 3x3 matrix")?;
     let view = a.as_array();
     if view.shape() != [3, 3] {
-        return Err(settings(format!("{name}: expected a 3x3 matrix, got an array of shape {}", shape_str(view.shape()))));
+        return Err(settings(format!(
+            "{name}: expected a 3x3 matrix, got an array of shape {}",
+            shape_str(view.shape())
+        )));
     }
     let mut out = Mat3::zeros();
     for ((r, c), v) in view.indexed_iter().map(|(ix, v)| ((ix[0], ix[1]), *v)) {
