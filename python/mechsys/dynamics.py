@@ -9,46 +9,41 @@ from . import _core
 from .model import Model
 
 
-def _q(model: Model, q) -> np.ndarray:
-    return np.ascontiguousarray(q, dtype=float)
+def _arr(x) -> np.ndarray:
+    # the engine takes contiguous float64 arrays; convert only when needed (the common case is free)
+    if type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous:
+        return x
+    return np.ascontiguousarray(x, dtype=float)
 
 
 def mass_matrix(model: Model, q, t: float = 0.0) -> np.ndarray:
     """M(q) by the composite-rigid-body algorithm (nu x nu)."""
-    return _core.crba(model.build(), _q(model, q), t)
+    return _core.crba(model.engine()[0], _arr(q), t)
 
 
 def forward_dynamics(model: Model, q, u, tau=None, t: float = 0.0) -> np.ndarray:
     """u_dot = M^-1 (h + tau) by the articulated-body algorithm (O(n))."""
-    core = model.build()
-    tau_a = None if tau is None else np.ascontiguousarray(tau, dtype=float)
-    return _core.aba(core, _q(model, q), np.ascontiguousarray(u, dtype=float), tau_a, t, model.callbacks or None)
+    core, cbs = model.engine()
+    return _core.aba(core, _arr(q), _arr(u), None if tau is None else _arr(tau), t, cbs)
 
 
 def inverse_dynamics(model: Model, q, u, udot, t: float = 0.0) -> np.ndarray:
     """tau = M u_dot - h by the recursive Newton-Euler algorithm: the generalized forces needed,
     beyond the model's own force elements, to produce ``udot``."""
-    core = model.build()
-    return _core.rnea(
-        core,
-        _q(model, q),
-        np.ascontiguousarray(u, dtype=float),
-        np.ascontiguousarray(udot, dtype=float),
-        t,
-        model.callbacks or None,
-    )
+    core, cbs = model.engine()
+    return _core.rnea(core, _arr(q), _arr(u), _arr(udot), t, cbs)
 
 
 def nonlinear_effects(model: Model, q, u, t: float = 0.0) -> np.ndarray:
     """h(q, u, t): gravity, gyroscopic/Coriolis terms and all force elements, with M u_dot = h + tau."""
-    core = model.build()
-    return _core.nonlinear_effects(core, _q(model, q), np.ascontiguousarray(u, dtype=float), t, model.callbacks or None)
+    core, cbs = model.engine()
+    return _core.nonlinear_effects(core, _arr(q), _arr(u), t, cbs)
 
 
 def energies(model: Model, q, u, t: float = 0.0) -> dict:
     """Kinetic and potential energy, per-body kinetic energy, linear momentum and moment of
     momentum about the inertial origin."""
-    return _core.energies(model.build(), _q(model, q), np.ascontiguousarray(u, dtype=float), t)
+    return _core.energies(model.engine()[0], _arr(q), _arr(u), t)
 
 
 aba = forward_dynamics

@@ -153,6 +153,14 @@ class Model:
             self._built = (text, _core.Model(text), callbacks)
         return self._built[1]
 
+    def engine(self) -> tuple:
+        """(engine model, callbacks or None): the fast path for repeated single evaluations."""
+        built = self._built
+        if built is None:
+            self.build()
+            built = self._built
+        return built[1], (built[2] or None)  # type: ignore[index]
+
     @property
     def callbacks(self) -> list:
         """Python callables referred to by the description."""
