@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import dynamics, forces, functions, inertia, joints
+from . import dynamics, forces, functions, inertia, joints, kinematics
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -47,6 +47,7 @@ __all__ = [
     "functions",
     "inertia",
     "dynamics",
+    "kinematics",
     "MechsysError",
     "ModelError",
     "SettingsError",

@@ -3,10 +3,10 @@
 //! Each field says which stage fills it and its shape. `Data::new(&model)` sizes everything; the
 //! algorithms then run without allocating.
 
-use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
+use nalgebra::{DMatrix, DVector};
 
 use crate::model::Model;
-use crate::spatial::{Force, Motion, Pose, RigidInertia};
+use crate::spatial::{Force, Motion, Pose, RigidInertia, M6, V6};
 
 /// The state of a simulation: time, coordinates, velocities (`q̇ = H*(q) u`, eq. 2.34).
 #[derive(Debug, Clone, PartialEq)]
@@ -51,13 +51,13 @@ pub struct Data {
     /// aba: generalized accelerations (nu).
     pub udot: Vec<f64>,
     /// aba: articulated-body inertias (nbody).
-    pub ia: Vec<Matrix6<f64>>,
+    pub ia: Vec<M6>,
     /// aba: articulated bias forces (nbody).
     pub pa: Vec<Force>,
     /// aba: `U = I^A S` per body (nbody × 6, nu used).
-    pub u_mat: Vec<[Vector6<f64>; 6]>,
+    pub u_mat: Vec<[V6; 6]>,
     /// aba: `D⁻¹ = (Sᵀ U)⁻¹` per body (nbody, nu × nu block used).
-    pub d_inv: Vec<Matrix6<f64>>,
+    pub d_inv: Vec<[[f64; 6]; 6]>,
     /// aba: `τ - Sᵀ p^A` per body (nbody × 6, nu used).
     pub u_bias: Vec<[f64; 6]>,
     /// scratch (nu).
@@ -86,10 +86,10 @@ impl Data {
             mass_matrix: DMatrix::zeros(nu, nu),
             h: DVector::zeros(nu),
             udot: vec![0.0; nu],
-            ia: vec![Matrix6::zeros(); nb],
+            ia: vec![M6::default(); nb],
             pa: vec![Force::ZERO; nb],
-            u_mat: vec![[Vector6::zeros(); 6]; nb],
-            d_inv: vec![Matrix6::zeros(); nb],
+            u_mat: vec![[[0.0; 6]; 6]; nb],
+            d_inv: vec![[[0.0; 6]; 6]; nb],
             u_bias: vec![[0.0; 6]; nb],
             scratch_u: vec![0.0; nu],
             zero_u: vec![0.0; nu],

@@ -158,6 +158,16 @@ impl Pose {
     pub fn compose(&self, other: &Pose) -> Pose {
         Pose { a: self.a * other.a, r: self.r + self.a * other.r }
     }
+    /// Composition with a pure translation `p` (B components): `self ∘ (E, p)`.
+    #[inline]
+    pub fn translate(&self, p: &Vec3) -> Pose {
+        Pose { a: self.a, r: self.r + self.a * p }
+    }
+    /// Whether the rotation is exactly the identity (fast paths for the common joint frames).
+    #[inline]
+    pub fn rotation_is_identity(&self) -> bool {
+        self.a == Mat3::identity()
+    }
     /// Inverse placement (P relative to B).
     #[inline]
     pub fn inverse(&self) -> Pose {
@@ -338,5 +348,89 @@ mod tests {
         // kinetic energy of a pure translation is ½ m v²
         let v = Motion::new(Vec3::zeros(), Vec3::new(3.0, 0.0, 4.0));
         assert!((ri.kinetic_energy(&v) - 0.5 * 1.5 * 25.0).abs() < 1e-12);
+    }
+}
+
+/// A 6-vector as a plain array (the inner loops of the ABA work on these; LLVM unrolls them).
+pub type V6 = [f64; 6];
+
+/// Dense 6×6 matrix (articulated-body inertias), row-major, with the few operations the ABA needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct M6(pub [[f64; 6]; 6]);
+
+impl Default for M6 {
+    fn default() -> Self {
+        M6([[0.0; 6]; 6])
+    }
+}
+
+impl Motion {
+    /// As a plain array `[w; v]`.
+    #[inline]
+    pub fn v6(&self) -> V6 {
+        [self.w.x, self.w.y, self.w.z, self.v.x, self.v.y, self.v.z]
+    }
+    /// Pairing with a force given as a plain array `[n; f]`.
+    #[inline]
+    pub fn dot6(&self, f: &V6) -> f64 {
+        self.w.x * f[0] + self.w.y * f[1] + self.w.z * f[2] + self.v.x * f[3] + self.v.y * f[4] + self.v.z * f[5]
+    }
+}
+
+impl Force {
+    /// As a plain array `[n; f]`.
+    #[inline]
+    pub fn v6(&self) -> V6 {
+        [self.n.x, self.n.y, self.n.z, self.f.x, self.f.y, self.f.z]
+    }
+    /// From a plain array `[n; f]`.
+    #[inline]
+    pub fn from_v6(x: &V6) -> Self {
+        Force { n: Vec3::new(x[0], x[1], x[2]), f: Vec3::new(x[3], x[4], x[5]) }
+    }
+}
+
+impl M6 {
+    /// Overwrites with the 6×6 form of a rigid-body inertia, `[i_o h̃; -h̃ m E]`.
+    #[inline]
+    pub fn set_rigid(&mut self, r: &RigidInertia) {
+        let (h, i) = (&r.h, &r.i_o);
+        self.0 = [
+            [i[(0, 0)], i[(0, 1)], i[(0, 2)], 0.0, -h.z, h.y],
+            [i[(1, 0)], i[(1, 1)], i[(1, 2)], h.z, 0.0, -h.x],
+            [i[(2, 0)], i[(2, 1)], i[(2, 2)], -h.y, h.x, 0.0],
+            [0.0, h.z, -h.y, r.m, 0.0, 0.0],
+            [-h.z, 0.0, h.x, 0.0, r.m, 0.0],
+            [h.y, -h.x, 0.0, 0.0, 0.0, r.m],
+        ];
+    }
+    /// Product with a motion vector; the result is a force vector.
+    #[inline]
+    pub fn mul_motion(&self, m: &Motion) -> V6 {
+        let x = m.v6();
+        let mut out = [0.0; 6];
+        for (o, row) in out.iter_mut().zip(&self.0) {
+            *o = row[0] * x[0] + row[1] * x[1] + row[2] * x[2] + row[3] * x[3] + row[4] * x[4] + row[5] * x[5];
+        }
+        out
+    }
+    /// `self -= a · u uᵀ`.
+    #[inline]
+    pub fn sub_outer(&mut self, a: f64, u: &V6) {
+        for (row, ui) in self.0.iter_mut().zip(u) {
+            let s = a * ui;
+            for (x, uj) in row.iter_mut().zip(u) {
+                *x -= s * uj;
+            }
+        }
+    }
+    /// `self += o`.
+    #[inline]
+    pub fn add(&mut self, o: &M6) {
+        for (r, ro) in self.0.iter_mut().zip(&o.0) {
+            for (x, y) in r.iter_mut().zip(ro) {
+                *x += y;
+            }
+        }
     }
 }

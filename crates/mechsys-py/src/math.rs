@@ -100,7 +100,7 @@ fn unit_quat(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Quat> {
     let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
     if (n - 1.0).abs() > UNIT_TOL {
         return Err(settings(format!(
-            "{name}: must be a unit quaternion, got norm {n:.6e} (normalize it with quat_normalize)"
+            "{name}: must be a unit quaternion, got norm {n} (normalize it with quat_normalize)"
         )));
     }
     Ok(q)
@@ -121,7 +121,7 @@ fn unit_axis(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec3> {
     let a = vec3(obj, name)?;
     let n = a.norm();
     if (n - 1.0).abs() > UNIT_TOL {
-        return Err(settings(format!("{name}: must be a unit vector, got norm {n:.6e}")));
+        return Err(settings(format!("{name}: must be a unit vector, got norm {n}")));
     }
     Ok(a)
 }

@@ -6,20 +6,49 @@
 //! All spatial quantities are in world components about the origin, so passing inertias and forces
 //! to the parent is a plain sum.
 
-use nalgebra::{Matrix6, Vector6};
-
 use crate::data::Data;
 use crate::error::Result;
 use crate::forces::Callbacks;
 use crate::model::Model;
-use crate::spatial::{Force, Motion};
+use crate::spatial::{Force, Motion, V6};
+
+/// Inverts the symmetric positive definite leading `n × n` block of `d` in place (Gauss–Jordan
+/// without pivoting, which is stable for SPD matrices). Returns false if it is not positive definite.
+fn invert_spd(d: &mut [[f64; 6]; 6], n: usize) -> bool {
+    for k in 0..n {
+        let p = d[k][k];
+        if !(p > 0.0) {
+            return false;
+        }
+        let inv = 1.0 / p;
+        d[k][k] = 1.0;
+        for c in 0..n {
+            d[k][c] *= inv;
+        }
+        for r in 0..n {
+            if r != k {
+                let f = d[r][k];
+                d[r][k] = 0.0;
+                for c in 0..n {
+                    d[r][c] -= f * d[k][c];
+                }
+            }
+        }
+    }
+    true
+}
+
+#[inline]
+fn dot6(a: &V6, b: &V6) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
+}
 
 /// ABA on prepared data (kinematics, inertias, `f_ext`, `tau_applied`); `tau` is an optional extra
 /// actuation (length nu). Writes `data.udot` and the body accelerations `data.a` (without gravity).
 pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
     let nb = model.nbodies();
     for i in 1..nb {
-        data.ia[i] = data.inertia[i].to_matrix();
+        data.ia[i].set_rigid(&data.inertia[i]);
         let iv = data.inertia[i].mul_motion(&data.v[i]);
         data.pa[i] = data.v[i].cross_force(&iv) - data.f_ext[i];
     }
@@ -27,71 +56,92 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
         let i = ji + 1;
         let nu = j.nu();
         let parent = j.parent;
+        let (lo, hi) = data.ia.split_at_mut(i);
+        let ia = &mut hi[0];
         if nu == 1 {
             // the common case, without small-matrix bookkeeping
-            let s = data.s[i][0].to_vec6();
-            let u_col = data.ia[i] * s;
-            let d_inv = 1.0 / s.dot(&u_col);
+            let s = &data.s[i][0];
+            let u_col = ia.mul_motion(s);
+            let d_inv = 1.0 / s.dot6(&u_col);
             let t = data.tau_applied[j.iu] + tau.map_or(0.0, |t| t[j.iu]);
-            let ub = t - s.dot(&data.pa[i].to_vec6());
+            let ub = t - s.dot(&data.pa[i]);
             data.u_mat[i][0] = u_col;
-            data.d_inv[i][(0, 0)] = d_inv;
+            data.d_inv[i][0][0] = d_inv;
             data.u_bias[i][0] = ub;
             if parent != 0 {
-                let mut i_art = data.ia[i];
-                i_art.ger(-d_inv, &u_col, &u_col, 1.0);
-                let pa = data.pa[i].to_vec6() + i_art * data.c[i].to_vec6() + u_col * (d_inv * ub);
-                data.ia[parent] += i_art;
-                data.pa[parent] += Force::from_vec6(&pa);
+                ia.sub_outer(d_inv, &u_col);
+                let ic = ia.mul_motion(&data.c[i]);
+                let k = d_inv * ub;
+                let mut pa = data.pa[i].v6();
+                for r in 0..6 {
+                    pa[r] += ic[r] + u_col[r] * k;
+                }
+                lo[parent].add(ia);
+                data.pa[parent] += Force::from_v6(&pa);
             }
             continue;
         }
-        let ia = data.ia[i];
-        let pa_a = data.pa[i];
         if nu == 0 {
             if parent != 0 {
-                let pa = pa_a.to_vec6() + ia * data.c[i].to_vec6();
-                data.ia[parent] += ia;
-                data.pa[parent] += Force::from_vec6(&pa);
+                let ic = ia.mul_motion(&data.c[i]);
+                let pa = data.pa[i] + Force::from_v6(&ic);
+                lo[parent].add(ia);
+                data.pa[parent] += pa;
             }
             continue;
         }
-        let mut u_cols = [Vector6::zeros(); 6];
+        let mut u_cols = [[0.0; 6]; 6];
         let mut ub = [0.0; 6];
         for k in 0..nu {
-            let s = data.s[i][k];
-            u_cols[k] = ia * s.to_vec6();
+            let s = &data.s[i][k];
+            u_cols[k] = ia.mul_motion(s);
             let t = data.tau_applied[j.iu + k] + tau.map_or(0.0, |t| t[j.iu + k]);
-            ub[k] = t - s.dot(&pa_a);
+            ub[k] = t - s.dot(&data.pa[i]);
         }
-        let mut d = Matrix6::identity();
+        let mut d = [[0.0; 6]; 6];
         for r in 0..nu {
             for c in 0..nu {
-                d[(r, c)] = data.s[i][r].to_vec6().dot(&u_cols[c]);
+                d[r][c] = data.s[i][r].dot6(&u_cols[c]);
             }
         }
-        // D is symmetric positive definite for a physical body; NaN propagates otherwise and the
-        // integrator reports the non-finite state with its time
-        let d_inv = d.cholesky().map(|c| c.inverse()).unwrap_or_else(|| Matrix6::from_element(f64::NAN));
+        // D is positive definite for a physical body; NaN propagates otherwise and the integrator
+        // reports the non-finite state with its time
+        if !invert_spd(&mut d, nu) {
+            d = [[f64::NAN; 6]; 6];
+        }
         if parent != 0 {
-            let mut i_art = ia;
-            let mut corr = Vector6::zeros();
+            // I^a = I^A - U D⁻¹ Uᵀ (D⁻¹ = L Lᵀ is not needed: subtract column by column)
+            let mut w = [[0.0; 6]; 6]; // W = U D⁻¹
             for r in 0..nu {
-                let mut du = Vector6::zeros();
-                let mut coef = 0.0;
                 for c in 0..nu {
-                    du += u_cols[c] * d_inv[(c, r)];
-                    coef += d_inv[(r, c)] * ub[c];
+                    for e in 0..6 {
+                        w[r][e] += u_cols[c][e] * d[c][r];
+                    }
                 }
-                i_art -= du * u_cols[r].transpose();
-                corr += u_cols[r] * coef;
             }
-            let pa = pa_a.to_vec6() + i_art * data.c[i].to_vec6() + corr;
-            data.ia[parent] += i_art;
-            data.pa[parent] += Force::from_vec6(&pa);
+            for r in 0..nu {
+                for e in 0..6 {
+                    for f in 0..6 {
+                        ia.0[e][f] -= w[r][e] * u_cols[r][f];
+                    }
+                }
+            }
+            let ic = ia.mul_motion(&data.c[i]);
+            let mut pa = data.pa[i].v6();
+            for r in 0..nu {
+                let coef: f64 = (0..nu).map(|c| d[r][c] * ub[c]).sum();
+                for e in 0..6 {
+                    pa[e] += u_cols[r][e] * coef;
+                }
+            }
+            for e in 0..6 {
+                pa[e] += ic[e];
+            }
+            lo[parent].add(ia);
+            data.pa[parent] += Force::from_v6(&pa);
         }
         data.u_mat[i] = u_cols;
-        data.d_inv[i] = d_inv;
+        data.d_inv[i] = d;
         data.u_bias[i] = ub;
     }
     data.a[0] = Motion::new(crate::math::Vec3::zeros(), -model.gravity);
@@ -100,20 +150,17 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
         let nu = j.nu();
         let mut a = data.a[j.parent] + data.c[i];
         if nu == 1 {
-            let ud = data.d_inv[i][(0, 0)] * (data.u_bias[i][0] - data.u_mat[i][0].dot(&a.to_vec6()));
+            let ud = data.d_inv[i][0][0] * (data.u_bias[i][0] - a.dot6(&data.u_mat[i][0]));
             data.udot[j.iu] = ud;
             a += data.s[i][0] * ud;
         } else if nu > 1 {
-            let ap = a.to_vec6();
+            let ap = a.v6();
             let mut rhs = [0.0; 6];
             for k in 0..nu {
-                rhs[k] = data.u_bias[i][k] - data.u_mat[i][k].dot(&ap);
+                rhs[k] = data.u_bias[i][k] - dot6(&data.u_mat[i][k], &ap);
             }
             for r in 0..nu {
-                let mut ud = 0.0;
-                for c in 0..nu {
-                    ud += data.d_inv[i][(r, c)] * rhs[c];
-                }
+                let ud: f64 = (0..nu).map(|c| data.d_inv[i][r][c] * rhs[c]).sum();
                 data.udot[j.iu + r] = ud;
                 a += data.s[i][r] * ud;
             }

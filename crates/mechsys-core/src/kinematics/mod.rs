@@ -31,10 +31,12 @@ pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
         let i = ji + 1;
         let qj = &q[j.iq..j.iq + j.nq()];
         let xj = j.kind.placement(qj);
-        // pose of the child joint frame in I, then of the child body frame
-        let x_pj = data.x_abs[j.parent].compose(&j.parent_frame);
+        // pose of the child joint frame in I, then of the child body frame (joint frames are
+        // mostly pure offsets: skip the rotation products then)
+        let xp = &data.x_abs[j.parent];
+        let x_pj = if j.frames_plain.0 { xp.translate(&j.parent_frame.r) } else { xp.compose(&j.parent_frame) };
         let x_cj = x_pj.compose(&xj);
-        data.x_abs[i] = x_cj.compose(&j.child_frame_inv);
+        data.x_abs[i] = if j.frames_plain.1 { x_cj.translate(&j.child_frame_inv.r) } else { x_cj.compose(&j.child_frame_inv) };
         data.x_joint[i] = x_cj;
         let mut s = [Motion::ZERO; 6];
         j.kind.subspace(qj, &mut s);

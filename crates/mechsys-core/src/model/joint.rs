@@ -241,8 +241,20 @@ fn unit(k: usize) -> Vec3 {
 #[inline]
 pub fn axis_rotation(axis: &Vec3, angle: f64) -> Mat3 {
     let (s, c) = angle.sin_cos();
-    let t = crate::math::tilde(axis);
-    Mat3::identity() + t * s + t * t * (1.0 - c)
+    // R = c E + s ã + (1 - c) a aᵀ
+    let (x, y, z) = (axis.x, axis.y, axis.z);
+    let k = 1.0 - c;
+    Mat3::new(
+        c + k * x * x,
+        k * x * y - s * z,
+        k * x * z + s * y,
+        k * x * y + s * z,
+        c + k * y * y,
+        k * y * z - s * x,
+        k * x * z - s * y,
+        k * y * z + s * x,
+        c + k * z * z,
+    )
 }
 
 /// Rotation matrix of the unit quaternion `w + x i + y j + z k` (scalar first).

@@ -109,6 +109,8 @@ pub struct Joint {
     pub iq: usize,
     /// Offset of this joint's velocities in u.
     pub iu: usize,
+    /// Whether the parent and child joint frames have identity rotations (pure offsets).
+    pub frames_plain: (bool, bool),
     /// Initial coordinates.
     pub q0: Vec<f64>,
     /// Initial velocities.

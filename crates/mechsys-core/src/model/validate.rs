@@ -404,14 +404,16 @@ impl Model {
                 None => vec![],
             };
             let child_frame = frame(&j.child_frame, &format!("{what}.child_frame"))?;
+            let parent_frame = frame(&j.parent_frame, &format!("{what}.parent_frame"))?;
             joints.push(Joint {
                 name: j.name.clone(),
                 kind,
                 parent: new_index[names[&j.parent]],
                 child: new_index[names[&j.child]],
-                parent_frame: frame(&j.parent_frame, &format!("{what}.parent_frame"))?,
+                parent_frame,
                 child_frame,
                 child_frame_inv: child_frame.inverse(),
+                frames_plain: (parent_frame.rotation_is_identity(), child_frame.rotation_is_identity()),
                 iq,
                 iu,
                 q0,
