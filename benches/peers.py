@@ -454,6 +454,14 @@ def versions(peers: dict) -> dict:
     import mechsys
 
     v = {"mechsys": mechsys.__version__, "numpy": numpy.__version__}
+    try:  # which sources: the commit, and whether the working tree had changes
+        import subprocess
+
+        rev = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT, capture_output=True, text=True, timeout=10)
+        if rev.returncode == 0:
+            v["mechsys"] += f" (git {rev.stdout.strip()})"
+    except (OSError, subprocess.SubprocessError):
+        pass
     for name, mod in peers.items():
         v[name] = getattr(mod, "__version__", "?")
     return v

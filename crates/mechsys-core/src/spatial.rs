@@ -229,8 +229,12 @@ pub struct RigidInertia {
 impl RigidInertia {
     /// From mass, centre of mass and inertia about the centre of mass (eq. 2.174-style Steiner shift).
     pub fn from_com(m: f64, c: &Vec3, i_c: &Mat3) -> Self {
-        let ct = tilde(c);
-        RigidInertia { m, h: c * m, i_o: i_c - ct * ct * m }
+        // Steiner: I_O = I_C + m (|c|² E - c cᵀ) = I_C - m c̃ c̃
+        let (x, y, z) = (c.x, c.y, c.z);
+        let (xx, yy, zz) = (m * x * x, m * y * y, m * z * z);
+        let (xy, xz, yz) = (m * x * y, m * x * z, m * y * z);
+        let shift = Mat3::new(yy + zz, -xy, -xz, -xy, xx + zz, -yz, -xz, -yz, xx + yy);
+        RigidInertia { m, h: c * m, i_o: i_c + shift }
     }
     /// Momentum (moment about origin, linear momentum) of the body moving with `v`.
     #[inline]

@@ -11,7 +11,7 @@
 use nalgebra::DMatrix;
 
 use crate::data::Data;
-use crate::math::Vec3;
+use crate::math::{Mat3, Vec3};
 use crate::model::Model;
 use crate::spatial::{Motion, Pose};
 
@@ -80,7 +80,18 @@ pub fn inertias(model: &Model, data: &mut Data, t: f64) {
             let m = b.mass_at(t);
             (m, b.inertia * (m / b.mass))
         };
-        let i_c_w = x.a * i_c * x.a.transpose();
+        let i_c_w = if b.principal_axes {
+            // A diag(d) Aᵀ = Σ d_k a_k a_kᵀ over the columns a_k of A (half the work of two products)
+            let d = i_c.diagonal();
+            let mut r = Mat3::zeros();
+            for k in 0..3 {
+                let col = x.a.column(k);
+                r += col * col.transpose() * d[k];
+            }
+            r
+        } else {
+            x.a * i_c * x.a.transpose()
+        };
         data.inertia[i] = crate::spatial::RigidInertia::from_com(m, &c, &i_c_w);
     }
 }

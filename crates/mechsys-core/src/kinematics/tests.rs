@@ -5,7 +5,7 @@ use nalgebra::DMatrix;
 use super::*;
 use crate::data::Data;
 use crate::fixtures;
-use crate::math::Vec3;
+use crate::math::{Mat3, Vec3};
 
 /// The point Jacobian times u equals the recursive point velocity, and both equal the finite
 /// difference of the point position along q ⊕ u dt (eq. 2.69).
@@ -70,4 +70,24 @@ fn point_acceleration_matches_finite_difference() {
     };
     let fd = (vel(h) - vel(-h)) / (2.0 * h);
     assert!((fd - a_rec).norm() < 1e-6, "fd {fd} vs {a_rec}");
+}
+
+/// The world-frame inertias (principal-axes fast path included) equal the textbook rotation
+/// A I_C Aᵀ and Steiner shift m(|c|²E - c cᵀ) (section 2.3.4).
+#[test]
+fn world_inertias_match_rotation_and_steiner() {
+    let model = fixtures::chain(3, "spherical");
+    assert!(model.bodies[1].principal_axes);
+    let mut data = Data::new(&model);
+    let q = model.q0();
+    positions(&model, &mut data, &q);
+    inertias(&model, &mut data, 0.0);
+    for i in 1..model.nbodies() {
+        let b = &model.bodies[i];
+        let x = &data.x_abs[i];
+        let c = x.r + x.a * b.com;
+        let expected = x.a * b.inertia * x.a.transpose() + (Mat3::identity() * c.norm_squared() - c * c.transpose()) * b.mass;
+        assert!((data.inertia[i].i_o - expected).norm() < 1e-13, "body {i}");
+        assert!((data.inertia[i].h - c * b.mass).norm() < 1e-14);
+    }
 }

@@ -47,6 +47,8 @@ pub struct Body {
     pub ejection_point: Vec3,
     /// Mass at which the flow stops.
     pub mass_final: f64,
+    /// Whether the inertia tensor is diagonal in the body frame (fast path in the kinematics).
+    pub principal_axes: bool,
 }
 
 impl Body {

@@ -272,6 +272,7 @@ impl Model {
             ejection_velocity: Vec3::zeros(),
             ejection_point: Vec3::zeros(),
             mass_final: 0.0,
+            principal_axes: true,
         }];
         let mut variable_mass = false;
         for &ji in &order {
@@ -317,6 +318,7 @@ impl Model {
                     None => com,
                 },
                 mass_final,
+                principal_axes: i_c.iter().enumerate().all(|(k, v)| k % 4 == 0 || *v == 0.0),
             });
         }
 
