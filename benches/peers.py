@@ -462,6 +462,11 @@ def versions(peers: dict) -> dict:
             v["mechsys"] += f" (git {rev.stdout.strip()})"
     except (OSError, subprocess.SubprocessError):
         pass
+    # the timed extension must be built from the sources the Rust benchmark compiled
+    so = Path(mechsys._core.__file__)
+    newer = [f for f in (ROOT / "crates").rglob("src/**/*.rs") if f.stat().st_mtime > so.stat().st_mtime]
+    if newer:
+        v["mechsys"] += f", **extension older than {len(newer)} source file(s): run `make build` first**"
     for name, mod in peers.items():
         v[name] = getattr(mod, "__version__", "?")
     return v

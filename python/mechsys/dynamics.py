@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
+from .errors import SettingsError
 from .model import Model
 
 
@@ -18,13 +19,23 @@ def _arr(x) -> np.ndarray:
 
 def mass_matrix(model: Model, q, t: float = 0.0) -> np.ndarray:
     """M(q) by the composite-rigid-body algorithm (nu x nu)."""
-    return _core.crba(model.engine()[0], _arr(q), t)
+    core = (model._engine or model.engine())[0]
+    try:
+        return _core.crba(core, q, t)
+    except SettingsError:
+        return _core.crba(core, _arr(q), t)
 
 
 def forward_dynamics(model: Model, q, u, tau=None, t: float = 0.0) -> np.ndarray:
-    """u_dot = M^-1 (h + tau) by the articulated-body algorithm (O(n))."""
-    core, cbs = model.engine()
-    return _core.aba(core, _arr(q), _arr(u), None if tau is None else _arr(tau), t, cbs)
+    """u_dot = M^-1 (h + tau) by the articulated-body algorithm (O(n)).
+
+    The fast path takes float64 numpy arrays as they are; anything else is converted once."""
+    core, cbs = model._engine or model.engine()
+    try:
+        return _core.aba(core, q, u, tau, t, cbs)
+    except SettingsError:
+        # lists, other dtypes, non-contiguous views: convert and try again (real errors re-raise)
+        return _core.aba(core, _arr(q), _arr(u), None if tau is None else _arr(tau), t, cbs)
 
 
 def inverse_dynamics(model: Model, q, u, udot, t: float = 0.0) -> np.ndarray:

@@ -55,6 +55,7 @@ class Model:
         self._forces: list[Any] = []
         self._ground_markers: list[dict] = []
         self._built: tuple[str, Any, list] | None = None
+        self._engine: tuple | None = None
         self._extra_callbacks: list = []
         self.ground = Body("ground", self)
 
@@ -91,7 +92,7 @@ class Model:
             if mass_final is not None:
                 body["mass_final"] = float(mass_final)
         self._bodies.append(body)
-        self._built = None
+        self._invalidate()
         return Body(name, self)
 
     def add_marker(self, body: str | Body, name: str, position: Sequence[float] = (0.0, 0.0, 0.0), **rotation) -> None:
@@ -108,14 +109,14 @@ class Model:
                     break
             else:
                 raise ModelError(f"add_marker: unknown body '{bname}'")
-        self._built = None
+        self._invalidate()
 
     def add_joint(self, joint: Joint | dict) -> Joint | dict:
         """Adds a joint (see :mod:`mechsys.joints`)."""
         if not isinstance(joint, (Joint, dict)):
             raise ModelError(f"add_joint: expected a mechsys.joints joint, got {type(joint).__name__}")
         self._joints.append(joint)
-        self._built = None
+        self._invalidate()
         return joint
 
     def add_force(self, force) -> Any:
@@ -123,7 +124,7 @@ class Model:
         if not (hasattr(force, "describe") or isinstance(force, dict)):
             raise ModelError(f"add_force: expected a mechsys.forces element, got {type(force).__name__}")
         self._forces.append(force)
-        self._built = None
+        self._invalidate()
         return force
 
     # ---- description and engine model -----------------------------------------------------------
@@ -153,13 +154,17 @@ class Model:
             self._built = (text, _core.Model(text), callbacks)
         return self._built[1]
 
+    def _invalidate(self) -> None:
+        self._built = None
+        self._engine = None
+
     def engine(self) -> tuple:
         """(engine model, callbacks or None): the fast path for repeated single evaluations."""
-        built = self._built
-        if built is None:
+        if self._engine is None:
             self.build()
             built = self._built
-        return built[1], (built[2] or None)  # type: ignore[index]
+            self._engine = (built[1], built[2] or None)  # type: ignore[index]
+        return self._engine
 
     @property
     def callbacks(self) -> list:

@@ -409,7 +409,7 @@ impl M6 {
         ];
     }
     /// Product with a motion vector; the result is a force vector.
-    #[inline]
+    #[inline(always)]
     pub fn mul_motion(&self, m: &Motion) -> V6 {
         let x = m.v6();
         let mut out = [0.0; 6];
@@ -419,7 +419,7 @@ impl M6 {
         out
     }
     /// `self -= a · u uᵀ`.
-    #[inline]
+    #[inline(always)]
     pub fn sub_outer(&mut self, a: f64, u: &V6) {
         for (row, ui) in self.0.iter_mut().zip(u) {
             let s = a * ui;
@@ -429,7 +429,7 @@ impl M6 {
         }
     }
     /// `self += o`.
-    #[inline]
+    #[inline(always)]
     pub fn add(&mut self, o: &M6) {
         for (r, ro) in self.0.iter_mut().zip(&o.0) {
             for (x, y) in r.iter_mut().zip(ro) {

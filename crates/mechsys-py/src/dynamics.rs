@@ -3,12 +3,12 @@
 use mechsys_core::dynamics::{self, energy};
 use mechsys_core::forces::Callbacks;
 use mechsys_core::kinematics;
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{settings, PyMechsysError};
-use crate::model::{check_len, PyModel};
+use crate::model::{check_len, fast_slice, PyModel};
 use crate::simulate::PyCallbacks;
 
 fn callbacks(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<PyCallbacks> {
@@ -26,13 +26,13 @@ fn callbacks(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<PyCallback
 /// Mass matrix M(q) by the composite-rigid-body algorithm.
 #[pyfunction]
 #[pyo3(signature = (model, q, t = 0.0))]
-fn crba<'py>(py: Python<'py>, model: &PyModel, q: PyReadonlyArray1<'py, f64>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let q = check_len(&q, model.model.nq, "q")?;
+fn crba<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let q = fast_slice(q, model.model.nq, "q")?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     dynamics::crba::mass_matrix(&model.model, &mut data, t, q);
     let n = model.model.nu;
-    let rows: Vec<Vec<f64>> = (0..n).map(|r| (0..n).map(|c| data.mass_matrix[(r, c)]).collect()).collect();
-    PyArray2::from_vec2(py, &rows).map_err(|e| settings(e.to_string()))
+    // M is symmetric, so its column-major storage reads as row-major
+    PyArray1::from_slice(py, data.mass_matrix.as_slice()).reshape([n, n])
 }
 
 /// Forward dynamics u̇ = M⁻¹(h + τ) by the articulated-body algorithm.
@@ -41,18 +41,18 @@ fn crba<'py>(py: Python<'py>, model: &PyModel, q: PyReadonlyArray1<'py, f64>, t:
 fn aba<'py>(
     py: Python<'py>,
     model: &PyModel,
-    q: PyReadonlyArray1<'py, f64>,
-    u: PyReadonlyArray1<'py, f64>,
-    tau: Option<PyReadonlyArray1<'py, f64>>,
+    q: &Bound<'py, PyAny>,
+    u: &Bound<'py, PyAny>,
+    tau: Option<&Bound<'py, PyAny>>,
     t: f64,
     callbacks: Option<Vec<PyObject>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
-    let u = check_len(&u, m.nu, "u")?;
-    let tau = match &tau {
-        Some(a) => Some(check_len(a, m.nu, "tau")?),
-        None => None,
+    let q = fast_slice(q, m.nq, "q")?;
+    let u = fast_slice(u, m.nu, "u")?;
+    let tau = match tau {
+        Some(a) if !a.is_none() => Some(fast_slice(a, m.nu, "tau")?),
+        _ => None,
     };
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     if m.n_callbacks == 0 && callbacks.is_none() {

@@ -161,6 +161,23 @@ pub fn check_len<'a>(a: &'a PyReadonlyArray1<'_, f64>, n: usize, what: &str) -> 
     Ok(s)
 }
 
+/// The hot-path variant of [`check_len`]: a 1-D float64 numpy array read in place without numpy's
+/// borrow registry (the GIL is held and the slice is only read during the call).
+pub fn fast_slice<'a>(a: &'a Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<&'a [f64]> {
+    let arr = a
+        .downcast::<numpy::PyArray1<f64>>()
+        .map_err(|_| settings(format!("{what}: must be a 1-D float64 numpy array")))?;
+    // SAFETY: read-only use while holding the GIL; no Rust code mutates the array meanwhile.
+    let s = unsafe { numpy::PyArrayMethods::as_slice(arr) }.map_err(|_| settings(format!("{what}: must be a contiguous float64 array")))?;
+    if s.len() != n {
+        return Err(settings(format!("{what}: expected length {n}, got {}", s.len())));
+    }
+    if let Some(i) = s.iter().position(|v| !v.is_finite()) {
+        return Err(settings(format!("{what}[{i}]: must be finite, got {}", s[i])));
+    }
+    Ok(s)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()
 }
