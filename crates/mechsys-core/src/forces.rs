@@ -65,17 +65,19 @@ pub fn interp(x: &[f64], y: &[f64], xi: f64) -> f64 {
 }
 
 /// ∫ of the piecewise-linear table from 0 to xi (potential of a tabulated spring), extrapolating
-/// with the end values as `interp` does.
+/// with the end values as `interp` does. Exact trapezoids between the table's nodes; no allocation.
 pub fn interp_integral(x: &[f64], y: &[f64], xi: f64) -> f64 {
-    // integrate f from 0 to xi by splitting at the table's nodes
-    let mut pts: Vec<f64> = x.iter().copied().filter(|v| (*v > 0.0f64.min(xi)) && (*v < 0.0f64.max(xi))).collect();
     let (lo, hi) = if xi >= 0.0 { (0.0, xi) } else { (xi, 0.0) };
-    pts.insert(0, lo);
-    pts.push(hi);
     let mut s = 0.0;
-    for w in pts.windows(2) {
-        s += 0.5 * (w[1] - w[0]) * (interp(x, y, w[0]) + interp(x, y, w[1]));
+    let mut a = lo;
+    let mut fa = interp(x, y, a);
+    for &node in x.iter().filter(|v| **v > lo && **v < hi) {
+        let fb = interp(x, y, node);
+        s += 0.5 * (node - a) * (fa + fb);
+        a = node;
+        fa = fb;
     }
+    s += 0.5 * (hi - a) * (fa + interp(x, y, hi));
     if xi >= 0.0 {
         s
     } else {

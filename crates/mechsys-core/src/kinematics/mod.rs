@@ -30,12 +30,23 @@ pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
         let i = ji + 1;
         let qj = &q[j.iq..j.iq + j.nq()];
-        let xj = j.kind.placement(qj);
         // pose of the child joint frame in I, then of the child body frame (joint frames are
         // mostly pure offsets: skip the rotation products then)
         let xp = &data.x_abs[j.parent];
         let x_pj = if j.frames_plain.0 { xp.translate(&j.parent_frame.r) } else { xp.compose(&j.parent_frame) };
-        let x_cj = x_pj.compose(&xj);
+        let x_cj = match j.coordinate_axis {
+            Some(k) => {
+                // rotation about coordinate axis k: only the two other columns turn (eq. 2.12-2.18)
+                let (s, c) = qj[0].sin_cos();
+                let (i1, i2) = ((k + 1) % 3, (k + 2) % 3);
+                let mut a = x_pj.a;
+                let (c1, c2) = (x_pj.a.column(i1).into_owned(), x_pj.a.column(i2).into_owned());
+                a.set_column(i1, &(c1 * c + c2 * s));
+                a.set_column(i2, &(c2 * c - c1 * s));
+                Pose::new(a, x_pj.r)
+            }
+            None => x_pj.compose(&j.kind.placement(qj)),
+        };
         data.x_abs[i] = if j.frames_plain.1 { x_cj.translate(&j.child_frame_inv.r) } else { x_cj.compose(&j.child_frame_inv) };
         data.x_joint[i] = x_cj;
         let mut s = [Motion::ZERO; 6];

@@ -113,6 +113,8 @@ pub struct Joint {
     pub iu: usize,
     /// Whether the parent and child joint frames have identity rotations (pure offsets).
     pub frames_plain: (bool, bool),
+    /// For a revolute joint about a coordinate axis of its joint frame: that axis (0, 1, 2).
+    pub coordinate_axis: Option<usize>,
     /// Initial coordinates.
     pub q0: Vec<f64>,
     /// Initial velocities.
@@ -326,6 +328,11 @@ impl Model {
     }
     /// q̇ = H*(q) u for the whole model (eq. 2.34).
     pub fn qdot(&self, q: &[f64], u: &[f64], qd: &mut [f64]) {
+        if self.nq == self.nu && !self.joints.iter().any(|j| j.kind.has_quaternion()) {
+            // no quaternions: every coordinate rate is its velocity
+            qd.copy_from_slice(u);
+            return;
+        }
         for j in &self.joints {
             j.kind.qdot(&q[j.iq..j.iq + j.nq()], &u[j.iu..j.iu + j.nu()], &mut qd[j.iq..j.iq + j.nq()]);
         }

@@ -416,6 +416,10 @@ impl Model {
                 child_frame,
                 child_frame_inv: child_frame.inverse(),
                 frames_plain: (parent_frame.rotation_is_identity(), child_frame.rotation_is_identity()),
+                coordinate_axis: match kind {
+                    JointKind::Revolute { axis } => (0..3).find(|&k| axis[k] == 1.0),
+                    _ => None,
+                },
                 iq,
                 iu,
                 q0,
