@@ -51,10 +51,11 @@ def nonlinear_effects(model: Model, q, u, t: float = 0.0) -> np.ndarray:
     return _core.nonlinear_effects(core, _arr(q), _arr(u), t, cbs)
 
 
-def energies(model: Model, q, u, t: float = 0.0) -> dict:
-    """Kinetic and potential energy, per-body kinetic energy, linear momentum and moment of
-    momentum about the inertial origin."""
-    return _core.energies(model.engine()[0], _arr(q), _arr(u), t)
+def energies(model: Model, q, u, t: float = 0.0, point=(0.0, 0.0, 0.0)) -> dict:
+    """Energies and momenta (sections 2.3, 2.4): ``kinetic``, ``potential`` (gravity and springs),
+    ``kinetic_per_body``, ``gravity_per_body``, ``momentum_linear`` and ``momentum_angular``
+    (about the fixed ``point``, inertial components), and their ``*_per_body`` arrays."""
+    return _core.energies(model.engine()[0], _arr(q), _arr(u), t, [float(x) for x in point])
 
 
 aba = forward_dynamics

@@ -42,25 +42,46 @@ class Frame:
     euler: Sequence[float] | None = None
     rotvec: Sequence[float] | None = None
 
-    def describe(self) -> dict:
-        d: dict = {"position": [float(x) for x in np.asarray(self.position, dtype=float).reshape(3)]}
+    def describe(self, what: str = "Frame") -> dict:
+        d: dict = {"position": _vec3(self.position, f"{what}.position")}
         given = [k for k in ("rotation", "cardan", "euler", "rotvec") if getattr(self, k) is not None]
         if len(given) > 1:
             raise ModelError(f"Frame: give only one of rotation, cardan, euler, rotvec (got {given})")
         if self.rotation is not None:
-            r = np.asarray(self.rotation, dtype=float)
+            try:
+                r = np.asarray(self.rotation, dtype=float)
+            except (TypeError, ValueError):
+                raise ModelError(f"{what}.rotation: expected a 3x3 matrix or a quaternion, got {self.rotation!r}") from None
             d["rotation"] = r.tolist()
         elif given:
             k = given[0]
-            d["rotation"] = {k: [float(x) for x in getattr(self, k)]}
+            d["rotation"] = {k: _vec3(getattr(self, k), f"{what}.{k}")}
         return d
+
+
+def _vec3(v, what: str) -> list[float]:
+    """Three floats, or a ModelError naming the item and key."""
+    try:
+        a = np.asarray(v, dtype=float).reshape(3)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what}: expected 3 numbers, got {v!r}") from None
+    return [float(x) for x in a]
+
+
+def _floats(v, what: str) -> list[float]:
+    """One or more floats, or a ModelError naming the item and key."""
+    try:
+        a = np.atleast_1d(np.asarray(v, dtype=float)).reshape(-1)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what}: expected a number or a list of numbers, got {v!r}") from None
+    return [float(x) for x in a]
 
 
 def _frame(f, what: str) -> dict:
     if f is None:
         return Frame().describe()
     if isinstance(f, Frame):
-        return f.describe()
+        return f.describe(what)
     if isinstance(f, dict):
         return f
     try:
@@ -81,9 +102,9 @@ class JointSpring:
     q_free: float | Sequence[float] | None = None
 
     def describe(self) -> dict:
-        d = {"k": [float(x) for x in np.atleast_1d(self.k)]}
+        d = {"k": _floats(self.k, "spring.k")}
         if self.q_free is not None:
-            d["q_free"] = [float(x) for x in np.atleast_1d(self.q_free)]
+            d["q_free"] = _floats(self.q_free, "spring.q_free")
         return d
 
 
@@ -94,7 +115,7 @@ class JointDamper:
     d: float | Sequence[float]
 
     def describe(self) -> dict:
-        return {"d": [float(x) for x in np.atleast_1d(self.d)]}
+        return {"d": _floats(self.d, "damper.d")}
 
 
 @dataclass
@@ -124,20 +145,27 @@ class Joint:
             "parent_frame": _frame(self.parent_frame, f"joint '{self.name}'.parent_frame"),
             "child_frame": _frame(self.child_frame, f"joint '{self.name}'.child_frame"),
         }
-        d.update(self._extra())
+        w = f"joint '{self.name}'"
+        try:
+            d.update(self._extra())
+        except ModelError as e:
+            raise ModelError(f"{w}.{e}") from None
         if self.q0 is not None:
-            d["q0"] = [float(x) for x in np.atleast_1d(np.asarray(self.q0, dtype=float))]
+            d["q0"] = _floats(self.q0, f"{w}.q0")
         if self.u0 is not None:
-            d["u0"] = [float(x) for x in np.atleast_1d(np.asarray(self.u0, dtype=float))]
-        if self.spring is not None:
-            d["spring"] = self.spring.describe()
-        if self.damper is not None:
-            d["damper"] = self.damper.describe()
+            d["u0"] = _floats(self.u0, f"{w}.u0")
+        try:
+            if self.spring is not None:
+                d["spring"] = self.spring.describe()
+            if self.damper is not None:
+                d["damper"] = self.damper.describe()
+        except ModelError as e:
+            raise ModelError(f"{w}.{e}") from None
         return d
 
 
-def _axis(a) -> list[float]:
-    return [float(x) for x in np.asarray(a, dtype=float).reshape(3)]
+def _axis(a, key: str = "axis") -> list[float]:
+    return _vec3(a, key)
 
 
 @dataclass
@@ -198,7 +226,7 @@ class Universal(Joint):
         self.type = "universal"
 
     def _extra(self):
-        return {"axis": _axis(self.axis), "axis2": _axis(self.axis2)}
+        return {"axis": _axis(self.axis), "axis2": _axis(self.axis2, "axis2")}
 
 
 @dataclass

@@ -76,10 +76,17 @@ class Model:
         matrix, its diagonal, or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. A variable-mass body (section
         2.1.1) has ``mass_rate`` (kg/s, negative when ejecting), the ``ejection_velocity`` of the
         ejected mass relative to the body (body frame), and the ``mass_final`` at which the flow stops."""
-        inert = np.asarray(inertia, dtype=float)
+        try:
+            mass_f = float(mass)
+        except (TypeError, ValueError):
+            raise ModelError(f"body '{name}'.mass: expected a number, got {mass!r}") from None
+        try:
+            inert = np.asarray(inertia, dtype=float)
+        except (TypeError, ValueError):
+            raise ModelError(f"body '{name}'.inertia: expected a 3x3 matrix or a list of numbers, got {inertia!r}") from None
         body = {
             "name": name,
-            "mass": float(mass),
+            "mass": mass_f,
             "inertia": inert.tolist(),
             "com": _vec3(com, f"body '{name}'.com"),
             "markers": [],

@@ -14,6 +14,7 @@ body/<b>/velocity               m/s          (n, 3)
 body/<b>/angular_velocity       rad/s        (n, 3)  inertial components
 body/<b>/acceleration           m/s^2        (n, 3)
 body/<b>/mass                   kg           (n,)
+body/<b>/kinetic_energy         J            (n,)
 energy/kinetic, potential,      J            (n,)
   total, dissipated,
   external_work
@@ -84,6 +85,7 @@ class Results:
             put(f"body/{b}/angular_velocity", raw["body_angular_velocity"][:, k, :], "rad/s")
             put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2")
             put(f"body/{b}/mass", raw["body_mass"][:, k], "kg")
+            put(f"body/{b}/kinetic_energy", raw["body_kinetic"][:, k], "J")
         put("energy/kinetic", raw["kinetic"], "J")
         put("energy/potential", raw["potential"], "J")
         put("energy/total", raw["kinetic"] + raw["potential"], "J")
@@ -115,6 +117,11 @@ class Results:
         """The unit of a signal."""
         self[name]
         return self._units.get(name, "")
+
+    def angular_momentum_about(self, point) -> np.ndarray:
+        """Moment of momentum about a fixed point P: L_P = L_O - r_P x p (n, 3), N m s."""
+        rp = np.asarray(point, dtype=float).reshape(3)
+        return self["momentum/angular"] - np.cross(rp, self["momentum/linear"])
 
     @property
     def t(self) -> np.ndarray:

@@ -26,6 +26,11 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0) -> dict:
         t0 = float(t0)
     except (TypeError, ValueError):
         raise SettingsError(f"t_end and t0 must be numbers, got {t_end!r}, {t0!r}") from None
+    if not (np.isfinite(t0) and np.isfinite(t_end) and t_end > t0):
+        raise SettingsError(f"t_end: must be finite and > t0 = {t0}, got {t_end}")
+    step = getattr(integrator, "dt", None)
+    if step is not None and not (isinstance(step, (int, float)) and np.isfinite(step) and step > 0):
+        raise SettingsError(f"integrator.dt: must be > 0, got {step}")
     if output_dt is None:
         if isinstance(integrator, (RK4, Radau5)):
             output_dt = integrator.dt

@@ -67,6 +67,8 @@ pub struct Recording {
     pub body_mass: Vec<f64>,
     /// Kinetic energy (n_out), J.
     pub kinetic: Vec<f64>,
+    /// Kinetic energy per body (n_out × n_bodies), J.
+    pub body_kinetic: Vec<f64>,
     /// Potential energy of gravity and springs (n_out), J.
     pub potential: Vec<f64>,
     /// Energy dissipated by dampers since t0 (n_out), J.
@@ -251,6 +253,7 @@ pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress
         body_acceleration: Vec::with_capacity(n_out * nb * 3),
         body_mass: Vec::with_capacity(n_out * nb),
         kinetic: Vec::with_capacity(n_out),
+        body_kinetic: Vec::with_capacity(n_out * nb),
         potential: Vec::with_capacity(n_out),
         dissipated: Vec::with_capacity(n_out),
         external_work: Vec::with_capacity(n_out),
@@ -306,7 +309,13 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
         rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
         rec.body_mass.push(data.inertia[i].m);
     }
-    rec.kinetic.push(energy::kinetic_energy(model, data));
+    let mut t_sum = 0.0;
+    for i in 1..model.nbodies() {
+        let e = energy::body_kinetic_energy(data, i);
+        rec.body_kinetic.push(e);
+        t_sum += e;
+    }
+    rec.kinetic.push(t_sum);
     rec.potential.push(energy::potential_energy(model, data, &y[..nq]));
     rec.dissipated.push(y[nq + nu]);
     rec.external_work.push(y[nq + nu + 1]);

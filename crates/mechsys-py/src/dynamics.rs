@@ -107,16 +107,21 @@ fn nonlinear_effects<'py>(
     Ok(PyArray1::from_slice(py, data.h.as_slice()))
 }
 
-/// Energies and momenta at (q, u, t): kinetic, potential, per-body kinetic, linear and angular momentum.
+/// Energies and momenta at (q, u, t): kinetic and potential energy (total and per body), linear
+/// momentum and moment of momentum about `point` (total and per body).
 #[pyfunction]
-#[pyo3(signature = (model, q, u, t = 0.0))]
+#[pyo3(signature = (model, q, u, t = 0.0, point = [0.0, 0.0, 0.0]))]
 fn energies<'py>(
     py: Python<'py>,
     model: &PyModel,
     q: PyReadonlyArray1<'py, f64>,
     u: PyReadonlyArray1<'py, f64>,
     t: f64,
+    point: [f64; 3],
 ) -> PyResult<Bound<'py, PyDict>> {
+    if point.iter().any(|x| !x.is_finite()) {
+        return Err(settings(format!("point: must be finite, got {point:?}")));
+    }
     let m = &model.model;
     let q = check_len(&q, m.nq, "q")?;
     let u = check_len(&u, m.nu, "u")?;
@@ -128,9 +133,24 @@ fn energies<'py>(
     d.set_item("potential", energy::potential_energy(m, &data, q))?;
     let per_body: Vec<f64> = (1..m.nbodies()).map(|i| energy::body_kinetic_energy(&data, i)).collect();
     d.set_item("kinetic_per_body", PyArray1::from_vec(py, per_body))?;
+    let gravity: Vec<f64> = (1..m.nbodies()).map(|i| energy::body_gravity_energy(m, &data, i)).collect();
+    d.set_item("gravity_per_body", PyArray1::from_vec(py, gravity))?;
+    // moment of momentum about a fixed point P: L_P = L_O - r_P × p (section 2.3.3)
+    let rp = mechsys_core::math::Vec3::from(point);
     let (p, l) = energy::momentum(m, &data);
     d.set_item("momentum_linear", PyArray1::from_slice(py, p.as_slice()))?;
-    d.set_item("momentum_angular", PyArray1::from_slice(py, l.as_slice()))?;
+    d.set_item("momentum_angular", PyArray1::from_slice(py, (l - rp.cross(&p)).as_slice()))?;
+    let mut pl = Vec::with_capacity(m.nbodies() - 1);
+    let mut pa = Vec::with_capacity(m.nbodies() - 1);
+    for i in 1..m.nbodies() {
+        let h = data.inertia[i].mul_motion(&data.v[i]);
+        pl.push(h.f.as_slice().to_vec());
+        pa.push((h.n - rp.cross(&h.f)).as_slice().to_vec());
+    }
+    if m.nbodies() > 1 {
+        d.set_item("momentum_linear_per_body", PyArray2::from_vec2(py, &pl).map_err(|e| settings(e.to_string()))?)?;
+        d.set_item("momentum_angular_per_body", PyArray2::from_vec2(py, &pa).map_err(|e| settings(e.to_string()))?)?;
+    }
     Ok(d)
 }
 

@@ -136,6 +136,7 @@ fn simulate<'py>(
     put("body_acceleration", rec.body_acceleration, &[n, nb, 3])?;
     put("body_mass", rec.body_mass, &[n, nb])?;
     put("kinetic", rec.kinetic, &[n])?;
+    put("body_kinetic", rec.body_kinetic, &[n, nb])?;
     put("potential", rec.potential, &[n])?;
     put("dissipated", rec.dissipated, &[n])?;
     put("external_work", rec.external_work, &[n])?;

@@ -120,7 +120,8 @@ pub fn integrate<S: OdeSystem>(
             }
             break;
         }
-        if h < 1e-14 * t.abs().max(1.0) {
+        // relative to the time and to the span, so that fast systems on short spans still start
+        if h < 1e-14 * t.abs().max(t_end - t0) {
             return Err(Error::Solver(format!(
                 "step size underflow at t = {t:.6} s (h = {h:.3e}); the system may be stiff (use radau5) or singular"
             )));
