@@ -283,6 +283,14 @@ PYTHON_SIDE = {
     "marker on unknown body": (lambda: one_body().add_marker("nobody", "tip"), ["nobody"]),
     "joint that is no joint": (lambda: one_body().add_joint(42), ["add_joint"]),
     "force that is no force": (lambda: one_body().add_force("gravity"), ["add_force"]),
+    # these four raised bare numpy ValueErrors naming nothing until f1f256b
+    "axis with 2 numbers": (lambda: with_joint(ms.joints.Revolute("hinge", "ground", "arm", axis=(0.0, 1.0))).build(), ["hinge", "axis"]),
+    "frame position with 2 numbers": (
+        lambda: with_joint(ms.joints.Revolute("hinge", "ground", "arm", parent_frame=ms.Frame(position=(1.0, 2.0)))).build(),
+        ["hinge", "position"],
+    ),
+    "mass given as text": (lambda: one_body(mass="heavy"), ["arm", "mass"]),
+    "q0 given as text": (lambda: with_joint(ms.joints.Revolute("hinge", "ground", "arm", q0="up")).build(), ["hinge", "q0"]),
 }
 
 
@@ -298,29 +306,6 @@ PYTHON_SIDE["function that is no function"] = (_force_function_string, ["motor",
 @pytest.mark.parametrize("name", list(PYTHON_SIDE))
 def test_python_side_shape_errors(name):
     call, fragments = PYTHON_SIDE[name]
-    check_raises(call, ms.ModelError, *fragments)
-
-
-PYTHON_SIDE_BUGS = {
-    "axis with 2 numbers": (lambda: with_joint(ms.joints.Revolute("hinge", "ground", "arm", axis=(0.0, 1.0))).build(), ["hinge", "axis"]),
-    "frame position with 2 numbers": (
-        lambda: with_joint(ms.joints.Revolute("hinge", "ground", "arm", parent_frame=ms.Frame(position=(1.0, 2.0)))).build(),
-        ["hinge", "position"],
-    ),
-    "mass given as text": (lambda: one_body(mass="heavy"), ["arm", "mass"]),
-    "q0 given as text": (lambda: with_joint(ms.joints.Revolute("hinge", "ground", "arm", q0="up")).build(), ["hinge", "q0"]),
-}
-
-
-@pytest.mark.parametrize("name", list(PYTHON_SIDE_BUGS))
-@pytest.mark.xfail(
-    reason="package bug (reported): joints._axis, Frame.describe, Model.add_body and Joint.describe convert with "
-    "numpy without catching errors, so a wrong-shaped or non-numeric value raises a bare numpy ValueError "
-    "('cannot reshape array of size 2 into shape (3,)') that names neither the joint/body nor the key",
-    strict=True,
-)
-def test_python_side_shape_errors_name_the_item(name):
-    call, fragments = PYTHON_SIDE_BUGS[name]
     check_raises(call, ms.ModelError, *fragments)
 
 
@@ -390,22 +375,15 @@ def test_settings_error_names_the_setting(name):
     [ms.RK4(dt=0.0), ms.RK4(dt=-1e-3), ms.Radau5(dt=0.0)],
     ids=["rk4-dt-0", "rk4-dt-negative", "radau5-dt-0"],
 )
-@pytest.mark.xfail(
-    reason="package bug (reported): with output_dt left at its default, simulate() copies the bad step into "
-    "output_dt and the engine blames 'output_dt: must be > 0' instead of naming integrator.dt",
-    strict=True,
-)
 def test_bad_fixed_step_is_named_without_output_dt(integrator):
+    """Regression: with output_dt left at its default, the bad step used to be copied into
+    output_dt and blamed as 'output_dt: must be > 0'."""
     check_raises(sim(integrator=integrator), ms.SettingsError, "dt: must be > 0")
     check_raises(sim(integrator=integrator), ms.SettingsError, "integrator")
 
 
-@pytest.mark.xfail(
-    reason="package bug (reported): t_end = inf makes simulate() derive output_dt = inf, and the error blames "
-    "output_dt instead of t_end",
-    strict=True,
-)
 def test_infinite_t_end_is_named():
+    """Regression: t_end = inf used to produce output_dt = inf and an error about output_dt."""
     check_raises(sim(t_end=np.inf), ms.SettingsError, "t_end")
 
 
@@ -419,6 +397,29 @@ def test_dynamics_functions_check_their_arguments():
     check_raises(lambda: ms.dynamics.nonlinear_effects(m, np.full(5, np.nan), u), ms.SettingsError, "q[0]", "finite")
     check_raises(lambda: ms.dynamics.energies(m, q, np.zeros(9)), ms.SettingsError, "u")
     check_raises(lambda: ms._core.point_jacobian(m.build(), q, "nobody"), ms.SettingsError, "nobody")
+
+
+def test_dynamics_functions_reject_a_zero_quaternion():
+    m = small_model()
+    q = m.q0()
+    q[1:5] = 0.0  # the 'ball' joint's quaternion
+    check_raises(lambda: ms.dynamics.mass_matrix(m, q), (ms.SettingsError, ms.ModelError), "ball", "quaternion")
+
+
+def test_absurd_callback_index_is_an_error_not_a_panic():
+    """A callback id of 2**64 - 1 (the engine counts callbacks as max(id + 1)) must end in a
+    CallbackError, in release and debug builds alike."""
+    desc = small_model().to_dict()
+    desc["forces"] = [{"type": "callback", "name": "law", "id": 2**64 - 1}]
+    try:
+        model = ms.Model.from_dict(desc)
+        model.build()
+    except BaseException as e:  # noqa: BLE001 - rejecting it at build time is fine too
+        assert_no_panic(e)
+        assert isinstance(e, ms.ModelError)
+        return
+    check_raises(lambda: ms.simulate(model, 0.01), ms.MechsysError, "law")
+    check_raises(lambda: ms.dynamics.forward_dynamics(model, model.q0(), model.u0()), ms.MechsysError, "law")
 
 
 # ---- failures during the solution -------------------------------------------------------------
@@ -470,14 +471,10 @@ def test_radau5_stays_stable_on_the_same_stiff_spring():
     assert np.max(np.abs(res["joint/slide/q"])) <= 0.1 + 1e-12  # L-stable: damped, never amplified
 
 
-@pytest.mark.xfail(
-    reason="engine bug (reported): DOPRI5's automatic first step (Hairer's estimate, 9e-17 s here because "
-    "u starts at 0 with atol = 1e-10 while u' = 1e14) falls below the absolute underflow floor "
-    "h < 1e-14 * max(|t|, 1), so a harmless fast oscillator (period 0.2 us, integrated with "
-    "first_step=1e-10 in ~1500 steps) fails at t = 0 with 'step size underflow'",
-    strict=True,
-)
 def test_dopri5_starts_on_a_fast_oscillator_without_first_step():
+    """Regression: the automatic first step (9e-17 s here: u starts at 0 with atol = 1e-10 while
+    u' = 1e14) fell below an absolute underflow floor of 1e-14 s, so this harmless oscillator
+    (period 0.2 us; ~1500 steps with first_step=1e-10) failed at t = 0 with 'step size underflow'."""
     omega = np.sqrt(1e12 / 1e-3)
     period = 2.0 * np.pi / omega
     res = ms.simulate(stiff_oscillator(), 20 * period, ms.DOPRI5(), output_dt=period / 10, q0={"slide": 0.1})

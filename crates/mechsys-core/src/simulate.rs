@@ -199,17 +199,8 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
                 model.nq,
                 q.len()
             );
-            for (i, v) in q.iter().enumerate() {
-                crate::ensure!(v.is_finite(), Settings, "q0[{i}]: must be finite, got {v}");
-            }
+            model.check_q(q, "q0")?;
             y[..model.nq].copy_from_slice(q);
-            for j in &model.joints {
-                if j.kind.has_quaternion() {
-                    let r = if j.nq() == 7 { j.iq + 3..j.iq + 7 } else { j.iq..j.iq + 4 };
-                    let n: f64 = y[r].iter().map(|x| x * x).sum::<f64>().sqrt();
-                    crate::ensure!(n > 1e-12, Settings, "q0: the quaternion of joint '{}' must not be zero", j.name);
-                }
-            }
             model.normalize(&mut y[..model.nq]);
         }
         None => y[..model.nq].copy_from_slice(&model.q0()),

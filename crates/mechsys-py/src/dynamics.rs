@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{settings, PyMechsysError};
-use crate::model::{check_len, fast_slice, PyModel};
+use crate::model::{check_len, fast_slice, q_checked, q_slice, PyModel};
 use crate::simulate::PyCallbacks;
 
 fn callbacks(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<PyCallbacks> {
@@ -27,7 +27,7 @@ fn callbacks(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<PyCallback
 #[pyfunction]
 #[pyo3(signature = (model, q, t = 0.0))]
 fn crba<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>, t: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let q = fast_slice(q, model.model.nq, "q")?;
+    let q = q_slice(model, q)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     dynamics::crba::mass_matrix(&model.model, &mut data, t, q);
     let n = model.model.nu;
@@ -48,7 +48,7 @@ fn aba<'py>(
     callbacks: Option<Vec<PyObject>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let q = fast_slice(q, m.nq, "q")?;
+    let q = q_slice(model, q)?;
     let u = fast_slice(u, m.nu, "u")?;
     let tau = match tau {
         Some(a) if !a.is_none() => Some(fast_slice(a, m.nu, "tau")?),
@@ -77,7 +77,7 @@ fn rnea<'py>(
     callbacks: Option<Vec<PyObject>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
+    let q = q_checked(model, &q)?;
     let u = check_len(&u, m.nu, "u")?;
     let ud = check_len(&udot, m.nu, "udot")?;
     let cb = self::callbacks(model, callbacks)?;
@@ -99,7 +99,7 @@ fn nonlinear_effects<'py>(
     callbacks: Option<Vec<PyObject>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
+    let q = q_checked(model, &q)?;
     let u = check_len(&u, m.nu, "u")?;
     let cb = self::callbacks(model, callbacks)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
@@ -123,7 +123,7 @@ fn energies<'py>(
         return Err(settings(format!("point: must be finite, got {point:?}")));
     }
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
+    let q = q_checked(model, &q)?;
     let u = check_len(&u, m.nu, "u")?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     kinematics::forward_kinematics(m, &mut data, q, u);

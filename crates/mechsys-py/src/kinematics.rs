@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::settings;
-use crate::model::{check_len, PyModel};
+use crate::model::{check_len, q_checked, PyModel};
 
 fn body_index(model: &PyModel, body: &str) -> PyResult<usize> {
     model.model.body_id(body).ok_or_else(|| settings(format!("body: unknown body '{body}'")))
@@ -25,7 +25,7 @@ fn body_states<'py>(
     u: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
+    let q = q_checked(model, &q)?;
     let zero = vec![0.0; m.nu];
     let u = match &u {
         Some(a) => check_len(a, m.nu, "u")?,
@@ -66,7 +66,7 @@ fn point_jacobian<'py>(
     point: [f64; 3],
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
+    let q = q_checked(model, &q)?;
     let b = body_index(model, body)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     kinematics::positions(m, &mut data, q);
@@ -90,7 +90,7 @@ fn point_position<'py>(
     point: [f64; 3],
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
-    let q = check_len(&q, m.nq, "q")?;
+    let q = q_checked(model, &q)?;
     let b = body_index(model, body)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     kinematics::positions(m, &mut data, q);

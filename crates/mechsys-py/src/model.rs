@@ -178,6 +178,20 @@ pub fn fast_slice<'a>(a: &'a Bound<'_, PyAny>, n: usize, what: &str) -> PyResult
     Ok(s)
 }
 
+/// A configuration vector read in place and checked like `simulate` checks q0.
+pub fn q_slice<'a>(model: &PyModel, a: &'a Bound<'_, PyAny>) -> PyResult<&'a [f64]> {
+    let q = fast_slice(a, model.model.nq, "q")?;
+    model.model.check_q(q, "q").map_err(crate::errors::PyMechsysError::from)?;
+    Ok(q)
+}
+
+/// As [`q_slice`] for arguments already extracted as readonly arrays.
+pub fn q_checked<'a>(model: &PyModel, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
+    let q = check_len(a, model.model.nq, "q")?;
+    model.model.check_q(q, "q").map_err(crate::errors::PyMechsysError::from)?;
+    Ok(q)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()
 }

@@ -344,10 +344,21 @@ fn display_path(p: &str) -> String {
     }
 }
 
-/// Drop serde_json's " at line X column Y" (meaningless for a TOML file or a Python dict).
+/// Drop serde_json's " at line X column Y" (meaningless for a TOML file or a Python dict) and
+/// say in plain words what the few opaque serde messages mean.
 fn clean_message(m: &str) -> String {
-    match m.find(" at line ") {
-        Some(i) => m[..i].to_string(),
-        None => m.to_string(),
+    let m = match m.find(" at line ") {
+        Some(i) => &m[..i],
+        None => m,
+    };
+    if m.contains("invalid number") || m == "expected value" {
+        // NaN and infinities reach the parser as non-JSON tokens
+        "must be a finite number (NaN and infinity are not allowed)".to_string()
+    } else if m.contains("untagged enum InertiaDescription") {
+        "expected a 3x3 matrix, 3 diagonal values or 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]".to_string()
+    } else if m.contains("untagged enum RotationDescription") {
+        "expected a 3x3 rotation matrix, a quaternion [w, x, y, z] or a table with one of cardan, euler, rotvec".to_string()
+    } else {
+        m.to_string()
     }
 }

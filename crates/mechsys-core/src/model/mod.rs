@@ -320,6 +320,24 @@ impl Model {
         }
         q
     }
+    /// Checks that q has the model's length, is finite, and that no quaternion is zero (a zero
+    /// quaternion is no rotation at all; any other norm is normalized where it is used).
+    pub fn check_q(&self, q: &[f64], what: &str) -> crate::error::Result<()> {
+        crate::ensure!(q.len() == self.nq, Settings, "{what}: the model has {} coordinates, got {}", self.nq, q.len());
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(crate::error::Error::Settings(format!("{what}[{i}]: must be finite, got {}", q[i])));
+        }
+        for j in &self.joints {
+            let r = match j.kind {
+                JointKind::Spherical => j.iq..j.iq + 4,
+                JointKind::Free => j.iq + 3..j.iq + 7,
+                _ => continue,
+            };
+            let n: f64 = q[r].iter().map(|x| x * x).sum();
+            crate::ensure!(n > 1e-24, Settings, "{what}: the quaternion of joint '{}' must not be zero", j.name);
+        }
+        Ok(())
+    }
     /// Normalizes all quaternions in q.
     pub fn normalize(&self, q: &mut [f64]) {
         for j in &self.joints {

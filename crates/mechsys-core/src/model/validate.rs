@@ -97,7 +97,8 @@ pub(crate) fn inertia(desc: &InertiaDescription, what: &str) -> Result<Mat3> {
         Model,
         "{what}: inertia tensor must be symmetric"
     );
-    let eig = SymmetricEigen::new(m).eigenvalues;
+    let mut eig: Vec<f64> = SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
+    eig.sort_by(|x, y| x.total_cmp(y));
     let (a, b, c) = (eig[0], eig[1], eig[2]);
     crate::ensure!(
         a > 0.0 && b > 0.0 && c > 0.0,
@@ -144,6 +145,7 @@ fn time_function(f: &Option<TimeFunctionDescription>, what: &str, n_cb: &mut usi
             TimeFunction::Table { t: t.clone(), values: values.clone() }
         }
         TimeFunctionDescription::Callback { id } => {
+            crate::ensure!(*id < 1 << 32, Model, "{what}.id: callback index {id} is out of range");
             *n_cb = (*n_cb).max(id + 1);
             TimeFunction::Callback(*id)
         }
@@ -169,7 +171,8 @@ fn per_dof(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>> {
     if v.len() == 1 {
         Ok(vec![v[0]; n])
     } else {
-        crate::ensure!(v.len() == n, Model, "{what}: expected 1 or {n} values (one per joint velocity), got {}", v.len());
+        let expected = if n == 1 { "1 value".to_string() } else { format!("1 or {n} values (one per joint velocity)") };
+        crate::ensure!(v.len() == n, Model, "{what}: expected {expected}, got {}", v.len());
         Ok(v.to_vec())
     }
 }
@@ -516,6 +519,7 @@ impl Model {
                     }
                 }
                 ForceDescription::Callback { id, .. } => {
+                    crate::ensure!(*id < 1 << 32, Model, "{what}.id: callback index {id} is out of range");
                     n_callbacks = n_callbacks.max(id + 1);
                     ForceElement::Callback { name, id: *id }
                 }
