@@ -24,7 +24,7 @@ $(BUILD): $(STAMP) $(CORE_SOURCES)
 build: $(BUILD)
 
 demo: $(BUILD)
-	$(VENV)/bin/mechsys run examples/heavy_top.py --out results/heavy_top.h5 --plot results/heavy_top.png
+	$(PY) examples/heavy_top.py
 
 test: $(BUILD)
 	cargo test -p mechsys-core

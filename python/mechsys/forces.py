@@ -13,14 +13,7 @@ import numpy as np
 from . import functions
 from .errors import ModelError
 from .joints import JointDamper, JointSpring, RotaryDamper, RotarySpring, LinearDamper, LinearSpring  # noqa: F401
-
-
-def _vec(v, what: str) -> list[float]:
-    try:
-        a = np.asarray(v, dtype=float).reshape(3)
-    except Exception:  # noqa: BLE001
-        raise ModelError(f"{what}: expected 3 numbers, got {v!r}") from None
-    return [float(x) for x in a]
+from .joints import _vec3 as _vec
 
 
 def _name(x) -> str:

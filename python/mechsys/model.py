@@ -32,12 +32,7 @@ class Body:
         return self
 
 
-def _vec3(v, what: str) -> list[float]:
-    try:
-        a = np.asarray(v, dtype=float).reshape(3)
-    except Exception:  # noqa: BLE001
-        raise ModelError(f"{what}: expected 3 numbers, got {v!r}") from None
-    return [float(x) for x in a]
+from .joints import _vec3  # noqa: E402  (one vector check for the whole builder)
 
 
 class Model:

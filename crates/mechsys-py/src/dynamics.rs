@@ -12,15 +12,7 @@ use crate::model::{check_len, fast_slice, q_checked, q_slice, PyModel};
 use crate::simulate::PyCallbacks;
 
 fn callbacks(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<PyCallbacks> {
-    let cb = PyCallbacks { funcs: cbs.unwrap_or_default(), nu: model.model.nu };
-    if cb.funcs.len() < model.model.n_callbacks {
-        return Err(settings(format!(
-            "callbacks: the model refers to {} callbacks, {} given",
-            model.model.n_callbacks,
-            cb.funcs.len()
-        )));
-    }
-    Ok(cb)
+    PyCallbacks::for_model(model, cbs)
 }
 
 /// Mass matrix M(q) by the composite-rigid-body algorithm.

@@ -21,6 +21,19 @@ pub struct PyCallbacks {
 }
 
 impl PyCallbacks {
+    /// The callables a model refers to; fails if fewer were given than the model uses.
+    pub fn for_model(model: &PyModel, cbs: Option<Vec<PyObject>>) -> PyResult<Self> {
+        let cb = PyCallbacks { funcs: cbs.unwrap_or_default(), nu: model.model.nu };
+        if cb.funcs.len() < model.model.n_callbacks {
+            return Err(settings(format!(
+                "callbacks: the model refers to {} callbacks, {} given",
+                model.model.n_callbacks,
+                cb.funcs.len()
+            )));
+        }
+        Ok(cb)
+    }
+
     fn get(&self, id: usize) -> Result<&PyObject, Error> {
         self.funcs.get(id).ok_or_else(|| Error::Callback(format!("callback {id} was not provided")))
     }
@@ -104,14 +117,7 @@ fn simulate<'py>(
         let m = m.split(" at line ").next().unwrap_or(&m).to_string();
         settings(format!("settings.{}: {m}", e.path()))
     })?;
-    let cb = PyCallbacks { funcs: callbacks.unwrap_or_default(), nu: model.model.nu };
-    if cb.funcs.len() < model.model.n_callbacks {
-        return Err(settings(format!(
-            "callbacks: the model refers to {} callbacks, {} given",
-            model.model.n_callbacks,
-            cb.funcs.len()
-        )));
-    }
+    let cb = PyCallbacks::for_model(model, callbacks)?;
     let prog = progress.map(|p| p.inner.clone());
     let m = &model.model;
     let rec = py
