@@ -59,24 +59,40 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
         let (lo, hi) = data.ia.split_at_mut(i);
         let ia = &mut hi[0];
         if nu == 1 {
-            // the common case, without small-matrix bookkeeping
-            let s = &data.s[i][0];
-            let u_col = ia.mul_motion(s);
-            let d_inv = 1.0 / s.dot6(&u_col);
+            // the common case: U = I^A S and I^A c in one sweep of I^A, then I^a = I^A - U Uᵀ/D
+            // added to the parent in a second sweep (I^a itself is never stored)
+            let s = data.s[i][0].v6();
+            let c = data.c[i].v6();
+            let mut u_col = [0.0; 6];
+            let mut ic = [0.0; 6];
+            for (r, row) in ia.0.iter().enumerate() {
+                let (mut a, mut b) = (0.0, 0.0);
+                for k in 0..6 {
+                    a += row[k] * s[k];
+                    b += row[k] * c[k];
+                }
+                u_col[r] = a;
+                ic[r] = b;
+            }
+            let d_inv = 1.0 / dot6(&s, &u_col);
             let t = data.tau_applied[j.iu] + tau.map_or(0.0, |t| t[j.iu]);
-            let ub = t - s.dot(&data.pa[i]);
+            let ub = t - data.s[i][0].dot(&data.pa[i]);
             data.u_mat[i][0] = u_col;
             data.d_inv[i][0][0] = d_inv;
             data.u_bias[i][0] = ub;
             if parent != 0 {
-                ia.sub_outer(d_inv, &u_col);
-                let ic = ia.mul_motion(&data.c[i]);
-                let k = d_inv * ub;
+                // p^a = p^A + I^a c + U D⁻¹ u, with I^a c = I^A c - U D⁻¹ (Uᵀ c)
+                let k = d_inv * (ub - dot6(&u_col, &c));
                 let mut pa = data.pa[i].v6();
                 for r in 0..6 {
                     pa[r] += ic[r] + u_col[r] * k;
                 }
-                lo[parent].add(ia);
+                for ((prow, irow), ur) in lo[parent].0.iter_mut().zip(&ia.0).zip(&u_col) {
+                    let sr = d_inv * ur;
+                    for ((x, y), uk) in prow.iter_mut().zip(irow).zip(&u_col) {
+                        *x += y - sr * uk;
+                    }
+                }
                 data.pa[parent] += Force::from_v6(&pa);
             }
             continue;
