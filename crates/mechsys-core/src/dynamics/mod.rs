@@ -29,8 +29,7 @@ use crate::model::Model;
 /// The stages before the solve: kinematics of (q, u), time-dependent inertias, force elements.
 /// Returns the power balance of the force elements.
 pub fn prepare(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<Powers> {
-    kinematics::forward_kinematics(model, data, q, u);
-    kinematics::inertias(model, data, t);
+    kinematics::forward_pass(model, data, t, q, u);
     forces::evaluate(model, data, t, q, u, cb)
 }
 

@@ -23,37 +23,87 @@ pub fn motion_to_world(x: &Pose, m: &Motion) -> Motion {
     Motion::new(w, x.a * m.v + x.r.cross(&w))
 }
 
+/// Position stage for the joint moving body `i`: its placement, joint frame and world subspace.
+#[inline(always)]
+fn position_step(j: &crate::model::Joint, data: &mut Data, i: usize, q: &[f64]) {
+    let qj = &q[j.iq..j.iq + j.nq()];
+    // pose of the child joint frame in I, then of the child body frame (joint frames are
+    // mostly pure offsets: skip the rotation products then)
+    let xp = &data.x_abs[j.parent];
+    let x_pj = if j.frames_plain.0 { xp.translate(&j.parent_frame.r) } else { xp.compose(&j.parent_frame) };
+    let x_cj = match j.coordinate_axis {
+        Some(k) => {
+            // rotation about coordinate axis k: only the two other columns turn (eq. 2.12-2.18)
+            let (s, c) = qj[0].sin_cos();
+            let (i1, i2) = ((k + 1) % 3, (k + 2) % 3);
+            let mut a = x_pj.a;
+            let (c1, c2) = (x_pj.a.column(i1).into_owned(), x_pj.a.column(i2).into_owned());
+            a.set_column(i1, &(c1 * c + c2 * s));
+            a.set_column(i2, &(c2 * c - c1 * s));
+            Pose::new(a, x_pj.r)
+        }
+        None => x_pj.compose(&j.kind.placement(qj)),
+    };
+    data.x_abs[i] = if j.frames_plain.1 { x_cj.translate(&j.child_frame_inv.r) } else { x_cj.compose(&j.child_frame_inv) };
+    data.x_joint[i] = x_cj;
+    let mut s = [Motion::ZERO; 6];
+    j.kind.subspace(qj, &mut s);
+    for k in 0..j.nu() {
+        data.s[i][k] = motion_to_world(&x_cj, &s[k]);
+    }
+}
+
+/// Velocity stage for the joint moving body `i`: twist and velocity-product acceleration.
+#[inline(always)]
+fn velocity_step(j: &crate::model::Joint, data: &mut Data, i: usize, q: &[f64], u: &[f64]) {
+    let uj = &u[j.iu..j.iu + j.nu()];
+    let mut vj = Motion::ZERO;
+    for (k, uk) in uj.iter().enumerate() {
+        vj += data.s[i][k] * *uk;
+    }
+    let vi = data.v[j.parent] + vj;
+    data.v[i] = vi;
+    // d/dt of world-frame S: the frame carrying S moves with v_i, plus the joint's own Ṡ u
+    let mut c = vi.cross_motion(&vj);
+    if j.kind.has_bias() {
+        let cj = j.kind.bias(&q[j.iq..j.iq + j.nq()], uj);
+        c += motion_to_world(&data.x_joint[i], &cj);
+    }
+    data.c[i] = c;
+}
+
+/// Inertia of body `i` at time t in world components about the origin (variable mass scaled).
+#[inline(always)]
+fn inertia_step(b: &crate::model::Body, data: &mut Data, i: usize, t: f64) {
+    let x = &data.x_abs[i];
+    let c = x.r + x.a * b.com;
+    let (m, i_c) = if b.mass_rate == 0.0 {
+        (b.mass, b.inertia)
+    } else {
+        let m = b.mass_at(t);
+        (m, b.inertia * (m / b.mass))
+    };
+    let i_c_w = if b.principal_axes {
+        // A diag(d) Aᵀ = Σ d_k a_k a_kᵀ over the columns a_k of A (half the work of two products)
+        let d = i_c.diagonal();
+        let mut r = Mat3::zeros();
+        for k in 0..3 {
+            let col = x.a.column(k);
+            r += col * col.transpose() * d[k];
+        }
+        r
+    } else {
+        x.a * i_c * x.a.transpose()
+    };
+    data.inertia[i] = crate::spatial::RigidInertia::from_com(m, &c, &i_c_w);
+}
+
 /// Position stage: placements `x_abs`, `x_joint` and motion subspaces `s` (world) of all bodies.
 ///
 /// eq. 2.46: A_IBi = A_IBi-1 · A_Bi-1Bi; eq. 2.51: r_IBi = r_IBi-1 + A_IBi-1 r_Bi-1Bi.
 pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
-        let i = ji + 1;
-        let qj = &q[j.iq..j.iq + j.nq()];
-        // pose of the child joint frame in I, then of the child body frame (joint frames are
-        // mostly pure offsets: skip the rotation products then)
-        let xp = &data.x_abs[j.parent];
-        let x_pj = if j.frames_plain.0 { xp.translate(&j.parent_frame.r) } else { xp.compose(&j.parent_frame) };
-        let x_cj = match j.coordinate_axis {
-            Some(k) => {
-                // rotation about coordinate axis k: only the two other columns turn (eq. 2.12-2.18)
-                let (s, c) = qj[0].sin_cos();
-                let (i1, i2) = ((k + 1) % 3, (k + 2) % 3);
-                let mut a = x_pj.a;
-                let (c1, c2) = (x_pj.a.column(i1).into_owned(), x_pj.a.column(i2).into_owned());
-                a.set_column(i1, &(c1 * c + c2 * s));
-                a.set_column(i2, &(c2 * c - c1 * s));
-                Pose::new(a, x_pj.r)
-            }
-            None => x_pj.compose(&j.kind.placement(qj)),
-        };
-        data.x_abs[i] = if j.frames_plain.1 { x_cj.translate(&j.child_frame_inv.r) } else { x_cj.compose(&j.child_frame_inv) };
-        data.x_joint[i] = x_cj;
-        let mut s = [Motion::ZERO; 6];
-        j.kind.subspace(qj, &mut s);
-        for k in 0..j.nu() {
-            data.s[i][k] = motion_to_world(&x_cj, &s[k]);
-        }
+        position_step(j, data, ji + 1, q);
     }
 }
 
@@ -61,21 +111,7 @@ pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
 /// (the ω̃ ω_rel and Coriolis terms of eqs. 2.56, 2.57). Requires [`positions`].
 pub fn velocities(model: &Model, data: &mut Data, q: &[f64], u: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
-        let i = ji + 1;
-        let uj = &u[j.iu..j.iu + j.nu()];
-        let mut vj = Motion::ZERO;
-        for (k, uk) in uj.iter().enumerate() {
-            vj += data.s[i][k] * *uk;
-        }
-        let vi = data.v[j.parent] + vj;
-        data.v[i] = vi;
-        // d/dt of world-frame S: the frame carrying S moves with v_i, plus the joint's own Ṡ u
-        let mut c = vi.cross_motion(&vj);
-        if j.kind.has_bias() {
-            let cj = j.kind.bias(&q[j.iq..j.iq + j.nq()], uj);
-            c += motion_to_world(&data.x_joint[i], &cj);
-        }
-        data.c[i] = c;
+        velocity_step(j, data, ji + 1, q, u);
     }
 }
 
@@ -83,27 +119,18 @@ pub fn velocities(model: &Model, data: &mut Data, q: &[f64], u: &[f64]) {
 /// Requires [`positions`].
 pub fn inertias(model: &Model, data: &mut Data, t: f64) {
     for (i, b) in model.bodies.iter().enumerate().skip(1) {
-        let x = &data.x_abs[i];
-        let c = x.r + x.a * b.com;
-        let (m, i_c) = if b.mass_rate == 0.0 {
-            (b.mass, b.inertia)
-        } else {
-            let m = b.mass_at(t);
-            (m, b.inertia * (m / b.mass))
-        };
-        let i_c_w = if b.principal_axes {
-            // A diag(d) Aᵀ = Σ d_k a_k a_kᵀ over the columns a_k of A (half the work of two products)
-            let d = i_c.diagonal();
-            let mut r = Mat3::zeros();
-            for k in 0..3 {
-                let col = x.a.column(k);
-                r += col * col.transpose() * d[k];
-            }
-            r
-        } else {
-            x.a * i_c * x.a.transpose()
-        };
-        data.inertia[i] = crate::spatial::RigidInertia::from_com(m, &c, &i_c_w);
+        inertia_step(b, data, i, t);
+    }
+}
+
+/// Positions, velocities and inertias in one sweep over the tree (the stages of one evaluation
+/// before the forces; fused so each body's placement is used while it is still in registers).
+pub fn forward_pass(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64]) {
+    for (ji, j) in model.joints.iter().enumerate() {
+        let i = ji + 1;
+        position_step(j, data, i, q);
+        velocity_step(j, data, i, q, u);
+        inertia_step(&model.bodies[i], data, i, t);
     }
 }
 
