@@ -300,17 +300,20 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
         rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
         rec.body_mass.push(data.inertia[i].m);
     }
-    let mut t_sum = 0.0;
+    // one product I v per body gives its kinetic energy and both momenta (world convention)
+    let (mut t_sum, mut p, mut l) = (0.0, crate::math::Vec3::zeros(), crate::math::Vec3::zeros());
     for i in 1..model.nbodies() {
-        let e = energy::body_kinetic_energy(data, i);
+        let h = data.inertia[i].mul_motion(&data.v[i]);
+        let e = 0.5 * data.v[i].dot(&h);
         rec.body_kinetic.push(e);
         t_sum += e;
+        p += h.f;
+        l += h.n;
     }
     rec.kinetic.push(t_sum);
     rec.potential.push(energy::potential_energy(model, data, &y[..nq]));
     rec.dissipated.push(y[nq + nu]);
     rec.external_work.push(y[nq + nu + 1]);
-    let (p, l) = energy::momentum(model, data);
     rec.momentum_linear.extend_from_slice(p.as_slice());
     rec.momentum_angular.extend_from_slice(l.as_slice());
 }

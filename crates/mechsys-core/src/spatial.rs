@@ -358,14 +358,17 @@ mod tests {
 /// A 6-vector as a plain array (the inner loops of the ABA work on these; LLVM unrolls them).
 pub type V6 = [f64; 6];
 
-/// Dense 6×6 matrix (articulated-body inertias), row-major, with the few operations the ABA needs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct M6(pub [[f64; 6]; 6]);
-
-impl Default for M6 {
-    fn default() -> Self {
-        M6([[0.0; 6]; 6])
-    }
+/// Symmetric 6×6 matrix in block form `[A B; Bᵀ C]` (articulated-body inertias): `A` and `C`
+/// symmetric, stored as their upper triangles `[xx, xy, xz, yy, yz, zz]`; 21 numbers instead of 36,
+/// which is what the ABA's inner loops read and write.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct M6 {
+    /// Upper triangle of the angular block.
+    pub a: [f64; 6],
+    /// Coupling block, row-major.
+    pub b: [[f64; 3]; 3],
+    /// Upper triangle of the linear block.
+    pub c: [f64; 6],
 }
 
 impl Motion {
@@ -399,41 +402,78 @@ impl M6 {
     #[inline]
     pub fn set_rigid(&mut self, r: &RigidInertia) {
         let (h, i) = (&r.h, &r.i_o);
-        self.0 = [
-            [i[(0, 0)], i[(0, 1)], i[(0, 2)], 0.0, -h.z, h.y],
-            [i[(1, 0)], i[(1, 1)], i[(1, 2)], h.z, 0.0, -h.x],
-            [i[(2, 0)], i[(2, 1)], i[(2, 2)], -h.y, h.x, 0.0],
-            [0.0, h.z, -h.y, r.m, 0.0, 0.0],
-            [-h.z, 0.0, h.x, 0.0, r.m, 0.0],
-            [h.y, -h.x, 0.0, 0.0, 0.0, r.m],
-        ];
+        self.a = [i[(0, 0)], i[(0, 1)], i[(0, 2)], i[(1, 1)], i[(1, 2)], i[(2, 2)]];
+        self.b = [[0.0, -h.z, h.y], [h.z, 0.0, -h.x], [-h.y, h.x, 0.0]];
+        self.c = [r.m, 0.0, 0.0, r.m, 0.0, r.m];
+    }
+    /// Entry (r, c) of the full matrix.
+    #[inline]
+    pub fn get(&self, r: usize, c: usize) -> f64 {
+        const TRI: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+        match (r < 3, c < 3) {
+            (true, true) => self.a[TRI[r][c]],
+            (true, false) => self.b[r][c - 3],
+            (false, true) => self.b[c][r - 3],
+            (false, false) => self.c[TRI[r - 3][c - 3]],
+        }
+    }
+    /// Product with a plain 6-vector.
+    #[inline(always)]
+    pub fn mul(&self, x: &V6) -> V6 {
+        let (a, b, c) = (&self.a, &self.b, &self.c);
+        [
+            a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + b[0][0] * x[3] + b[0][1] * x[4] + b[0][2] * x[5],
+            a[1] * x[0] + a[3] * x[1] + a[4] * x[2] + b[1][0] * x[3] + b[1][1] * x[4] + b[1][2] * x[5],
+            a[2] * x[0] + a[4] * x[1] + a[5] * x[2] + b[2][0] * x[3] + b[2][1] * x[4] + b[2][2] * x[5],
+            b[0][0] * x[0] + b[1][0] * x[1] + b[2][0] * x[2] + c[0] * x[3] + c[1] * x[4] + c[2] * x[5],
+            b[0][1] * x[0] + b[1][1] * x[1] + b[2][1] * x[2] + c[1] * x[3] + c[3] * x[4] + c[4] * x[5],
+            b[0][2] * x[0] + b[1][2] * x[1] + b[2][2] * x[2] + c[2] * x[3] + c[4] * x[4] + c[5] * x[5],
+        ]
     }
     /// Product with a motion vector; the result is a force vector.
     #[inline(always)]
     pub fn mul_motion(&self, m: &Motion) -> V6 {
-        let x = m.v6();
-        let mut out = [0.0; 6];
-        for (o, row) in out.iter_mut().zip(&self.0) {
-            *o = row[0] * x[0] + row[1] * x[1] + row[2] * x[2] + row[3] * x[3] + row[4] * x[4] + row[5] * x[5];
-        }
-        out
+        self.mul(&m.v6())
     }
-    /// `self -= a · u uᵀ`.
+    /// `self += o - s · u uᵀ` (adding a child's articulated inertia with its joint's motion removed).
     #[inline(always)]
-    pub fn sub_outer(&mut self, a: f64, u: &V6) {
-        for (row, ui) in self.0.iter_mut().zip(u) {
-            let s = a * ui;
-            for (x, uj) in row.iter_mut().zip(u) {
-                *x -= s * uj;
+    pub fn add_minus_outer(&mut self, o: &M6, s: f64, u: &V6) {
+        const TRI: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+        for (k, &(r, c)) in TRI.iter().enumerate() {
+            self.a[k] += o.a[k] - s * u[r] * u[c];
+            self.c[k] += o.c[k] - s * u[r + 3] * u[c + 3];
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                self.b[r][c] += o.b[r][c] - s * u[r] * u[c + 3];
+            }
+        }
+    }
+    /// `self -= x yᵀ` on the stored entries only; used to subtract `U D⁻¹ Uᵀ = Σ_r w_r u_rᵀ`
+    /// term by term, whose sum is symmetric even though each term is not.
+    #[inline]
+    pub fn sub_product(&mut self, x: &V6, y: &V6) {
+        const TRI: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+        for (k, &(r, c)) in TRI.iter().enumerate() {
+            self.a[k] -= x[r] * y[c];
+            self.c[k] -= x[r + 3] * y[c + 3];
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                self.b[r][c] -= x[r] * y[c + 3];
             }
         }
     }
     /// `self += o`.
     #[inline(always)]
     pub fn add(&mut self, o: &M6) {
-        for (r, ro) in self.0.iter_mut().zip(&o.0) {
-            for (x, y) in r.iter_mut().zip(ro) {
-                *x += y;
+        for k in 0..6 {
+            self.a[k] += o.a[k];
+            self.c[k] += o.c[k];
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                self.b[r][c] += o.b[r][c];
             }
         }
     }

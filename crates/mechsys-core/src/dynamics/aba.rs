@@ -63,17 +63,8 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
             // added to the parent in a second sweep (I^a itself is never stored)
             let s = data.s[i][0].v6();
             let c = data.c[i].v6();
-            let mut u_col = [0.0; 6];
-            let mut ic = [0.0; 6];
-            for (r, row) in ia.0.iter().enumerate() {
-                let (mut a, mut b) = (0.0, 0.0);
-                for k in 0..6 {
-                    a += row[k] * s[k];
-                    b += row[k] * c[k];
-                }
-                u_col[r] = a;
-                ic[r] = b;
-            }
+            let u_col = ia.mul(&s);
+            let ic = ia.mul(&c);
             let d_inv = 1.0 / dot6(&s, &u_col);
             let t = data.tau_applied[j.iu] + tau.map_or(0.0, |t| t[j.iu]);
             let ub = t - data.s[i][0].dot(&data.pa[i]);
@@ -87,12 +78,7 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
                 for r in 0..6 {
                     pa[r] += ic[r] + u_col[r] * k;
                 }
-                for ((prow, irow), ur) in lo[parent].0.iter_mut().zip(&ia.0).zip(&u_col) {
-                    let sr = d_inv * ur;
-                    for ((x, y), uk) in prow.iter_mut().zip(irow).zip(&u_col) {
-                        *x += y - sr * uk;
-                    }
-                }
+                lo[parent].add_minus_outer(ia, d_inv, &u_col);
                 data.pa[parent] += Force::from_v6(&pa);
             }
             continue;
@@ -126,7 +112,7 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
             d = [[f64::NAN; 6]; 6];
         }
         if parent != 0 {
-            // I^a = I^A - U D⁻¹ Uᵀ (D⁻¹ = L Lᵀ is not needed: subtract column by column)
+            // I^a = I^A - U D⁻¹ Uᵀ, subtracted as Σ_r (U D⁻¹)_r U_rᵀ
             let mut w = [[0.0; 6]; 6]; // W = U D⁻¹
             for r in 0..nu {
                 for c in 0..nu {
@@ -136,11 +122,7 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
                 }
             }
             for r in 0..nu {
-                for e in 0..6 {
-                    for f in 0..6 {
-                        ia.0[e][f] -= w[r][e] * u_cols[r][f];
-                    }
-                }
+                ia.sub_product(&w[r], &u_cols[r]);
             }
             let ic = ia.mul_motion(&data.c[i]);
             let mut pa = data.pa[i].v6();

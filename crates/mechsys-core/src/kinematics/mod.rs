@@ -44,8 +44,18 @@ fn position_step(j: &crate::model::Joint, data: &mut Data, i: usize, q: &[f64]) 
         }
         None => x_pj.compose(&j.kind.placement(qj)),
     };
-    data.x_abs[i] = if j.frames_plain.1 { x_cj.translate(&j.child_frame_inv.r) } else { x_cj.compose(&j.child_frame_inv) };
+    data.x_abs[i] = match (j.frames_plain.1, j.child_frame_inv.r == Vec3::zeros()) {
+        (true, true) => x_cj,
+        (true, false) => x_cj.translate(&j.child_frame_inv.r),
+        _ => x_cj.compose(&j.child_frame_inv),
+    };
     data.x_joint[i] = x_cj;
+    if let Some(k) = j.coordinate_axis {
+        // the axis in I is a column of A; the twist about it through r is (ω, r × ω)
+        let w = x_cj.a.column(k).into_owned();
+        data.s[i][0] = Motion::new(w, x_cj.r.cross(&w));
+        return;
+    }
     let mut s = [Motion::ZERO; 6];
     j.kind.subspace(qj, &mut s);
     for k in 0..j.nu() {
@@ -84,14 +94,12 @@ fn inertia_step(b: &crate::model::Body, data: &mut Data, i: usize, t: f64) {
         (m, b.inertia * (m / b.mass))
     };
     let i_c_w = if b.principal_axes {
-        // A diag(d) Aᵀ = Σ d_k a_k a_kᵀ over the columns a_k of A (half the work of two products)
-        let d = i_c.diagonal();
-        let mut r = Mat3::zeros();
-        for k in 0..3 {
-            let col = x.a.column(k);
-            r += col * col.transpose() * d[k];
-        }
-        r
+        // A diag(d) Aᵀ = Σ d_k a_k a_kᵀ over the columns a_k of A, symmetric: 6 entries
+        let a = &x.a;
+        let (d0, d1, d2) = (i_c[(0, 0)], i_c[(1, 1)], i_c[(2, 2)]);
+        let e = |r: usize, c: usize| d0 * a[(r, 0)] * a[(c, 0)] + d1 * a[(r, 1)] * a[(c, 1)] + d2 * a[(r, 2)] * a[(c, 2)];
+        let (xx, xy, xz, yy, yz, zz) = (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2));
+        Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
     } else {
         x.a * i_c * x.a.transpose()
     };
