@@ -34,7 +34,7 @@ fn position_step(j: &crate::model::Joint, data: &mut Data, i: usize, q: &[f64]) 
     let x_cj = match j.coordinate_axis {
         Some(k) => {
             // rotation about coordinate axis k: only the two other columns turn (eq. 2.12-2.18)
-            let (s, c) = qj[0].sin_cos();
+            let (s, c) = crate::math::trig::sin_cos(qj[0]);
             let (i1, i2) = ((k + 1) % 3, (k + 2) % 3);
             let mut a = x_pj.a;
             let (c1, c2) = (x_pj.a.column(i1).into_owned(), x_pj.a.column(i2).into_owned());

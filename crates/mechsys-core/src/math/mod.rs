@@ -6,6 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 
 pub mod frames;
 pub mod linalg;
+pub mod trig;
 pub mod rotation;
 
 /// 3-vector of `f64`.

@@ -240,7 +240,7 @@ fn unit(k: usize) -> Vec3 {
 /// Rotation matrix about a unit axis (Rodrigues), A_PC of a rotation by `angle`.
 #[inline]
 pub fn axis_rotation(axis: &Vec3, angle: f64) -> Mat3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = crate::math::trig::sin_cos(angle);
     // R = c E + s ã + (1 - c) a aᵀ
     let (x, y, z) = (axis.x, axis.y, axis.z);
     let k = 1.0 - c;
