@@ -20,6 +20,10 @@ energy/kinetic, potential,      J            (n,)
   external_work
 momentum/linear                 N s          (n, 3)
 momentum/angular                N m s        (n, 3)  about the inertial origin
+joint/<j>/reaction_force        N            (n, 3)  wrench of the parent on the child through
+joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint origin, child
+                                                     joint frame components (computed on first
+                                                     access from the recorded state)
 ==============================  ===========  =============================================
 """
 
@@ -27,7 +31,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Iterable
+from typing import Callable, Iterable
 
 import numpy as np
 
@@ -49,14 +53,24 @@ class Results:
     """Named signals of one simulation. ``res["joint/hinge/q"]`` is a numpy array (a view into the
     recorded block, no copy); ``res.unit(name)`` its unit; ``res.model`` the model description."""
 
-    def __init__(self, signals: dict[str, np.ndarray], units: dict[str, str], attrs: dict | None = None):
+    def __init__(
+        self,
+        signals: dict[str, np.ndarray],
+        units: dict[str, str],
+        attrs: dict | None = None,
+        lazy: dict[str, tuple[str, Callable[[], dict[str, np.ndarray]]]] | None = None,
+    ):
         self._signals = signals
         self._units = units
         self.attrs = dict(attrs or {})
+        # signals derived from the recorded state on first access: name -> (unit, group computer)
+        self._lazy = dict(lazy or {})
 
     # ---- construction from a simulation --------------------------------------------------------
     @classmethod
-    def from_raw(cls, raw: dict, joints: list[dict], body_names: list[str], attrs: dict) -> "Results":
+    def from_raw(
+        cls, raw: dict, joints: list[dict], body_names: list[str], attrs: dict, engine=None, callbacks=None
+    ) -> "Results":
         s: dict[str, np.ndarray] = {}
         u: dict[str, str] = {}
 
@@ -93,28 +107,45 @@ class Results:
         put("energy/external_work", raw["external_work"], "J")
         put("momentum/linear", raw["momentum_linear"], "N s")
         put("momentum/angular", raw["momentum_angular"], "N m s")
-        return cls(s, u, attrs)
+        lazy = {}
+        if engine is not None and joints:
+            group = _reaction_group(engine, callbacks, joints, raw)
+            for j in joints:
+                lazy[f"joint/{j['name']}/reaction_force"] = ("N", group)
+                lazy[f"joint/{j['name']}/reaction_torque"] = ("N m", group)
+        return cls(s, u, attrs, lazy)
 
     # ---- access --------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> np.ndarray:
         try:
             return self._signals[name]
         except KeyError:
+            if name in self._lazy:
+                self._materialize(name)
+                return self._signals[name]
             import difflib
 
             close = difflib.get_close_matches(name, list(self._signals), n=6, cutoff=0.6)
             hint = f"; similar: {', '.join(close)}" if close else ""
             raise ResultsError(f"unknown signal '{name}'{hint} (res.names() lists all)") from None
 
+    def _materialize(self, name: str) -> None:
+        unit, compute = self._lazy[name]
+        for n, arr in compute().items():
+            self._signals[n] = arr
+            self._units[n] = self._lazy.pop(n, (unit, None))[0]
+
     def __contains__(self, name: str) -> bool:
-        return name in self._signals
+        return name in self._signals or name in self._lazy
 
     def names(self) -> list[str]:
-        """All signal names."""
-        return list(self._signals)
+        """All signal names (including those computed on first access)."""
+        return list(self._signals) + list(self._lazy)
 
     def unit(self, name: str) -> str:
         """The unit of a signal."""
+        if name in self._lazy:
+            return self._lazy[name][0]
         self[name]
         return self._units.get(name, "")
 
@@ -154,6 +185,9 @@ class Results:
         description, settings and statistics as file attributes)."""
         import h5py
 
+        for name in list(self._lazy):
+            if name in self._lazy:
+                self._materialize(name)
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         with h5py.File(path, "w", track_order=True) as f:
@@ -218,6 +252,26 @@ class Results:
         path.parent.mkdir(parents=True, exist_ok=True)
         np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
         return path
+
+
+def _reaction_group(engine, callbacks, joints: list[dict], raw: dict):
+    """A computer of every joint's reaction wrench from the recorded t, q, u, u_dot (cut principle;
+    see mechsys_core::dynamics::reactions), run once on first access."""
+
+    def compute() -> dict[str, np.ndarray]:
+        from . import _core
+
+        force, torque = _core.joint_reactions(engine, raw["t"], raw["q"], raw["u"], raw["udot"], callbacks)
+        n, nj = len(raw["t"]), len(joints)
+        force = force.reshape(n, nj, 3)
+        torque = torque.reshape(n, nj, 3)
+        out = {}
+        for k, j in enumerate(joints):
+            out[f"joint/{j['name']}/reaction_force"] = force[:, k, :]
+            out[f"joint/{j['name']}/reaction_torque"] = torque[:, k, :]
+        return out
+
+    return compute
 
 
 def load(path: str | Path) -> Results:

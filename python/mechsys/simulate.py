@@ -106,7 +106,7 @@ def simulate(
         "mechsys_version": _core.__version__,
     }
     body_names = core.body_names[1:]
-    return Results.from_raw(raw, core.joints(), body_names, attrs)
+    return Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
 
 
 def _wait(worker: threading.Thread, prog, n_expected: int, progress: bool | None) -> None:

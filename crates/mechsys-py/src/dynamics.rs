@@ -3,7 +3,7 @@
 use mechsys_core::dynamics::{self, energy};
 use mechsys_core::forces::Callbacks;
 use mechsys_core::kinematics;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -152,5 +152,54 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea, m)?)?;
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
-    Ok(())
+    register_reactions(m)
+}
+
+/// Joint reaction wrenches for a whole recorded run: for each sample (t, q, u, udot) the wrench
+/// the parent exerts on the child through every joint, at the joint origin, in child-joint-frame
+/// components. Returns (force, torque), each (n_samples × n_joints × 3).
+#[pyfunction]
+#[pyo3(signature = (model, t, q, u, udot, callbacks = None))]
+fn joint_reactions<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    t: PyReadonlyArray1<'py, f64>,
+    q: numpy::PyReadonlyArray2<'py, f64>,
+    u: numpy::PyReadonlyArray2<'py, f64>,
+    udot: numpy::PyReadonlyArray2<'py, f64>,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let m = &model.model;
+    let t = t.as_slice().map_err(|_| settings("t: must be a contiguous float64 array"))?;
+    let n = t.len();
+    let shape_ok = |a: &numpy::PyReadonlyArray2<'py, f64>, cols: usize| a.shape() == [n, cols];
+    if !shape_ok(&q, m.nq) || !shape_ok(&u, m.nu) || !shape_ok(&udot, m.nu) {
+        return Err(settings(format!("q, u, udot: expected shapes ({n}, {}), ({n}, {}), ({n}, {})", m.nq, m.nu, m.nu)));
+    }
+    let (q, u, udot) = (
+        q.as_slice().map_err(|_| settings("q: must be C-contiguous"))?,
+        u.as_slice().map_err(|_| settings("u: must be C-contiguous"))?,
+        udot.as_slice().map_err(|_| settings("udot: must be C-contiguous"))?,
+    );
+    let cb = self::callbacks(model, callbacks)?;
+    let nj = m.joints.len();
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let mut fo = vec![mechsys_core::math::Vec3::zeros(); nj];
+    let mut to = vec![mechsys_core::math::Vec3::zeros(); nj];
+    let mut force = Vec::with_capacity(n * nj * 3);
+    let mut torque = Vec::with_capacity(n * nj * 3);
+    for k in 0..n {
+        let (qk, uk, ak) = (&q[k * m.nq..(k + 1) * m.nq], &u[k * m.nu..(k + 1) * m.nu], &udot[k * m.nu..(k + 1) * m.nu]);
+        m.check_q(qk, "q").map_err(PyMechsysError::from)?;
+        dynamics::joint_reactions(m, &mut data, t[k], qk, uk, ak, &cb, &mut fo, &mut to).map_err(PyMechsysError::from)?;
+        for j in 0..nj {
+            force.extend_from_slice(fo[j].as_slice());
+            torque.extend_from_slice(to[j].as_slice());
+        }
+    }
+    Ok((PyArray1::from_vec(py, force), PyArray1::from_vec(py, torque)))
+}
+
+pub fn register_reactions(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(joint_reactions, m)?)
 }

@@ -11,10 +11,12 @@
 pub mod aba;
 pub mod crba;
 pub mod energy;
+pub mod reactions;
 pub mod rnea;
 
 pub use aba::aba;
 pub use crba::crba;
+pub use reactions::joint_reactions;
 pub use rnea::{inverse_dynamics, nonlinear_effects, rnea};
 
 #[cfg(test)]
