@@ -9,6 +9,9 @@
 //! [`dynamics::rnea`], [`dynamics::aba`]) fill it; [`simulate::simulate`] runs the step loop and
 //! records signals.
 #![warn(missing_docs)]
+// Index loops mirror the formulas in the numeric kernels, and `!(x > 0.0)` is how NaN is rejected
+// together with the out-of-range values; both lints would make those places less clear.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod error;
 pub mod math;

@@ -58,11 +58,6 @@ impl Motion {
     pub fn to_vec6(&self) -> Vector6<f64> {
         Vector6::new(self.w.x, self.w.y, self.w.z, self.v.x, self.v.y, self.v.z)
     }
-    /// From a 6-vector `[w; v]`.
-    #[inline]
-    pub fn from_vec6(x: &Vector6<f64>) -> Self {
-        Motion { w: Vec3::new(x[0], x[1], x[2]), v: Vec3::new(x[3], x[4], x[5]) }
-    }
 }
 
 impl Force {
@@ -77,11 +72,6 @@ impl Force {
     #[inline]
     pub fn to_vec6(&self) -> Vector6<f64> {
         Vector6::new(self.n.x, self.n.y, self.n.z, self.f.x, self.f.y, self.f.z)
-    }
-    /// From a 6-vector `[n; f]`.
-    #[inline]
-    pub fn from_vec6(x: &Vector6<f64>) -> Self {
-        Force { n: Vec3::new(x[0], x[1], x[2]), f: Vec3::new(x[3], x[4], x[5]) }
     }
 }
 
@@ -271,32 +261,6 @@ impl RigidInertia {
     }
 }
 
-/// Congruence `Xᵀ I X` of a symmetric 6×6 inertia given in child coordinates, returned in parent
-/// coordinates, where X is the motion transform parent→child of `pose` (the ABA and CRBA step
-/// "inertia to parent"). Done by blocks to avoid two dense 6×6 products.
-#[inline]
-pub fn inertia6_to_parent(pose: &Pose, i: &Matrix6<f64>) -> Matrix6<f64> {
-    let a = &pose.a;
-    let at = a.transpose();
-    let blk_a: Mat3 = i.fixed_view::<3, 3>(0, 0).into_owned();
-    let blk_b: Mat3 = i.fixed_view::<3, 3>(0, 3).into_owned();
-    let blk_c: Mat3 = i.fixed_view::<3, 3>(3, 3).into_owned();
-    // rotate: blocks into parent orientation
-    let ar = a * blk_a * at;
-    let br = a * blk_b * at;
-    let cr = a * blk_c * at;
-    // translate: X = [1 0; -r̃ 1] in parent orientation, so Xᵀ I X = [1 r̃; 0 1] I [1 0; -r̃ 1]
-    let rt = tilde(&pose.r);
-    let b_new = br + rt * cr;
-    let a_new = ar + rt * br.transpose() - b_new * rt;
-    let mut out = Matrix6::zeros();
-    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&a_new);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&b_new);
-    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&b_new.transpose());
-    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&cr);
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -348,7 +312,6 @@ mod tests {
         let x = p.motion_matrix_to_child();
         let dense = x.transpose() * ri.to_matrix() * x;
         assert!((ri.to_parent(&p).to_matrix() - dense).norm() < 1e-12);
-        assert!((inertia6_to_parent(&p, &ri.to_matrix()) - dense).norm() < 1e-12);
         // kinetic energy of a pure translation is ½ m v²
         let v = Motion::new(Vec3::zeros(), Vec3::new(3.0, 0.0, 4.0));
         assert!((ri.kinetic_energy(&v) - 0.5 * 1.5 * 25.0).abs() < 1e-12);

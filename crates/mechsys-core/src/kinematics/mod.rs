@@ -185,12 +185,6 @@ pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     a.v + a.w.cross(&p) + v.w.cross(&vp)
 }
 
-/// Angular velocity of a body in its own frame, `Bω` (eq. 2.31/2.33 left-hand side).
-#[inline]
-pub fn angular_velocity_body(data: &Data, body: usize) -> Vec3 {
-    data.x_abs[body].a.transpose() * data.v[body].w
-}
-
 /// Jacobians of a body-fixed point (translational `jt`, 3 × nu) and of the body's angular velocity
 /// (`jr`, 3 × nu), both I components, so that `v_P = jt u` and `ω_I = jr u` (eq. 2.69 with j = 0).
 /// Requires [`positions`].
