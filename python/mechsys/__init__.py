@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import dynamics, forces, functions, inertia, joints, kinematics
+from . import constraints, dynamics, forces, functions, inertia, joints, kinematics
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -43,6 +43,7 @@ __all__ = [
     "DOPRI5",
     "Radau5",
     "joints",
+    "constraints",
     "forces",
     "functions",
     "inertia",

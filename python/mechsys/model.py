@@ -48,6 +48,7 @@ class Model:
         self._bodies: list[dict] = []
         self._joints: list[Joint | dict] = []
         self._forces: list[Any] = []
+        self._constraints: list[Any] = []
         self._ground_markers: list[dict] = []
         self._built: tuple[str, Any, list] | None = None
         self._engine: tuple | None = None
@@ -129,11 +130,20 @@ class Model:
         self._invalidate()
         return force
 
+    def add_constraint(self, constraint) -> Any:
+        """Adds a bilateral constraint (see :mod:`mechsys.constraints`)."""
+        if not (hasattr(constraint, "describe") or isinstance(constraint, dict)):
+            raise ModelError(f"add_constraint: expected a mechsys.constraints element, got {type(constraint).__name__}")
+        self._constraints.append(constraint)
+        self._invalidate()
+        return constraint
+
     # ---- description and engine model -----------------------------------------------------------
     def describe(self) -> tuple[dict, list]:
         """The plain-data description (as in a model file) and the Python callbacks it refers to."""
         callbacks: list = list(self._extra_callbacks)
         forces = [f if isinstance(f, dict) else f.describe(callbacks) for f in self._forces]
+        constraints = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._constraints]
         desc = {
             "name": self.name,
             "gravity": list(self.gravity),
@@ -142,6 +152,8 @@ class Model:
             "forces": forces,
             "ground_markers": copy.deepcopy(self._ground_markers),
         }
+        if constraints:
+            desc["constraints"] = constraints
         return desc, callbacks
 
     def to_dict(self) -> dict:
@@ -189,7 +201,8 @@ class Model:
         m._joints = seq("joints")
         m._forces = seq("forces")
         m._ground_markers = seq("ground_markers")
-        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers"}
+        m._constraints = seq("constraints")
+        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers", "constraints"}
         extra = set(desc) - known
         if extra:
             # let the engine produce the canonical message for a misspelt top-level key

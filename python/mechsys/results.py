@@ -20,6 +20,8 @@ energy/kinetic, potential,      J            (n,)
   external_work
 momentum/linear                 N s          (n, 3)
 momentum/angular                N m s        (n, 3)  about the inertial origin
+constraint/<c>/lambda           N, N m, ...  (n,) or (n, 3)  Lagrange multipliers
+constraint/<c>/violation        m, rad, ...  (n,) or (n, 3)  Phi(q, t)
 joint/<j>/reaction_force        N            (n, 3)  wrench of the parent on the child through
 joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint origin, child
                                                      joint frame components (computed on first
@@ -107,6 +109,12 @@ class Results:
         put("energy/external_work", raw["external_work"], "J")
         put("momentum/linear", raw["momentum_linear"], "N s")
         put("momentum/angular", raw["momentum_angular"], "N m s")
+        if engine is not None:
+            for c in engine.constraints():
+                sl = slice(c["row"], c["row"] + c["rows"])
+                unit = c["unit"]
+                put(f"constraint/{c['name']}/lambda", raw["constraint_lambda"][:, sl] if c["rows"] > 1 else raw["constraint_lambda"][:, c["row"]], unit)
+                put(f"constraint/{c['name']}/violation", raw["constraint_violation"][:, sl] if c["rows"] > 1 else raw["constraint_violation"][:, c["row"]], c["violation_unit"])
         lazy = {}
         if engine is not None and joints:
             group = _reaction_group(engine, callbacks, joints, raw)

@@ -64,6 +64,34 @@ pub struct Data {
     pub scratch_u: Vec<f64>,
     /// zeros (nu), for h = -rnea(u̇ = 0).
     pub zero_u: Vec<f64>,
+    /// constraints: violation Φ (nc).
+    pub phi: Vec<f64>,
+    /// constraints: G = Wᵀ, rows of the velocity form G u = b (nc × nu).
+    pub g: DMatrix<f64>,
+    /// constraints: velocity right-hand side b (nc).
+    pub b: Vec<f64>,
+    /// constraints: acceleration right-hand side γ of G u̇ = γ (nc).
+    pub gamma: Vec<f64>,
+    /// constraints: Lagrange multipliers λ (nc).
+    pub lambda: Vec<f64>,
+    /// constrained solve: Cholesky factor of M, row-major (nu × nu).
+    pub m_factor: Vec<f64>,
+    /// constrained solve: M⁻¹ Gᵀ, column k contiguous (nc × nu).
+    pub minv_gt: Vec<f64>,
+    /// constrained solve: Schur complement G M⁻¹ Gᵀ or G Gᵀ, row-major (nc × nc).
+    pub schur: Vec<f64>,
+    /// constrained solve: pivot orders (nu) and (nc).
+    pub perm_u: Vec<usize>,
+    /// constrained solve: pivot order (nc).
+    pub perm_c: Vec<usize>,
+    /// constrained solve: scratch (max(nu, nc)) × 2.
+    pub work: Vec<f64>,
+    /// constrained solve: scratch (max(nu, nc)).
+    pub work2: Vec<f64>,
+    /// constrained solve: scratch configuration (nq).
+    pub q_tmp: Vec<f64>,
+    /// constraints: numerical rank of G at the last solve.
+    pub constraint_rank: usize,
 }
 
 impl Data {
@@ -93,6 +121,20 @@ impl Data {
             u_bias: vec![[0.0; 6]; nb],
             scratch_u: vec![0.0; nu],
             zero_u: vec![0.0; nu],
+            phi: vec![0.0; model.nc],
+            g: DMatrix::zeros(model.nc, nu),
+            b: vec![0.0; model.nc],
+            gamma: vec![0.0; model.nc],
+            lambda: vec![0.0; model.nc],
+            m_factor: vec![0.0; if model.nc > 0 { nu * nu } else { 0 }],
+            minv_gt: vec![0.0; model.nc * nu],
+            schur: vec![0.0; model.nc * model.nc],
+            perm_u: vec![0; nu],
+            perm_c: vec![0; model.nc],
+            work: vec![0.0; nu.max(model.nc)],
+            work2: vec![0.0; nu.max(model.nc)],
+            q_tmp: vec![0.0; model.nq],
+            constraint_rank: 0,
         }
     }
 }

@@ -19,6 +19,7 @@ pub mod spatial;
 pub mod model;
 pub mod data;
 pub mod kinematics;
+pub mod constraints;
 pub mod dynamics;
 pub mod forces;
 pub mod integrator;

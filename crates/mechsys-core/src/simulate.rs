@@ -79,6 +79,10 @@ pub struct Recording {
     pub momentum_linear: Vec<f64>,
     /// Moment of momentum about the inertial origin, I components (n_out × 3), N m s.
     pub momentum_angular: Vec<f64>,
+    /// Constraint multipliers λ (n_out × nc).
+    pub constraint_lambda: Vec<f64>,
+    /// Constraint violations Φ (n_out × nc).
+    pub constraint_violation: Vec<f64>,
     /// Integrator counters.
     pub stats: Stats,
 }
@@ -122,8 +126,14 @@ impl OdeSystem for MultibodySystem<'_> {
         dy[nq + nu + 1] = p.external;
         Ok(())
     }
-    fn project(&self, y: &mut [f64]) {
-        self.model.normalize(&mut y[..self.model.nq]);
+    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        self.model.normalize(&mut y[..nq]);
+        if self.model.nc > 0 {
+            let (q, rest) = y.split_at_mut(nq);
+            crate::dynamics::constrained::project(self.model, &mut self.data, t, q, &mut rest[..nu], self.cb)?;
+        }
+        Ok(())
     }
 }
 
@@ -250,9 +260,14 @@ pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress
         external_work: Vec::with_capacity(n_out),
         momentum_linear: Vec::with_capacity(n_out * 3),
         momentum_angular: Vec::with_capacity(n_out * 3),
+        constraint_lambda: Vec::with_capacity(n_out * model.nc),
+        constraint_violation: Vec::with_capacity(n_out * model.nc),
         stats: Stats::default(),
     };
     let mut sys = MultibodySystem::new(model, cb);
+    // a consistent initial state: on the constraint manifolds (assembly from the given q0, u0)
+    let mut y0 = y0;
+    sys.project(settings.t0, &mut y0)?;
     let mut scratch = vec![0.0; sys.dim()];
     let mut observer = |sys: &mut MultibodySystem, t: f64, y: &[f64], fresh: bool| -> Result<()> {
         if !fresh {
@@ -316,4 +331,6 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
     rec.external_work.push(y[nq + nu + 1]);
     rec.momentum_linear.extend_from_slice(p.as_slice());
     rec.momentum_angular.extend_from_slice(l.as_slice());
+    rec.constraint_lambda.extend_from_slice(&data.lambda);
+    rec.constraint_violation.extend_from_slice(&data.phi);
 }

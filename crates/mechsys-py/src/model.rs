@@ -90,6 +90,50 @@ impl PyModel {
         }
         Ok(out)
     }
+    /// Number of constraint equations.
+    #[getter]
+    fn nc(&self) -> usize {
+        self.model.nc
+    }
+    /// One dict per constraint: name, type, row, rows, unit (of λ), violation_unit.
+    fn constraints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        use mechsys_core::constraints::ConstraintKind as K;
+        use mechsys_core::model::JointKind;
+        // unit of the coordinate with velocity index iu (revolute-like: rad; prismatic-like: m)
+        let coord_units = |iu: usize| -> (&'static str, &'static str) {
+            for j in &self.model.joints {
+                if iu >= j.iu && iu < j.iu + j.nu() {
+                    let k = iu - j.iu;
+                    let angular = match j.kind {
+                        JointKind::Revolute { .. } | JointKind::Universal { .. } => true,
+                        JointKind::Cylindrical { .. } => k == 0,
+                        JointKind::Planar => k == 2,
+                        _ => false,
+                    };
+                    return if angular { ("N m", "rad") } else { ("N", "m") };
+                }
+            }
+            ("", "")
+        };
+        let mut out = vec![];
+        for c in &self.model.constraints {
+            let d = PyDict::new(py);
+            let (t, (unit, vunit)) = match &c.kind {
+                K::Point { .. } => ("point", ("N", "m")),
+                K::Distance { .. } => ("distance", ("N", "m")),
+                K::Coupler { iu_a, .. } => ("coupler", coord_units(*iu_a)),
+                K::Prescribed { iu, .. } => ("prescribed", coord_units(*iu)),
+            };
+            d.set_item("name", &c.name)?;
+            d.set_item("type", t)?;
+            d.set_item("row", c.row)?;
+            d.set_item("rows", c.kind.rows())?;
+            d.set_item("unit", unit)?;
+            d.set_item("violation_unit", vunit)?;
+            out.push(d);
+        }
+        Ok(out)
+    }
     /// Force element (name, type) pairs.
     fn forces(&self) -> Vec<(String, String)> {
         use mechsys_core::model::ForceElement as F;

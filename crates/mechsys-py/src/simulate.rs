@@ -148,6 +148,8 @@ fn simulate<'py>(
     put("external_work", rec.external_work, &[n])?;
     put("momentum_linear", rec.momentum_linear, &[n, 3])?;
     put("momentum_angular", rec.momentum_angular, &[n, 3])?;
+    put("constraint_lambda", rec.constraint_lambda, &[n, m.nc])?;
+    put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
     let st = PyDict::new(py);
     st.set_item("steps", rec.stats.steps)?;
     st.set_item("rejected", rec.stats.rejected)?;

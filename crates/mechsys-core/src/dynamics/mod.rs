@@ -9,6 +9,7 @@
 //! force elements, joint springs and dampers); `τ` is an extra actuation input.
 
 pub mod aba;
+pub mod constrained;
 pub mod crba;
 pub mod energy;
 pub mod reactions;
@@ -45,6 +46,9 @@ pub fn forward_dynamics(
     tau: Option<&[f64]>,
     cb: &dyn Callbacks,
 ) -> Result<Powers> {
+    if model.nc > 0 {
+        return constrained::forward_dynamics(model, data, t, q, u, tau, cb);
+    }
     let p = prepare(model, data, t, q, u, cb)?;
     aba::aba_prepared(model, data, tau);
     Ok(p)

@@ -27,9 +27,18 @@ pub fn joint_reactions(
     force: &mut [Vec3],
     torque: &mut [Vec3],
 ) -> Result<()> {
-    super::prepare(model, data, t, q, u, cb)?;
     let mut tmp = std::mem::take(&mut data.scratch_u);
-    super::rnea::rnea_prepared(model, data, udot, &mut tmp);
+    if model.nc > 0 {
+        // the loop closures and drives load the bodies too: solve for λ and add Gᵀ λ
+        super::constrained::forward_dynamics(model, data, t, q, u, None, cb)?;
+        crate::constraints::apply_forces(model, data);
+        let ud = std::mem::take(&mut data.udot);
+        super::rnea::rnea_prepared(model, data, &ud, &mut tmp);
+        data.udot = ud;
+    } else {
+        super::prepare(model, data, t, q, u, cb)?;
+        super::rnea::rnea_prepared(model, data, udot, &mut tmp);
+    }
     data.scratch_u = tmp;
     for (ji, _) in model.joints.iter().enumerate() {
         let i = ji + 1;

@@ -73,6 +73,7 @@ fn mixed_tree() -> Model {
         joints,
         forces,
         ground_markers: vec![],
+        constraints: vec![],
     })
     .unwrap()
 }

@@ -175,7 +175,7 @@ pub fn integrate<S: OdeSystem>(
                 r[4][i] = h * (D1 * k[0][i] + D3 * k[2][i] + D4 * k[3][i] + D5 * k[4][i] + D6 * k[5][i] + D7 * k[6][i]);
             }
             let t_new = t + h;
-            sys.project(&mut ynew);
+            sys.project(t_new, &mut ynew)?;
             check_finite(t_new, &ynew)?;
             while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
                 let to = t_out[next];
@@ -187,7 +187,7 @@ pub fn integrate<S: OdeSystem>(
                     for i in 0..n {
                         yout[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
                     }
-                    sys.project(&mut yout);
+                    sys.project(to, &mut yout)?;
                     obs(sys, to, &yout, false)?;
                 }
                 next += 1;

@@ -20,8 +20,10 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Evaluates `dy = f(t, y)`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()>;
-    /// Projects y back onto its manifold after a step (e.g. renormalizes quaternions).
-    fn project(&self, _y: &mut [f64]) {}
+    /// Projects y at time t back onto its manifolds after a step (unit quaternions, constraints).
+    fn project(&mut self, _t: f64, _y: &mut [f64]) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Called at each output time with the system and the state; `fresh` says the system's last `rhs`

@@ -105,7 +105,7 @@ fn step<S: OdeSystem>(sys: &mut S, w: &mut Work, t: f64, y: &mut [f64], h: f64, 
             for i in 0..n {
                 y[i] += w.z[2 * n + i]; // stiffly accurate: y_new = y + Z_3
             }
-            sys.project(y);
+            sys.project(t + h, y)?;
             return Ok(true);
         }
         last = nrm;

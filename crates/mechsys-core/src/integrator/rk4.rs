@@ -53,7 +53,7 @@ pub fn integrate<S: OdeSystem>(
         for i in 0..n {
             y[i] += h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
-        sys.project(&mut y);
+        sys.project(t + h, &mut y)?;
         check_finite(t + h, &y)?;
         step += 1;
         stats.steps += 1;

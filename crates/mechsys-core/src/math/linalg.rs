@@ -59,6 +59,91 @@ pub fn lu_solve(a: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
     }
 }
 
+
+/// Cholesky factorization with diagonal pivoting of the symmetric positive semidefinite row-major
+/// `n × n` matrix `a`, in place (lower factor). Pivots smaller than `tol` times the largest are
+/// treated as zero: their rows are dependent on the others (redundant constraints). Returns the rank;
+/// `perm` receives the pivot order.
+pub fn cholesky_semidefinite(a: &mut [f64], n: usize, perm: &mut [usize], tol: f64) -> usize {
+    for (i, p) in perm.iter_mut().enumerate().take(n) {
+        *p = i;
+    }
+    let max_diag = (0..n).map(|i| a[i * n + i]).fold(0.0f64, f64::max);
+    let eps = tol * max_diag.max(f64::MIN_POSITIVE);
+    let mut rank = 0;
+    for k in 0..n {
+        // largest remaining diagonal
+        let (mut p, mut best) = (k, a[k * n + k]);
+        for i in k + 1..n {
+            if a[i * n + i] > best {
+                best = a[i * n + i];
+                p = i;
+            }
+        }
+        if !(best > eps) {
+            break;
+        }
+        if p != k {
+            perm.swap(k, p);
+            for c in 0..n {
+                a.swap(k * n + c, p * n + c);
+            }
+            for r in 0..n {
+                a.swap(r * n + k, r * n + p);
+            }
+        }
+        let d = a[k * n + k].sqrt();
+        a[k * n + k] = d;
+        for r in k + 1..n {
+            a[r * n + k] /= d;
+        }
+        // update the whole trailing block (both triangles) so that later symmetric pivoting swaps
+        // read valid entries
+        for r in k + 1..n {
+            let l = a[r * n + k];
+            for c in k + 1..n {
+                a[r * n + c] -= l * a[c * n + k];
+            }
+        }
+        rank += 1;
+    }
+    // keep the upper triangle consistent for callers that read it
+    for r in 0..n {
+        for c in r + 1..n {
+            a[r * n + c] = a[c * n + r];
+        }
+    }
+    rank
+}
+
+/// Solves `A x = b` with the factor of [`cholesky_semidefinite`] of rank `rank`: the dependent
+/// unknowns (pivots beyond the rank) are set to zero, a basic solution of a consistent system.
+pub fn cholesky_semidefinite_solve(a: &[f64], n: usize, perm: &[usize], rank: usize, b: &mut [f64], work: &mut [f64]) {
+    for i in 0..n {
+        work[i] = b[perm[i]];
+    }
+    for r in 0..rank {
+        let mut s = work[r];
+        for c in 0..r {
+            s -= a[r * n + c] * work[c];
+        }
+        work[r] = s / a[r * n + r];
+    }
+    for r in (0..rank).rev() {
+        let mut s = work[r];
+        for c in r + 1..rank {
+            s -= a[c * n + r] * work[c];
+        }
+        work[r] = s / a[r * n + r];
+    }
+    for w in work.iter_mut().take(n).skip(rank) {
+        *w = 0.0;
+    }
+    for i in 0..n {
+        b[perm[i]] = work[i];
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,5 +166,33 @@ mod tests {
         }
         let mut s = [1.0, 2.0, 2.0, 4.0];
         assert!(lu_factor(&mut s, 2, &mut [0; 2]).is_err());
+    }
+
+    #[test]
+    fn semidefinite_cholesky_finds_rank_and_solves_consistent_systems() {
+        // A = B Bᵀ with B 3×2: rank 2; b in the range of A
+        let bm = [[0.1, 0.2], [0.5, -1.0], [0.6, -0.8]]; // third row = first + second; pivots move
+        let mut a = [0.0; 9];
+        for r in 0..3 {
+            for c in 0..3 {
+                a[r * 3 + c] = bm[r][0] * bm[c][0] + bm[r][1] * bm[c][1];
+            }
+        }
+        let a0 = a;
+        let x_true = [0.3, -0.2, 0.0];
+        let mut b = [0.0; 3];
+        for r in 0..3 {
+            b[r] = (0..3).map(|c| a0[r * 3 + c] * x_true[c]).sum();
+        }
+        let mut perm = [0; 3];
+        let rank = cholesky_semidefinite(&mut a, 3, &mut perm, 1e-12);
+        assert_eq!(rank, 2);
+        let mut x = b;
+        cholesky_semidefinite_solve(&a, 3, &perm, rank, &mut x, &mut [0.0; 3]);
+        // any solution reproduces b
+        for r in 0..3 {
+            let ax: f64 = (0..3).map(|c| a0[r * 3 + c] * x[c]).sum();
+            assert!((ax - b[r]).abs() < 1e-12, "row {r}");
+        }
     }
 }

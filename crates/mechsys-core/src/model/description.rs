@@ -29,6 +29,73 @@ pub struct ModelDescription {
     /// Markers (named frames) on the ground.
     #[serde(default)]
     pub ground_markers: Vec<MarkerDescription>,
+    /// Bilateral constraints beyond the tree (loop closures, couplers, driven coordinates).
+    #[serde(default)]
+    pub constraints: Vec<ConstraintDescription>,
+}
+
+/// A bilateral constraint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ConstraintDescription {
+    /// Point `point1` on `body1` coincides with point `point2` on `body2` (a spherical loop closure).
+    Point {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Point on body1, body frame.
+        #[serde(default)]
+        point1: [f64; 3],
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Point on body2, body frame.
+        #[serde(default)]
+        point2: [f64; 3],
+    },
+    /// Fixed distance between two body points (a massless rod with ball joints at both ends).
+    Distance {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Point on body1, body frame.
+        #[serde(default)]
+        point1: [f64; 3],
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Point on body2, body frame.
+        #[serde(default)]
+        point2: [f64; 3],
+        /// Distance (m), > 0.
+        length: f64,
+    },
+    /// Coupler (gear) between single-coordinate joints: q(joint1) = ratio · q(joint2) + offset.
+    Coupler {
+        /// Constraint name.
+        name: String,
+        /// Driven joint.
+        joint1: String,
+        /// Driving joint.
+        joint2: String,
+        /// Ratio.
+        ratio: f64,
+        /// Offset.
+        #[serde(default)]
+        offset: f64,
+    },
+    /// Prescribed motion of one joint coordinate: q(joint)[index] = f(t).
+    Prescribed {
+        /// Constraint name.
+        name: String,
+        /// Driven joint.
+        joint: String,
+        /// Coordinate of the joint (default 0).
+        #[serde(default)]
+        index: usize,
+        /// The motion q(t).
+        function: TimeFunctionDescription,
+    },
 }
 
 fn default_name() -> String {

@@ -269,6 +269,10 @@ pub struct Model {
     pub joints: Vec<Joint>,
     /// Force elements.
     pub forces: Vec<ForceElement>,
+    /// Bilateral constraints beyond the tree.
+    pub constraints: Vec<crate::constraints::Constraint>,
+    /// Total number of constraint equations.
+    pub nc: usize,
     /// Total number of coordinates.
     pub nq: usize,
     /// Total number of velocities (degrees of freedom).

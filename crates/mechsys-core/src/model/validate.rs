@@ -526,6 +526,95 @@ impl Model {
             });
         }
 
+        // ---- constraints ---------------------------------------------------------------------------
+        let mut constraints = Vec::with_capacity(desc.constraints.len());
+        let mut constraint_names = HashSet::new();
+        let mut row = 0usize;
+        let single = |jname: &str, what: &str, key: &str| -> Result<usize> {
+            let ji = *joint_index.get(jname).ok_or_else(|| err(format!("{what}.{key}: unknown joint '{jname}'")))?;
+            Ok(ji)
+        };
+        for (ci, c) in desc.constraints.iter().enumerate() {
+            use crate::constraints::{Constraint, ConstraintKind};
+            let name = match c {
+                ConstraintDescription::Point { name, .. }
+                | ConstraintDescription::Distance { name, .. }
+                | ConstraintDescription::Coupler { name, .. }
+                | ConstraintDescription::Prescribed { name, .. } => name.clone(),
+            };
+            let what = format!("constraints[{ci}] '{name}'");
+            crate::ensure!(!name.trim().is_empty(), Model, "constraints[{ci}]: name must not be empty");
+            crate::ensure!(constraint_names.insert(name.clone()), Model, "{what}: duplicate constraint name");
+            let kind = match c {
+                ConstraintDescription::Point { body1, point1, body2, point2, .. } => {
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    ConstraintKind::Point {
+                        body1: b1,
+                        p1: finite3(point1, &format!("{what}.point1"))?,
+                        body2: b2,
+                        p2: finite3(point2, &format!("{what}.point2"))?,
+                    }
+                }
+                ConstraintDescription::Distance { body1, point1, body2, point2, length, .. } => {
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    crate::ensure!(length.is_finite() && *length > 0.0, Model, "{what}.length: must be > 0, got {length}");
+                    ConstraintKind::Distance {
+                        body1: b1,
+                        p1: finite3(point1, &format!("{what}.point1"))?,
+                        body2: b2,
+                        p2: finite3(point2, &format!("{what}.point2"))?,
+                        length: *length,
+                    }
+                }
+                ConstraintDescription::Coupler { joint1, joint2, ratio, offset, .. } => {
+                    let (ja, jb) = (single(joint1, &what, "joint1")?, single(joint2, &what, "joint2")?);
+                    crate::ensure!(ja != jb, Model, "{what}: joint1 and joint2 are the same joint '{joint1}'");
+                    for (ji, key) in [(ja, "joint1"), (jb, "joint2")] {
+                        let j = &joints[ji];
+                        crate::ensure!(
+                            j.nq() == 1 && j.nu() == 1,
+                            Model,
+                            "{what}.{key}: a coupler needs single-coordinate joints (revolute, prismatic), '{}' is {}",
+                            j.name,
+                            j.kind.type_name()
+                        );
+                    }
+                    crate::ensure!(ratio.is_finite() && offset.is_finite(), Model, "{what}: ratio and offset must be finite");
+                    ConstraintKind::Coupler {
+                        iq_a: joints[ja].iq,
+                        iu_a: joints[ja].iu,
+                        iq_b: joints[jb].iq,
+                        iu_b: joints[jb].iu,
+                        ratio: *ratio,
+                        offset: *offset,
+                    }
+                }
+                ConstraintDescription::Prescribed { joint, index, function, .. } => {
+                    let ji = single(joint, &what, "joint")?;
+                    let j = &joints[ji];
+                    crate::ensure!(
+                        !j.kind.has_quaternion() && *index < j.nu(),
+                        Model,
+                        "{what}.index: joint '{}' ({}) has no coordinate {index} that can be prescribed",
+                        j.name,
+                        j.kind.type_name()
+                    );
+                    ConstraintKind::Prescribed {
+                        iq: j.iq + index,
+                        iu: j.iu + index,
+                        function: time_function(&Some(function.clone()), &format!("{what}.function"), &mut n_callbacks)?,
+                    }
+                }
+            };
+            let rows = kind.rows();
+            constraints.push(Constraint { name, kind, row });
+            row += rows;
+        }
+
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
         Ok(Model {
             name: desc.name.clone(),
@@ -533,6 +622,8 @@ impl Model {
             bodies,
             joints,
             forces,
+            constraints,
+            nc: row,
             nq: iq,
             nu: iu,
             variable_mass,

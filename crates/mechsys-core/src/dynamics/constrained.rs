@@ -1,0 +1,168 @@
+//! Forward dynamics with bilateral constraints by Lagrange multipliers (section 2.2.5, eq. 2.70):
+//!
+//! ```text
+//! M u̇ = h + τ + Gᵀ λ,      G u̇ = γ
+//! ```
+//!
+//! solved through the unconstrained accelerations (ABA) and the Schur complement
+//! `(G M⁻¹ Gᵀ) λ = γ - G u̇_free`, `u̇ = u̇_free + M⁻¹ Gᵀ λ`. The Schur complement is factored
+//! by a pivoted Cholesky decomposition that detects dependent (redundant) constraint rows and gives
+//! them zero multipliers. After each step [`project`] puts q and u back on the constraint
+//! manifolds (`Φ = 0` by Newton with minimum-norm corrections, then `G u = b`).
+
+use crate::constraints;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::forces::{Callbacks, Powers};
+use crate::math::linalg::{cholesky_semidefinite, cholesky_semidefinite_solve};
+use crate::model::Model;
+use crate::spatial::Motion;
+
+/// Relative size below which a pivot counts as zero (dependent rows, singular mass matrix).
+const RANK_TOL: f64 = 1e-12;
+
+/// Forward dynamics of a constrained model; fills `data.udot`, `data.lambda`, `data.phi`.
+pub fn forward_dynamics(
+    model: &Model,
+    data: &mut Data,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    tau: Option<&[f64]>,
+    cb: &dyn Callbacks,
+) -> Result<Powers> {
+    let (nu, nc) = (model.nu, model.nc);
+    let mut p = super::prepare(model, data, t, q, u, cb)?;
+    constraints::positions(model, data, t, q, cb)?;
+    // velocity-product accelerations (u̇ = 0, no gravity) for γ
+    data.a[0] = Motion::ZERO;
+    let zero = std::mem::take(&mut data.zero_u);
+    crate::kinematics::accelerations(model, data, &zero);
+    data.zero_u = zero;
+    constraints::accelerations(model, data, t, cb)?;
+    super::aba::aba_prepared(model, data, tau);
+    // M = L Lᵀ
+    super::crba::crba(model, data);
+    for r in 0..nu {
+        for c in 0..nu {
+            data.m_factor[r * nu + c] = data.mass_matrix[(r, c)];
+        }
+    }
+    let rank_m = cholesky_semidefinite(&mut data.m_factor, nu, &mut data.perm_u, RANK_TOL);
+    if rank_m < nu {
+        return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s (rank {rank_m} of {nu})")));
+    }
+    // M⁻¹ Gᵀ column by column
+    for k in 0..nc {
+        let col = &mut data.minv_gt[k * nu..(k + 1) * nu];
+        for i in 0..nu {
+            col[i] = data.g[(k, i)];
+        }
+        cholesky_semidefinite_solve(&data.m_factor, nu, &data.perm_u, nu, col, &mut data.work);
+    }
+    // S = G M⁻¹ Gᵀ, rhs = γ - G u̇_free
+    for r in 0..nc {
+        for c in 0..nc {
+            let mut s = 0.0;
+            for i in 0..nu {
+                s += data.g[(r, i)] * data.minv_gt[c * nu + i];
+            }
+            data.schur[r * nc + c] = s;
+        }
+        let mut gu = 0.0;
+        for i in 0..nu {
+            gu += data.g[(r, i)] * data.udot[i];
+        }
+        data.lambda[r] = data.gamma[r] - gu;
+    }
+    data.constraint_rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
+    cholesky_semidefinite_solve(&data.schur, nc, &data.perm_c, data.constraint_rank, &mut data.lambda, &mut data.work);
+    for k in 0..nc {
+        let l = data.lambda[k];
+        for i in 0..nu {
+            data.udot[i] += data.minv_gt[k * nu + i] * l;
+        }
+        // driving constraints do work: λ · b (b = 0 for scleronomic rows)
+        p.external += l * data.b[k];
+    }
+    // body accelerations of the constrained motion (without gravity), for records and reactions
+    data.a[0] = Motion::ZERO;
+    let udot = std::mem::take(&mut data.udot);
+    crate::kinematics::accelerations(model, data, &udot);
+    data.udot = udot;
+    Ok(p)
+}
+
+/// Solves `(G Gᵀ) μ = r` in place (minimum-norm correction `-Gᵀ μ` of a residual `r`); `r` is
+/// `data.work2[..nc]`. Dependent rows get zero.
+fn min_norm_correction(data: &mut Data, nc: usize, nu: usize) {
+    for r in 0..nc {
+        for c in 0..nc {
+            let mut s = 0.0;
+            for i in 0..nu {
+                s += data.g[(r, i)] * data.g[(c, i)];
+            }
+            data.schur[r * nc + c] = s;
+        }
+    }
+    let rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
+    let mut rhs = std::mem::take(&mut data.work2);
+    cholesky_semidefinite_solve(&data.schur, nc, &data.perm_c, rank, &mut rhs[..nc], &mut data.work);
+    data.work2 = rhs;
+}
+
+/// Projects (q, u) at time t onto `Φ(q, t) = 0` and `G u = b`: Newton iterations with minimum-norm
+/// corrections (the pseudo-inverse relation of eq. 2.68), then one velocity correction.
+pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f64], cb: &dyn Callbacks) -> Result<()> {
+    let (nu, nc) = (model.nu, model.nc);
+    if nc == 0 {
+        return Ok(());
+    }
+    let mut converged = false;
+    let mut worst = (0.0, 0usize);
+    for _ in 0..20 {
+        crate::kinematics::positions(model, data, q);
+        constraints::positions(model, data, t, q, cb)?;
+        worst = data.phi.iter().enumerate().fold((0.0, 0), |w, (k, v)| if v.abs() > w.0 { (v.abs(), k) } else { w });
+        if worst.0 <= 1e-13 {
+            converged = true;
+            break;
+        }
+        data.work2[..nc].copy_from_slice(&data.phi);
+        min_norm_correction(data, nc, nu);
+        // Δu = -Gᵀ μ, applied on the configuration manifold
+        for i in 0..nu {
+            let mut s = 0.0;
+            for k in 0..nc {
+                s -= data.g[(k, i)] * data.work2[k];
+            }
+            data.scratch_u[i] = s;
+        }
+        data.q_tmp.copy_from_slice(q);
+        model.integrate(&data.q_tmp, &data.scratch_u, 1.0, q);
+    }
+    if !converged && worst.0 > 1e-8 {
+        let name = model.constraints.iter().rev().find(|c| c.row <= worst.1).map_or("?", |c| c.name.as_str());
+        return Err(Error::Solver(format!(
+            "constraint '{name}' cannot be satisfied at t = {t:.6} s (violation {:.3e}): the mechanism does not close",
+            worst.0
+        )));
+    }
+    // velocities: u ← u - Gᵀ (G Gᵀ)⁺ (G u - b), with G at the projected q
+    for k in 0..nc {
+        let mut s = -data.b[k];
+        for i in 0..nu {
+            s += data.g[(k, i)] * u[i];
+        }
+        data.work2[k] = s;
+    }
+    min_norm_correction(data, nc, nu);
+    for i in 0..nu {
+        let mut s = 0.0;
+        for k in 0..nc {
+            s += data.g[(k, i)] * data.work2[k];
+        }
+        u[i] -= s;
+    }
+    Ok(())
+}
