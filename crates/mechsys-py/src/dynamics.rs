@@ -152,7 +152,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea, m)?)?;
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
-    register_reactions(m)
+    register_reactions(m)?;
+    register_constraints(m)
 }
 
 /// Joint reaction wrenches for a whole recorded run: for each sample (t, q, u, udot) the wrench
@@ -202,4 +203,34 @@ fn joint_reactions<'py>(
 
 pub fn register_reactions(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(joint_reactions, m)?)
+}
+
+/// Constraint violation Φ (nc) and its Jacobian G = Wᵀ (nc × nu, so that Φ̇ = G u - b) at (q, t),
+/// plus the velocity right-hand side b (nc) — eq. 2.70.
+#[pyfunction]
+#[pyo3(signature = (model, q, t = 0.0, callbacks = None))]
+fn constraint_jacobian<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: &Bound<'py, PyAny>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let m = &model.model;
+    let q = q_slice(model, q)?;
+    let cb = self::callbacks(model, callbacks)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    kinematics::positions(m, &mut data, q);
+    mechsys_core::constraints::positions(m, &mut data, t, q, &cb).map_err(PyMechsysError::from)?;
+    let rows: Vec<Vec<f64>> = (0..m.nc).map(|r| (0..m.nu).map(|c| data.g[(r, c)]).collect()).collect();
+    let g = if m.nc == 0 {
+        PyArray2::zeros(py, [0, m.nu], false)
+    } else {
+        PyArray2::from_vec2(py, &rows).map_err(|e| settings(e.to_string()))?
+    };
+    Ok((PyArray1::from_slice(py, &data.phi), g, PyArray1::from_slice(py, &data.b)))
+}
+
+pub fn register_constraints(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(constraint_jacobian, m)?)
 }
