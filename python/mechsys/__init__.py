@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import constraints, dynamics, forces, functions, inertia, joints, kinematics
+from . import constraints, dynamics, forces, functions, inertia, joints, kinematics, mechanisms
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -44,6 +44,7 @@ __all__ = [
     "Radau5",
     "joints",
     "constraints",
+    "mechanisms",
     "forces",
     "functions",
     "inertia",

@@ -249,7 +249,16 @@ def info(model_file: Path) -> None:
 
     click.echo(f"model    {model.name} ({model_file})")
     click.echo(f"gravity  {_fmt_vec(core.gravity)} m/s^2")
-    click.echo(f"DOF      {model.nu} (nu), nq = {model.nq}")
+    constraints = core.constraints()
+    if constraints:
+        from .mechanisms import mobility
+
+        mob = mobility(model)
+        click.echo(
+            f"DOF      {mob['dof']} (nu = {model.nu} minus constraint rank {mob['rank']} of {mob['nc']} equations), nq = {model.nq}"
+        )
+    else:
+        click.echo(f"DOF      {model.nu} (nu), nq = {model.nq}")
     click.echo("")
     click.echo(f"bodies ({len(bodies)}):")
     if bodies:
@@ -267,6 +276,13 @@ def info(model_file: Path) -> None:
     click.echo(f"force elements ({len(forces)}):")
     if forces:
         click.echo(_table(["name", "type"], [(n, t) for n, t in forces]))
+    if constraints:
+        click.echo("")
+        click.echo(f"constraints ({len(constraints)}):")
+        click.echo(_table(["name", "type", "equations"], [(c["name"], c["type"], str(c["rows"])) for c in constraints]))
+        if mob["redundant"]:
+            names = ", ".join(f"{n}[{k}]" for n, k in mob["redundant"])
+            click.echo(f"warning: {len(mob['redundant'])} redundant equation(s) at q0: {names} (their multipliers are set to zero)")
     if sim:
         click.echo("")
         click.echo("simulation defaults:")
