@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import constraints, dynamics, forces, functions, inertia, joints, kinematics, mechanisms
+from . import analysis, constraints, dynamics, forces, functions, inertia, joints, kinematics, mechanisms
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -45,6 +45,7 @@ __all__ = [
     "joints",
     "constraints",
     "mechanisms",
+    "analysis",
     "forces",
     "functions",
     "inertia",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import threading
 import time
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -63,6 +63,7 @@ def simulate(
     u0: Any = None,
     t0: float = 0.0,
     progress: bool | None = None,
+    keep: Sequence[str] = (),
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
@@ -70,11 +71,19 @@ def simulate(
     ``output_dt``: sampling interval of the results (default: the step of a fixed-step scheme,
     else 1/1000 of the span). ``q0``/``u0``: full vectors or ``{joint name: value}`` dicts
     (the joints' own q0/u0 elsewhere). ``progress``: show a progress bar (default: only when
-    the run takes longer than about a second and stderr is a terminal).
+    the run takes longer than about a second and stderr is a terminal). ``keep``: joints whose
+    q0 and u0 stay as given when a constrained model is assembled to a consistent start (the
+    others move by minimum-norm corrections).
     """
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
     core = model.build()
+    if keep:
+        # assemble with the named joints held at their given q0, u0 (the engine's own start
+        # projection then finds the state consistent and leaves it)
+        from .analysis import assemble
+
+        q0, u0 = assemble(model, q0, u0, float(t0), keep=keep)
     settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0)
     text = json.dumps(settings)
     callbacks = model.callbacks or None

@@ -153,7 +153,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
     register_reactions(m)?;
-    register_constraints(m)
+    register_constraints(m)?;
+    register_constraint_gamma(m)
 }
 
 /// Joint reaction wrenches for a whole recorded run: for each sample (t, q, u, udot) the wrench
@@ -233,4 +234,33 @@ fn constraint_jacobian<'py>(
 
 pub fn register_constraints(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constraint_jacobian, m)?)
+}
+
+/// Acceleration right-hand side γ of the constraints, G u̇ = γ, at (q, u, t) (nc).
+#[pyfunction]
+#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None))]
+fn constraint_gamma<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: &Bound<'py, PyAny>,
+    u: &Bound<'py, PyAny>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = &model.model;
+    let q = q_slice(model, q)?;
+    let u = fast_slice(u, m.nu, "u")?;
+    let cb = self::callbacks(model, callbacks)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    kinematics::forward_kinematics(m, &mut data, q, u);
+    mechsys_core::constraints::positions(m, &mut data, t, q, &cb).map_err(PyMechsysError::from)?;
+    data.a[0] = mechsys_core::spatial::Motion::ZERO;
+    let zero = vec![0.0; m.nu];
+    kinematics::accelerations(m, &mut data, &zero);
+    mechsys_core::constraints::accelerations(m, &mut data, t, &cb).map_err(PyMechsysError::from)?;
+    Ok(PyArray1::from_slice(py, &data.gamma))
+}
+
+pub fn register_constraint_gamma(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(constraint_gamma, m)?)
 }

@@ -98,6 +98,7 @@ impl PyModel {
     /// One dict per constraint: name, type, row, rows, unit (of λ), violation_unit.
     fn constraints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         use mechsys_core::constraints::ConstraintKind as K;
+        use mechsys_core::constraints::LoopJoint;
         use mechsys_core::model::JointKind;
         // unit of the coordinate with velocity index iu (revolute-like: rad; prismatic-like: m)
         let coord_units = |iu: usize| -> (&'static str, &'static str) {
@@ -123,6 +124,15 @@ impl PyModel {
                 K::Distance { .. } => ("distance", ("N", "m")),
                 K::Coupler { iu_a, .. } => ("coupler", coord_units(*iu_a)),
                 K::Prescribed { iu, .. } => ("prescribed", coord_units(*iu)),
+                K::PointOnLine { .. } => ("point_on_line", ("N", "m")),
+                K::PointOnPlane { .. } => ("point_on_plane", ("N", "m")),
+                K::Loop { joint: LoopJoint::Spherical, .. } => ("loop_spherical", ("N", "m")),
+                // rows 0-2 forces and origin offsets, the rest moments and (small) angles
+                K::Loop { joint: LoopJoint::Revolute, .. } => ("loop_revolute", ("N, N m", "m, rad")),
+                K::Loop { joint: LoopJoint::Fixed, .. } => ("loop_fixed", ("N, N m", "m, rad")),
+                // non-holonomic rows have no position violation (recorded as 0)
+                K::KnifeEdge { .. } => ("knife_edge", ("N", "m")),
+                K::RollingDisc { .. } => ("rolling_disc", ("N", "m")),
             };
             d.set_item("name", &c.name)?;
             d.set_item("type", t)?;

@@ -9,7 +9,20 @@
 //!
 //! Kinds: coincidence of two body points (a spherical loop closure, 3 rows), a fixed distance
 //! between two body points (1 row), a coupler `q_a = r q_b + c` between joint coordinates (1 row),
-//! and a prescribed joint coordinate `q = f(t)` (1 row, rheonomic).
+//! a prescribed joint coordinate `q = f(t)` (1 row, rheonomic), a point on a line (2 rows) or on a
+//! plane (1 row) of another body, loop-closing spherical / revolute / fixed joints between frames
+//! on two bodies (3 / 5 / 6 rows), and the non-holonomic knife edge (1 velocity row) and rolling
+//! disc (1 holonomic + 2 velocity rows).
+//!
+//! Non-holonomic rows (eq. 2.70 given directly at velocity level, not reducible to eq. 2.3) have
+//! velocity and acceleration rows but no position row: their `Φ` is 0 and the position projection
+//! skips them ([`ConstraintKind::holonomic_rows`]; the holonomic rows of a kind come first).
+//!
+//! Rows that act on bodies are written through one world wrench per body and row: with `W₁`, `W₂`
+//! the wrenches (moment about the origin, force) of a row, its entry for a joint velocity with
+//! world subspace `S` is `S·W₁` on the path of body1 minus `S·W₂` on the path of body2, and its
+//! multiplier λ loads body1 with `λ W₁` and body2 with `-λ W₂` (so `Gᵀλ` and the applied loads
+//! agree by construction).
 
 use nalgebra::DMatrix;
 
@@ -17,9 +30,9 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::kinematics::{point_acceleration, point_position, point_velocity};
-use crate::math::Vec3;
+use crate::math::{Mat3, Vec3};
 use crate::model::{Model, TimeFunction};
-use crate::spatial::Motion;
+use crate::spatial::{Force, Motion, Pose};
 
 /// What a constraint holds.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,6 +85,82 @@ pub enum ConstraintKind {
         /// The motion.
         function: TimeFunction,
     },
+    /// Point `p1` on `body1` stays on the line through `p2` of `body2` (2 rows): the offset
+    /// `d = r₁ - r₂` has no component along the two body2-fixed unit normals `n` of the line.
+    PointOnLine {
+        /// First body.
+        body1: usize,
+        /// Point on body1, body frame.
+        p1: Vec3,
+        /// Second body.
+        body2: usize,
+        /// Point of the line, body2 frame.
+        p2: Vec3,
+        /// Two orthonormal unit vectors perpendicular to the line direction, body2 frame.
+        n: [Vec3; 2],
+    },
+    /// Point `p1` on `body1` stays in the plane through `p2` of `body2` with unit normal `n`
+    /// (body2 frame): `Φ = n·(r₁ - r₂)` (1 row; λ is the normal force on body1).
+    PointOnPlane {
+        /// First body.
+        body1: usize,
+        /// Point on body1, body frame.
+        p1: Vec3,
+        /// Second body.
+        body2: usize,
+        /// Point of the plane, body2 frame.
+        p2: Vec3,
+        /// Unit normal, body2 frame.
+        n: Vec3,
+    },
+    /// A loop-closing joint between frame `f1` on `body1` and frame `f2` on `body2`.
+    Loop {
+        /// Which joint.
+        joint: LoopJoint,
+        /// First body.
+        body1: usize,
+        /// Frame on body1 (placement relative to the body frame).
+        f1: Pose,
+        /// Second body.
+        body2: usize,
+        /// Frame on body2.
+        f2: Pose,
+    },
+    /// Knife edge / sledge: the velocity of point `p` of `body` along the body-fixed unit
+    /// direction `e` is zero (1 non-holonomic row; λ is the lateral force on the blade).
+    KnifeEdge {
+        /// The body.
+        body: usize,
+        /// Contact point, body frame.
+        p: Vec3,
+        /// Unit blocked direction, body frame.
+        e: Vec3,
+    },
+    /// Disc of `radius` about the body-fixed unit `axis` through `center` rolling without slipping
+    /// on the ground plane z = 0: the material point at the contact has zero velocity (3 rows:
+    /// the normal row, holonomic — the contact point's height is zero — then the x and y rows,
+    /// non-holonomic). λ is the contact force (N) on the disc, in world (z, x, y) order.
+    RollingDisc {
+        /// The disc body.
+        body: usize,
+        /// Disc centre, body frame.
+        center: Vec3,
+        /// Unit axis, body frame.
+        axis: Vec3,
+        /// Radius (m), > 0.
+        radius: f64,
+    },
+}
+
+/// Which loop-closing joint a [`ConstraintKind::Loop`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopJoint {
+    /// Frame origins coincide (3 rows).
+    Spherical,
+    /// Frame origins coincide and the z-axes stay parallel (5 rows).
+    Revolute,
+    /// Frame origins and orientations coincide (6 rows).
+    Fixed,
 }
 
 /// A named constraint with its row offset in the stacked constraint vector.
@@ -89,8 +178,21 @@ impl ConstraintKind {
     /// Number of scalar equations.
     pub fn rows(&self) -> usize {
         match self {
-            ConstraintKind::Point { .. } => 3,
+            ConstraintKind::Point { .. } | ConstraintKind::RollingDisc { .. } => 3,
+            ConstraintKind::PointOnLine { .. } => 2,
+            ConstraintKind::Loop { joint: LoopJoint::Spherical, .. } => 3,
+            ConstraintKind::Loop { joint: LoopJoint::Revolute, .. } => 5,
+            ConstraintKind::Loop { joint: LoopJoint::Fixed, .. } => 6,
             _ => 1,
+        }
+    }
+    /// Number of holonomic rows (they come first; the rest are non-holonomic velocity rows with
+    /// `Φ = 0` that the position projection leaves out).
+    pub fn holonomic_rows(&self) -> usize {
+        match self {
+            ConstraintKind::KnifeEdge { .. } => 0,
+            ConstraintKind::RollingDisc { .. } => 1,
+            k => k.rows(),
         }
     }
 }
@@ -116,6 +218,264 @@ fn add_point_rows(model: &Model, s_all: &[[Motion; 6]], body: usize, p: &Vec3, s
         }
         b = j.parent;
     }
+}
+
+/// At most this many rows per constraint kind.
+const MAX_ROWS: usize = 6;
+
+/// Position-level rows of a body constraint: violations and the per-body world wrenches (see the
+/// module documentation). Lives on the stack: no allocation per evaluation.
+struct BodyRows {
+    body1: usize,
+    body2: usize,
+    n: usize,
+    phi: [f64; MAX_ROWS],
+    w1: [Force; MAX_ROWS],
+    w2: [Force; MAX_ROWS],
+}
+
+impl BodyRows {
+    fn new(body1: usize, body2: usize) -> Self {
+        BodyRows { body1, body2, n: 0, phi: [0.0; MAX_ROWS], w1: [Force::ZERO; MAX_ROWS], w2: [Force::ZERO; MAX_ROWS] }
+    }
+    /// A row with violation `phi`, wrench `w1` on body1 and `w2` on body2.
+    fn push(&mut self, phi: f64, w1: Force, w2: Force) {
+        self.phi[self.n] = phi;
+        self.w1[self.n] = w1;
+        self.w2[self.n] = w2;
+        self.n += 1;
+    }
+}
+
+/// The wrench of a unit force along `d` acting at the world point `p`: `(p × d, d)`.
+#[inline]
+fn force_at(p: &Vec3, d: &Vec3) -> Force {
+    Force::new(p.cross(d), *d)
+}
+
+/// A pure moment about `g`.
+#[inline]
+fn moment(g: &Vec3) -> Force {
+    Force::new(*g, Vec3::zeros())
+}
+
+/// Adds `sign · S·w` for every joint velocity on the path of `body` into row `row` of `g`.
+fn add_wrench_row(model: &Model, s_all: &[[Motion; 6]], body: usize, w: &Force, sign: f64, g: &mut DMatrix<f64>, row: usize) {
+    let mut b = body;
+    while b != 0 {
+        let j = &model.joints[b - 1];
+        for k in 0..j.nu() {
+            let s = &s_all[b][k];
+            g[(row, j.iu + k)] += sign * (s.w.dot(&w.n) + s.v.dot(&w.f));
+        }
+        b = j.parent;
+    }
+}
+
+/// Acceleration (velocity-product part, `data.a` at u̇ = 0) of the material point of `body` at
+/// the world point `p`.
+#[inline]
+fn acceleration_at(data: &Data, body: usize, p: &Vec3) -> Vec3 {
+    let (v, a) = (&data.v[body], &data.a[body]);
+    a.v + a.w.cross(p) + v.w.cross(&(v.v + v.w.cross(p)))
+}
+
+/// First and second time derivatives (velocity-product part) of a world vector `n` fixed in
+/// `body`: `ṅ = ω × n`, `n̈ = ω̇ × n + ω × ṅ`.
+#[inline]
+fn fixed_vector_rates(data: &Data, body: usize, n: &Vec3) -> (Vec3, Vec3) {
+    let (w, al) = (data.v[body].w, data.a[body].w);
+    let nd = w.cross(n);
+    (nd, al.cross(n) + w.cross(&nd))
+}
+
+/// `vee` of the skew-symmetric part: `½ vee(M - Mᵀ)`.
+#[inline]
+fn skew_vee(m: &Mat3) -> Vec3 {
+    Vec3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]) * 0.5
+}
+
+/// `E(M) = ½ (tr(M) I - M)`: with `Ṁ = w̃ M`, `d/dt ½vee(M - Mᵀ) = E(M) w`.
+#[inline]
+fn vee_rate_matrix(m: &Mat3) -> Mat3 {
+    (Mat3::identity() * m.trace() - m) * 0.5
+}
+
+/// World placements of the two frames of a loop joint.
+#[inline]
+fn loop_frames(data: &Data, body1: usize, f1: &Pose, body2: usize, f2: &Pose) -> (Pose, Pose) {
+    (data.x_abs[body1].compose(f1), data.x_abs[body2].compose(f2))
+}
+
+/// Geometry of a rolling disc: world axis `a`, unit in-plane vector `k̂` towards the ground side
+/// reversed (the contact point is `C - R k̂`), `|k|` and the contact point.
+fn disc_contact(data: &Data, c: &Constraint, t: f64, body: usize, center: &Vec3, axis: &Vec3, radius: f64) -> Result<(Vec3, Vec3, f64, Vec3)> {
+    let a = data.x_abs[body].a * axis;
+    let k = Vec3::z() - a * a.z;
+    let kn = k.norm();
+    if kn < 1e-9 {
+        return Err(Error::Solver(format!(
+            "constraint '{}': the disc lies flat on the ground at t = {t} s, the contact point is undefined",
+            c.name
+        )));
+    }
+    let kh = k / kn;
+    let p = point_position(data, body, center) - kh * radius;
+    Ok((a, kh, kn, p))
+}
+
+/// Position-level rows of the body kinds handled through wrenches (None for the others).
+fn body_rows(c: &Constraint, data: &Data, t: f64) -> Result<Option<BodyRows>> {
+    let (ex, ey, ez) = (Vec3::x(), Vec3::y(), Vec3::z());
+    Ok(Some(match &c.kind {
+        ConstraintKind::PointOnLine { body1, p1, body2, p2, n } => {
+            let mut r = BodyRows::new(*body1, *body2);
+            let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
+            let a2 = &data.x_abs[*body2].a;
+            for nb in n {
+                // body2's Jacobian at r₁ carries the ṅ·d term: n·(v₁ - v₂(r₁)) = n·ḋ + ṅ·d
+                let nw = a2 * nb;
+                let f = force_at(&w1, &nw);
+                r.push(nw.dot(&(w1 - w2)), f, f);
+            }
+            r
+        }
+        ConstraintKind::PointOnPlane { body1, p1, body2, p2, n } => {
+            let mut r = BodyRows::new(*body1, *body2);
+            let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
+            let nw = data.x_abs[*body2].a * n;
+            let f = force_at(&w1, &nw);
+            r.push(nw.dot(&(w1 - w2)), f, f);
+            r
+        }
+        ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
+            let mut r = BodyRows::new(*body1, *body2);
+            let (x1, x2) = loop_frames(data, *body1, f1, *body2, f2);
+            let d = x1.r - x2.r;
+            for e in [ex, ey, ez] {
+                r.push(e.dot(&d), force_at(&x1.r, &e), force_at(&x2.r, &e));
+            }
+            match joint {
+                LoopJoint::Spherical => {}
+                LoopJoint::Revolute => {
+                    // Φ = z₁·x₂, z₁·y₂;  Φ̇ = (ω₁ - ω₂)·(z₁ × x₂), …
+                    let z1 = x1.a.column(2).into_owned();
+                    for k in 0..2 {
+                        let e2 = x2.a.column(k).into_owned();
+                        let m = moment(&z1.cross(&e2));
+                        r.push(z1.dot(&e2), m, m);
+                    }
+                }
+                LoopJoint::Fixed => {
+                    // R = A₂ᵀA₁ (frame 1 in frame 2), Φ = ½ vee(R - Rᵀ) = sin θ · axis (frame 2),
+                    // Φ̇ = E(R) A₂ᵀ (ω₁ - ω₂) exactly: row k is the moment column k of A₂ E(R)ᵀ
+                    let rel = x2.a.transpose() * x1.a;
+                    let phi = skew_vee(&rel);
+                    let g = x2.a * vee_rate_matrix(&rel).transpose();
+                    for k in 0..3 {
+                        let m = moment(&g.column(k).into_owned());
+                        r.push(phi[k], m, m);
+                    }
+                }
+            }
+            r
+        }
+        ConstraintKind::KnifeEdge { body, p, e } => {
+            let mut r = BodyRows::new(*body, 0);
+            let w = point_position(data, *body, p);
+            let ew = data.x_abs[*body].a * e;
+            r.push(0.0, force_at(&w, &ew), Force::ZERO);
+            r
+        }
+        ConstraintKind::RollingDisc { body, center, axis, radius } => {
+            let mut r = BodyRows::new(*body, 0);
+            let (_, _, _, p) = disc_contact(data, c, t, *body, center, axis, *radius)?;
+            r.push(p.z, force_at(&p, &ez), Force::ZERO);
+            r.push(0.0, force_at(&p, &ex), Force::ZERO);
+            r.push(0.0, force_at(&p, &ey), Force::ZERO);
+            r
+        }
+        _ => return Ok(None),
+    }))
+}
+
+/// Velocity-product part of the time derivative of the velocity rows of the body kinds, i.e.
+/// `-γ` (`Ġ u`), into `out`; false for the other kinds.
+fn body_rows_rate(c: &Constraint, data: &Data, t: f64, out: &mut [f64; MAX_ROWS]) -> Result<bool> {
+    match &c.kind {
+        ConstraintKind::PointOnLine { body1, p1, body2, p2, .. } | ConstraintKind::PointOnPlane { body1, p1, body2, p2, .. } => {
+            // Φ = n·d with n fixed in body2: Φ̈ = n̈·d + 2 ṅ·ḋ + n·d̈
+            let d = point_position(data, *body1, p1) - point_position(data, *body2, p2);
+            let dd = point_velocity(data, *body1, p1) - point_velocity(data, *body2, p2);
+            let ddd = point_acceleration(data, *body1, p1) - point_acceleration(data, *body2, p2);
+            let a2 = data.x_abs[*body2].a;
+            let mut one = |k: usize, nb: &Vec3| {
+                let nw = a2 * nb;
+                let (nd, ndd) = fixed_vector_rates(data, *body2, &nw);
+                out[k] = ndd.dot(&d) + 2.0 * nd.dot(&dd) + nw.dot(&ddd);
+            };
+            match &c.kind {
+                ConstraintKind::PointOnLine { n, .. } => {
+                    one(0, &n[0]);
+                    one(1, &n[1]);
+                }
+                ConstraintKind::PointOnPlane { n, .. } => one(0, n),
+                _ => unreachable!(),
+            }
+        }
+        ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
+            let (x1, x2) = loop_frames(data, *body1, f1, *body2, f2);
+            let acc = acceleration_at(data, *body1, &x1.r) - acceleration_at(data, *body2, &x2.r);
+            out[..3].copy_from_slice(acc.as_slice());
+            match joint {
+                LoopJoint::Spherical => {}
+                LoopJoint::Revolute => {
+                    let z1 = x1.a.column(2).into_owned();
+                    let (z1d, z1dd) = fixed_vector_rates(data, *body1, &z1);
+                    for k in 0..2 {
+                        let e2 = x2.a.column(k).into_owned();
+                        let (ed, edd) = fixed_vector_rates(data, *body2, &e2);
+                        out[3 + k] = z1dd.dot(&e2) + 2.0 * z1d.dot(&ed) + z1.dot(&edd);
+                    }
+                }
+                LoopJoint::Fixed => {
+                    // Φ̇ = E(R) w, w = A₂ᵀ ω_rel; Ṙ = w̃ R, ẇ = A₂ᵀ (ω̇_rel - ω₂ × ω_rel)
+                    let rel = x2.a.transpose() * x1.a;
+                    let (w1, w2) = (data.v[*body1].w, data.v[*body2].w);
+                    let wrel = w1 - w2;
+                    let arel = data.a[*body1].w - data.a[*body2].w;
+                    let a2t = x2.a.transpose();
+                    let w = a2t * wrel;
+                    let wd = a2t * (arel - w2.cross(&wrel));
+                    let rel_d = w.cross_matrix() * rel;
+                    let phidd = vee_rate_matrix(&rel_d) * w + vee_rate_matrix(&rel) * wd;
+                    out[3..6].copy_from_slice(phidd.as_slice());
+                }
+            }
+        }
+        ConstraintKind::KnifeEdge { body, p, e } => {
+            // d/dt (e·v_P) = ė·v_P + e·a_P
+            let ew = data.x_abs[*body].a * e;
+            let (ed, _) = fixed_vector_rates(data, *body, &ew);
+            out[0] = ed.dot(&point_velocity(data, *body, p)) + ew.dot(&point_acceleration(data, *body, p));
+        }
+        ConstraintKind::RollingDisc { body, center, axis, radius } => {
+            // G u = e·(v_O + ω × P) with P the (moving) contact point:
+            // d/dt = e·(a_O + ω̇ × P + ω × Ṗ), Ṗ = v_C - R dk̂/dt
+            let (a, kh, kn, p) = disc_contact(data, c, t, *body, center, axis, *radius)?;
+            let (v, acc) = (&data.v[*body], &data.a[*body]);
+            let ad = v.w.cross(&a);
+            let kd = -(a * ad.z + ad * a.z);
+            let khd = (kd - kh * kh.dot(&kd)) / kn;
+            let pd = point_velocity(data, *body, center) - khd * *radius;
+            let r = acc.v + acc.w.cross(&p) + v.w.cross(&pd);
+            out[0] = r.z;
+            out[1] = r.x;
+            out[2] = r.y;
+        }
+        _ => return Ok(false),
+    }
+    Ok(true)
 }
 
 /// Value and first two time derivatives of a time function (callbacks by central differences).
@@ -195,6 +555,15 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 data.b[r] = fd;
                 data.g[(r, *iu)] += 1.0;
             }
+            _ => {
+                let rows = body_rows(c, data, t)?.expect("a body constraint kind");
+                for k in 0..rows.n {
+                    data.phi[r + k] = rows.phi[k];
+                    data.b[r + k] = 0.0;
+                    add_wrench_row(model, &data.s, rows.body1, &rows.w1[k], 1.0, &mut data.g, r + k);
+                    add_wrench_row(model, &data.s, rows.body2, &rows.w2[k], -1.0, &mut data.g, r + k);
+                }
+            }
         }
     }
     Ok(())
@@ -225,6 +594,13 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, cb: &dyn Callbacks)
             ConstraintKind::Prescribed { function, .. } => {
                 data.gamma[r] = function_derivatives(function, t, cb)?.2;
             }
+            _ => {
+                let mut rate = [0.0; MAX_ROWS];
+                body_rows_rate(c, data, t, &mut rate)?;
+                for k in 0..c.kind.rows() {
+                    data.gamma[r + k] = -rate[k];
+                }
+            }
         }
     }
     Ok(())
@@ -234,6 +610,10 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, cb: &dyn Callbacks)
 /// (`data.f_ext`) and generalized forces on joint coordinates (`data.tau_applied`), so that the
 /// reaction forces at the joints include them.
 pub fn apply_forces(model: &Model, data: &mut Data) {
+    apply_forces_checked(model, data).expect("constraint geometry was valid in the last solve");
+}
+
+fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
     for c in &model.constraints {
         let r = c.row;
         match &c.kind {
@@ -253,8 +633,21 @@ pub fn apply_forces(model: &Model, data: &mut Data) {
                 data.tau_applied[*iu_b] -= ratio * data.lambda[r];
             }
             ConstraintKind::Prescribed { iu, .. } => data.tau_applied[*iu] += data.lambda[r],
+            _ => {
+                let rows = body_rows(c, data, f64::NAN)?.expect("a body constraint kind");
+                for k in 0..rows.n {
+                    let l = data.lambda[r + k];
+                    if rows.body1 != 0 {
+                        data.f_ext[rows.body1] += rows.w1[k] * l;
+                    }
+                    if rows.body2 != 0 {
+                        data.f_ext[rows.body2] += rows.w2[k] * (-l);
+                    }
+                }
+            }
         }
     }
+    Ok(())
 }
 
 fn add_point_force(data: &mut Data, body: usize, p_b: &Vec3, f: &Vec3) {

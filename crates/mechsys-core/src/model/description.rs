@@ -96,6 +96,135 @@ pub enum ConstraintDescription {
         /// The motion q(t).
         function: TimeFunctionDescription,
     },
+    /// Point `point1` on `body1` stays on the line through `point2` of `body2` along `direction`
+    /// (body2 frame): 2 rows.
+    PointOnLine {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Point on body1, body frame.
+        #[serde(default)]
+        point1: [f64; 3],
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// A point of the line, body2 frame.
+        #[serde(default)]
+        point2: [f64; 3],
+        /// Line direction, body2 frame (normalized).
+        direction: [f64; 3],
+    },
+    /// Point `point1` on `body1` stays in the plane through `point2` of `body2` with `normal`
+    /// (body2 frame): 1 row.
+    PointOnPlane {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Point on body1, body frame.
+        #[serde(default)]
+        point1: [f64; 3],
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// A point of the plane, body2 frame.
+        #[serde(default)]
+        point2: [f64; 3],
+        /// Plane normal, body2 frame (normalized).
+        normal: [f64; 3],
+    },
+    /// Loop-closing spherical joint: the origins of `frame1` (on body1) and `frame2` (on body2)
+    /// coincide (3 rows).
+    LoopSpherical {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Loop-closing revolute joint about the common z-axis of `frame1` and `frame2` (5 rows).
+    LoopRevolute {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Loop-closing fixed joint: `frame1` and `frame2` coincide (6 rows).
+    LoopFixed {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Knife edge (sledge, skate): the velocity of `point` of `body` along the body-fixed
+    /// `direction` is zero (1 non-holonomic row).
+    KnifeEdge {
+        /// Constraint name.
+        name: String,
+        /// The body.
+        body: String,
+        /// Contact point, body frame.
+        #[serde(default)]
+        point: [f64; 3],
+        /// Blocked direction, body frame (normalized).
+        direction: [f64; 3],
+    },
+    /// A disc of `radius` about the body-fixed `axis` through `center` rolls without slipping on
+    /// the ground plane z = 0 (1 holonomic + 2 non-holonomic rows).
+    RollingDisc {
+        /// Constraint name.
+        name: String,
+        /// The disc body.
+        body: String,
+        /// Disc centre, body frame.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Disc axis, body frame (normalized).
+        axis: [f64; 3],
+        /// Radius (m), > 0.
+        radius: f64,
+    },
+}
+
+impl ConstraintDescription {
+    /// The constraint's name.
+    pub fn name(&self) -> &str {
+        match self {
+            ConstraintDescription::Point { name, .. }
+            | ConstraintDescription::Distance { name, .. }
+            | ConstraintDescription::Coupler { name, .. }
+            | ConstraintDescription::Prescribed { name, .. }
+            | ConstraintDescription::PointOnLine { name, .. }
+            | ConstraintDescription::PointOnPlane { name, .. }
+            | ConstraintDescription::LoopSpherical { name, .. }
+            | ConstraintDescription::LoopRevolute { name, .. }
+            | ConstraintDescription::LoopFixed { name, .. }
+            | ConstraintDescription::KnifeEdge { name, .. }
+            | ConstraintDescription::RollingDisc { name, .. } => name,
+        }
+    }
 }
 
 fn default_name() -> String {

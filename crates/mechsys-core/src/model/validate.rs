@@ -26,6 +26,14 @@ fn unit_axis(v: &[f64; 3], what: &str) -> Result<Vec3> {
     Ok(a / n)
 }
 
+/// A unit vector from a nonzero finite direction; the error names the key.
+fn nonzero_direction(v: &[f64; 3], what: &str) -> Result<Vec3> {
+    let a = finite3(v, what)?;
+    let n = a.norm();
+    crate::ensure!(n > 1e-12, Model, "{what}: must not be the zero vector, got {v:?}");
+    Ok(a / n)
+}
+
 fn rotation(r: &Option<RotationDescription>, what: &str) -> Result<Mat3> {
     let Some(r) = r else { return Ok(Mat3::identity()) };
     match r {
@@ -536,12 +544,7 @@ impl Model {
         };
         for (ci, c) in desc.constraints.iter().enumerate() {
             use crate::constraints::{Constraint, ConstraintKind};
-            let name = match c {
-                ConstraintDescription::Point { name, .. }
-                | ConstraintDescription::Distance { name, .. }
-                | ConstraintDescription::Coupler { name, .. }
-                | ConstraintDescription::Prescribed { name, .. } => name.clone(),
-            };
+            let name = c.name().to_string();
             let what = format!("constraints[{ci}] '{name}'");
             crate::ensure!(!name.trim().is_empty(), Model, "constraints[{ci}]: name must not be empty");
             crate::ensure!(constraint_names.insert(name.clone()), Model, "{what}: duplicate constraint name");
@@ -607,6 +610,61 @@ impl Model {
                         iq: j.iq + index,
                         iu: j.iu + index,
                         function: time_function(&Some(function.clone()), &format!("{what}.function"), &mut n_callbacks)?,
+                    }
+                }
+                ConstraintDescription::PointOnLine { body1, point1, body2, point2, direction, .. }
+                | ConstraintDescription::PointOnPlane { body1, point1, body2, point2, normal: direction, .. } => {
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    let (p1, p2) = (finite3(point1, &format!("{what}.point1"))?, finite3(point2, &format!("{what}.point2"))?);
+                    if let ConstraintDescription::PointOnLine { .. } = c {
+                        let d = nonzero_direction(direction, &format!("{what}.direction"))?;
+                        // two unit normals of the line, fixed in body2
+                        let helper = if d.x.abs() < 0.6 { Vec3::x() } else { Vec3::y() };
+                        let n1 = d.cross(&helper).normalize();
+                        ConstraintKind::PointOnLine { body1: b1, p1, body2: b2, p2, n: [n1, d.cross(&n1)] }
+                    } else {
+                        let n = nonzero_direction(direction, &format!("{what}.normal"))?;
+                        ConstraintKind::PointOnPlane { body1: b1, p1, body2: b2, p2, n }
+                    }
+                }
+                ConstraintDescription::LoopSpherical { body1, frame1, body2, frame2, .. }
+                | ConstraintDescription::LoopRevolute { body1, frame1, body2, frame2, .. }
+                | ConstraintDescription::LoopFixed { body1, frame1, body2, frame2, .. } => {
+                    use crate::constraints::LoopJoint;
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    let frame = |f: &FrameDescription, key: &str| -> Result<Pose> {
+                        let w = format!("{what}.{key}");
+                        Ok(Pose::new(rotation(&f.rotation, &format!("{w}.rotation"))?, finite3(&f.position, &format!("{w}.position"))?))
+                    };
+                    let joint = match c {
+                        ConstraintDescription::LoopSpherical { .. } => LoopJoint::Spherical,
+                        ConstraintDescription::LoopRevolute { .. } => LoopJoint::Revolute,
+                        _ => LoopJoint::Fixed,
+                    };
+                    ConstraintKind::Loop { joint, body1: b1, f1: frame(frame1, "frame1")?, body2: b2, f2: frame(frame2, "frame2")? }
+                }
+                ConstraintDescription::KnifeEdge { body: b, point, direction, .. } => {
+                    let bi = body(b, &format!("{what}.body"))?;
+                    crate::ensure!(bi != 0, Model, "{what}.body: a knife edge needs a moving body, got 'ground'");
+                    ConstraintKind::KnifeEdge {
+                        body: bi,
+                        p: finite3(point, &format!("{what}.point"))?,
+                        e: nonzero_direction(direction, &format!("{what}.direction"))?,
+                    }
+                }
+                ConstraintDescription::RollingDisc { body: b, center, axis, radius, .. } => {
+                    let bi = body(b, &format!("{what}.body"))?;
+                    crate::ensure!(bi != 0, Model, "{what}.body: a rolling disc needs a moving body, got 'ground'");
+                    crate::ensure!(radius.is_finite() && *radius > 0.0, Model, "{what}.radius: must be > 0, got {radius}");
+                    ConstraintKind::RollingDisc {
+                        body: bi,
+                        center: finite3(center, &format!("{what}.center"))?,
+                        axis: nonzero_direction(axis, &format!("{what}.axis"))?,
+                        radius: *radius,
                     }
                 }
             };

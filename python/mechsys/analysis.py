@@ -1,0 +1,140 @@
+"""Analyses of constrained mechanisms without time integration: assembly (consistent initial
+states), kinematic analysis of fully driven mechanisms, and static equilibrium.
+
+All three work on the constraint equations Phi(q, t) = 0, G u = b, G u' = gamma (eq. 2.70) and
+use minimum-norm corrections (the pseudo-inverse of eq. 2.68) so that redundant equations are
+harmless.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from . import _core
+from .errors import ModelError, SolverError
+from .model import Model
+
+
+def _free_mask(model: Model, keep: Iterable[str]) -> np.ndarray:
+    info = {j["name"]: j for j in model.joint_info()}
+    mask = np.ones(model.nu, dtype=bool)
+    for name in keep:
+        if name not in info:
+            raise ModelError(f"keep: unknown joint '{name}' (joints: {', '.join(info)})")
+        j = info[name]
+        mask[j["iu"] : j["iu"] + j["nu"]] = False
+    return mask
+
+
+def _worst(core, phi: np.ndarray) -> str:
+    k = int(np.argmax(np.abs(phi)))
+    for c in core.constraints():
+        if c["row"] <= k < c["row"] + c["rows"]:
+            return c["name"]
+    return "?"
+
+
+def assemble(
+    model: Model, q=None, u=None, t: float = 0.0, keep: Sequence[str] = (), tol: float = 1e-12, max_iter: int = 50
+) -> tuple[np.ndarray, np.ndarray]:
+    """A consistent state near (q, u): Newton on Phi(q, t) = 0 with minimum-norm steps over the
+    coordinates of all joints not named in ``keep``, then the velocities projected onto
+    G u = b the same way. Raises SolverError naming the constraint that cannot be closed."""
+    core, callbacks = model.engine()
+    q = model.state_vector(q, "q").astype(float)
+    u = model.state_vector(u, "u").astype(float)
+    free = _free_mask(model, keep)
+    if core.nc == 0:
+        return q, u
+    for _ in range(max_iter):
+        phi, g, b = _core.constraint_jacobian(core, q, t, callbacks)
+        if np.abs(phi).max() <= tol:
+            break
+        du = np.zeros(core.nu)
+        du[free] = -np.linalg.lstsq(g[:, free], phi, rcond=1e-12)[0]
+        q = core.integrate(q, du, 1.0)
+    else:
+        raise SolverError(
+            f"assembly: constraint '{_worst(core, phi)}' cannot be closed (violation {np.abs(phi).max():.3e})"
+            + (f" with joints {list(keep)} kept" if keep else "")
+        )
+    phi, g, b = _core.constraint_jacobian(core, q, t, callbacks)
+    r = g @ u - b
+    u = u.copy()
+    u[free] -= np.linalg.lstsq(g[:, free], r, rcond=1e-12)[0]
+    res = np.abs(g @ u - b).max()
+    if res > 1e-9 * max(1.0, np.abs(u).max()):
+        raise SolverError(f"assembly: velocities of the kept joints {list(keep)} violate constraint '{_worst(core, g @ u - b)}'")
+    return q, u
+
+
+def kinematic_analysis(model: Model, t: Sequence[float], q=None) -> dict[str, np.ndarray]:
+    """Positions, velocities and accelerations of a fully driven mechanism (no degree of freedom
+    left) at the times ``t``, from the constraints alone: Phi = 0 by Newton (continuing from the
+    previous time), G u = b, G u' = gamma. Returns ``{"t", "q", "u", "udot"}`` (rows per time)."""
+    from .mechanisms import mobility
+
+    core, callbacks = model.engine()
+    ts = np.asarray(t, dtype=float).reshape(-1)
+    qk = model.state_vector(q, "q").astype(float)
+    mob = mobility(model, qk, float(ts[0]) if ts.size else 0.0)
+    if mob["dof"] != 0:
+        raise ModelError(
+            f"kinematic analysis needs a fully driven mechanism; {mob['dof']} degree(s) of freedom are left (add drives)"
+        )
+    out_q, out_u, out_a = [], [], []
+    for tk in ts:
+        qk, _ = assemble(model, qk, np.zeros(core.nu), float(tk))
+        _, g, b = _core.constraint_jacobian(core, qk, float(tk), callbacks)
+        uk = np.linalg.lstsq(g, b, rcond=1e-12)[0]
+        gamma = _core.constraint_gamma(core, qk, uk, float(tk), callbacks)
+        ak = np.linalg.lstsq(g, gamma, rcond=1e-12)[0]
+        out_q.append(qk)
+        out_u.append(uk)
+        out_a.append(ak)
+    return {"t": ts, "q": np.array(out_q), "u": np.array(out_u), "udot": np.array(out_a)}
+
+
+def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10, max_iter: int = 50) -> dict:
+    """Static equilibrium of a constrained model at time t: h(q, 0, t) + G(q)^T lambda = 0 with
+    Phi(q, t) = 0, by Newton with a finite-difference stiffness in the velocity coordinates.
+    Returns ``{"q", "lambda": {constraint: multipliers}, "residual"}``; the multiplier of a
+    driving constraint is the force or torque the drive must supply (virtual work)."""
+    core, callbacks = model.engine()
+    qk, _ = assemble(model, q, None, t)
+    nu, nc = core.nu, core.nc
+    zero = np.zeros(nu)
+    lam = np.zeros(nc)
+
+    def h_of(qv):
+        return _core.nonlinear_effects(core, qv, zero, t, callbacks)
+
+    for _ in range(max_iter):
+        h = h_of(qk)
+        phi, g, _ = _core.constraint_jacobian(core, qk, t, callbacks)
+        f = np.concatenate([h + g.T @ lam, phi])
+        if np.abs(f).max() <= tol * max(1.0, np.abs(h).max()):
+            break
+        # d/d(du) of h + G^T lambda by central differences on the configuration manifold
+        kmat = np.zeros((nu, nu))
+        eps = 1e-7
+        for i in range(nu):
+            e = np.zeros(nu)
+            e[i] = eps
+            qp, qm = core.integrate(qk, e, 1.0), core.integrate(qk, -e, 1.0)
+            _, gp, _ = _core.constraint_jacobian(core, qp, t, callbacks)
+            _, gm, _ = _core.constraint_jacobian(core, qm, t, callbacks)
+            kmat[:, i] = ((h_of(qp) + gp.T @ lam) - (h_of(qm) + gm.T @ lam)) / (2 * eps)
+        jac = np.block([[kmat, g.T], [g, np.zeros((nc, nc))]])
+        step = np.linalg.lstsq(jac, -f, rcond=1e-12)[0]
+        qk = core.integrate(qk, step[:nu], 1.0)
+        lam = lam + step[nu:]
+    else:
+        raise SolverError(f"static equilibrium: Newton did not converge (residual {np.abs(f).max():.3e})")
+    names = {c["name"]: lam[c["row"] : c["row"] + c["rows"]].copy() for c in core.constraints()}
+    return {"q": qk, "lambda": names, "residual": float(np.abs(f).max())}
+
+
+__all__ = ["assemble", "kinematic_analysis", "static_equilibrium"]
