@@ -78,6 +78,8 @@ def simulate(
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
     core = model.build()
+    if core.nc:
+        _warn_redundant(model, q0, t0)
     if keep:
         # assemble with the named joints held at their given q0, u0 (the engine's own start
         # projection then finds the state consistent and leaves it)
@@ -116,6 +118,30 @@ def simulate(
     }
     body_names = core.body_names[1:]
     return Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
+
+
+def _warn_redundant(model: Model, q0, t0) -> None:
+    """Warns once per model when constraint equations are dependent at the start (e.g. a planar
+    loop closed in 3-D); the engine gives them zero multipliers, which is usually what one wants."""
+    import warnings
+
+    from .mechanisms import mobility
+
+    key = (model._built[0] if model._built else None, "redundancy-warned")
+    if getattr(model, "_warned", None) == key:
+        return
+    try:
+        mob = mobility(model, model.state_vector(q0, "q"), float(t0))
+    except Exception:  # noqa: BLE001 - the simulation itself reports bad states properly
+        return
+    model._warned = key
+    if mob["redundant"]:
+        names = ", ".join(f"{n}[{k}]" for n, k in mob["redundant"])
+        warnings.warn(
+            f"model '{model.name}': {len(mob['redundant'])} redundant constraint equation(s) at t0: {names}; "
+            "their multipliers are set to zero (minimum-norm)",
+            stacklevel=3,
+        )
 
 
 def _wait(worker: threading.Thread, prog, n_expected: int, progress: bool | None) -> None:

@@ -659,3 +659,6 @@ fn add_point_force(data: &mut Data, body: usize, p_b: &Vec3, f: &Vec3) {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod tests_kinds;

@@ -94,8 +94,10 @@ pub fn forward_dynamics(
 }
 
 /// Solves `(G Gᵀ) μ = r` in place (minimum-norm correction `-Gᵀ μ` of a residual `r`); `r` is
-/// `data.work2[..nc]`. Dependent rows get zero.
-fn min_norm_correction(data: &mut Data, nc: usize, nu: usize) {
+/// `data.work2[..nc]`. Dependent rows get zero. With `holonomic_only` the non-holonomic rows are
+/// left out (zero rows and columns of `G Gᵀ` count as dependent, so their μ is zero): the
+/// position Newton then solves only `Φ_h = 0` and is not restricted by velocity-only rows.
+fn min_norm_correction(model: &Model, data: &mut Data, nc: usize, nu: usize, holonomic_only: bool) {
     for r in 0..nc {
         for c in 0..nc {
             let mut s = 0.0;
@@ -105,6 +107,18 @@ fn min_norm_correction(data: &mut Data, nc: usize, nu: usize) {
             data.schur[r * nc + c] = s;
         }
     }
+    if holonomic_only {
+        for con in &model.constraints {
+            for k in con.kind.holonomic_rows()..con.kind.rows() {
+                let r = con.row + k;
+                for c in 0..nc {
+                    data.schur[r * nc + c] = 0.0;
+                    data.schur[c * nc + r] = 0.0;
+                }
+                data.work2[r] = 0.0;
+            }
+        }
+    }
     let rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
     let mut rhs = std::mem::take(&mut data.work2);
     cholesky_semidefinite_solve(&data.schur, nc, &data.perm_c, rank, &mut rhs[..nc], &mut data.work);
@@ -112,7 +126,8 @@ fn min_norm_correction(data: &mut Data, nc: usize, nu: usize) {
 }
 
 /// Projects (q, u) at time t onto `Φ(q, t) = 0` and `G u = b`: Newton iterations with minimum-norm
-/// corrections (the pseudo-inverse relation of eq. 2.68), then one velocity correction.
+/// corrections (the pseudo-inverse relation of eq. 2.68) over the holonomic rows only, then one
+/// velocity correction over all rows (holonomic and non-holonomic).
 pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f64], cb: &dyn Callbacks) -> Result<()> {
     let (nu, nc) = (model.nu, model.nc);
     if nc == 0 {
@@ -129,7 +144,7 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
             break;
         }
         data.work2[..nc].copy_from_slice(&data.phi);
-        min_norm_correction(data, nc, nu);
+        min_norm_correction(model, data, nc, nu, true);
         // Δu = -Gᵀ μ, applied on the configuration manifold
         for i in 0..nu {
             let mut s = 0.0;
@@ -156,7 +171,7 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
         }
         data.work2[k] = s;
     }
-    min_norm_correction(data, nc, nu);
+    min_norm_correction(model, data, nc, nu, false);
     for i in 0..nu {
         let mut s = 0.0;
         for k in 0..nc {
