@@ -137,4 +137,53 @@ def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10,
     return {"q": qk, "lambda": names, "residual": float(np.abs(f).max())}
 
 
-__all__ = ["assemble", "kinematic_analysis", "static_equilibrium"]
+
+
+def system_jacobian(model: Model, q) -> np.ndarray:
+    """The Jacobian J = dz/dq-dot of the system coordinates z (each body's origin velocity and
+    angular velocity, inertial components, stacked per body: 6 n rows) with respect to the
+    generalized velocities u, so that z-dot = J u (eqs. 2.63, 2.64, 2.69)."""
+    core, _ = model.engine()
+    qv = np.ascontiguousarray(q, dtype=float)
+    blocks = []
+    for name in core.body_names[1:]:
+        jt, jr = _core.point_jacobian(core, qv, name, [0.0, 0.0, 0.0])
+        blocks += [np.asarray(jt), np.asarray(jr)]
+    return np.vstack(blocks) if blocks else np.zeros((0, core.nu))
+
+
+def velocities_from_system(model: Model, q, zdot) -> np.ndarray:
+    """Generalized velocities from system velocities by the pseudo-inverse relation
+    u = (J^T J)^-1 J^T z-dot (eq. 2.68), the least-squares fit when z-dot is not exactly compatible."""
+    j = system_jacobian(model, q)
+    return np.linalg.lstsq(j, np.asarray(zdot, dtype=float).reshape(-1), rcond=1e-12)[0]
+
+
+def coordinate_partitioning(model: Model, q=None, t: float = 0.0, tol: float = 1e-10) -> dict:
+    """Splits the velocities into dependent and independent ones by pivoting on the constraint
+    Jacobian G (QR with column pivoting): the dependent velocities are the pivot columns, the
+    others can be chosen freely. Returns ``{"independent", "dependent"}`` as lists of
+    ``(joint, component)`` and ``velocity_map`` V (nu x dof) with u = V u_independent, G V = 0."""
+    from scipy.linalg import qr
+
+    core, callbacks = model.engine()
+    qv = np.ascontiguousarray(model.q0() if q is None else q, dtype=float)
+    _, g, _ = _core.constraint_jacobian(core, qv, float(t), callbacks)
+    nu = core.nu
+    names = []
+    for j in core.joints():
+        names += [(j["name"], k) for k in range(j["nu"])]
+    if core.nc == 0:
+        return {"independent": names, "dependent": [], "velocity_map": np.eye(nu)}
+    _, r, piv = qr(g, mode="economic", pivoting=True)
+    d = np.abs(np.diag(r))
+    rank = int(np.sum(d > tol * max(d.max(), 1e-300))) if d.size else 0
+    dep, ind = np.sort(piv[:rank]), np.sort(piv[rank:])
+    # G_d u_d + G_i u_i = 0 -> u_d = -G_d^+ G_i u_i
+    vmap = np.zeros((nu, ind.size))
+    vmap[ind, np.arange(ind.size)] = 1.0
+    vmap[dep, :] = -np.linalg.lstsq(g[:, dep], g[:, ind], rcond=1e-12)[0]
+    return {"independent": [names[i] for i in ind], "dependent": [names[i] for i in dep], "velocity_map": vmap}
+
+
+__all__ = ["assemble", "kinematic_analysis", "static_equilibrium", "system_jacobian", "velocities_from_system", "coordinate_partitioning"]
