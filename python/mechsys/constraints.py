@@ -10,6 +10,16 @@ the driving force or torque for prescribed motion) and ``constraint/<name>/viola
   ``lambda`` is the force along the line from point 2 to point 1 acting on body 1.
 - :class:`Coupler`: ``q(joint1) = ratio * q(joint2) + offset`` (gears, belts).
 - :class:`Prescribed`: ``q(joint)[index] = f(t)`` (a driven joint; ``lambda`` is the drive).
+- :class:`PointOnLine`, :class:`PointOnPlane`: a point of one body slides on a line / in a plane
+  fixed to another body (2 / 1 equations; ``lambda`` is the force on body 1, N).
+- :class:`LoopSpherical`, :class:`LoopRevolute`, :class:`LoopFixed`: loop-closing joints between
+  a frame on each of two bodies (3 / 5 / 6 equations; ``lambda`` rows 0-2 are the force on body 1
+  in world axes, N, the remaining rows moments, N m).
+- :class:`KnifeEdge`, :class:`RollingDisc`: non-holonomic constraints, eq. (2.70) given at velocity
+  level (no position equation; their ``violation`` rows read 0).
+
+Redundant equations (a planar loop closed by a 3-D joint) are allowed: the solver gives dependent
+rows zero multipliers.
 """
 
 from __future__ import annotations
@@ -18,7 +28,8 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 from . import functions
-from .joints import _vec3
+from .errors import ModelError
+from .joints import _frame, _vec3
 
 
 def _name(x) -> str:
@@ -108,4 +119,162 @@ class Prescribed:
         return {"type": "prescribed", "name": self.name, "joint": _name(self.joint), "index": int(self.index), "function": f}
 
 
-__all__ = ["Point", "Distance", "Coupler", "Prescribed"]
+def _bodies(c, w: str) -> dict:
+    return {
+        "name": c.name,
+        "body1": _name(c.body1),
+        "point1": _vec3(c.point1, f"{w}.point1"),
+        "body2": _name(c.body2),
+        "point2": _vec3(c.point2, f"{w}.point2"),
+    }
+
+
+@dataclass
+class PointOnLine:
+    """``point1`` on ``body1`` stays on the line through ``point2`` of ``body2`` along ``direction``
+    (body2 frame; the line moves with body2). 2 equations: the offset components along two unit
+    normals of the line fixed in body2; ``lambda`` is the force on body 1 along them (N)."""
+
+    name: str
+    body1: Any
+    body2: Any
+    direction: Sequence[float]
+    point1: Sequence[float] = (0.0, 0.0, 0.0)
+    point2: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"constraint '{self.name}'"
+        return {"type": "point_on_line", **_bodies(self, w), "direction": _vec3(self.direction, f"{w}.direction")}
+
+
+@dataclass
+class PointOnPlane:
+    """``point1`` on ``body1`` stays in the plane through ``point2`` of ``body2`` with ``normal``
+    (body2 frame). 1 equation ``n . (r1 - r2) = 0``; ``lambda`` is the normal force on body 1 (N)."""
+
+    name: str
+    body1: Any
+    body2: Any
+    normal: Sequence[float]
+    point1: Sequence[float] = (0.0, 0.0, 0.0)
+    point2: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"constraint '{self.name}'"
+        return {"type": "point_on_plane", **_bodies(self, w), "normal": _vec3(self.normal, f"{w}.normal")}
+
+
+@dataclass
+class _Loop:
+    name: str
+    body1: Any
+    body2: Any
+    frame1: Any = None
+    frame2: Any = None
+    _type = ""
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"constraint '{self.name}'"
+        return {
+            "type": self._type,
+            "name": self.name,
+            "body1": _name(self.body1),
+            "frame1": _frame(self.frame1, f"{w}.frame1"),
+            "body2": _name(self.body2),
+            "frame2": _frame(self.frame2, f"{w}.frame2"),
+        }
+
+
+@dataclass
+class LoopSpherical(_Loop):
+    """Loop-closing ball joint: the origins of ``frame1`` (a :class:`mechsys.Frame` or a position on
+    ``body1``) and ``frame2`` (on ``body2``) coincide. 3 equations; ``lambda`` is the force on
+    body 1 (N, world axes)."""
+
+    _type = "loop_spherical"
+
+
+@dataclass
+class LoopRevolute(_Loop):
+    """Loop-closing hinge about the z-axes of ``frame1`` and ``frame2``: the origins coincide and
+    the z-axis of frame 1 stays perpendicular to the x- and y-axes of frame 2. 5 equations:
+    ``lambda[0:3]`` the force on body 1 (N, world axes), ``lambda[3:5]`` the moments (N m) about
+    ``z1 x x2`` and ``z1 x y2``."""
+
+    _type = "loop_revolute"
+
+
+@dataclass
+class LoopFixed(_Loop):
+    """Loop-closing weld: ``frame1`` and ``frame2`` coincide. 6 equations: origins, and the relative
+    rotation ``R = A2^T A1`` through ``1/2 vee(R - R^T)`` (= sin(angle) * axis, the rotation vector
+    to first order). ``lambda[0:3]`` is the force on body 1 (N), ``lambda[3:6]`` the moment (N m,
+    frame-2 axes when assembled)."""
+
+    _type = "loop_fixed"
+
+
+@dataclass
+class KnifeEdge:
+    """Knife edge, sledge or skate: the velocity of ``point`` on ``body`` along the body-fixed
+    ``direction`` is zero (1 non-holonomic equation); ``lambda`` is the lateral force on the blade
+    (N). The body may still translate along the blade and turn."""
+
+    name: str
+    body: Any
+    direction: Sequence[float]
+    point: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"constraint '{self.name}'"
+        return {
+            "type": "knife_edge",
+            "name": self.name,
+            "body": _name(self.body),
+            "point": _vec3(self.point, f"{w}.point"),
+            "direction": _vec3(self.direction, f"{w}.direction"),
+        }
+
+
+@dataclass
+class RollingDisc:
+    """A disc of ``radius`` about the body-fixed ``axis`` through ``center`` rolls without slipping
+    on the ground plane z = 0 (world z up). 3 equations, world order (z, x, y): the contact height
+    is zero (holonomic) and the disc's material point at the contact has no horizontal velocity
+    (non-holonomic). ``lambda`` is the contact force on the disc (N): normal, then tangential."""
+
+    name: str
+    body: Any
+    radius: float
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"constraint '{self.name}'"
+        try:
+            radius = float(self.radius)
+        except (TypeError, ValueError):
+            raise ModelError(f"{w}.radius: expected a number, got {self.radius!r}") from None
+        return {
+            "type": "rolling_disc",
+            "name": self.name,
+            "body": _name(self.body),
+            "center": _vec3(self.center, f"{w}.center"),
+            "axis": _vec3(self.axis, f"{w}.axis"),
+            "radius": radius,
+        }
+
+
+__all__ = [
+    "Point",
+    "Distance",
+    "Coupler",
+    "Prescribed",
+    "PointOnLine",
+    "PointOnPlane",
+    "LoopSpherical",
+    "LoopRevolute",
+    "LoopFixed",
+    "KnifeEdge",
+    "RollingDisc",
+]

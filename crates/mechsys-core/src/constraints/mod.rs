@@ -200,7 +200,16 @@ impl ConstraintKind {
 /// Adds `sign · dirᵀ J_T(point)` (or all three rows of `sign · J_T` when `dir` is None) of the
 /// world point `p` attached to `body` into the rows of `g` starting at `row`.
 #[allow(clippy::too_many_arguments)]
-fn add_point_rows(model: &Model, s_all: &[[Motion; 6]], body: usize, p: &Vec3, sign: f64, dir: Option<&Vec3>, g: &mut DMatrix<f64>, row: usize) {
+fn add_point_rows(
+    model: &Model,
+    s_all: &[[Motion; 6]],
+    body: usize,
+    p: &Vec3,
+    sign: f64,
+    dir: Option<&Vec3>,
+    g: &mut DMatrix<f64>,
+    row: usize,
+) {
     let mut b = body;
     while b != 0 {
         let j = &model.joints[b - 1];
@@ -260,7 +269,15 @@ fn moment(g: &Vec3) -> Force {
 }
 
 /// Adds `sign · S·w` for every joint velocity on the path of `body` into row `row` of `g`.
-fn add_wrench_row(model: &Model, s_all: &[[Motion; 6]], body: usize, w: &Force, sign: f64, g: &mut DMatrix<f64>, row: usize) {
+fn add_wrench_row(
+    model: &Model,
+    s_all: &[[Motion; 6]],
+    body: usize,
+    w: &Force,
+    sign: f64,
+    g: &mut DMatrix<f64>,
+    row: usize,
+) {
     let mut b = body;
     while b != 0 {
         let j = &model.joints[b - 1];
@@ -309,7 +326,15 @@ fn loop_frames(data: &Data, body1: usize, f1: &Pose, body2: usize, f2: &Pose) ->
 
 /// Geometry of a rolling disc: world axis `a`, unit in-plane vector `k̂` towards the ground side
 /// reversed (the contact point is `C - R k̂`), `|k|` and the contact point.
-fn disc_contact(data: &Data, c: &Constraint, t: f64, body: usize, center: &Vec3, axis: &Vec3, radius: f64) -> Result<(Vec3, Vec3, f64, Vec3)> {
+fn disc_contact(
+    data: &Data,
+    c: &Constraint,
+    t: f64,
+    body: usize,
+    center: &Vec3,
+    axis: &Vec3,
+    radius: f64,
+) -> Result<(Vec3, Vec3, f64, Vec3)> {
     let a = data.x_abs[body].a * axis;
     let k = Vec3::z() - a * a.z;
     let kn = k.norm();
@@ -403,7 +428,8 @@ fn body_rows(c: &Constraint, data: &Data, t: f64) -> Result<Option<BodyRows>> {
 /// `-γ` (`Ġ u`), into `out`; false for the other kinds.
 fn body_rows_rate(c: &Constraint, data: &Data, t: f64, out: &mut [f64; MAX_ROWS]) -> Result<bool> {
     match &c.kind {
-        ConstraintKind::PointOnLine { body1, p1, body2, p2, .. } | ConstraintKind::PointOnPlane { body1, p1, body2, p2, .. } => {
+        ConstraintKind::PointOnLine { body1, p1, body2, p2, .. }
+        | ConstraintKind::PointOnPlane { body1, p1, body2, p2, .. } => {
             // Φ = n·d with n fixed in body2: Φ̈ = n̈·d + 2 ṅ·ḋ + n·d̈
             let d = point_position(data, *body1, p1) - point_position(data, *body2, p2);
             let dd = point_velocity(data, *body1, p1) - point_velocity(data, *body2, p2);

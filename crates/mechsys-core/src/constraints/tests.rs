@@ -21,7 +21,15 @@ fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
     }
 }
 
-fn joint(name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis: Option<[f64; 3]>, q0: Option<Vec<f64>>) -> JointDescription {
+fn joint(
+    name: &str,
+    kind: &str,
+    parent: &str,
+    child: &str,
+    pos: [f64; 3],
+    axis: Option<[f64; 3]>,
+    q0: Option<Vec<f64>>,
+) -> JointDescription {
     JointDescription {
         name: name.into(),
         kind: kind.into(),
@@ -44,7 +52,12 @@ fn model_with_all_kinds() -> Model {
     let desc = ModelDescription {
         name: "all".into(),
         gravity: [0.0, 0.0, -9.81],
-        bodies: vec![body("a", 1.0, [0.2, 0.0, 0.0]), body("b", 0.5, [0.1, 0.0, 0.0]), body("c", 0.8, [0.0, 0.0, 0.0]), body("d", 0.3, [0.05, 0.0, 0.0])],
+        bodies: vec![
+            body("a", 1.0, [0.2, 0.0, 0.0]),
+            body("b", 0.5, [0.1, 0.0, 0.0]),
+            body("c", 0.8, [0.0, 0.0, 0.0]),
+            body("d", 0.3, [0.05, 0.0, 0.0]),
+        ],
         joints: vec![
             joint("ja", "revolute", "ground", "a", [0.0; 3], Some([0.0, 0.0, 1.0]), Some(vec![0.3])),
             joint("jb", "revolute", "a", "b", [0.4, 0.0, 0.0], Some([0.0, 1.0, 0.0]), Some(vec![0.5])),
@@ -54,9 +67,28 @@ fn model_with_all_kinds() -> Model {
         forces: vec![],
         ground_markers: vec![],
         constraints: vec![
-            ConstraintDescription::Point { name: "pin".into(), body1: "b".into(), point1: [0.2, 0.0, 0.0], body2: "c".into(), point2: [0.1, 0.0, 0.0] },
-            ConstraintDescription::Distance { name: "rod".into(), body1: "c".into(), point1: [-0.1, 0.05, 0.0], body2: "ground".into(), point2: [0.8, 0.2, 0.0], length: 0.35 },
-            ConstraintDescription::Coupler { name: "gear".into(), joint1: "jd".into(), joint2: "ja".into(), ratio: -2.0, offset: 0.3 },
+            ConstraintDescription::Point {
+                name: "pin".into(),
+                body1: "b".into(),
+                point1: [0.2, 0.0, 0.0],
+                body2: "c".into(),
+                point2: [0.1, 0.0, 0.0],
+            },
+            ConstraintDescription::Distance {
+                name: "rod".into(),
+                body1: "c".into(),
+                point1: [-0.1, 0.05, 0.0],
+                body2: "ground".into(),
+                point2: [0.8, 0.2, 0.0],
+                length: 0.35,
+            },
+            ConstraintDescription::Coupler {
+                name: "gear".into(),
+                joint1: "jd".into(),
+                joint2: "ja".into(),
+                ratio: -2.0,
+                offset: 0.3,
+            },
             ConstraintDescription::Prescribed {
                 name: "drive".into(),
                 joint: "jb".into(),
@@ -119,7 +151,9 @@ fn acceleration_rows_are_the_second_derivative_of_the_violation() {
         let us: Vec<f64> = u.iter().zip(&udot).map(|(a, b)| a + b * s).collect();
         crate::kinematics::positions(&model, data, &qs);
         positions(&model, data, t + s, &qs, &NoCallbacks).unwrap();
-        (0..model.nc).map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r]).collect::<Vec<f64>>()
+        (0..model.nc)
+            .map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r])
+            .collect::<Vec<f64>>()
     };
     let (rp, rm) = (residual_at(&mut data, h), residual_at(&mut data, -h));
     for r in 0..model.nc {

@@ -22,7 +22,15 @@ fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
     }
 }
 
-fn joint(name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis: Option<[f64; 3]>, q0: Vec<f64>) -> JointDescription {
+fn joint(
+    name: &str,
+    kind: &str,
+    parent: &str,
+    child: &str,
+    pos: [f64; 3],
+    axis: Option<[f64; 3]>,
+    q0: Vec<f64>,
+) -> JointDescription {
     JointDescription {
         name: name.into(),
         kind: kind.into(),
@@ -42,7 +50,11 @@ fn joint(name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis:
 fn frame(position: [f64; 3], cardan: [f64; 3]) -> FrameDescription {
     FrameDescription {
         position,
-        rotation: Some(RotationDescription::Angles(AnglesDescription { cardan: Some(cardan), euler: None, rotvec: None })),
+        rotation: Some(RotationDescription::Angles(AnglesDescription {
+            cardan: Some(cardan),
+            euler: None,
+            rotvec: None,
+        })),
     }
 }
 
@@ -114,8 +126,19 @@ fn model_with_new_kinds() -> Model {
                 body2: s("ground"),
                 frame2: frame([0.4, 0.1, 0.0], [0.2, 0.1, 2.0]),
             },
-            ConstraintDescription::KnifeEdge { name: s("blade"), body: s("d"), point: [0.1, 0.2, 0.0], direction: [0.2, 1.0, 0.3] },
-            ConstraintDescription::RollingDisc { name: s("wheel"), body: s("disc"), center: [0.02, 0.0, 0.01], axis: [0.1, 0.2, 1.0], radius: 0.3 },
+            ConstraintDescription::KnifeEdge {
+                name: s("blade"),
+                body: s("d"),
+                point: [0.1, 0.2, 0.0],
+                direction: [0.2, 1.0, 0.3],
+            },
+            ConstraintDescription::RollingDisc {
+                name: s("wheel"),
+                body: s("disc"),
+                center: [0.02, 0.0, 0.01],
+                axis: [0.1, 0.2, 1.0],
+                radius: 0.3,
+            },
         ],
     };
     Model::from_description(desc).unwrap()
@@ -187,7 +210,9 @@ fn new_kinds_acceleration_rows_are_the_derivative_of_the_velocity_rows() {
         let us: Vec<f64> = u.iter().zip(&udot).map(|(a, b)| a + b * s).collect();
         crate::kinematics::positions(&model, data, &qs);
         positions(&model, data, t + s, &qs, &NoCallbacks).unwrap();
-        (0..model.nc).map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r]).collect::<Vec<f64>>()
+        (0..model.nc)
+            .map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r])
+            .collect::<Vec<f64>>()
     };
     let (rp, rm) = (residual_at(&mut data, h), residual_at(&mut data, -h));
     let mut worst = 0.0f64;

@@ -34,9 +34,10 @@ pub struct ModelDescription {
     pub constraints: Vec<ConstraintDescription>,
 }
 
-/// A bilateral constraint.
+/// A bilateral constraint. Read through a JSON value so that a malformed entry's error names the
+/// constraint and the key inside it (`constraint 'k'.frame1: unknown field ...`).
 #[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(remote = "Self", tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ConstraintDescription {
     /// Point `point1` on `body1` coincides with point `point2` on `body2` (a spherical loop closure).
     Point {
@@ -206,6 +207,43 @@ pub enum ConstraintDescription {
         /// Radius (m), > 0.
         radius: f64,
     },
+}
+
+impl Serialize for ConstraintDescription {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        ConstraintDescription::serialize(self, s)
+    }
+}
+
+impl<'de> Deserialize<'de> for ConstraintDescription {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Derived(ConstraintDescription);
+        impl<'de> Deserialize<'de> for Derived {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+                ConstraintDescription::deserialize(d).map(Derived)
+            }
+        }
+        let v = serde_json::Value::deserialize(d)?;
+        serde_path_to_error::deserialize::<_, Derived>(&v).map(|x| x.0).map_err(|e| {
+            let who = match v.get("name").and_then(|n| n.as_str()) {
+                Some(n) => format!("constraint '{n}'"),
+                None => "constraint".to_string(),
+            };
+            let mut path = e.path().to_string();
+            let msg = e.inner().to_string();
+            // an internally tagged enum buffers its content, so the path stops at the variant:
+            // locate a misspelt key inside a nested table (frame1, frame2) by its name
+            if let Some(key) = msg.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
+                if let Some(obj) = v.as_object().filter(|o| !o.contains_key(key)) {
+                    if let Some((outer, _)) = obj.iter().find(|(_, x)| x.as_object().is_some_and(|o| o.contains_key(key))) {
+                        path = outer.clone();
+                    }
+                }
+            }
+            let at = if path == "." || path.is_empty() { who } else { format!("{who}.{path}") };
+            <D::Error as serde::de::Error>::custom(format!("{at}: {msg}"))
+        })
+    }
 }
 
 impl ConstraintDescription {
