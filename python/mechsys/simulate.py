@@ -16,7 +16,7 @@ from .model import Model
 from .results import Results
 
 
-def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0) -> dict:
+def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilization=None) -> dict:
     if integrator is None:
         integrator = DOPRI5()
     if not hasattr(integrator, "describe"):
@@ -51,6 +51,7 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0) -> dict:
         "integrator": integrator.describe(),
         "q0": model.state_vector(q0, "q").tolist(),
         "u0": model.state_vector(u0, "u").tolist(),
+        "stabilization": _stabilization(stabilization),
     }
 
 
@@ -64,6 +65,7 @@ def simulate(
     t0: float = 0.0,
     progress: bool | None = None,
     keep: Sequence[str] = (),
+    stabilization: Any = None,
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
@@ -73,7 +75,8 @@ def simulate(
     (the joints' own q0/u0 elsewhere). ``progress``: show a progress bar (default: only when
     the run takes longer than about a second and stderr is a terminal). ``keep``: joints whose
     q0 and u0 stay as given when a constrained model is assembled to a consistent start (the
-    others move by minimum-norm corrections).
+    others move by minimum-norm corrections). ``stabilization``: constraint drift control,
+    ``"projection"`` (default), ``"none"`` or :class:`mechsys.constraints.Baumgarte`.
     """
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
@@ -86,7 +89,7 @@ def simulate(
         from .analysis import assemble
 
         q0, u0 = assemble(model, q0, u0, float(t0), keep=keep)
-    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0)
+    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization)
     text = json.dumps(settings)
     callbacks = model.callbacks or None
     prog = _core.Progress()
@@ -118,6 +121,12 @@ def simulate(
     }
     body_names = core.body_names[1:]
     return Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
+
+
+def _stabilization(value) -> dict:
+    from .constraints import stabilization
+
+    return stabilization(value)
 
 
 def _warn_redundant(model: Model, q0, t0) -> None:

@@ -155,6 +155,7 @@ fn bench_stepping(c: &mut Criterion) {
             integrator: IntegratorKind::Rk4 { dt },
             q0: None,
             u0: None,
+            stabilization: Default::default(),
         };
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {

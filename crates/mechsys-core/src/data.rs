@@ -92,6 +92,8 @@ pub struct Data {
     pub q_tmp: Vec<f64>,
     /// constraints: numerical rank of G at the last solve.
     pub constraint_rank: usize,
+    /// constraints: Baumgarte feedback (α, β) when that drift control is chosen.
+    pub baumgarte: Option<(f64, f64)>,
 }
 
 impl Data {
@@ -135,6 +137,7 @@ impl Data {
             work2: vec![0.0; nu.max(model.nc)],
             q_tmp: vec![0.0; model.nq],
             constraint_rank: 0,
+            baumgarte: None,
         }
     }
 }

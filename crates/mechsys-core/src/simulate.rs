@@ -36,6 +36,29 @@ pub struct Settings {
     /// Initial velocities (nu); the model's u0 if absent.
     #[serde(default)]
     pub u0: Option<Vec<f64>>,
+    /// Drift control of the constraints.
+    #[serde(default)]
+    pub stabilization: Stabilization,
+}
+
+/// How the constraint drift of a simulation is controlled.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Stabilization {
+    /// Project q and u onto the constraint manifolds after every step (exact to round-off).
+    #[default]
+    Projection,
+    /// Baumgarte: enforce `Φ̈ + 2α Φ̇ + β² Φ = 0` instead of `Φ̈ = 0`; cruder (the violation decays
+    /// but never vanishes, and large α, β stiffen the equations), kept for comparison with codes
+    /// that use it.
+    Baumgarte {
+        /// Velocity feedback (1/s).
+        alpha: f64,
+        /// Position feedback (1/s).
+        beta: f64,
+    },
+    /// No drift control: the violation grows with the integration error.
+    None,
 }
 
 /// Recorded signals, sample-major flat arrays (`n_out` samples).
@@ -102,12 +125,25 @@ pub struct MultibodySystem<'a> {
     /// The workspace (public so that observers can read the last evaluation).
     pub data: Data,
     cb: &'a dyn Callbacks,
+    stabilization: Stabilization,
+    /// Rank of the constraint equations at the first evaluation (a drop means a singular configuration).
+    rank0: Option<usize>,
 }
 
 impl<'a> MultibodySystem<'a> {
     /// Wraps a model with a fresh workspace.
     pub fn new(model: &'a Model, cb: &'a dyn Callbacks) -> Self {
-        MultibodySystem { model, data: Data::new(model), cb }
+        MultibodySystem { model, data: Data::new(model), cb, stabilization: Stabilization::Projection, rank0: None }
+    }
+
+    /// Chooses the constraint drift control.
+    pub fn with_stabilization(mut self, s: Stabilization) -> Self {
+        self.stabilization = s;
+        self.data.baumgarte = match s {
+            Stabilization::Baumgarte { alpha, beta } => Some((alpha, beta)),
+            _ => None,
+        };
+        self
     }
 }
 
@@ -120,6 +156,20 @@ impl OdeSystem for MultibodySystem<'_> {
         let (q, rest) = y.split_at(nq);
         let u = &rest[..nu];
         let p = dynamics::forward_dynamics(self.model, &mut self.data, t, q, u, None, self.cb)?;
+        if self.model.nc > 0 {
+            let rank = self.data.constraint_rank;
+            match self.rank0 {
+                None => self.rank0 = Some(rank),
+                Some(r0) if rank < r0 => {
+                    let row = self.data.perm_c[rank];
+                    let name = self.model.constraints.iter().rev().find(|c| c.row <= row).map_or("?", |c| c.name.as_str());
+                    return Err(Error::Solver(format!(
+                        "singular configuration at t = {t:.6} s: the constraint equations lost rank ({r0} → {rank}); constraint '{name}' became dependent"
+                    )));
+                }
+                _ => {}
+            }
+        }
         self.model.qdot(q, u, &mut dy[..nq]);
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
         dy[nq + nu] = p.dissipated;
@@ -129,7 +179,7 @@ impl OdeSystem for MultibodySystem<'_> {
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         self.model.normalize(&mut y[..nq]);
-        if self.model.nc > 0 {
+        if self.model.nc > 0 && self.stabilization == Stabilization::Projection {
             let (q, rest) = y.split_at_mut(nq);
             crate::dynamics::constrained::project(self.model, &mut self.data, t, q, &mut rest[..nu], self.cb)?;
         }
@@ -264,10 +314,23 @@ pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress
         constraint_violation: Vec::with_capacity(n_out * model.nc),
         stats: Stats::default(),
     };
-    let mut sys = MultibodySystem::new(model, cb);
+    match settings.stabilization {
+        Stabilization::Baumgarte { alpha, beta } => crate::ensure!(
+            alpha.is_finite() && beta.is_finite() && alpha >= 0.0 && beta >= 0.0,
+            Settings,
+            "stabilization: Baumgarte alpha and beta must be >= 0, got {alpha}, {beta}"
+        ),
+        _ => {}
+    }
+    let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization);
     // a consistent initial state: on the constraint manifolds (assembly from the given q0, u0)
+    // (always by projection, whatever the drift control during the run)
     let mut y0 = y0;
-    sys.project(settings.t0, &mut y0)?;
+    model.normalize(&mut y0[..model.nq]);
+    if model.nc > 0 {
+        let (q, rest) = y0.split_at_mut(model.nq);
+        crate::dynamics::constrained::project(model, &mut sys.data, settings.t0, q, &mut rest[..model.nu], cb)?;
+    }
     let mut scratch = vec![0.0; sys.dim()];
     let mut observer = |sys: &mut MultibodySystem, t: f64, y: &[f64], fresh: bool| -> Result<()> {
         if !fresh {

@@ -60,6 +60,16 @@ pub fn forward_dynamics(
         }
         cholesky_semidefinite_solve(&data.m_factor, nu, &data.perm_u, nu, col, &mut data.work);
     }
+    if let Some((alpha, beta)) = data.baumgarte {
+        // Φ̈ + 2α Φ̇ + β² Φ = 0 (Φ is zero on velocity-only rows)
+        for r in 0..nc {
+            let mut gu = -data.b[r];
+            for i in 0..nu {
+                gu += data.g[(r, i)] * u[i];
+            }
+            data.gamma[r] -= 2.0 * alpha * gu + beta * beta * data.phi[r];
+        }
+    }
     // S = G M⁻¹ Gᵀ, rhs = γ - G u̇_free
     for r in 0..nc {
         for c in 0..nc {

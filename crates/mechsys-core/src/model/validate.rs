@@ -537,6 +537,7 @@ impl Model {
         // ---- constraints ---------------------------------------------------------------------------
         let mut constraints = Vec::with_capacity(desc.constraints.len());
         let mut constraint_names = HashSet::new();
+        let mut driven: HashMap<usize, String> = HashMap::new(); // velocity index -> drive name
         let mut row = 0usize;
         let single = |jname: &str, what: &str, key: &str| -> Result<usize> {
             let ji = *joint_index.get(jname).ok_or_else(|| err(format!("{what}.{key}: unknown joint '{jname}'")))?;
@@ -606,6 +607,12 @@ impl Model {
                         j.name,
                         j.kind.type_name()
                     );
+                    if let Some(other) = driven.insert(j.iu + index, name.clone()) {
+                        return Err(err(format!(
+                            "{what}: coordinate {index} of joint '{}' is already driven by constraint '{other}' (two drives on one coordinate)",
+                            j.name
+                        )));
+                    }
                     ConstraintKind::Prescribed {
                         iq: j.iq + index,
                         iu: j.iu + index,
