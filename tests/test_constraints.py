@@ -170,3 +170,16 @@ def test_two_drives_on_one_coordinate_are_rejected():
     with pytest.raises(ms.ModelError) as e:
         m.build()
     assert "second_motor" in str(e.value) and "motor" in str(e.value) and "crank_pin" in str(e.value)
+
+
+def test_redundant_constraints_share_the_load_by_minimum_norm():
+    # the same rod twice: the tension is split equally between the two copies
+    single = ms.simulate(spherical_pendulum_as_free_body(), 1.0, TIGHT, output_dt=0.05)
+    m = spherical_pendulum_as_free_body()
+    m.add_constraint(ms.constraints.Distance("rod_copy", body1="bob", body2=m.ground, length=0.9))
+    with pytest.warns(UserWarning, match="redundant"):
+        double = ms.simulate(m, 1.0, TIGHT, output_dt=0.05)
+    np.testing.assert_allclose(double["body/bob/position"], single["body/bob/position"], atol=1e-9)
+    half = 0.5 * single["constraint/rod/lambda"]
+    np.testing.assert_allclose(double["constraint/rod/lambda"], half, atol=1e-8)
+    np.testing.assert_allclose(double["constraint/rod_copy/lambda"], half, atol=1e-8)

@@ -94,6 +94,14 @@ pub struct Data {
     pub constraint_rank: usize,
     /// constraints: Baumgarte feedback (α, β) when that drift control is chosen.
     pub baumgarte: Option<(f64, f64)>,
+    /// minimum-norm multipliers: null-space basis of S, column-major (nc × nc at most).
+    pub null_basis: Vec<f64>,
+    /// minimum-norm multipliers: NᵀN (nc × nc at most).
+    pub null_gram: Vec<f64>,
+    /// minimum-norm multipliers: pivot order (nc).
+    pub perm_null: Vec<usize>,
+    /// minimum-norm multipliers: scratch (nc).
+    pub null_scratch: Vec<f64>,
 }
 
 impl Data {
@@ -138,6 +146,10 @@ impl Data {
             q_tmp: vec![0.0; model.nq],
             constraint_rank: 0,
             baumgarte: None,
+            null_basis: vec![0.0; model.nc * model.nc],
+            null_gram: vec![0.0; model.nc * model.nc],
+            perm_null: vec![0; model.nc],
+            null_scratch: vec![0.0; model.nc],
         }
     }
 }

@@ -87,6 +87,9 @@ pub fn forward_dynamics(
     }
     data.constraint_rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
     cholesky_semidefinite_solve(&data.schur, nc, &data.perm_c, data.constraint_rank, &mut data.lambda, &mut data.work);
+    if data.constraint_rank < nc {
+        min_norm_multipliers(data, nc);
+    }
     for k in 0..nc {
         let l = data.lambda[k];
         for i in 0..nu {
@@ -101,6 +104,70 @@ pub fn forward_dynamics(
     crate::kinematics::accelerations(model, data, &udot);
     data.udot = udot;
     Ok(p)
+}
+
+/// Turns the basic solution λ of a rank-deficient `S λ = r` (dependent rows set to zero) into the
+/// minimum-norm one by removing its component in the null space of S: with the pivoted factor
+/// `[L11 0; L21 ~0]`, the null space is spanned by the columns of `N = [-L11⁻ᵀ L21ᵀ; E]`, and
+/// `λ_min = λ - N (NᵀN)⁻¹ Nᵀ λ`. Redundant constraints then share their load equally.
+fn min_norm_multipliers(data: &mut Data, nc: usize) {
+    let r = data.constraint_rank;
+    let k = nc - r;
+    // λ in pivot order
+    for i in 0..nc {
+        data.work[i] = data.lambda[data.perm_c[i]];
+    }
+    // N (nc × k), column-major in null_basis
+    for j in 0..k {
+        let col = &mut data.null_basis[j * nc..(j + 1) * nc];
+        // solve L11ᵀ x = L21[j, :]ᵀ by back substitution
+        for i in (0..r).rev() {
+            let mut s = data.schur[(r + j) * nc + i];
+            for m in i + 1..r {
+                s -= data.schur[m * nc + i] * col[m];
+            }
+            col[i] = s / data.schur[i * nc + i];
+        }
+        for v in col.iter_mut().take(r) {
+            *v = -*v;
+        }
+        for (m, v) in col.iter_mut().enumerate().skip(r) {
+            *v = if m == r + j { 1.0 } else { 0.0 };
+        }
+    }
+    // (NᵀN) z = Nᵀ λ
+    for a in 0..k {
+        let mut c = 0.0;
+        for i in 0..nc {
+            c += data.null_basis[a * nc + i] * data.work[i];
+        }
+        data.work2[a] = c;
+        for b in 0..k {
+            let mut s = 0.0;
+            for i in 0..nc {
+                s += data.null_basis[a * nc + i] * data.null_basis[b * nc + i];
+            }
+            data.null_gram[a * k + b] = s;
+        }
+    }
+    let mut perm = std::mem::take(&mut data.perm_null);
+    let mut z = std::mem::take(&mut data.work2);
+    let rank = cholesky_semidefinite(&mut data.null_gram[..k * k], k, &mut perm, RANK_TOL);
+    let mut scratch = std::mem::take(&mut data.null_scratch);
+    cholesky_semidefinite_solve(&data.null_gram[..k * k], k, &perm, rank, &mut z[..k], &mut scratch);
+    for i in 0..nc {
+        let mut s = 0.0;
+        for a in 0..k {
+            s += data.null_basis[a * nc + i] * z[a];
+        }
+        data.work[i] -= s;
+    }
+    for i in 0..nc {
+        data.lambda[data.perm_c[i]] = data.work[i];
+    }
+    data.perm_null = perm;
+    data.work2 = z;
+    data.null_scratch = scratch;
 }
 
 /// Solves `(G Gᵀ) μ = r` in place (minimum-norm correction `-Gᵀ μ` of a residual `r`); `r` is
