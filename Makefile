@@ -36,6 +36,7 @@ bench-rust:
 bench: $(BUILD)
 	$(PY) -m pip install --quiet pin mujoco exudyn
 	$(PY) benches/peers.py --out docs/benchmarks.md
+	$(PY) benches/constraints.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results
