@@ -76,6 +76,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchdoc import fmt_time, machine, ratio, write_doc  # noqa: E402  (shared report helpers)
+
 ROOT = Path(__file__).resolve().parent.parent
 DT = 1e-3
 G = 9.81
@@ -562,14 +564,6 @@ def measure_slider_crank(peers: set, t_end: float, repeat: int, budget: float, l
 
 
 # ---- formatting ---------------------------------------------------------------------------------------------
-def fmt_time(s) -> str:
-    if s is None or not math.isfinite(s):
-        return "–"
-    if s < 1e-3:
-        return f"{s * 1e6:.3g} µs"
-    if s < 1.0:
-        return f"{s * 1e3:.3g} ms"
-    return f"{s:.3g} s"
 
 
 def fmt_run(r: dict) -> str:
@@ -580,22 +574,8 @@ def fmt_run(r: dict) -> str:
     return f"{fmt_time(r['min'])} ({fmt_time(r['med'])})"
 
 
-def ratio(ours, peer) -> str:
-    """mechsys vs a peer from the minimum times."""
-    if ours is None or peer is None:
-        return "–"
-    return f"**{peer / ours:.2f}× faster**" if ours <= peer else f"{ours / peer:.2f}× slower"
 
 
-def machine() -> dict:
-    cpu = platform.processor() or "unknown"
-    with contextlib.suppress(OSError):
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    load = os.getloadavg() if hasattr(os, "getloadavg") else (float("nan"),) * 3
-    return {"nproc": os.cpu_count(), "cpu": cpu, "os": platform.platform(), "python": platform.python_version(), "load": load}
 
 
 def versions(mods: dict) -> dict:
@@ -813,19 +793,6 @@ def report(fb, ch, sc, peers, missing, mach, vers, argv, elapsed) -> str:
 BEGIN, END = "<!-- constraints.py:begin -->", "<!-- constraints.py:end -->"
 
 
-def write_doc(path: Path, section: str) -> None:
-    """Replaces the text between this script's markers, or appends the marked section at the end."""
-    block = f"{BEGIN}\n{section}\n{END}"
-    if path.exists():
-        text = path.read_text()
-        if BEGIN in text and END in text:
-            text = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: block, text, count=1, flags=re.S)
-        else:
-            text = text.rstrip("\n") + "\n\n" + block + "\n"
-    else:
-        text = f"# Benchmarks\n\n{block}\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
 
 
 def main(argv=None) -> int:
@@ -883,7 +850,7 @@ def main(argv=None) -> int:
     text = report(fb, ch, sc, peers, missing, mach, vers, argv, time.perf_counter() - start)
     print(text)
     if a.out:
-        write_doc(a.out if a.out.is_absolute() else Path.cwd() / a.out, text)
+        write_doc(a.out if a.out.is_absolute() else Path.cwd() / a.out, text, BEGIN, END, None)
         log(f"updated {a.out}")
     return 0
 

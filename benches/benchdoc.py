@@ -1,0 +1,58 @@
+"""Shared helpers of the benchmark scripts: formatting of times and ratios, the machine
+description, and replacing a script's marked section of docs/benchmarks.md."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import platform
+import re
+from pathlib import Path
+
+
+def fmt_time(s: float | None) -> str:
+    """A duration in µs, ms or s with three significant digits ("–" for none)."""
+    if s is None or not math.isfinite(s):
+        return "–"
+    if s < 1e-3:
+        return f"{s * 1e6:.3g} µs"
+    if s < 1.0:
+        return f"{s * 1e3:.3g} ms"
+    return f"{s:.3g} s"
+
+
+def ratio(ours: float | None, peer: float | None) -> str:
+    """mechsys against a peer, from the minimum times."""
+    if ours is None or peer is None:
+        return "–"
+    return f"**{peer / ours:.2f}× faster**" if ours <= peer else f"{ours / peer:.2f}× slower"
+
+
+def machine() -> dict:
+    """Cores, CPU model, OS, Python version and the load average now."""
+    cpu = platform.processor() or "unknown"
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    load = os.getloadavg() if hasattr(os, "getloadavg") else (float("nan"),) * 3
+    return {"nproc": os.cpu_count(), "cpu": cpu, "os": platform.platform(), "python": platform.python_version(), "load": load}
+
+
+def write_doc(path: Path, section: str, begin: str, end: str, heading: str | None = None) -> None:
+    """Replaces the text between a script's markers in ``path``, or appends the marked section
+    (under ``heading`` if given); the rest of the file is kept."""
+    block = f"{begin}\n{section}\n{end}"
+    head = f"{heading}\n\n" if heading else ""
+    if path.exists():
+        text = path.read_text()
+        if begin in text and end in text:
+            text = re.sub(re.escape(begin) + r".*?" + re.escape(end), lambda _: block, text, count=1, flags=re.S)
+        else:
+            text = text.rstrip("\n") + "\n\n" + head + block + "\n"
+    else:
+        text = f"# Benchmarks\n\n{head}{block}\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
