@@ -281,7 +281,9 @@ def measure_calls(sizes, repeat, peers, log) -> list[dict]:
         q, u = q_init(n), u_test(n)
         a_ms = ms.dynamics.forward_dynamics(m, q, u)
         mm_ms = ms.dynamics.mass_matrix(m, q)
-        row["mechsys_aba"] = per_call(lambda: ms.dynamics.forward_dynamics(m, q, u), repeat)
+        # like Pinocchio (which returns its data.ddq), write into a kept array: no allocation per call
+        out = np.empty(m.nu)
+        row["mechsys_aba"] = per_call(lambda: ms.dynamics.forward_dynamics(m, q, u, out=out), repeat)
         row["mechsys_crba"] = per_call(lambda: ms.dynamics.mass_matrix(m, q), repeat)
         if "pinocchio" in peers:
             import pinocchio as pin

@@ -86,3 +86,14 @@ def test_reactions_are_listed_saved_and_loaded(tmp_path):
     back = ms.load(path)
     np.testing.assert_array_equal(back["joint/hinge/reaction_force"], res["joint/hinge/reaction_force"])
     assert back.unit("joint/hinge/reaction_torque") == "N m"
+
+
+def test_forward_dynamics_can_write_into_a_given_array():
+    m = physical_pendulum()
+    q, u = m.q0(), m.u0()
+    out = np.empty(m.nu)
+    res = ms.dynamics.forward_dynamics(m, q, u, out=out)
+    assert res is out
+    np.testing.assert_array_equal(out, ms.dynamics.forward_dynamics(m, q, u))
+    with pytest.raises(ms.SettingsError):
+        ms.dynamics.forward_dynamics(m, q, u, out=np.empty(3))

@@ -26,16 +26,17 @@ def mass_matrix(model: Model, q, t: float = 0.0) -> np.ndarray:
         return _core.crba(core, _arr(q), t)
 
 
-def forward_dynamics(model: Model, q, u, tau=None, t: float = 0.0) -> np.ndarray:
+def forward_dynamics(model: Model, q, u, tau=None, t: float = 0.0, out: np.ndarray | None = None) -> np.ndarray:
     """u_dot = M^-1 (h + tau) by the articulated-body algorithm (O(n)).
 
-    The fast path takes float64 numpy arrays as they are; anything else is converted once."""
+    The fast path takes float64 numpy arrays as they are; anything else is converted once.
+    ``out``: a float64 array of length nu to write the result into (no allocation per call)."""
     core, cbs = model._engine or model.engine()
     try:
-        return _core.aba(core, q, u, tau, t, cbs)
+        return _core.aba(core, q, u, tau, t, cbs, out)
     except SettingsError:
         # lists, other dtypes, non-contiguous views: convert and try again (real errors re-raise)
-        return _core.aba(core, _arr(q), _arr(u), None if tau is None else _arr(tau), t, cbs)
+        return _core.aba(core, _arr(q), _arr(u), None if tau is None else _arr(tau), t, cbs, out)
 
 
 def inverse_dynamics(model: Model, q, u, udot, t: float = 0.0) -> np.ndarray:

@@ -29,7 +29,8 @@ fn crba<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>, t: f64) ->
 
 /// Forward dynamics u̇ = M⁻¹(h + τ) by the articulated-body algorithm.
 #[pyfunction]
-#[pyo3(signature = (model, q, u, tau = None, t = 0.0, callbacks = None))]
+#[pyo3(signature = (model, q, u, tau = None, t = 0.0, callbacks = None, out = None))]
+#[allow(clippy::too_many_arguments)]
 fn aba<'py>(
     py: Python<'py>,
     model: &PyModel,
@@ -38,6 +39,7 @@ fn aba<'py>(
     tau: Option<&Bound<'py, PyAny>>,
     t: f64,
     callbacks: Option<Vec<PyObject>>,
+    out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let m = &model.model;
     let q = q_slice(model, q)?;
@@ -53,7 +55,24 @@ fn aba<'py>(
         let cb = self::callbacks(model, callbacks)?;
         dynamics::aba(m, &mut data, t, q, u, tau, &cb).map_err(PyMechsysError::from)?;
     }
-    Ok(PyArray1::from_slice(py, &data.udot))
+    match out {
+        // write into the caller's array: no allocation per call
+        Some(o) if !o.is_none() => {
+            let arr = o
+                .downcast_into::<PyArray1<f64>>()
+                .map_err(|_| settings("out: must be a 1-D float64 numpy array"))?;
+            {
+                // SAFETY: the GIL is held and no other Rust reference to the array exists.
+                let s = unsafe { arr.as_slice_mut() }.map_err(|_| settings("out: must be contiguous and writeable"))?;
+                if s.len() != m.nu {
+                    return Err(settings(format!("out: expected length {}, got {}", m.nu, s.len())));
+                }
+                s.copy_from_slice(&data.udot);
+            }
+            Ok(arr)
+        }
+        _ => Ok(PyArray1::from_slice(py, &data.udot)),
+    }
 }
 
 /// Inverse dynamics τ = M u̇ - h by the recursive Newton–Euler algorithm.
