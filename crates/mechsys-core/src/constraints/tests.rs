@@ -7,7 +7,7 @@ use crate::forces::NoCallbacks;
 use crate::model::description::*;
 use crate::model::Model;
 
-fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
+pub(super) fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
     BodyDescription {
         name: name.into(),
         mass: m,
@@ -21,7 +21,7 @@ fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
     }
 }
 
-fn joint(
+pub(super) fn joint(
     name: &str,
     kind: &str,
     parent: &str,
@@ -100,30 +100,56 @@ fn model_with_all_kinds() -> Model {
     Model::from_description(desc).unwrap()
 }
 
+/// Per row: (finite-difference dΦ/dt along q ⊕ u s, G u - b) at (q, t).
+pub(super) fn velocity_pairs(model: &Model, q: &[f64], u: &[f64], t: f64) -> Vec<(f64, f64)> {
+    let mut data = Data::new(model);
+    crate::kinematics::positions(model, &mut data, q);
+    positions(model, &mut data, t, q, &NoCallbacks).unwrap();
+    let (g, b) = (data.g.clone(), data.b.clone());
+    let h = 1e-6;
+    let mut phi_at = |s: f64| {
+        let mut qs = q.to_vec();
+        model.integrate(q, u, s, &mut qs);
+        crate::kinematics::positions(model, &mut data, &qs);
+        positions(model, &mut data, t + s, &qs, &NoCallbacks).unwrap();
+        data.phi.clone()
+    };
+    let (pp, pm) = (phi_at(h), phi_at(-h));
+    (0..model.nc)
+        .map(|r| ((pp[r] - pm[r]) / (2.0 * h), (0..model.nu).map(|i| g[(r, i)] * u[i]).sum::<f64>() - b[r]))
+        .collect()
+}
+
+/// Per row: (finite-difference d(G u - b)/dt along q' = H*(q) u, u' = u̇, and G u̇ - γ) at (q, u, t).
+pub(super) fn acceleration_pairs(model: &Model, q: &[f64], u: &[f64], udot: &[f64], t: f64) -> Vec<(f64, f64)> {
+    let mut data = Data::new(model);
+    crate::kinematics::forward_kinematics(model, &mut data, q, u);
+    positions(model, &mut data, t, q, &NoCallbacks).unwrap();
+    data.a[0] = crate::spatial::Motion::ZERO;
+    crate::kinematics::accelerations(model, &mut data, &vec![0.0; model.nu]);
+    accelerations(model, &mut data, t, &NoCallbacks).unwrap();
+    let (g, gamma) = (data.g.clone(), data.gamma.clone());
+    let h = 1e-6;
+    let mut residual_at = |s: f64| {
+        let mut qs = q.to_vec();
+        model.integrate(q, u, s, &mut qs);
+        let us: Vec<f64> = u.iter().zip(udot).map(|(a, b)| a + b * s).collect();
+        crate::kinematics::positions(model, &mut data, &qs);
+        positions(model, &mut data, t + s, &qs, &NoCallbacks).unwrap();
+        (0..model.nc).map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r]).collect::<Vec<f64>>()
+    };
+    let (rp, rm) = (residual_at(h), residual_at(-h));
+    (0..model.nc)
+        .map(|r| ((rp[r] - rm[r]) / (2.0 * h), (0..model.nu).map(|i| g[(r, i)] * udot[i]).sum::<f64>() - gamma[r]))
+        .collect()
+}
+
 #[test]
 fn velocity_rows_are_the_time_derivative_of_the_violation() {
     let model = model_with_all_kinds();
     assert_eq!(model.nc, 3 + 1 + 1 + 1);
-    let mut data = Data::new(&model);
-    let q = model.q0();
     let u: Vec<f64> = (0..model.nu).map(|i| 0.3 - 0.07 * i as f64).collect();
-    let t = 0.4;
-    crate::kinematics::positions(&model, &mut data, &q);
-    positions(&model, &mut data, t, &q, &NoCallbacks).unwrap();
-    let g = data.g.clone();
-    let b = data.b.clone();
-    let h = 1e-6;
-    let phi_at = |data: &mut Data, s: f64| {
-        let mut qs = q.clone();
-        model.integrate(&q, &u, s, &mut qs);
-        crate::kinematics::positions(&model, data, &qs);
-        positions(&model, data, t + s, &qs, &NoCallbacks).unwrap();
-        data.phi.clone()
-    };
-    let (pp, pm) = (phi_at(&mut data, h), phi_at(&mut data, -h));
-    for r in 0..model.nc {
-        let fd = (pp[r] - pm[r]) / (2.0 * h);
-        let gu: f64 = (0..model.nu).map(|i| g[(r, i)] * u[i]).sum::<f64>() - b[r];
+    for (r, (fd, gu)) in velocity_pairs(&model, &model.q0(), &u, 0.4).into_iter().enumerate() {
         assert!((fd - gu).abs() < 1e-7, "row {r}: dΦ/dt {fd} vs G u - b {gu}");
     }
 }
@@ -131,34 +157,9 @@ fn velocity_rows_are_the_time_derivative_of_the_violation() {
 #[test]
 fn acceleration_rows_are_the_second_derivative_of_the_violation() {
     let model = model_with_all_kinds();
-    let mut data = Data::new(&model);
-    let q = model.q0();
     let u: Vec<f64> = (0..model.nu).map(|i| 0.2 + 0.05 * i as f64).collect();
     let udot: Vec<f64> = (0..model.nu).map(|i| -0.4 + 0.1 * i as f64).collect();
-    let t = 0.3;
-    // γ from the velocity-product accelerations
-    crate::kinematics::forward_kinematics(&model, &mut data, &q, &u);
-    positions(&model, &mut data, t, &q, &NoCallbacks).unwrap();
-    data.a[0] = crate::spatial::Motion::ZERO;
-    crate::kinematics::accelerations(&model, &mut data, &vec![0.0; model.nu]);
-    accelerations(&model, &mut data, t, &NoCallbacks).unwrap();
-    let (g, gamma) = (data.g.clone(), data.gamma.clone());
-    // d/dt (G u - b) along q' = H*(q) u, u' = u̇ equals G u̇ - γ
-    let h = 1e-6;
-    let residual_at = |data: &mut Data, s: f64| {
-        let mut qs = q.clone();
-        model.integrate(&q, &u, s, &mut qs);
-        let us: Vec<f64> = u.iter().zip(&udot).map(|(a, b)| a + b * s).collect();
-        crate::kinematics::positions(&model, data, &qs);
-        positions(&model, data, t + s, &qs, &NoCallbacks).unwrap();
-        (0..model.nc)
-            .map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r])
-            .collect::<Vec<f64>>()
-    };
-    let (rp, rm) = (residual_at(&mut data, h), residual_at(&mut data, -h));
-    for r in 0..model.nc {
-        let fd = (rp[r] - rm[r]) / (2.0 * h);
-        let expected: f64 = (0..model.nu).map(|i| g[(r, i)] * udot[i]).sum::<f64>() - gamma[r];
+    for (r, (fd, expected)) in acceleration_pairs(&model, &model.q0(), &u, &udot, 0.3).into_iter().enumerate() {
         assert!((fd - expected).abs() < 1e-6, "row {r}: d(Gu - b)/dt {fd} vs G u̇ - γ {expected}");
     }
 }

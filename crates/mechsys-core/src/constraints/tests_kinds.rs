@@ -8,19 +8,7 @@ use crate::forces::NoCallbacks;
 use crate::model::description::*;
 use crate::model::Model;
 
-fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
-    BodyDescription {
-        name: name.into(),
-        mass: m,
-        inertia: InertiaDescription::List(vec![0.01 * m, 0.02 * m, 0.025 * m]),
-        com,
-        markers: vec![],
-        mass_rate: 0.0,
-        ejection_velocity: [0.0; 3],
-        ejection_point: None,
-        mass_final: None,
-    }
-}
+use super::tests::body;
 
 fn joint(
     name: &str,
@@ -31,20 +19,7 @@ fn joint(
     axis: Option<[f64; 3]>,
     q0: Vec<f64>,
 ) -> JointDescription {
-    JointDescription {
-        name: name.into(),
-        kind: kind.into(),
-        parent: parent.into(),
-        child: child.into(),
-        axis,
-        axis2: None,
-        parent_frame: FrameDescription { position: pos, rotation: None },
-        child_frame: FrameDescription::default(),
-        q0: Some(q0),
-        u0: None,
-        spring: None,
-        damper: None,
-    }
+    super::tests::joint(name, kind, parent, child, pos, axis, Some(q0))
 }
 
 fn frame(position: [f64; 3], cardan: [f64; 3]) -> FrameDescription {
@@ -159,70 +134,24 @@ fn new_kinds_have_their_row_counts() {
 #[test]
 fn new_kinds_velocity_rows_are_the_time_derivative_of_the_violation() {
     let model = model_with_new_kinds();
-    let mut data = Data::new(&model);
-    let q = model.q0();
     let u: Vec<f64> = (0..model.nu).map(|i| 0.6 * ((i as f64) * 1.3).sin() + 0.1).collect();
-    let t = 0.4;
-    crate::kinematics::positions(&model, &mut data, &q);
-    positions(&model, &mut data, t, &q, &NoCallbacks).unwrap();
-    let (g, b) = (data.g.clone(), data.b.clone());
-    let h = 1e-6;
-    let phi_at = |data: &mut Data, s: f64| {
-        let mut qs = q.clone();
-        model.integrate(&q, &u, s, &mut qs);
-        crate::kinematics::positions(&model, data, &qs);
-        positions(&model, data, t + s, &qs, &NoCallbacks).unwrap();
-        data.phi.clone()
-    };
-    let (pp, pm) = (phi_at(&mut data, h), phi_at(&mut data, -h));
-    let mut worst = 0.0f64;
-    for r in 0..model.nc {
+    for (r, (fd, gu)) in super::tests::velocity_pairs(&model, &model.q0(), &u, 0.4).into_iter().enumerate() {
         if !holonomic(&model, r) {
-            assert_eq!(pp[r], 0.0, "row {r}: a non-holonomic row has no position violation");
+            assert_eq!(fd, 0.0, "row {r}: a non-holonomic row has no position violation");
             continue;
         }
-        let fd = (pp[r] - pm[r]) / (2.0 * h);
-        let gu: f64 = (0..model.nu).map(|i| g[(r, i)] * u[i]).sum::<f64>() - b[r];
-        worst = worst.max((fd - gu).abs());
         assert!((fd - gu).abs() < 1e-8, "row {r}: dΦ/dt {fd} vs G u - b {gu}");
     }
-    eprintln!("worst |dΦ/dt - (G u - b)| = {worst:.2e}");
 }
 
 #[test]
 fn new_kinds_acceleration_rows_are_the_derivative_of_the_velocity_rows() {
     let model = model_with_new_kinds();
-    let mut data = Data::new(&model);
-    let q = model.q0();
     let u: Vec<f64> = (0..model.nu).map(|i| 0.5 * ((i as f64) * 0.7).cos() - 0.1).collect();
     let udot: Vec<f64> = (0..model.nu).map(|i| -0.4 + 0.1 * i as f64).collect();
-    let t = 0.3;
-    crate::kinematics::forward_kinematics(&model, &mut data, &q, &u);
-    positions(&model, &mut data, t, &q, &NoCallbacks).unwrap();
-    data.a[0] = crate::spatial::Motion::ZERO;
-    crate::kinematics::accelerations(&model, &mut data, &vec![0.0; model.nu]);
-    accelerations(&model, &mut data, t, &NoCallbacks).unwrap();
-    let (g, gamma) = (data.g.clone(), data.gamma.clone());
-    let h = 1e-6;
-    let residual_at = |data: &mut Data, s: f64| {
-        let mut qs = q.clone();
-        model.integrate(&q, &u, s, &mut qs);
-        let us: Vec<f64> = u.iter().zip(&udot).map(|(a, b)| a + b * s).collect();
-        crate::kinematics::positions(&model, data, &qs);
-        positions(&model, data, t + s, &qs, &NoCallbacks).unwrap();
-        (0..model.nc)
-            .map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r])
-            .collect::<Vec<f64>>()
-    };
-    let (rp, rm) = (residual_at(&mut data, h), residual_at(&mut data, -h));
-    let mut worst = 0.0f64;
-    for r in 0..model.nc {
-        let fd = (rp[r] - rm[r]) / (2.0 * h);
-        let expected: f64 = (0..model.nu).map(|i| g[(r, i)] * udot[i]).sum::<f64>() - gamma[r];
-        worst = worst.max((fd - expected).abs());
+    for (r, (fd, expected)) in super::tests::acceleration_pairs(&model, &model.q0(), &u, &udot, 0.3).into_iter().enumerate() {
         assert!((fd - expected).abs() < 1e-7, "row {r}: d(Gu - b)/dt {fd} vs G u̇ - γ {expected}");
     }
-    eprintln!("worst |d(Gu - b)/dt - (G u̇ - γ)| = {worst:.2e}");
 }
 
 #[test]
