@@ -159,7 +159,12 @@ class Results:
 
     def angular_momentum_about(self, point) -> np.ndarray:
         """Moment of momentum about a fixed point P: L_P = L_O - r_P x p (n, 3), N m s."""
-        rp = np.asarray(point, dtype=float).reshape(3)
+        try:
+            rp = np.asarray(point, dtype=float).reshape(3)
+        except (TypeError, ValueError):
+            raise ResultsError(f"angular_momentum_about: point must be 3 numbers, got {point!r}") from None
+        if not np.all(np.isfinite(rp)):
+            raise ResultsError(f"angular_momentum_about: point must be finite, got {point!r}")
         return self["momentum/angular"] - np.cross(rp, self["momentum/linear"])
 
     @property

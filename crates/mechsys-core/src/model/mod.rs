@@ -279,6 +279,8 @@ pub struct Model {
     pub nu: usize,
     /// Whether any body has variable mass.
     pub variable_mass: bool,
+    /// Whether q̇ = u holds for every coordinate (no quaternion joints), decided once here.
+    pub qdot_is_u: bool,
     /// Number of user callbacks the model refers to.
     pub n_callbacks: usize,
     /// The description it was built from (stored with results).
@@ -350,7 +352,7 @@ impl Model {
     }
     /// q̇ = H*(q) u for the whole model (eq. 2.34).
     pub fn qdot(&self, q: &[f64], u: &[f64], qd: &mut [f64]) {
-        if self.nq == self.nu && !self.joints.iter().any(|j| j.kind.has_quaternion()) {
+        if self.qdot_is_u {
             // no quaternions: every coordinate rate is its velocity
             qd.copy_from_slice(u);
             return;

@@ -680,6 +680,7 @@ impl Model {
             row += rows;
         }
 
+        let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
         Ok(Model {
             name: desc.name.clone(),
@@ -692,6 +693,7 @@ impl Model {
             nq: iq,
             nu: iu,
             variable_mass,
+            qdot_is_u,
             n_callbacks,
             description: desc,
             body_index,
