@@ -163,6 +163,18 @@ pub enum LoopJoint {
     Fixed,
 }
 
+/// Which generalized velocities a constraint's rows may involve (the structure that the sparse
+/// constrained solve is planned from, once per model).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reach {
+    /// The joints on the paths from the root to these bodies (0 = ground, reaches nothing).
+    Bodies(usize, usize),
+    /// These velocity indices only.
+    Velocities(usize, usize),
+    /// Possibly any velocity (treated as dense).
+    All,
+}
+
 /// A named constraint with its row offset in the stacked constraint vector.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Constraint {
@@ -184,6 +196,19 @@ impl ConstraintKind {
             ConstraintKind::Loop { joint: LoopJoint::Revolute, .. } => 5,
             ConstraintKind::Loop { joint: LoopJoint::Fixed, .. } => 6,
             _ => 1,
+        }
+    }
+    /// Which velocities the rows may involve (see [`Reach`]).
+    pub fn reach(&self) -> Reach {
+        match self {
+            ConstraintKind::Point { body1, body2, .. }
+            | ConstraintKind::Distance { body1, body2, .. }
+            | ConstraintKind::PointOnLine { body1, body2, .. }
+            | ConstraintKind::PointOnPlane { body1, body2, .. }
+            | ConstraintKind::Loop { body1, body2, .. } => Reach::Bodies(*body1, *body2),
+            ConstraintKind::KnifeEdge { body, .. } | ConstraintKind::RollingDisc { body, .. } => Reach::Bodies(*body, 0),
+            ConstraintKind::Coupler { iu_a, iu_b, .. } => Reach::Velocities(*iu_a, *iu_b),
+            ConstraintKind::Prescribed { iu, .. } => Reach::Velocities(*iu, *iu),
         }
     }
     /// Number of holonomic rows (they come first; the rest are non-holonomic velocity rows with
