@@ -102,6 +102,13 @@ pub struct Data {
     pub perm_null: Vec<usize>,
     /// minimum-norm multipliers: scratch (nc).
     pub null_scratch: Vec<f64>,
+    /// constrained solve: the sparse plan and its workspace.
+    pub saddle: crate::dynamics::sparse::Saddle,
+    /// constraints: rows found dependent at the last solve (nc).
+    pub dependent: Vec<bool>,
+    /// constraints: smallest `pivot / diagonal` of an independent row at the last sparse solve
+    /// (the squared sine of its angle to the rows before it) and that row.
+    pub weakest: (f64, usize),
 }
 
 impl Data {
@@ -150,6 +157,9 @@ impl Data {
             null_gram: vec![0.0; model.nc * model.nc],
             perm_null: vec![0; model.nc],
             null_scratch: vec![0.0; model.nc],
+            saddle: crate::dynamics::sparse::Saddle::new(model),
+            dependent: vec![false; model.nc],
+            weakest: (1.0, 0),
         }
     }
 }

@@ -106,6 +106,10 @@ pub struct Recording {
     pub constraint_lambda: Vec<f64>,
     /// Constraint violations Φ (n_out × nc).
     pub constraint_violation: Vec<f64>,
+    /// Velocity-level constraint residuals `G u - b` (n_out × nc).
+    pub constraint_velocity_violation: Vec<f64>,
+    /// Notes on the run that did not stop it (near-singular configurations), in time order.
+    pub warnings: Vec<String>,
     /// Integrator counters.
     pub stats: Stats,
 }
@@ -126,14 +130,27 @@ pub struct MultibodySystem<'a> {
     pub data: Data,
     cb: &'a dyn Callbacks,
     stabilization: Stabilization,
-    /// Rank of the constraint equations at the first evaluation (a drop means a singular configuration).
-    rank0: Option<usize>,
+    /// Rows dependent at the first evaluation (a row that becomes dependent later, or nearly so,
+    /// marks a singular configuration).
+    dependent0: Option<Vec<bool>>,
+    /// Whether the last evaluation was near a singular configuration (one warning per passage).
+    near_singular: bool,
+    /// Near-singular passages met so far.
+    pub warnings: Vec<String>,
 }
 
 impl<'a> MultibodySystem<'a> {
     /// Wraps a model with a fresh workspace.
     pub fn new(model: &'a Model, cb: &'a dyn Callbacks) -> Self {
-        MultibodySystem { model, data: Data::new(model), cb, stabilization: Stabilization::Projection, rank0: None }
+        MultibodySystem {
+            model,
+            data: Data::new(model),
+            cb,
+            stabilization: Stabilization::Projection,
+            dependent0: None,
+            near_singular: false,
+            warnings: Vec::new(),
+        }
     }
 
     /// Chooses the constraint drift control.
@@ -147,6 +164,47 @@ impl<'a> MultibodySystem<'a> {
     }
 }
 
+/// An independent constraint row whose squared sine to the rows before it (in the metric of
+/// `G M⁻¹ Gᵀ`) falls below this marks a near-singular configuration (an angle below about 1e-3
+/// rad): a warning, since the motion may pass it smoothly; rows with a relative pivot below 1e-12
+/// count as dependent, and a rank drop stops the run.
+const NEAR_SINGULAR: f64 = 1e-6;
+
+impl MultibodySystem<'_> {
+    /// Stops the run when the constraint equations lost rank since the start (a dead point or a
+    /// change point of the mechanism), and notes passages near such a configuration.
+    fn check_singular(&mut self, t: f64) -> Result<()> {
+        let dep = &self.data.dependent;
+        let Some(d0) = &self.dependent0 else {
+            self.dependent0 = Some(dep.clone());
+            return Ok(());
+        };
+        let name_of = |row: usize| {
+            let c = self.model.constraints.iter().rev().find(|c| c.row <= row);
+            (c.map_or("?", |c| c.name.as_str()), c.map_or(0, |c| row - c.row))
+        };
+        // which rows of a redundant set count as the dependent ones may change: only a rank drop counts
+        let (r0, r1) = (d0.iter().filter(|d| !**d).count(), dep.iter().filter(|d| !**d).count());
+        if r1 < r0 {
+            let row = (0..dep.len()).find(|&r| dep[r] && !d0[r]).unwrap_or(0);
+            let (name, k) = name_of(row);
+            return Err(Error::Solver(format!(
+                "singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) became dependent on the others (rank {r0} → {r1})"
+            )));
+        }
+        let (weak, row) = self.data.weakest;
+        let near = weak < NEAR_SINGULAR;
+        if near && !self.near_singular {
+            let (name, k) = name_of(row);
+            self.warnings.push(format!(
+                "near-singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) is nearly dependent on the others (squared sine {weak:.1e}); its multipliers may be large"
+            ));
+        }
+        self.near_singular = near;
+        Ok(())
+    }
+}
+
 impl OdeSystem for MultibodySystem<'_> {
     fn dim(&self) -> usize {
         self.model.nq + self.model.nu + 2
@@ -157,18 +215,7 @@ impl OdeSystem for MultibodySystem<'_> {
         let u = &rest[..nu];
         let p = dynamics::forward_dynamics(self.model, &mut self.data, t, q, u, None, self.cb)?;
         if self.model.nc > 0 {
-            let rank = self.data.constraint_rank;
-            match self.rank0 {
-                None => self.rank0 = Some(rank),
-                Some(r0) if rank < r0 => {
-                    let row = self.data.perm_c[rank];
-                    let name = self.model.constraints.iter().rev().find(|c| c.row <= row).map_or("?", |c| c.name.as_str());
-                    return Err(Error::Solver(format!(
-                        "singular configuration at t = {t:.6} s: the constraint equations lost rank ({r0} → {rank}); constraint '{name}' became dependent"
-                    )));
-                }
-                _ => {}
-            }
+            self.check_singular(t)?;
         }
         self.model.qdot(q, u, &mut dy[..nq]);
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
@@ -267,13 +314,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
     }
     match &s.u0 {
         Some(u) => {
-            crate::ensure!(
-                u.len() == model.nu,
-                Settings,
-                "u0: the model has {} velocities, got {}",
-                model.nu,
-                u.len()
-            );
+            crate::ensure!(u.len() == model.nu, Settings, "u0: the model has {} velocities, got {}", model.nu, u.len());
             for (i, v) in u.iter().enumerate() {
                 crate::ensure!(v.is_finite(), Settings, "u0[{i}]: must be finite, got {v}");
             }
@@ -285,7 +326,12 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
 }
 
 /// Runs a simulation and records all signals.
-pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress: Option<&Progress>) -> Result<Recording> {
+pub fn simulate(
+    model: &Model,
+    settings: &Settings,
+    cb: &dyn Callbacks,
+    progress: Option<&Progress>,
+) -> Result<Recording> {
     let (t_out, y0) = prepare(model, settings)?;
     let n_out = t_out.len();
     let nb = model.nbodies() - 1;
@@ -312,6 +358,8 @@ pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress
         momentum_angular: Vec::with_capacity(n_out * 3),
         constraint_lambda: Vec::with_capacity(n_out * model.nc),
         constraint_violation: Vec::with_capacity(n_out * model.nc),
+        constraint_velocity_violation: Vec::with_capacity(n_out * model.nc),
+        warnings: Vec::new(),
         stats: Stats::default(),
     };
     match settings.stabilization {
@@ -347,6 +395,7 @@ pub fn simulate(model: &Model, settings: &Settings, cb: &dyn Callbacks, progress
     };
     let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
     rec.stats = stats;
+    rec.warnings = std::mem::take(&mut sys.warnings);
     Ok(rec)
 }
 
@@ -396,4 +445,13 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
     rec.momentum_angular.extend_from_slice(l.as_slice());
     rec.constraint_lambda.extend_from_slice(&data.lambda);
     rec.constraint_violation.extend_from_slice(&data.phi);
+    let k = rec.constraint_velocity_violation.len();
+    rec.constraint_velocity_violation.resize(k + model.nc, 0.0);
+    if model.nc > 0 {
+        let out = &mut rec.constraint_velocity_violation[k..];
+        data.saddle.g_times(&y[nq..nq + nu], out);
+        for (o, b) in out.iter_mut().zip(&data.b) {
+            *o -= b;
+        }
+    }
 }

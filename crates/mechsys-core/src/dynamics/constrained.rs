@@ -18,6 +18,8 @@ use crate::math::linalg::{cholesky_semidefinite, cholesky_semidefinite_solve};
 use crate::model::Model;
 use crate::spatial::Motion;
 
+use super::sparse::Saddle;
+
 /// Relative size below which a pivot counts as zero (dependent rows, singular mass matrix).
 const RANK_TOL: f64 = 1e-12;
 
@@ -31,7 +33,7 @@ pub fn forward_dynamics(
     tau: Option<&[f64]>,
     cb: &dyn Callbacks,
 ) -> Result<Powers> {
-    let (nu, nc) = (model.nu, model.nc);
+    let nc = model.nc;
     let mut p = super::prepare(model, data, t, q, u, cb)?;
     constraints::positions(model, data, t, q, cb)?;
     // velocity-product accelerations (u̇ = 0, no gravity) for γ
@@ -41,6 +43,77 @@ pub fn forward_dynamics(
     data.zero_u = zero;
     constraints::accelerations(model, data, t, cb)?;
     super::aba::aba_prepared(model, data, tau);
+    let mut sp = std::mem::take(&mut data.saddle);
+    let sparse = solve_sparse(model, data, &mut sp, t, u);
+    data.saddle = sp;
+    if !sparse? {
+        solve_dense(model, data, t)?;
+    }
+    for k in 0..nc {
+        // driving constraints do work: λ · b (b = 0 for scleronomic rows)
+        p.external += data.lambda[k] * data.b[k];
+    }
+    // body accelerations of the constrained motion (without gravity), for records and reactions
+    data.a[0] = Motion::ZERO;
+    let udot = std::mem::take(&mut data.udot);
+    crate::kinematics::accelerations(model, data, &udot);
+    data.udot = udot;
+    Ok(p)
+}
+
+/// Baumgarte feedback `Φ̈ + 2α Φ̇ + β² Φ = 0` folded into γ (Φ is zero on velocity-only rows);
+/// `gu` holds `G u`.
+fn baumgarte(data: &mut Data, gu: &[f64]) {
+    if let Some((alpha, beta)) = data.baumgarte {
+        for r in 0..data.gamma.len() {
+            data.gamma[r] -= 2.0 * alpha * (gu[r] - data.b[r]) + beta * beta * data.phi[r];
+        }
+    }
+}
+
+/// The sparse path (see [`super::sparse`]): `M = LᵀDL` on the tree, `S = G M⁻¹ Gᵀ` on the row
+/// patterns, λ and `u̇ += M⁻¹ Gᵀ λ`. Returns false, leaving `data.udot` as the unconstrained
+/// accelerations, when the rows are redundant in a way that needs the dense minimum-norm path.
+fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f64]) -> Result<bool> {
+    let nc = model.nc;
+    {
+        let Data { inertia, s, ic, .. } = &mut *data;
+        super::crba::composite_inertias(model, inertia, s, ic, |r, c, v| sp.put_mass(r, c, v));
+    }
+    if !sp.factor_mass() {
+        return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));
+    }
+    sp.gather_g(&data.g);
+    if data.baumgarte.is_some() {
+        let mut gu = std::mem::take(&mut data.work2);
+        sp.g_times(u, &mut gu[..nc]);
+        baumgarte(data, &gu[..nc]);
+        data.work2 = gu;
+    }
+    sp.assemble_schur(true);
+    if !sp.factor_schur(RANK_TOL) {
+        return Ok(false);
+    }
+    sp.g_times(&data.udot, &mut data.lambda);
+    for r in 0..nc {
+        data.lambda[r] = data.gamma[r] - data.lambda[r];
+    }
+    sp.solve_schur(&mut data.lambda);
+    sp.gt_times(&data.lambda, &mut data.scratch_u);
+    sp.solve_mass(&mut data.scratch_u);
+    for (a, d) in data.udot.iter_mut().zip(&data.scratch_u) {
+        *a += d;
+    }
+    data.constraint_rank = sp.rank();
+    data.dependent.copy_from_slice(&sp.dependent);
+    data.weakest = sp.weakest;
+    Ok(true)
+}
+
+/// The dense path: Cholesky of M, `S = G M⁻¹ Gᵀ` by pivoted Cholesky, minimum-norm multipliers
+/// for redundant rows. `data.udot` holds the unconstrained accelerations on entry.
+fn solve_dense(model: &Model, data: &mut Data, t: f64) -> Result<()> {
+    let (nu, nc) = (model.nu, model.nc);
     // M = L Lᵀ
     super::crba::crba(model, data);
     for r in 0..nu {
@@ -60,16 +133,7 @@ pub fn forward_dynamics(
         }
         cholesky_semidefinite_solve(&data.m_factor, nu, &data.perm_u, nu, col, &mut data.work);
     }
-    if let Some((alpha, beta)) = data.baumgarte {
-        // Φ̈ + 2α Φ̇ + β² Φ = 0 (Φ is zero on velocity-only rows)
-        for r in 0..nc {
-            let mut gu = -data.b[r];
-            for i in 0..nu {
-                gu += data.g[(r, i)] * u[i];
-            }
-            data.gamma[r] -= 2.0 * alpha * gu + beta * beta * data.phi[r];
-        }
-    }
+    // (γ already carries the Baumgarte terms: the sparse path ran first)
     // S = G M⁻¹ Gᵀ, rhs = γ - G u̇_free
     for r in 0..nc {
         for c in 0..nc {
@@ -95,15 +159,18 @@ pub fn forward_dynamics(
         for i in 0..nu {
             data.udot[i] += data.minv_gt[k * nu + i] * l;
         }
-        // driving constraints do work: λ · b (b = 0 for scleronomic rows)
-        p.external += l * data.b[k];
     }
-    // body accelerations of the constrained motion (without gravity), for records and reactions
-    data.a[0] = Motion::ZERO;
-    let udot = std::mem::take(&mut data.udot);
-    crate::kinematics::accelerations(model, data, &udot);
-    data.udot = udot;
-    Ok(p)
+    mark_dependent(data, nc);
+    Ok(())
+}
+
+/// Dependent-row flags from the pivot order of a dense pivoted factorization of `data.schur`.
+fn mark_dependent(data: &mut Data, nc: usize) {
+    data.dependent.fill(false);
+    for k in data.constraint_rank..nc {
+        data.dependent[data.perm_c[k]] = true;
+    }
+    data.weakest = (1.0, 0);
 }
 
 /// Turns the basic solution λ of a rank-deficient `S λ = r` (dependent rows set to zero) into the
@@ -170,11 +237,62 @@ fn min_norm_multipliers(data: &mut Data, nc: usize) {
     data.null_scratch = scratch;
 }
 
-/// Solves `(G Gᵀ) μ = r` in place (minimum-norm correction `-Gᵀ μ` of a residual `r`); `r` is
-/// `data.work2[..nc]`. Dependent rows get zero. With `holonomic_only` the non-holonomic rows are
-/// left out (zero rows and columns of `G Gᵀ` count as dependent, so their μ is zero): the
-/// position Newton then solves only `Φ_h = 0` and is not restricted by velocity-only rows.
-fn min_norm_correction(model: &Model, data: &mut Data, nc: usize, nu: usize, holonomic_only: bool) {
+/// Minimum-norm correction of a residual `r` (`data.work2[..nc]`): solves `(G Gᵀ) μ = r` and
+/// writes `Gᵀ μ` into `data.scratch_u`, with G as last gathered into `data.saddle`. Dependent rows
+/// get zero. With `holonomic_only` the non-holonomic rows are left out (their rows of G count as
+/// zero, so their μ is zero): the position Newton then solves only `Φ_h = 0` and is not restricted
+/// by velocity-only rows. With `reuse`, the factor of `G Gᵀ` from the previous call is kept (a
+/// simplified Newton step: G moved by the last correction only, O(|Φ|)). Returns whether the
+/// sparse factor was used (false: the dense pivoted one in `data.schur`, for redundant rows).
+fn min_norm_correction(model: &Model, data: &mut Data, holonomic_only: bool, reuse: Option<bool>) -> bool {
+    let (nu, nc) = (model.nu, model.nc);
+    let mut sp = std::mem::take(&mut data.saddle);
+    if holonomic_only {
+        for con in &model.constraints {
+            let rows = con.row + con.kind.holonomic_rows()..con.row + con.kind.rows();
+            data.work2[rows.clone()].fill(0.0);
+            sp.clear_rows(rows);
+        }
+    }
+    let sparse = match reuse {
+        Some(sparse) => sparse,
+        None => {
+            sp.assemble_schur(false);
+            sp.factor_schur(RANK_TOL) || {
+                dense_gram_factor(model, data, holonomic_only);
+                false
+            }
+        }
+    };
+    if sparse {
+        sp.solve_schur(&mut data.work2[..nc]);
+        sp.gt_times(&data.work2[..nc], &mut data.scratch_u);
+    } else {
+        let mut rhs = std::mem::take(&mut data.work2);
+        cholesky_semidefinite_solve(
+            &data.schur,
+            nc,
+            &data.perm_c,
+            data.constraint_rank,
+            &mut rhs[..nc],
+            &mut data.work,
+        );
+        for i in 0..nu {
+            let mut s = 0.0;
+            for k in 0..nc {
+                s += data.g[(k, i)] * rhs[k];
+            }
+            data.scratch_u[i] = s;
+        }
+        data.work2 = rhs;
+    }
+    data.saddle = sp;
+    sparse
+}
+
+/// Dense pivoted factor of `G Gᵀ` into `data.schur` (rank in `data.constraint_rank`).
+fn dense_gram_factor(model: &Model, data: &mut Data, holonomic_only: bool) {
+    let (nu, nc) = (model.nu, model.nc);
     for r in 0..nc {
         for c in 0..nc {
             let mut s = 0.0;
@@ -192,24 +310,25 @@ fn min_norm_correction(model: &Model, data: &mut Data, nc: usize, nu: usize, hol
                     data.schur[r * nc + c] = 0.0;
                     data.schur[c * nc + r] = 0.0;
                 }
-                data.work2[r] = 0.0;
             }
         }
     }
-    let rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
-    let mut rhs = std::mem::take(&mut data.work2);
-    cholesky_semidefinite_solve(&data.schur, nc, &data.perm_c, rank, &mut rhs[..nc], &mut data.work);
-    data.work2 = rhs;
+    data.constraint_rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
 }
 
 /// Projects (q, u) at time t onto `Φ(q, t) = 0` and `G u = b`: Newton iterations with minimum-norm
 /// corrections (the pseudo-inverse relation of eq. 2.68) over the holonomic rows only, then one
 /// velocity correction over all rows (holonomic and non-holonomic).
 pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f64], cb: &dyn Callbacks) -> Result<()> {
-    let (nu, nc) = (model.nu, model.nc);
+    let nc = model.nc;
     if nc == 0 {
         return Ok(());
     }
+    // one factor of G Gᵀ serves every Newton step and, when every row is holonomic, the velocity
+    // correction too: G changes between them only by the O(|Φ|) position corrections
+    let all_holonomic = model.constraints.iter().all(|c| c.kind.holonomic_rows() == c.kind.rows());
+    let mut factor: Option<bool> = None;
+    let mut factor_far = false;
     let mut converged = false;
     let mut worst = (0.0, 0usize);
     for _ in 0..20 {
@@ -221,14 +340,15 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
             break;
         }
         data.work2[..nc].copy_from_slice(&data.phi);
-        min_norm_correction(model, data, nc, nu, true);
+        data.saddle.gather_g(&data.g);
+        // a frozen factor only for the small corrections after a step; full Newton from afar
+        let small = worst.0 < 1e-8;
+        factor = Some(min_norm_correction(model, data, true, if small { factor } else { None }));
+        // a factor taken far from the manifold does not serve the velocity correction
+        factor_far = !small;
         // Δu = -Gᵀ μ, applied on the configuration manifold
-        for i in 0..nu {
-            let mut s = 0.0;
-            for k in 0..nc {
-                s -= data.g[(k, i)] * data.work2[k];
-            }
-            data.scratch_u[i] = s;
+        for v in data.scratch_u.iter_mut() {
+            *v = -*v;
         }
         data.q_tmp.copy_from_slice(q);
         model.integrate(&data.q_tmp, &data.scratch_u, 1.0, q);
@@ -241,20 +361,16 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
         )));
     }
     // velocities: u ← u - Gᵀ (G Gᵀ)⁺ (G u - b), with G at the projected q
+    data.saddle.gather_g(&data.g);
+    let mut r = std::mem::take(&mut data.work2);
+    data.saddle.g_times(u, &mut r[..nc]);
     for k in 0..nc {
-        let mut s = -data.b[k];
-        for i in 0..nu {
-            s += data.g[(k, i)] * u[i];
-        }
-        data.work2[k] = s;
+        r[k] -= data.b[k];
     }
-    min_norm_correction(model, data, nc, nu, false);
-    for i in 0..nu {
-        let mut s = 0.0;
-        for k in 0..nc {
-            s += data.g[(k, i)] * data.work2[k];
-        }
-        u[i] -= s;
+    data.work2 = r;
+    min_norm_correction(model, data, false, if all_holonomic && !factor_far { factor } else { None });
+    for (v, d) in u.iter_mut().zip(&data.scratch_u) {
+        *v -= d;
     }
     Ok(())
 }

@@ -10,32 +10,47 @@ use crate::model::Model;
 /// Fills `data.mass_matrix` from the placements and inertias of the last
 /// [`crate::kinematics::positions`] and [`crate::kinematics::inertias`] calls.
 pub fn crba(model: &Model, data: &mut Data) {
+    data.mass_matrix.as_mut_slice().fill(0.0);
+    let Data { ic, inertia, s, mass_matrix, .. } = data;
+    composite_inertias(model, inertia, s, ic, |r, c, v| {
+        mass_matrix[(r, c)] = v;
+        mass_matrix[(c, r)] = v;
+    });
+}
+
+/// The composite-rigid-body recursion: hands every structurally nonzero entry `M(r, c)` (r a
+/// velocity of the same joint as c or of one of its ancestors) to `put`, once per pair and
+/// triangle, so dense and sparse storages share one algorithm.
+pub(crate) fn composite_inertias(
+    model: &Model,
+    inertia: &[crate::spatial::RigidInertia],
+    s: &[[crate::spatial::Motion; 6]],
+    ic: &mut [crate::spatial::RigidInertia],
+    mut put: impl FnMut(usize, usize, f64),
+) {
     let nb = model.nbodies();
-    data.ic[..nb].copy_from_slice(&data.inertia[..nb]);
-    data.mass_matrix.fill(0.0);
+    ic[..nb].copy_from_slice(&inertia[..nb]);
     for (ji, j) in model.joints.iter().enumerate().rev() {
         let i = ji + 1;
         if j.parent != 0 {
-            let c = data.ic[i];
-            let p = &mut data.ic[j.parent];
+            let c = ic[i];
+            let p = &mut ic[j.parent];
             p.m += c.m;
             p.h += c.h;
             p.i_o += c.i_o;
         }
         for k in 0..j.nu() {
-            let f = data.ic[i].mul_motion(&data.s[i][k]);
+            let f = ic[i].mul_motion(&s[i][k]);
             let col = j.iu + k;
-            for kk in 0..j.nu() {
-                data.mass_matrix[(j.iu + kk, col)] = data.s[i][kk].dot(&f);
+            for kk in 0..=k {
+                put(j.iu + kk, col, s[i][kk].dot(&f));
             }
             // M_(ancestor, col) = S_ancᵀ F: the composite body's reaction seen by each ancestor joint
             let mut b = j.parent;
             while b != 0 {
                 let jb = &model.joints[b - 1];
                 for kk in 0..jb.nu() {
-                    let v = data.s[b][kk].dot(&f);
-                    data.mass_matrix[(jb.iu + kk, col)] = v;
-                    data.mass_matrix[(col, jb.iu + kk)] = v;
+                    put(jb.iu + kk, col, s[b][kk].dot(&f));
                 }
                 b = jb.parent;
             }

@@ -14,6 +14,7 @@ pub mod crba;
 pub mod energy;
 pub mod reactions;
 pub mod rnea;
+pub mod sparse;
 
 pub use aba::aba;
 pub use crba::crba;
