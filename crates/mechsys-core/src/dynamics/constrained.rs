@@ -42,7 +42,13 @@ pub fn forward_dynamics(
     crate::kinematics::accelerations(model, data, &zero);
     data.zero_u = zero;
     constraints::accelerations(model, data, t, cb)?;
-    super::aba::aba_prepared(model, data, tau);
+    // the bias forces from the same velocity-product accelerations: M u̇_free = τ - c
+    let mut c = std::mem::take(&mut data.udot);
+    super::rnea::rnea_inward(model, data, &mut c);
+    for (i, ci) in c.iter_mut().enumerate() {
+        *ci = tau.map_or(0.0, |x| x[i]) - *ci;
+    }
+    data.udot = c;
     let mut sp = std::mem::take(&mut data.saddle);
     let sparse = solve_sparse(model, data, &mut sp, t, u);
     data.saddle = sp;
@@ -72,8 +78,9 @@ fn baumgarte(data: &mut Data, gu: &[f64]) {
 }
 
 /// The sparse path (see [`super::sparse`]): `M = LᵀDL` on the tree, `S = G M⁻¹ Gᵀ` on the row
-/// patterns, λ and `u̇ += M⁻¹ Gᵀ λ`. Returns false, leaving `data.udot` as the unconstrained
-/// accelerations, when the rows are redundant in a way that needs the dense minimum-norm path.
+/// patterns, λ and `u̇ += M⁻¹ Gᵀ λ`. `data.udot` holds `τ - c` on entry. Returns false, leaving
+/// `data.udot` as the unconstrained accelerations, when the rows are redundant in a way that needs
+/// the dense minimum-norm path.
 fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f64]) -> Result<bool> {
     let nc = model.nc;
     {
@@ -83,6 +90,7 @@ fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f6
     if !sp.factor_mass() {
         return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));
     }
+    sp.solve_mass(&mut data.udot);
     sp.gather_g(&data.g);
     if data.baumgarte.is_some() {
         let mut gu = std::mem::take(&mut data.work2);

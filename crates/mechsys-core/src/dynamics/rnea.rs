@@ -14,12 +14,18 @@ use crate::spatial::Motion;
 /// Core of the RNEA on prepared data (kinematics, inertias and `f_ext`, `tau_applied` filled):
 /// writes `out = M udot - h` (the extra generalized forces needed to produce `udot`).
 pub fn rnea_prepared(model: &Model, data: &mut Data, udot: &[f64], out: &mut [f64]) {
-    // gravity as a fictitious upward acceleration of the base
-    data.a[0] = Motion::new(crate::math::Vec3::zeros(), -model.gravity);
+    data.a[0] = Motion::ZERO;
     crate::kinematics::accelerations(model, data, udot);
+    rnea_inward(model, data, out);
+}
+
+/// The Newton–Euler equations and the inward pass on the accelerations in `data.a` (without
+/// gravity, which enters as the d'Alembert term `-I g`): `out = Sᵀ f - τ_applied`.
+pub fn rnea_inward(model: &Model, data: &mut Data, out: &mut [f64]) {
+    let g = Motion::new(crate::math::Vec3::zeros(), model.gravity);
     for i in 1..model.nbodies() {
         let iv = data.inertia[i].mul_motion(&data.v[i]);
-        data.f[i] = data.inertia[i].mul_motion(&data.a[i]) + data.v[i].cross_force(&iv) - data.f_ext[i];
+        data.f[i] = data.inertia[i].mul_motion(&(data.a[i] - g)) + data.v[i].cross_force(&iv) - data.f_ext[i];
     }
     for (ji, j) in model.joints.iter().enumerate().rev() {
         let i = ji + 1;
@@ -30,10 +36,6 @@ pub fn rnea_prepared(model: &Model, data: &mut Data, udot: &[f64], out: &mut [f6
             let fi = data.f[i];
             data.f[j.parent] += fi;
         }
-    }
-    data.a[0] = Motion::ZERO;
-    for i in 1..model.nbodies() {
-        data.a[i].v += model.gravity;
     }
 }
 
