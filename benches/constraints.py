@@ -443,6 +443,7 @@ def measure_four_bar(peers: set, repeat: int, budget: float, log) -> dict:
 
     for integ, setting, key in ((ms.RK4(DT), "RK4, dt = 1e-3", "rk4"),
                                 (ms.RK4(DT / 2), "RK4, dt = 5e-4", "rk4_half"),
+                                (ms.DOPRI5(rtol=1e-11, atol=1e-13), "DOPRI5, rtol 1e-11, atol 1e-13", "dopri"),
                                 (ms.DOPRI5(**REF_TOL), "DOPRI5, rtol 1e-13, atol 1e-15 (reference)", "ref")):
         tmin, tmed, runs, res = whole_run(lambda: mechsys_run(model, q0, u0, t_end, integ), repeat, budget)
         add("mechsys", setting, (tmin, tmed, runs), np.array(res["q"][-1]),
@@ -730,19 +731,24 @@ def report(fb, ch, sc, peers, missing, mach, vers, argv, elapsed) -> str:
     L.append("")
     L.append("Issue 3's target: **“Pinocchio-RK4 accuracy (crank angle within 1e-8°, closure at machine precision) in no "
              "more time than MuJoCo takes, i.e. at least 5× faster than Exudyn”**, checked on the four-bar of table 1 "
-             f"with mechsys RK4 at dt = 1e-3 (closure at machine precision taken as ≤ {CLOSURE_TARGET:.0e} m), and on "
+             f"with each mechsys setting (the time and closure parts with RK4 at dt = 1e-3; closure at machine precision taken as ≤ {CLOSURE_TARGET:.0e} m), and on "
              "tables 2 and 3 for the time parts.")
     L.append("")
     if ms_rk4:
-        ok = ms_rk4["dcrank_deg"] <= CRANK_TARGET_DEG
-        half = next((r for r in fb["rows"] if r.get("key") == "rk4_half"), None)
-        extra = ""
-        if not ok and half is not None:
-            extra = (f"; RK4 at dt = 5e-4 gets {half['dcrank_deg']:.1e}° in {fmt_time(half['min'])}"
-                     + (f" ({ratio(half['min'], next(r['min'] for r in fb['rows'] if r.get('key') == 'default')).strip('*')} than default MuJoCo)"
-                        if any(r.get("key") == "default" for r in fb["rows"]) else ""))
-        L.append(f"- Crank angle within 1e-8° of the reference at 1 s: **{'met' if ok else 'missed'}** "
-                 f"({ms_rk4['dcrank_deg']:.1e}°{extra}).")
+        # accuracy within MuJoCo's time: the fastest mechsys setting that reaches the crank target
+        mj_default = next((r for r in fb["rows"] if r.get("key") == "default"), None)
+        accurate = sorted((r for r in fb["rows"] if r["engine"] == "mechsys" and r.get("key") != "ref"
+                           and r["dcrank_deg"] <= CRANK_TARGET_DEG), key=lambda r: r["min"])
+        for r in fb["rows"]:
+            if r["engine"] == "mechsys" and r.get("key") != "ref":
+                L.append(f"- Crank angle within 1e-8° with mechsys {r['setting']}: "
+                         f"**{'met' if r['dcrank_deg'] <= CRANK_TARGET_DEG else 'missed'}** ({r['dcrank_deg']:.1e}° in {fmt_time(r['min'])}).")
+        if mj_default is not None:
+            best = accurate[0] if accurate else None
+            ok = best is not None and best["min"] <= mj_default["min"]
+            L.append(f"- Crank angle within 1e-8° in no more time than MuJoCo (default) takes: **{'met' if ok else 'missed'}**"
+                     + (f" ({best['setting']}: {best['dcrank_deg']:.1e}° in {fmt_time(best['min'])}, "
+                        f"{ratio(best['min'], mj_default['min']).strip('*')} than MuJoCo)." if best else "."))
         ok = ms_rk4["closure"] <= CLOSURE_TARGET
         L.append(f"- Loop closure at machine precision at 1 s: **{'met' if ok else 'missed'}** ({ms_rk4['closure']:.1e} m; "
                  f"the largest violation at any step of the run, from mechsys' own signal: {ms_rk4['closure_run']:.1e} m).")

@@ -27,6 +27,9 @@ joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint ori
                                                      joint frame components (computed on first
                                                      access from the recorded state)
 ==============================  ===========  =============================================
+
+``constraint/<c>/velocity_violation`` (the violation's unit per second, same shape as
+``violation``) is ``G u - b`` for every row, the velocity-only (non-holonomic) rows included.
 """
 
 from __future__ import annotations
@@ -115,6 +118,10 @@ class Results:
                 unit = c["unit"]
                 put(f"constraint/{c['name']}/lambda", raw["constraint_lambda"][:, sl] if c["rows"] > 1 else raw["constraint_lambda"][:, c["row"]], unit)
                 put(f"constraint/{c['name']}/violation", raw["constraint_violation"][:, sl] if c["rows"] > 1 else raw["constraint_violation"][:, c["row"]], c["violation_unit"])
+                if "constraint_velocity_violation" in raw:
+                    vv = raw["constraint_velocity_violation"]
+                    put(f"constraint/{c['name']}/velocity_violation", vv[:, sl] if c["rows"] > 1 else vv[:, c["row"]],
+                        _rate_unit(c["violation_unit"]))
         lazy = {}
         if engine is not None and joints:
             group = _reaction_group(engine, callbacks, joints, raw)
@@ -293,3 +300,10 @@ def load(path: str | Path) -> Results:
 
 
 __all__ = ["Results", "load"]
+
+
+def _rate_unit(unit: str) -> str:
+    """The unit of the time rate of a quantity in ``unit`` ("m" -> "m/s", "N, N m" style lists per part)."""
+    if not unit:
+        return "1/s"
+    return ", ".join(f"{part.strip()}/s" for part in unit.split(","))

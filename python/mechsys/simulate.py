@@ -113,6 +113,10 @@ def simulate(
         _wait(worker, prog, n_expected, progress)
     if error:
         raise error[0]
+    import warnings
+
+    for note in raw.pop("warnings", []):
+        warnings.warn(f"model '{model.name}': {note}", UserWarning, stacklevel=2)
     attrs = {
         "model": core.description_json(),
         "settings": text,

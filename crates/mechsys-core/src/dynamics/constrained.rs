@@ -107,11 +107,7 @@ fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f6
         data.lambda[r] = data.gamma[r] - data.lambda[r];
     }
     sp.solve_schur(&mut data.lambda);
-    sp.gt_times(&data.lambda, &mut data.scratch_u);
-    sp.solve_mass(&mut data.scratch_u);
-    for (a, d) in data.udot.iter_mut().zip(&data.scratch_u) {
-        *a += d;
-    }
+    sp.add_constraint_accelerations(&data.lambda, &mut data.udot);
     data.constraint_rank = sp.rank();
     data.dependent.copy_from_slice(&sp.dependent);
     data.weakest = sp.weakest;
@@ -249,10 +245,10 @@ fn min_norm_multipliers(data: &mut Data, nc: usize) {
 /// writes `Gᵀ μ` into `data.scratch_u`, with G as last gathered into `data.saddle`. Dependent rows
 /// get zero. With `holonomic_only` the non-holonomic rows are left out (their rows of G count as
 /// zero, so their μ is zero): the position Newton then solves only `Φ_h = 0` and is not restricted
-/// by velocity-only rows. With `reuse`, the factor of `G Gᵀ` from the previous call is kept (a
-/// simplified Newton step: G moved by the last correction only, O(|Φ|)). Returns whether the
-/// sparse factor was used (false: the dense pivoted one in `data.schur`, for redundant rows).
-fn min_norm_correction(model: &Model, data: &mut Data, holonomic_only: bool, reuse: Option<bool>) -> bool {
+/// by velocity-only rows. With `reuse`, the sparse factor of `G Gᵀ` from the previous call is kept
+/// (a simplified Newton step: G moved by the last correction only, O(|Φ|)). Returns whether the
+/// sparse factor was used (false: the dense pivoted one, for redundant rows; it is not kept).
+fn min_norm_correction(model: &Model, data: &mut Data, holonomic_only: bool, reuse: bool) -> bool {
     let (nu, nc) = (model.nu, model.nc);
     let mut sp = std::mem::take(&mut data.saddle);
     if holonomic_only {
@@ -262,14 +258,11 @@ fn min_norm_correction(model: &Model, data: &mut Data, holonomic_only: bool, reu
             sp.clear_rows(rows);
         }
     }
-    let sparse = match reuse {
-        Some(sparse) => sparse,
-        None => {
-            sp.assemble_schur(false);
-            sp.factor_schur(RANK_TOL) || {
-                dense_gram_factor(model, data, holonomic_only);
-                false
-            }
+    let sparse = reuse || {
+        sp.assemble_schur(false);
+        sp.factor_schur(RANK_TOL) || {
+            dense_gram_factor(model, data, holonomic_only);
+            false
         }
     };
     if sparse {
@@ -335,7 +328,7 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
     // one factor of G Gᵀ serves every Newton step and, when every row is holonomic, the velocity
     // correction too: G changes between them only by the O(|Φ|) position corrections
     let all_holonomic = model.constraints.iter().all(|c| c.kind.holonomic_rows() == c.kind.rows());
-    let mut factor: Option<bool> = None;
+    let mut factor = false;
     let mut factor_far = false;
     let mut converged = false;
     let mut worst = (0.0, 0usize);
@@ -351,7 +344,10 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
         data.saddle.gather_g(&data.g);
         // a frozen factor only for the small corrections after a step; full Newton from afar
         let small = worst.0 < 1e-8;
-        factor = Some(min_norm_correction(model, data, true, if small { factor } else { None }));
+        let used = min_norm_correction(model, data, true, small && factor);
+        // keep only a well-conditioned sparse factor: with nearly dependent rows (a redundancy that
+        // is exact only on the manifold) a frozen factor amplifies the change of G
+        factor = used && data.saddle.weakest.0 > 1e-8;
         // a factor taken far from the manifold does not serve the velocity correction
         factor_far = !small;
         // Δu = -Gᵀ μ, applied on the configuration manifold
@@ -376,7 +372,7 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
         r[k] -= data.b[k];
     }
     data.work2 = r;
-    min_norm_correction(model, data, false, if all_holonomic && !factor_far { factor } else { None });
+    min_norm_correction(model, data, false, all_holonomic && !factor_far && factor);
     for (v, d) in u.iter_mut().zip(&data.scratch_u) {
         *v -= d;
     }

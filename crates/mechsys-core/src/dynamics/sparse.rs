@@ -482,6 +482,17 @@ impl Saddle {
         }
     }
 
+    /// `udot += M⁻¹ Gᵀ λ` (the accelerations the multipliers add), with the mass factor.
+    pub fn add_constraint_accelerations(&mut self, lambda: &[f64], udot: &mut [f64]) {
+        let mut x = std::mem::take(&mut self.scratch_u);
+        self.gt_times(lambda, &mut x);
+        self.solve_mass(&mut x);
+        for (a, d) in udot.iter_mut().zip(&x) {
+            *a += d;
+        }
+        self.scratch_u = x;
+    }
+
     /// `out = Gᵀ λ`.
     pub fn gt_times(&self, lambda: &[f64], out: &mut [f64]) {
         out.fill(0.0);
