@@ -183,3 +183,36 @@ def test_redundant_constraints_share_the_load_by_minimum_norm():
     half = 0.5 * single["constraint/rod/lambda"]
     np.testing.assert_allclose(double["constraint/rod/lambda"], half, atol=1e-8)
     np.testing.assert_allclose(double["constraint/rod_copy/lambda"], half, atol=1e-8)
+
+
+def test_singular_configuration_met_during_a_run_is_reported_with_time_and_constraint():
+    """A driven slider-crank with rod length = crank radius: at crank angle pi/2 the rod lies on
+    the crank and the wrist's y-equation vanishes (the Jacobian loses rank). Passing near it is
+    smooth on this branch (the slider follows x = 2 r cos(theta)) but is reported as a warning
+    naming the time and the constraint; landing exactly on it stops the run with a SolverError."""
+    r, omega = 0.2, 2.0
+    with pytest.warns(UserWarning, match="near-singular configuration at t = 0.78") as rec:
+        res = ms.simulate(slider_crank(r=r, l=r, omega=omega), 1.5, ms.RK4(1e-3), output_dt=1e-2)
+    msg = [str(w.message) for w in rec if "near-singular" in str(w.message)]
+    assert len(msg) == 1 and "constraint 'wrist' (row 1)" in msg[0]
+    t_warn = float(msg[0].split("t = ")[1].split(" s")[0])
+    assert abs(t_warn - np.pi / 2 / omega) < 2e-3
+    np.testing.assert_allclose(res["joint/guide/q"], 2 * r * np.cos(omega * res.t), atol=1e-12)
+    # a step that lands on theta = pi/2 exactly (omega t = pi/2 at t = 0.5 s)
+    with pytest.raises(ms.SolverError, match=r"singular configuration at t = 0\.500000 s: constraint 'wrist'"):
+        ms.simulate(slider_crank(r=r, l=r, omega=np.pi), 1.0, ms.RK4(1e-3), output_dt=1e-2)
+
+
+def test_velocity_violation_signal_is_recorded_for_every_row():
+    res = ms.simulate(slider_crank(), 0.2, ms.RK4(1e-3), output_dt=1e-2)
+    vv = res["constraint/wrist/velocity_violation"]
+    assert vv.shape == (21, 3) and res.unit("constraint/wrist/velocity_violation") == "m/s"
+    assert np.abs(vv).max() < 1e-12
+    assert np.abs(res["constraint/motor/velocity_violation"]).max() < 1e-12
+    # without drift control the velocity residual drifts; for the rod it is e . v of the bob
+    free = ms.simulate(spherical_pendulum_as_free_body(), 2.0, ms.RK4(2e-2), output_dt=2e-2, stabilization="none")
+    r, v = free["body/bob/position"], free["body/bob/velocity"]
+    ev = np.sum(r * v, axis=1) / np.linalg.norm(r, axis=1)
+    vv = free["constraint/rod/velocity_violation"]
+    assert np.abs(vv).max() > 1e-7
+    np.testing.assert_allclose(vv, ev, rtol=0, atol=1e-15)

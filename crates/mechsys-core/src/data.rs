@@ -106,9 +106,6 @@ pub struct Data {
     pub saddle: crate::dynamics::sparse::Saddle,
     /// constraints: rows found dependent at the last solve (nc).
     pub dependent: Vec<bool>,
-    /// constraints: smallest `pivot / diagonal` of an independent row at the last sparse solve
-    /// (the squared sine of its angle to the rows before it) and that row.
-    pub weakest: (f64, usize),
 }
 
 impl Data {
@@ -159,7 +156,6 @@ impl Data {
             null_scratch: vec![0.0; model.nc],
             saddle: crate::dynamics::sparse::Saddle::new(model),
             dependent: vec![false; model.nc],
-            weakest: (1.0, 0),
         }
     }
 }

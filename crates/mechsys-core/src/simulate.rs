@@ -130,9 +130,9 @@ pub struct MultibodySystem<'a> {
     pub data: Data,
     cb: &'a dyn Callbacks,
     stabilization: Stabilization,
-    /// Rows dependent at the first evaluation (a row that becomes dependent later, or nearly so,
-    /// marks a singular configuration).
-    dependent0: Option<Vec<bool>>,
+    /// Dependent rows and pivots of the constraint factorization at the first evaluation (a rank
+    /// drop or a pivot that collapses later marks a singular configuration).
+    start: Option<(Vec<bool>, Vec<f64>)>,
     /// Whether the last evaluation was near a singular configuration (one warning per passage).
     near_singular: bool,
     /// Near-singular passages met so far.
@@ -147,7 +147,7 @@ impl<'a> MultibodySystem<'a> {
             data: Data::new(model),
             cb,
             stabilization: Stabilization::Projection,
-            dependent0: None,
+            start: None,
             near_singular: false,
             warnings: Vec::new(),
         }
@@ -164,10 +164,10 @@ impl<'a> MultibodySystem<'a> {
     }
 }
 
-/// An independent constraint row whose squared sine to the rows before it (in the metric of
-/// `G M⁻¹ Gᵀ`) falls below this marks a near-singular configuration (an angle below about 1e-3
-/// rad): a warning, since the motion may pass it smoothly; rows with a relative pivot below 1e-12
-/// count as dependent, and a rank drop stops the run.
+/// A pivot of the constraint factorization that fell below this fraction of its value at the
+/// start marks a near-singular configuration (its row vanishes or turns dependent, and its
+/// multiplier may grow without bound). A warning, since the motion may pass it smoothly; an
+/// actual rank drop stops the run.
 const NEAR_SINGULAR: f64 = 1e-6;
 
 impl MultibodySystem<'_> {
@@ -175,8 +175,9 @@ impl MultibodySystem<'_> {
     /// change point of the mechanism), and notes passages near such a configuration.
     fn check_singular(&mut self, t: f64) -> Result<()> {
         let dep = &self.data.dependent;
-        let Some(d0) = &self.dependent0 else {
-            self.dependent0 = Some(dep.clone());
+        let (pivots, rows) = self.data.saddle.pivots();
+        let Some((d0, p0)) = &self.start else {
+            self.start = Some((dep.clone(), pivots.to_vec()));
             return Ok(());
         };
         let name_of = |row: usize| {
@@ -192,12 +193,16 @@ impl MultibodySystem<'_> {
                 "singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) became dependent on the others (rank {r0} → {r1})"
             )));
         }
-        let (weak, row) = self.data.weakest;
-        let near = weak < NEAR_SINGULAR;
+        let weakest = (0..pivots.len())
+            .filter(|&j| p0[j] > 0.0)
+            .map(|j| (pivots[j] / p0[j], rows[j]))
+            .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
+        let near = weakest.0 < NEAR_SINGULAR;
         if near && !self.near_singular {
-            let (name, k) = name_of(row);
+            let (name, k) = name_of(weakest.1);
             self.warnings.push(format!(
-                "near-singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) is nearly dependent on the others (squared sine {weak:.1e}); its multipliers may be large"
+                "near-singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) nearly vanishes or depends on the others (its pivot fell to {:.1e} of its start value); its multipliers may be large",
+                weakest.0
             ));
         }
         self.near_singular = near;

@@ -110,7 +110,6 @@ fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f6
     sp.add_constraint_accelerations(&data.lambda, &mut data.udot);
     data.constraint_rank = sp.rank();
     data.dependent.copy_from_slice(&sp.dependent);
-    data.weakest = sp.weakest;
     Ok(true)
 }
 
@@ -174,7 +173,6 @@ fn mark_dependent(data: &mut Data, nc: usize) {
     for k in data.constraint_rank..nc {
         data.dependent[data.perm_c[k]] = true;
     }
-    data.weakest = (1.0, 0);
 }
 
 /// Turns the basic solution λ of a rank-deficient `S λ = r` (dependent rows set to zero) into the
@@ -347,7 +345,7 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
         let used = min_norm_correction(model, data, true, small && factor);
         // keep only a well-conditioned sparse factor: with nearly dependent rows (a redundancy that
         // is exact only on the manifold) a frozen factor amplifies the change of G
-        factor = used && data.saddle.weakest.0 > 1e-8;
+        factor = used && data.saddle.well_conditioned(1e-8);
         // a factor taken far from the manifold does not serve the velocity correction
         factor_far = !small;
         // Δu = -Gᵀ μ, applied on the configuration manifold

@@ -58,9 +58,6 @@ pub struct Saddle {
     s_diag0: Vec<f64>,
     /// Dependent rows (original numbering) at the last factorization.
     pub(crate) dependent: Vec<bool>,
-    /// Smallest `pivot / diagonal` of an accepted row (the squared sine of the angle, in the
-    /// metric of S, between the row and the rows eliminated before it) and the row (original numbering).
-    pub(crate) weakest: (f64, usize),
     scratch_u: Vec<f64>,
     scratch_c: Vec<f64>,
 }
@@ -259,7 +256,6 @@ impl Saddle {
             d_s: vec![0.0; nc],
             s_diag0: vec![0.0; nc],
             dependent: vec![false; nc],
-            weakest: (1.0, 0),
             scratch_u: vec![0.0; nu],
             scratch_c: vec![0.0; nc],
         }
@@ -394,7 +390,6 @@ impl Saddle {
         let eps = tol * max_diag.max(f64::MIN_POSITIVE);
         let mut only_zero_rows = true;
         let mut t = 0;
-        self.weakest = (f64::INFINITY, 0);
         for j in 0..nc {
             let (s, e) = (self.s_ptr[j], self.s_ptr[j + 1]);
             let d = self.s_val[s];
@@ -412,10 +407,6 @@ impl Saddle {
                 continue;
             }
             self.dependent[old] = false;
-            let rel = d / self.s_diag0[j];
-            if rel < self.weakest.0 {
-                self.weakest = (rel, old);
-            }
             self.d_s[j] = d;
             let inv_d = 1.0 / d;
             for a in s + 1..e {
@@ -437,6 +428,19 @@ impl Saddle {
     /// products, factorization updates), for benchmarks and profiles.
     pub fn size(&self) -> (usize, usize, usize, usize) {
         (self.row_idx.len(), self.s_row.len(), self.assemble.len(), self.update.len())
+    }
+
+    /// Pivots `D_S` of the last factorization in elimination order (0 for dependent rows) and
+    /// the constraint row of each: a pivot that shrinks by orders of magnitude during a run marks
+    /// a row that vanishes or turns dependent (a singular configuration).
+    pub fn pivots(&self) -> (&[f64], &[usize]) {
+        (&self.d_s, &self.perm)
+    }
+
+    /// Whether every accepted pivot kept more than `tol` of its row's diagonal (no row nearly
+    /// dependent on the rows eliminated before it).
+    pub fn well_conditioned(&self, tol: f64) -> bool {
+        (0..self.nc).all(|j| self.d_s[j] == 0.0 || self.d_s[j] > tol * self.s_diag0[j])
     }
 
     /// Number of independent rows at the last factorization.
