@@ -23,6 +23,7 @@ pub mod constraints;
 pub mod dynamics;
 pub mod forces;
 pub mod integrator;
+pub mod solver;
 pub mod simulate;
 pub mod fixtures;
 
