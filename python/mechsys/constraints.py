@@ -1,22 +1,43 @@
-"""Bilateral constraints beyond the kinematic tree (loop closures, couplers, driven coordinates).
+"""Bilateral constraints beyond the kinematic tree (loop closures, couplers, drives, non-holonomic
+rows).
 
 The engine adds Lagrange multipliers: ``M u' = h + tau + G^T lambda`` with ``G u' = gamma``
 (eq. 2.70), and after every step projects q and u back onto the constraints. Results carry
-``constraint/<name>/lambda`` (the multipliers: force in N for point and distance constraints,
-the driving force or torque for prescribed motion) and ``constraint/<name>/violation``.
+``constraint/<name>/lambda`` (the multipliers, meaning below) and ``constraint/<name>/violation``
+(``Phi``; 0 on velocity-only rows). "Force on body 1" is the load the constraint puts on
+``body1`` (``body2`` gets the opposite).
 
-- :class:`Point`: a point of one body coincides with a point of another (spherical loop closure).
+- :class:`Point`: a point of one body coincides with a point of another (spherical loop closure);
+  ``lambda``: force on body 1, world axes (N).
 - :class:`Distance`: fixed distance between two body points (massless rod with ball ends);
-  ``lambda`` is the force along the line from point 2 to point 1 acting on body 1.
-- :class:`Coupler`: ``q(joint1) = ratio * q(joint2) + offset`` (gears, belts).
-- :class:`Prescribed`: ``q(joint)[index] = f(t)`` (a driven joint; ``lambda`` is the drive).
+  ``lambda`` is the force on body 1 along the unit vector from point 2 to point 1 (N; a rod in
+  tension has ``lambda < 0``).
+- :class:`Coupler`: ``q(joint1) = ratio * q(joint2) + offset`` (gears, belts); ``lambda``: the
+  generalized force on joint 1 (N or N m).
+- :class:`Prescribed`: ``q(joint)[index] = f(t)``; ``lambda`` is the driving force or torque.
+- :class:`PrescribedBody`: a frame on a body follows ``position(t)`` and optionally Cardan angles
+  ``orientation(t)`` (3 or 6 equations); ``lambda``: driving force (N) then moment (N m), world axes.
 - :class:`PointOnLine`, :class:`PointOnPlane`: a point of one body slides on a line / in a plane
-  fixed to another body (2 / 1 equations; ``lambda`` is the force on body 1, N).
-- :class:`LoopSpherical`, :class:`LoopRevolute`, :class:`LoopFixed`: loop-closing joints between
-  a frame on each of two bodies (3 / 5 / 6 equations; ``lambda`` rows 0-2 are the force on body 1
-  in world axes, N, the remaining rows moments, N m).
-- :class:`KnifeEdge`, :class:`RollingDisc`: non-holonomic constraints, eq. (2.70) given at velocity
-  level (no position equation; their ``violation`` rows read 0).
+  fixed to another body (2 / 1 equations; ``lambda``: force on body 1 along the normals, N).
+- Loop-closing joints between a frame on each of two bodies, the joint axis being the frames'
+  z-axis; ``lambda`` lists forces on body 1 (N) first, then moments (N m):
+
+  ========================  ====  ==================================================================
+  class                     rows  lambda
+  ========================  ====  ==================================================================
+  :class:`LoopSpherical`    3     force, world axes
+  :class:`LoopRevolute`     5     force, world axes; moments about ``z1 x x2``, ``z1 x y2``
+  :class:`LoopFixed`        6     force, world axes; moment (frame-2 axes when assembled)
+  :class:`LoopPrismatic`    5     force along ``x2``, ``y2``; moment as LoopFixed
+  :class:`LoopCylindrical`  4     force along ``x2``, ``y2``; moments about ``z1 x x2``, ``z1 x y2``
+  :class:`LoopUniversal`    4     force, world axes; moment about ``x1 x y2`` (the cross's pins)
+  :class:`LoopPlanar`       3     force along ``z2``; moments about ``z1 x x2``, ``z1 x y2``
+  ========================  ====  ==================================================================
+
+- :class:`KnifeEdge`, :class:`RollingDisc`, :class:`Velocity`: non-holonomic constraints, eq. (2.70)
+  given at velocity level (no position equation; their ``violation`` rows read 0). ``lambda``: the
+  lateral blade force (N); the contact force (N); for a user :class:`Velocity` constraint the
+  multipliers whose generalized force is ``W lambda``.
 
 Redundant equations (a planar loop closed by a 3-D joint) are allowed: the solver gives dependent
 rows zero multipliers.
@@ -24,8 +45,9 @@ rows zero multipliers.
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from . import functions
 from .errors import ModelError
@@ -117,6 +139,44 @@ class Prescribed:
     def describe(self, callbacks: list) -> dict:
         f = functions.describe(self.function, callbacks, f"constraint '{self.name}'.function")
         return {"type": "prescribed", "name": self.name, "joint": _name(self.joint), "index": int(self.index), "function": f}
+
+
+def _three_functions(fs, callbacks: list, what: str, meaning: str) -> list:
+    """Three time functions (numbers, mechsys.functions objects or callables f(t)); a wrong count
+    is left to the engine, which names the constraint and the key."""
+    if isinstance(fs, (str, bytes, dict)) or not hasattr(fs, "__len__"):
+        raise ModelError(f"{what}: expected a sequence of 3 time functions ({meaning}), got {fs!r}")
+    return [functions.describe(f, callbacks, f"{what}[{k}]") for k, f in enumerate(fs)]
+
+
+@dataclass
+class PrescribedBody:
+    """Prescribed motion of a frame on a body (a rheonomic driving constraint): its origin follows
+    ``position = (f_x, f_y, f_z)`` (world axes, m) and, if ``orientation = (f_a, f_b, f_c)`` is given,
+    its orientation follows those Cardan angles x-y-z (``A = Rx(a) Ry(b) Rz(c)``, rad). Each ``f``
+    is a number, a :mod:`mechsys.functions` object or a callable ``f(t)`` (derivatives by central
+    differences, slow). ``frame``: a :class:`mechsys.Frame` or a position on the body (default:
+    the body frame). 3 or 6 equations: ``lambda[0:3]`` is the driving force on the body at the frame
+    origin (N, world axes), ``lambda[3:6]`` the driving moment (N m, world axes)."""
+
+    name: str
+    body: Any
+    position: Sequence[Any]
+    orientation: Sequence[Any] | None = None
+    frame: Any = None
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"constraint '{self.name}'"
+        d = {
+            "type": "prescribed_body",
+            "name": self.name,
+            "body": _name(self.body),
+            "frame": _frame(self.frame, f"{w}.frame"),
+            "position": _three_functions(self.position, callbacks, f"{w}.position", "x, y, z"),
+        }
+        if self.orientation is not None:
+            d["orientation"] = _three_functions(self.orientation, callbacks, f"{w}.orientation", "Cardan angles x-y-z")
+        return d
 
 
 def _bodies(c, w: str) -> dict:
@@ -215,6 +275,90 @@ class LoopFixed(_Loop):
 
 
 @dataclass
+class LoopPrismatic(_Loop):
+    """Loop-closing slider along the z-axis of ``frame2``: the origin of ``frame1`` stays on that
+    axis and the orientations coincide. 5 equations: ``lambda[0:2]`` the force on body 1 along the
+    x- and y-axes of frame 2 (N), ``lambda[2:5]`` the moment rows of :class:`LoopFixed` (N m)."""
+
+    _type = "loop_prismatic"
+
+
+@dataclass
+class LoopCylindrical(_Loop):
+    """Loop-closing cylindrical joint: the origin of ``frame1`` stays on the z-axis of ``frame2``
+    and the z-axes stay parallel (sliding along and turning about it are free). 4 equations:
+    ``lambda[0:2]`` the force on body 1 along x2 and y2 (N), ``lambda[2:4]`` the moments (N m)
+    about ``z1 x x2`` and ``z1 x y2``."""
+
+    _type = "loop_cylindrical"
+
+
+@dataclass
+class LoopUniversal(_Loop):
+    """Loop-closing universal (Hooke) joint: the origins coincide and the cross's pins, the x-axis
+    of ``frame1`` (fixed in body 1) and the y-axis of ``frame2`` (fixed in body 2), stay
+    perpendicular; the shafts are the z-axes (aligned when the frames coincide). 4 equations:
+    ``lambda[0:3]`` the force on body 1 (N, world axes), ``lambda[3]`` the moment (N m) about
+    ``x1 x y2``."""
+
+    _type = "loop_universal"
+
+
+@dataclass
+class LoopPlanar(_Loop):
+    """Loop-closing planar joint: the z-axes stay parallel and the origin of ``frame1`` stays in
+    the x-y plane of ``frame2``. 3 equations: ``lambda[0]`` the force on body 1 along z2 (N),
+    ``lambda[1:3]`` the moments (N m) about ``z1 x x2`` and ``z1 x y2``."""
+
+    _type = "loop_planar"
+
+
+@dataclass
+class Velocity:
+    """A non-holonomic constraint written by the user, ``W(q, t)^T u + w(q, t) = 0`` (eq. 2.70),
+    ``rows`` velocity equations without a position form. The callables:
+
+    - ``W(t, q)`` returns ``W^T``, shape ``(rows, nu)`` (or ``(nu,)`` when ``rows == 1``): row k
+      holds the coefficients of the generalized velocities u in equation k;
+    - ``w(t, q)`` returns shape ``(rows,)`` (optional, zero if absent);
+    - ``Wdot(t, q, u)`` returns ``d(W^T)/dt u + dw/dt``, shape ``(rows,)`` (optional). Without it
+      the engine differentiates ``W(q, t)^T u + w(q, t)`` along the motion by central differences
+      (q moved by ``q' = H(q) u``, t with it, u held; step ``eps^(1/3) / max(1, |u|_inf)``), which
+      costs four extra calls per evaluation and is accurate to about 1e-9.
+
+    ``lambda`` (one per row) are the multipliers: the generalized constraint force is ``W lambda``
+    (in N or N m per unit of the row's coefficients: a row of direction cosines times velocities,
+    as for a knife edge, gives a force in N). Each call is checked: a wrong shape, NaN or inf
+    raises :class:`mechsys.CallbackError` naming the constraint. Slow (Python in the step loop)."""
+
+    name: str
+    rows: int
+    W: Callable
+    w: Callable | None = None
+    Wdot: Callable | None = None
+
+    def describe(self, callbacks: list) -> dict:
+        where = f"constraint '{self.name}'"
+        if isinstance(self.rows, bool) or not isinstance(self.rows, numbers.Integral):
+            raise ModelError(f"{where}.rows: expected an integer, got {self.rows!r}")
+        if self.rows < 1:
+            raise ModelError(f"{where}.rows: must be >= 1, got {self.rows}")
+        d: dict = {"type": "velocity", "name": self.name, "rows": int(self.rows)}
+        for key, f, signature, required in (
+            ("W", self.W, "W(t, q)", True),
+            ("w", self.w, "w(t, q)", False),
+            ("Wdot", self.Wdot, "Wdot(t, q, u)", False),
+        ):
+            if f is None and not required:
+                continue
+            if not callable(f):
+                raise ModelError(f"{where}.{key}: expected a callable {signature}, got {type(f).__name__}")
+            callbacks.append(f)
+            d[key] = len(callbacks) - 1
+        return d
+
+
+@dataclass
 class KnifeEdge:
     """Knife edge, sledge or skate: the velocity of ``point`` on ``body`` along the body-fixed
     ``direction`` is zero (1 non-holonomic equation); ``lambda`` is the lateral force on the blade
@@ -301,10 +445,16 @@ __all__ = [
     "Distance",
     "Coupler",
     "Prescribed",
+    "PrescribedBody",
     "PointOnLine",
     "PointOnPlane",
     "LoopSpherical",
     "LoopRevolute",
     "LoopFixed",
+    "LoopPrismatic",
+    "LoopCylindrical",
+    "LoopUniversal",
+    "LoopPlanar",
+    "Velocity",
     "KnifeEdge",
     "RollingDisc", "Baumgarte", "stabilization"]

@@ -130,6 +130,14 @@ def _load_toml(path: Path) -> tuple[Model, Any]:
     for key in _LIST_KEYS:
         if key in data and not isinstance(data[key], list):
             raise ModelError(f"{key}: expected an array of tables ([[{key}]]), got {_tname(data[key])}")
+    constraints = data.get("constraints", [])
+    for i, c in enumerate(constraints if isinstance(constraints, list) else []):
+        if isinstance(c, dict) and c.get("type") == "velocity":
+            # its W, w, Wdot are Python callables, which a TOML file cannot hold
+            raise ModelError(
+                f"constraints[{i}] '{c.get('name', '?')}': a velocity constraint needs Python callables (W, w, Wdot); "
+                "define it with mechsys.constraints.Velocity in a .py model file"
+            )
     return Model.from_dict(data), sim
 
 

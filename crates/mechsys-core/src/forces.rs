@@ -9,12 +9,52 @@ use crate::math::Vec3;
 use crate::model::{ForceElement, ForceFrame, Model, TimeFunction};
 use crate::spatial::Force;
 
+/// Which array of a user velocity constraint `W(q, t)ᵀ u + w(q, t) = 0` (eq. 2.70) a callback
+/// returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VelocityArray {
+    /// `Wᵀ` (rows × nu, row-major), from `f(t, q)`.
+    W,
+    /// `w` (rows), from `f(t, q)`.
+    Offset,
+    /// `d(Wᵀ)/dt u + ẇ` (rows), from `f(t, q, u)`.
+    Rate,
+}
+
+impl VelocityArray {
+    /// The name the user gave the array (`W`, `w`, `Wdot`), for error messages.
+    pub fn label(self) -> &'static str {
+        match self {
+            VelocityArray::W => "W",
+            VelocityArray::Offset => "w",
+            VelocityArray::Rate => "Wdot",
+        }
+    }
+}
+
 /// User callbacks (Python callables through the bindings). Calling them is slow.
 pub trait Callbacks {
     /// Value of time function `id` at `t`.
     fn time_function(&self, id: usize, t: f64) -> Result<f64>;
     /// Generalized forces of callback element `id`, added to `out` (length nu).
     fn generalized_force(&self, id: usize, t: f64, q: &[f64], u: &[f64], out: &mut [f64]) -> Result<()>;
+    /// Array `which` of the user velocity constraint callback `id` with `rows` rows at (t, q), and
+    /// u for [`VelocityArray::Rate`] (empty otherwise), written to `out` (rows × nu or rows). An
+    /// implementation checks the shape and that every value is finite.
+    #[allow(clippy::too_many_arguments)]
+    fn velocity_constraint(
+        &self,
+        id: usize,
+        which: VelocityArray,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        rows: usize,
+        out: &mut [f64],
+    ) -> Result<()> {
+        let _ = (t, q, u, rows, out);
+        Err(Error::Callback(format!("{} callback {id} was not provided", which.label())))
+    }
 }
 
 /// No callbacks: any model referring to one fails when built into a simulation.
@@ -42,7 +82,9 @@ impl TimeFunction {
                     _ => v,
                 }
             }
-            TimeFunction::Harmonic { amplitude, omega, phase, offset } => offset + amplitude * (omega * t + phase).sin(),
+            TimeFunction::Harmonic { amplitude, omega, phase, offset } => {
+                offset + amplitude * (omega * t + phase).sin()
+            }
             TimeFunction::Table { t: ts, values } => interp(ts, values, t),
             TimeFunction::Callback(id) => cb.time_function(*id, t)?,
         })

@@ -13,18 +13,18 @@
 // together with the out-of-range values; both lints would make those places less clear.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod error;
-pub mod math;
-pub mod spatial;
-pub mod model;
-pub mod data;
-pub mod kinematics;
 pub mod constraints;
+pub mod data;
 pub mod dynamics;
+pub mod error;
+pub mod fixtures;
 pub mod forces;
 pub mod integrator;
-pub mod solver;
+pub mod kinematics;
+pub mod math;
+pub mod model;
 pub mod simulate;
-pub mod fixtures;
+pub mod solver;
+pub mod spatial;
 
 pub use error::{Error, Result};

@@ -134,10 +134,8 @@ impl Default for Pose {
 
 impl Pose {
     /// The identity placement.
-    pub const IDENTITY: Pose = Pose {
-        a: Mat3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
-        r: Vec3::new(0.0, 0.0, 0.0),
-    };
+    pub const IDENTITY: Pose =
+        Pose { a: Mat3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0), r: Vec3::new(0.0, 0.0, 0.0) };
     /// Builds from parts.
     #[inline]
     pub fn new(a: Mat3, r: Vec3) -> Self {

@@ -58,9 +58,8 @@ fn aba<'py>(
     match out {
         // write into the caller's array: no allocation per call
         Some(o) if !o.is_none() => {
-            let arr = o
-                .downcast_into::<PyArray1<f64>>()
-                .map_err(|_| settings("out: must be a 1-D float64 numpy array"))?;
+            let arr =
+                o.downcast_into::<PyArray1<f64>>().map_err(|_| settings("out: must be a 1-D float64 numpy array"))?;
             {
                 // SAFETY: the GIL is held and no other Rust reference to the array exists.
                 let s = unsafe { arr.as_slice_mut() }.map_err(|_| settings("out: must be contiguous and writeable"))?;
@@ -94,7 +93,8 @@ fn rnea<'py>(
     let cb = self::callbacks(model, callbacks)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
     let mut tau = vec![0.0; m.nu];
-    dynamics::inverse_dynamics(m, &mut data, t, q, u, ud, &cb as &dyn Callbacks, &mut tau).map_err(PyMechsysError::from)?;
+    dynamics::inverse_dynamics(m, &mut data, t, q, u, ud, &cb as &dyn Callbacks, &mut tau)
+        .map_err(PyMechsysError::from)?;
     Ok(PyArray1::from_vec(py, tau))
 }
 
@@ -210,9 +210,11 @@ fn joint_reactions<'py>(
     let mut force = Vec::with_capacity(n * nj * 3);
     let mut torque = Vec::with_capacity(n * nj * 3);
     for k in 0..n {
-        let (qk, uk, ak) = (&q[k * m.nq..(k + 1) * m.nq], &u[k * m.nu..(k + 1) * m.nu], &udot[k * m.nu..(k + 1) * m.nu]);
+        let (qk, uk, ak) =
+            (&q[k * m.nq..(k + 1) * m.nq], &u[k * m.nu..(k + 1) * m.nu], &udot[k * m.nu..(k + 1) * m.nu]);
         m.check_q(qk, "q").map_err(PyMechsysError::from)?;
-        dynamics::joint_reactions(m, &mut data, t[k], qk, uk, ak, &cb, &mut fo, &mut to).map_err(PyMechsysError::from)?;
+        dynamics::joint_reactions(m, &mut data, t[k], qk, uk, ak, &cb, &mut fo, &mut to)
+            .map_err(PyMechsysError::from)?;
         for j in 0..nj {
             force.extend_from_slice(fo[j].as_slice());
             torque.extend_from_slice(to[j].as_slice());
@@ -276,7 +278,7 @@ fn constraint_gamma<'py>(
     data.a[0] = mechsys_core::spatial::Motion::ZERO;
     let zero = vec![0.0; m.nu];
     kinematics::accelerations(m, &mut data, &zero);
-    mechsys_core::constraints::accelerations(m, &mut data, t, &cb).map_err(PyMechsysError::from)?;
+    mechsys_core::constraints::accelerations(m, &mut data, t, q, u, &cb).map_err(PyMechsysError::from)?;
     Ok(PyArray1::from_slice(py, &data.gamma))
 }
 

@@ -17,10 +17,7 @@ impl From<Error> for PyMechsysError {
 
 fn raise(class: &str, msg: String) -> PyErr {
     Python::with_gil(|py| {
-        let made = py
-            .import("mechsys.errors")
-            .and_then(|m| m.getattr(class))
-            .and_then(|c| c.call1((msg.clone(),)));
+        let made = py.import("mechsys.errors").and_then(|m| m.getattr(class)).and_then(|c| c.call1((msg.clone(),)));
         match made {
             Ok(exc) => PyErr::from_value(exc),
             Err(_) => PyRuntimeError::new_err(msg),

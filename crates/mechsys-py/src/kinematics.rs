@@ -73,7 +73,8 @@ fn point_jacobian<'py>(
     let mut jt = DMatrix::zeros(3, m.nu);
     let mut jr = DMatrix::zeros(3, m.nu);
     kinematics::point_jacobian(m, &data, b, &Vec3::from(point), &mut jt, &mut jr);
-    let to_rows = |j: &DMatrix<f64>| -> Vec<Vec<f64>> { (0..3).map(|r| (0..m.nu).map(|c| j[(r, c)]).collect()).collect() };
+    let to_rows =
+        |j: &DMatrix<f64>| -> Vec<Vec<f64>> { (0..3).map(|r| (0..m.nu).map(|c| j[(r, c)]).collect()).collect() };
     let a = PyArray2::from_vec2(py, &to_rows(&jt)).map_err(|e| settings(e.to_string()))?;
     let b = PyArray2::from_vec2(py, &to_rows(&jr)).map_err(|e| settings(e.to_string()))?;
     Ok((a, b))

@@ -130,6 +130,14 @@ impl PyModel {
                 // rows 0-2 forces and origin offsets, the rest moments and (small) angles
                 K::Loop { joint: LoopJoint::Revolute, .. } => ("loop_revolute", ("N, N m", "m, rad")),
                 K::Loop { joint: LoopJoint::Fixed, .. } => ("loop_fixed", ("N, N m", "m, rad")),
+                K::Loop { joint: LoopJoint::Prismatic, .. } => ("loop_prismatic", ("N, N m", "m, rad")),
+                K::Loop { joint: LoopJoint::Cylindrical, .. } => ("loop_cylindrical", ("N, N m", "m, rad")),
+                K::Loop { joint: LoopJoint::Universal, .. } => ("loop_universal", ("N, N m", "m, rad")),
+                K::Loop { joint: LoopJoint::Planar, .. } => ("loop_planar", ("N, N m", "m, rad")),
+                K::PrescribedBody { orientation: None, .. } => ("prescribed_body", ("N", "m")),
+                K::PrescribedBody { orientation: Some(_), .. } => ("prescribed_body", ("N, N m", "m, rad")),
+                // the unit of λ depends on how the user scaled the rows of W
+                K::Velocity { .. } => ("velocity", ("", "")),
                 // non-holonomic rows have no position violation (recorded as 0)
                 K::KnifeEdge { .. } => ("knife_edge", ("N", "m")),
                 K::RollingDisc { .. } => ("rolling_disc", ("N", "m")),
@@ -222,7 +230,8 @@ pub fn fast_slice<'a>(a: &'a Bound<'_, PyAny>, n: usize, what: &str) -> PyResult
         .downcast::<numpy::PyArray1<f64>>()
         .map_err(|_| settings(format!("{what}: must be a 1-D float64 numpy array")))?;
     // SAFETY: read-only use while holding the GIL; no Rust code mutates the array meanwhile.
-    let s = unsafe { numpy::PyArrayMethods::as_slice(arr) }.map_err(|_| settings(format!("{what}: must be a contiguous float64 array")))?;
+    let s = unsafe { numpy::PyArrayMethods::as_slice(arr) }
+        .map_err(|_| settings(format!("{what}: must be a contiguous float64 array")))?;
     if s.len() != n {
         return Err(settings(format!("{what}: expected length {n}, got {}", s.len())));
     }

@@ -5,16 +5,17 @@ use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use mechsys_core::error::Error;
-use mechsys_core::forces::Callbacks;
+use mechsys_core::forces::{Callbacks, VelocityArray};
 use mechsys_core::simulate::{Progress, Settings};
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{settings, PyMechsysError};
 use crate::model::PyModel;
 
-/// Python callables: time functions `f(t) -> float` and force laws `f(t, q, u) -> array(nu)`.
+/// Python callables: time functions `f(t) -> float`, force laws `f(t, q, u) -> array(nu)` and
+/// the arrays of user velocity constraints (`W(t, q)`, `w(t, q)`, `Wdot(t, q, u)`).
 pub struct PyCallbacks {
     pub funcs: Vec<PyObject>,
     pub nu: usize,
@@ -36,6 +37,14 @@ impl PyCallbacks {
 
     fn get(&self, id: usize) -> Result<&PyObject, Error> {
         self.funcs.get(id).ok_or_else(|| Error::Callback(format!("callback {id} was not provided")))
+    }
+}
+
+/// A shape as Python prints it: `(2, 5)`, `(6,)`, `()`.
+fn shape_str(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!("({})", shape.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ")),
     }
 }
 
@@ -66,12 +75,85 @@ impl Callbacks for PyCallbacks {
             let r = f.call1(py, (t, qa, ua)).map_err(py_err)?;
             let v: Vec<f64> = r.extract(py).map_err(py_err)?;
             if v.len() != self.nu {
-                return Err(Error::Callback(format!("force callback returned {} values, expected nu = {}", v.len(), self.nu)));
+                return Err(Error::Callback(format!(
+                    "force callback returned {} values, expected nu = {}",
+                    v.len(),
+                    self.nu
+                )));
             }
             if let Some(i) = v.iter().position(|x| !x.is_finite()) {
                 return Err(Error::Callback(format!("force callback returned {} at index {i}, t = {t}", v[i])));
             }
             out.iter_mut().zip(&v).for_each(|(o, x)| *o += x);
+            Ok(())
+        })
+    }
+    fn velocity_constraint(
+        &self,
+        id: usize,
+        which: VelocityArray,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        rows: usize,
+        out: &mut [f64],
+    ) -> Result<(), Error> {
+        let f = self.get(id)?;
+        let label = which.label();
+        let nu = self.nu;
+        // W is (rows, nu), or (nu,) for one row; w and Wdot (rows,), or a number for one row
+        let is_w = which == VelocityArray::W;
+        let expected = match (is_w, rows) {
+            (true, 1) => format!("(1, {nu}) or ({nu},)"),
+            (true, _) => shape_str(&[rows, nu]),
+            (false, 1) => "(1,) or a number".to_string(),
+            (false, _) => shape_str(&[rows]),
+        };
+        let accepts = |s: &[usize]| {
+            if is_w {
+                s == [rows, nu] || (rows == 1 && s == [nu])
+            } else {
+                s == [rows] || (rows == 1 && s.is_empty())
+            }
+        };
+        Python::with_gil(|py| {
+            let qa = PyArray1::from_slice(py, q);
+            let called = match which {
+                VelocityArray::Rate => f.call1(py, (t, qa, PyArray1::from_slice(py, u))),
+                _ => f.call1(py, (t, qa)),
+            };
+            let r = called.map_err(|e| Error::Callback(format!("{label} raised {}", py_err(e))))?;
+            let r = r.bind(py);
+            if r.is_none() {
+                return Err(Error::Callback(format!("{label} returned None, expected an array of shape {expected}")));
+            }
+            let not_numbers = || {
+                let tn = r.get_type().name().map(|n| n.to_string()).unwrap_or_default();
+                Error::Callback(format!(
+                    "{label} returned a {tn} that is not an array of numbers, expected shape {expected}"
+                ))
+            };
+            let arr = py
+                .import("numpy")
+                .and_then(|np| np.call_method1("asarray", (r, "float64")))
+                .map_err(|_| not_numbers())?;
+            let arr = arr.downcast_into::<PyArrayDyn<f64>>().map_err(|_| not_numbers())?;
+            let shape = arr.shape().to_vec();
+            if !accepts(&shape) {
+                return Err(Error::Callback(format!(
+                    "{label} returned shape {}, expected {expected}",
+                    shape_str(&shape)
+                )));
+            }
+            let ro = arr.readonly();
+            for (k, (o, v)) in out.iter_mut().zip(ro.as_array().iter()).enumerate() {
+                if !v.is_finite() {
+                    let at =
+                        if which == VelocityArray::W { format!("[{}, {}]", k / nu, k % nu) } else { format!("[{k}]") };
+                    return Err(Error::Callback(format!("{label} returned {v} at {at}, t = {t}")));
+                }
+                *o = *v;
+            }
             Ok(())
         })
     }
@@ -150,6 +232,8 @@ fn simulate<'py>(
     put("momentum_angular", rec.momentum_angular, &[n, 3])?;
     put("constraint_lambda", rec.constraint_lambda, &[n, m.nc])?;
     put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
+    put("constraint_velocity_violation", rec.constraint_velocity_violation, &[n, m.nc])?;
+    d.set_item("warnings", rec.warnings)?;
     let st = PyDict::new(py);
     st.set_item("steps", rec.stats.steps)?;
     st.set_item("rejected", rec.stats.rejected)?;

@@ -9,10 +9,16 @@
 //!
 //! Kinds: coincidence of two body points (a spherical loop closure, 3 rows), a fixed distance
 //! between two body points (1 row), a coupler `q_a = r q_b + c` between joint coordinates (1 row),
-//! a prescribed joint coordinate `q = f(t)` (1 row, rheonomic), a point on a line (2 rows) or on a
-//! plane (1 row) of another body, loop-closing spherical / revolute / fixed joints between frames
-//! on two bodies (3 / 5 / 6 rows), and the non-holonomic knife edge (1 velocity row) and rolling
-//! disc (1 holonomic + 2 velocity rows).
+//! a prescribed joint coordinate `q = f(t)` (1 row, rheonomic), a prescribed body motion (a frame's
+//! origin and optionally its Cardan angles as functions of time, 3 or 6 rows, rheonomic), a point
+//! on a line (2 rows) or on a plane (1 row) of another body, loop-closing spherical / revolute /
+//! fixed / prismatic / cylindrical / universal / planar joints between frames on two bodies
+//! (3 / 5 / 6 / 5 / 4 / 4 / 3 rows, see [`LoopJoint`]), and the non-holonomic knife edge (1 velocity
+//! row), rolling disc (1 holonomic + 2 velocity rows) and user rows `W(q, t)ᵀ u + w(q, t) = 0`
+//! from callbacks (any number of velocity rows).
+//!
+//! Rheonomic rows carry their time dependence in `b` (`Φ̇ = G u - b`) and `γ`; a user velocity
+//! constraint needs the state itself in the acceleration stage ([`accelerations`]).
 //!
 //! Non-holonomic rows (eq. 2.70 given directly at velocity level, not reducible to eq. 2.3) have
 //! velocity and acceleration rows but no position row: their `Φ` is 0 and the position projection
@@ -28,7 +34,7 @@ use nalgebra::DMatrix;
 
 use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::forces::Callbacks;
+use crate::forces::{Callbacks, VelocityArray};
 use crate::kinematics::{point_acceleration, point_position, point_velocity};
 use crate::math::{Mat3, Vec3};
 use crate::model::{Model, TimeFunction};
@@ -48,7 +54,8 @@ pub enum ConstraintKind {
         /// Point on body2, body frame.
         p2: Vec3,
     },
-    /// |r_P1 - r_P2| = length (1 row; λ is the tension pulling the points together).
+    /// |r_P1 - r_P2| = length (1 row; λ is the force on body1 along the unit vector from P2 to
+    /// P1, so a rod in tension has λ < 0).
     Distance {
         /// First body.
         body1: usize,
@@ -126,6 +133,37 @@ pub enum ConstraintKind {
         /// Frame on body2.
         f2: Pose,
     },
+    /// Prescribed motion of the frame `frame` on `body` (rheonomic driving constraint): its
+    /// origin follows `position(t)` (world components, 3 rows) and, if given, its orientation
+    /// follows the Cardan angles x-y-z `orientation(t)`, `A_p = Rx(α) Ry(β) Rz(γ)` (eq. 2.19), by
+    /// `Φ = ½ vee(Q - Qᵀ)` with `Q = A_f A_pᵀ` (3 more rows, sin θ · axis in world axes). λ is the
+    /// driving force on the body at the frame origin (N, world axes), then the driving moment
+    /// (N m, world axes where the orientation is on its prescribed course, `E(I) = I`).
+    PrescribedBody {
+        /// The driven body.
+        body: usize,
+        /// The driven frame on the body.
+        frame: Pose,
+        /// World x, y, z of the frame origin.
+        position: [TimeFunction; 3],
+        /// Cardan angles x-y-z of the frame (None: only the origin is driven).
+        orientation: Option<[TimeFunction; 3]>,
+    },
+    /// A user-given non-holonomic constraint `W(q, t)ᵀ u + w(q, t) = 0` (eq. 2.70), `rows`
+    /// velocity rows with `G = Wᵀ` and `b = -w` from callbacks (no position rows). `γ` comes from
+    /// the `rate` callback `d(Wᵀ)/dt u + ẇ`, or else by central differences of `Wᵀ u + w` along
+    /// the motion (step `ε^(1/3) / max(1, |u|∞)`; needs [`accelerations`]). λ: the generalized
+    /// constraint force is `W λ`.
+    Velocity {
+        /// Number of rows, ≥ 1.
+        rows: usize,
+        /// Callback id of `Wᵀ(t, q)` (rows × nu).
+        w_matrix: usize,
+        /// Callback id of `w(t, q)` (rows); None: `w = 0`.
+        w_offset: Option<usize>,
+        /// Callback id of `d(Wᵀ)/dt u + ẇ` at (t, q, u) (rows); None: central differences.
+        w_rate: Option<usize>,
+    },
     /// Knife edge / sledge: the velocity of point `p` of `body` along the body-fixed unit
     /// direction `e` is zero (1 non-holonomic row; λ is the lateral force on the blade).
     KnifeEdge {
@@ -152,15 +190,32 @@ pub enum ConstraintKind {
     },
 }
 
-/// Which loop-closing joint a [`ConstraintKind::Loop`] is.
+/// Which loop-closing joint a [`ConstraintKind::Loop`] is. The joint axis is the z-axis of the
+/// two frames. Rows come in the order: translation rows (λ a force on body1, N), then rotation
+/// rows (λ a moment, N m).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoopJoint {
-    /// Frame origins coincide (3 rows).
+    /// Frame origins coincide (3 rows: force along world x, y, z).
     Spherical,
-    /// Frame origins coincide and the z-axes stay parallel (5 rows).
+    /// Frame origins coincide and the z-axes stay parallel (5 rows: 3 world forces, then the
+    /// moments about `z₁ × x₂` and `z₁ × y₂`).
     Revolute,
-    /// Frame origins and orientations coincide (6 rows).
+    /// Frame origins and orientations coincide (6 rows: 3 world forces, then the moment rows of
+    /// `½ vee(R - Rᵀ)`, `R = A₂ᵀA₁`: frame-2 axes when assembled).
     Fixed,
+    /// Frame 1's origin stays on the z-axis of frame 2 and the orientations coincide (5 rows:
+    /// forces along x₂ and y₂, then the 3 moment rows of `Fixed`).
+    Prismatic,
+    /// Frame 1's origin stays on the z-axis of frame 2 and the z-axes stay parallel (4 rows:
+    /// forces along x₂ and y₂, then the moments about `z₁ × x₂` and `z₁ × y₂`).
+    Cylindrical,
+    /// Hooke joint: the origins coincide and the cross's pins, x-axis of frame 1 (fixed in body1)
+    /// and y-axis of frame 2 (fixed in body2), stay perpendicular (4 rows: 3 world forces, then
+    /// the moment about `x₁ × y₂`); the shafts are the z-axes, aligned in the straight position.
+    Universal,
+    /// The z-axes stay parallel and frame 1's origin stays in the x-y plane of frame 2 (3 rows:
+    /// the force along z₂, then the moments about `z₁ × x₂` and `z₁ × y₂`).
+    Planar,
 }
 
 /// Which generalized velocities a constraint's rows may involve (the structure that the sparse
@@ -192,9 +247,14 @@ impl ConstraintKind {
         match self {
             ConstraintKind::Point { .. } | ConstraintKind::RollingDisc { .. } => 3,
             ConstraintKind::PointOnLine { .. } => 2,
-            ConstraintKind::Loop { joint: LoopJoint::Spherical, .. } => 3,
-            ConstraintKind::Loop { joint: LoopJoint::Revolute, .. } => 5,
-            ConstraintKind::Loop { joint: LoopJoint::Fixed, .. } => 6,
+            ConstraintKind::PrescribedBody { orientation, .. } => 3 + 3 * usize::from(orientation.is_some()),
+            ConstraintKind::Velocity { rows, .. } => *rows,
+            ConstraintKind::Loop { joint, .. } => match joint {
+                LoopJoint::Spherical | LoopJoint::Planar => 3,
+                LoopJoint::Cylindrical | LoopJoint::Universal => 4,
+                LoopJoint::Revolute | LoopJoint::Prismatic => 5,
+                LoopJoint::Fixed => 6,
+            },
             _ => 1,
         }
     }
@@ -206,16 +266,19 @@ impl ConstraintKind {
             | ConstraintKind::PointOnLine { body1, body2, .. }
             | ConstraintKind::PointOnPlane { body1, body2, .. }
             | ConstraintKind::Loop { body1, body2, .. } => Reach::Bodies(*body1, *body2),
-            ConstraintKind::KnifeEdge { body, .. } | ConstraintKind::RollingDisc { body, .. } => Reach::Bodies(*body, 0),
+            ConstraintKind::KnifeEdge { body, .. }
+            | ConstraintKind::RollingDisc { body, .. }
+            | ConstraintKind::PrescribedBody { body, .. } => Reach::Bodies(*body, 0),
             ConstraintKind::Coupler { iu_a, iu_b, .. } => Reach::Velocities(*iu_a, *iu_b),
             ConstraintKind::Prescribed { iu, .. } => Reach::Velocities(*iu, *iu),
+            ConstraintKind::Velocity { .. } => Reach::All,
         }
     }
     /// Number of holonomic rows (they come first; the rest are non-holonomic velocity rows with
     /// `Φ = 0` that the position projection leaves out).
     pub fn holonomic_rows(&self) -> usize {
         match self {
-            ConstraintKind::KnifeEdge { .. } => 0,
+            ConstraintKind::KnifeEdge { .. } | ConstraintKind::Velocity { .. } => 0,
             ConstraintKind::RollingDisc { .. } => 1,
             k => k.rows(),
         }
@@ -349,6 +412,47 @@ fn loop_frames(data: &Data, body1: usize, f1: &Pose, body2: usize, f2: &Pose) ->
     (data.x_abs[body1].compose(f1), data.x_abs[body2].compose(f2))
 }
 
+/// World direction of axis `k` of a placed frame.
+#[inline]
+fn frame_axis(x: &Pose, k: usize) -> Vec3 {
+    x.a.column(k).into_owned()
+}
+
+/// Velocity of the material point of `body` at the world point `p`.
+#[inline]
+fn velocity_at(data: &Data, body: usize, p: &Vec3) -> Vec3 {
+    let v = &data.v[body];
+    v.v + v.w.cross(p)
+}
+
+/// A row `Φ = a·b` with `a` fixed in body1 and `b` fixed in body2:
+/// `Φ̇ = (ω₁ × a)·b + a·(ω₂ × b) = (ω₁ - ω₂)·(a × b)`, a moment about `a × b`.
+#[inline]
+fn push_perpendicular(r: &mut BodyRows, a: &Vec3, b: &Vec3) {
+    let m = moment(&a.cross(b));
+    r.push(a.dot(b), m, m);
+}
+
+/// Velocity-product part of `d²(a·b)/dt²` for `a` fixed in `body1`, `b` fixed in `body2`:
+/// `ä·b + 2 ȧ·ḃ + a·b̈`.
+#[inline]
+fn perpendicular_rate(data: &Data, body1: usize, a: &Vec3, body2: usize, b: &Vec3) -> f64 {
+    let (ad, add) = fixed_vector_rates(data, body1, a);
+    let (bd, bdd) = fixed_vector_rates(data, body2, b);
+    add.dot(b) + 2.0 * ad.dot(&bd) + a.dot(&bdd)
+}
+
+impl LoopJoint {
+    /// The frame-2 axes along which the origin offset is held (None: all three world axes).
+    fn offset_axes(self) -> Option<&'static [usize]> {
+        match self {
+            LoopJoint::Prismatic | LoopJoint::Cylindrical => Some(&[0, 1]),
+            LoopJoint::Planar => Some(&[2]),
+            _ => None,
+        }
+    }
+}
+
 /// Geometry of a rolling disc: world axis `a`, unit in-plane vector `k̂` towards the ground side
 /// reversed (the contact point is `C - R k̂`), `|k|` and the contact point.
 fn disc_contact(
@@ -402,21 +506,31 @@ fn body_rows(c: &Constraint, data: &Data, t: f64) -> Result<Option<BodyRows>> {
             let mut r = BodyRows::new(*body1, *body2);
             let (x1, x2) = loop_frames(data, *body1, f1, *body2, f2);
             let d = x1.r - x2.r;
-            for e in [ex, ey, ez] {
-                r.push(e.dot(&d), force_at(&x1.r, &e), force_at(&x2.r, &e));
+            match joint.offset_axes() {
+                None => {
+                    for e in [ex, ey, ez] {
+                        r.push(e.dot(&d), force_at(&x1.r, &e), force_at(&x2.r, &e));
+                    }
+                }
+                Some(axes) => {
+                    // n fixed in body2: as for PointOnLine, body2's Jacobian at r₁ carries ṅ·d
+                    for &k in axes {
+                        let n = frame_axis(&x2, k);
+                        let f = force_at(&x1.r, &n);
+                        r.push(n.dot(&d), f, f);
+                    }
+                }
             }
             match joint {
                 LoopJoint::Spherical => {}
-                LoopJoint::Revolute => {
-                    // Φ = z₁·x₂, z₁·y₂;  Φ̇ = (ω₁ - ω₂)·(z₁ × x₂), …
-                    let z1 = x1.a.column(2).into_owned();
-                    for k in 0..2 {
-                        let e2 = x2.a.column(k).into_owned();
-                        let m = moment(&z1.cross(&e2));
-                        r.push(z1.dot(&e2), m, m);
-                    }
+                LoopJoint::Revolute | LoopJoint::Cylindrical | LoopJoint::Planar => {
+                    // Φ = z₁·x₂, z₁·y₂
+                    let z1 = frame_axis(&x1, 2);
+                    push_perpendicular(&mut r, &z1, &frame_axis(&x2, 0));
+                    push_perpendicular(&mut r, &z1, &frame_axis(&x2, 1));
                 }
-                LoopJoint::Fixed => {
+                LoopJoint::Universal => push_perpendicular(&mut r, &frame_axis(&x1, 0), &frame_axis(&x2, 1)),
+                LoopJoint::Fixed | LoopJoint::Prismatic => {
                     // R = A₂ᵀA₁ (frame 1 in frame 2), Φ = ½ vee(R - Rᵀ) = sin θ · axis (frame 2),
                     // Φ̇ = E(R) A₂ᵀ (ω₁ - ω₂) exactly: row k is the moment column k of A₂ E(R)ᵀ
                     let rel = x2.a.transpose() * x1.a;
@@ -476,31 +590,49 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, out: &mut [f64; MAX_ROWS]
         }
         ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
             let (x1, x2) = loop_frames(data, *body1, f1, *body2, f2);
-            let acc = acceleration_at(data, *body1, &x1.r) - acceleration_at(data, *body2, &x2.r);
-            out[..3].copy_from_slice(acc.as_slice());
+            let (b1, b2) = (*body1, *body2);
+            let ddd = acceleration_at(data, b1, &x1.r) - acceleration_at(data, b2, &x2.r);
+            let mut k = match joint.offset_axes() {
+                None => {
+                    out[..3].copy_from_slice(ddd.as_slice());
+                    3
+                }
+                Some(axes) => {
+                    // Φ = n·d with n fixed in body2: Φ̈ = n̈·d + 2 ṅ·ḋ + n·d̈
+                    let d = x1.r - x2.r;
+                    let dd = velocity_at(data, b1, &x1.r) - velocity_at(data, b2, &x2.r);
+                    for (i, &ax) in axes.iter().enumerate() {
+                        let n = frame_axis(&x2, ax);
+                        let (nd, ndd) = fixed_vector_rates(data, b2, &n);
+                        out[i] = ndd.dot(&d) + 2.0 * nd.dot(&dd) + n.dot(&ddd);
+                    }
+                    axes.len()
+                }
+            };
             match joint {
                 LoopJoint::Spherical => {}
-                LoopJoint::Revolute => {
-                    let z1 = x1.a.column(2).into_owned();
-                    let (z1d, z1dd) = fixed_vector_rates(data, *body1, &z1);
-                    for k in 0..2 {
-                        let e2 = x2.a.column(k).into_owned();
-                        let (ed, edd) = fixed_vector_rates(data, *body2, &e2);
-                        out[3 + k] = z1dd.dot(&e2) + 2.0 * z1d.dot(&ed) + z1.dot(&edd);
+                LoopJoint::Revolute | LoopJoint::Cylindrical | LoopJoint::Planar => {
+                    let z1 = frame_axis(&x1, 2);
+                    for ax in 0..2 {
+                        out[k] = perpendicular_rate(data, b1, &z1, b2, &frame_axis(&x2, ax));
+                        k += 1;
                     }
                 }
-                LoopJoint::Fixed => {
+                LoopJoint::Universal => {
+                    out[k] = perpendicular_rate(data, b1, &frame_axis(&x1, 0), b2, &frame_axis(&x2, 1));
+                }
+                LoopJoint::Fixed | LoopJoint::Prismatic => {
                     // Φ̇ = E(R) w, w = A₂ᵀ ω_rel; Ṙ = w̃ R, ẇ = A₂ᵀ (ω̇_rel - ω₂ × ω_rel)
                     let rel = x2.a.transpose() * x1.a;
-                    let (w1, w2) = (data.v[*body1].w, data.v[*body2].w);
+                    let (w1, w2) = (data.v[b1].w, data.v[b2].w);
                     let wrel = w1 - w2;
-                    let arel = data.a[*body1].w - data.a[*body2].w;
+                    let arel = data.a[b1].w - data.a[b2].w;
                     let a2t = x2.a.transpose();
                     let w = a2t * wrel;
                     let wd = a2t * (arel - w2.cross(&wrel));
                     let rel_d = w.cross_matrix() * rel;
                     let phidd = vee_rate_matrix(&rel_d) * w + vee_rate_matrix(&rel) * wd;
-                    out[3..6].copy_from_slice(phidd.as_slice());
+                    out[k..k + 3].copy_from_slice(phidd.as_slice());
                 }
             }
         }
@@ -561,10 +693,118 @@ pub fn function_derivatives(f: &TimeFunction, t: f64, cb: &dyn Callbacks) -> Res
     })
 }
 
+/// Prefixes a callback's error with the constraint and key it belongs to.
+fn in_constraint<'a>(c: &'a Constraint, key: &str) -> impl Fn(Error) -> Error + 'a {
+    let key = if key.is_empty() { String::new() } else { format!(".{key}") };
+    move |e| match e {
+        Error::Callback(m) => Error::Callback(format!("constraint '{}'{key}: {m}", c.name)),
+        other => other,
+    }
+}
+
+/// `Wᵀ(t, q) u + w(t, q)` of a user velocity constraint into `out` (rows).
+#[allow(clippy::too_many_arguments)]
+fn velocity_residual(
+    model: &Model,
+    c: &Constraint,
+    (w_matrix, w_offset): (usize, Option<usize>),
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    out: &mut [f64],
+) -> Result<()> {
+    let (rows, nu) = (out.len(), model.nu);
+    let mut w = vec![0.0; rows * nu];
+    cb.velocity_constraint(w_matrix, VelocityArray::W, t, q, &[], rows, &mut w).map_err(in_constraint(c, ""))?;
+    match w_offset {
+        Some(id) => {
+            cb.velocity_constraint(id, VelocityArray::Offset, t, q, &[], rows, out).map_err(in_constraint(c, ""))?
+        }
+        None => out.fill(0.0),
+    }
+    for (k, o) in out.iter_mut().enumerate() {
+        *o += w[k * nu..(k + 1) * nu].iter().zip(u).map(|(a, b)| a * b).sum::<f64>();
+    }
+    Ok(())
+}
+
+/// `γ = -(d(Wᵀ)/dt u + ẇ)` of a user velocity constraint without a rate callback: central
+/// differences of `Wᵀ u + w` along the motion, `q(s) = q ⊕ u s` (Model::integrate), `t + s`, u held,
+/// with the step `h = ε^(1/3) / max(1, |u|∞)` (balances the O(h²) truncation against round-off
+/// for motions of unit time scale) rounded so that `t + h - t = h` exactly.
+#[allow(clippy::too_many_arguments)]
+fn velocity_rate_by_differences(
+    model: &Model,
+    c: &Constraint,
+    ids: (usize, Option<usize>),
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    gamma: &mut [f64],
+) -> Result<()> {
+    let umax = u.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let h0 = f64::EPSILON.cbrt() / umax;
+    let h = (t + h0) - t;
+    let mut qs = vec![0.0; model.nq];
+    let (mut plus, mut minus) = (vec![0.0; gamma.len()], vec![0.0; gamma.len()]);
+    model.integrate(q, u, h, &mut qs);
+    velocity_residual(model, c, ids, t + h, &qs, u, cb, &mut plus)?;
+    model.integrate(q, u, -h, &mut qs);
+    velocity_residual(model, c, ids, t - h, &qs, u, cb, &mut minus)?;
+    for (g, (p, m)) in gamma.iter_mut().zip(plus.iter().zip(&minus)) {
+        *g = -(p - m) / (2.0 * h);
+    }
+    Ok(())
+}
+
+/// Value, rate and second derivative of three time functions (a prescribed world point); a
+/// callback's error names constraint `c` and the function `key[k]`.
+fn prescribed_point(f: &[TimeFunction; 3], t: f64, cb: &dyn Callbacks, c: &Constraint, key: &str) -> Result<[Vec3; 3]> {
+    let mut out = [Vec3::zeros(); 3];
+    for (k, fk) in f.iter().enumerate() {
+        let (v, vd, vdd) = function_derivatives(fk, t, cb).map_err(in_constraint(c, &format!("{key}[{k}]")))?;
+        out[0][k] = v;
+        out[1][k] = vd;
+        out[2][k] = vdd;
+    }
+    Ok(out)
+}
+
+/// Orientation `A_p = Rx(α) Ry(β) Rz(γ)` of prescribed Cardan angles (eq. 2.19), its world angular
+/// velocity `ω_p = α̇ eₓ + β̇ c₂ + γ̇ c₃` (eq. 2.32: `c₂ = Rx(α) e_y`, `c₃ = Rx(α) Ry(β) e_z`) and
+/// angular acceleration `ω̇_p = α̈ eₓ + β̈ c₂ + γ̈ c₃ + β̇ ċ₂ + γ̇ ċ₃`, where `ċ₂ = α̇ eₓ × c₂`
+/// and `ċ₃ = (α̇ eₓ + β̇ c₂) × c₃` (the angular velocities of the intermediate frames).
+fn prescribed_rotation(
+    f: &[TimeFunction; 3],
+    t: f64,
+    cb: &dyn Callbacks,
+    c: &Constraint,
+) -> Result<(Mat3, Vec3, Vec3)> {
+    let [a, ad, add] = prescribed_point(f, t, cb, c, "orientation")?;
+    let a_p = crate::math::rotation::cardan_xyz_to_matrix([a[0], a[1], a[2]]);
+    let h = crate::math::rotation::cardan_h_inertial([a[0], a[1], a[2]]);
+    let (ex, c2, c3) = (Vec3::x(), h.column(1).into_owned(), h.column(2).into_owned());
+    let w1 = ex * ad[0];
+    let c2d = w1.cross(&c2);
+    let c3d = (w1 + c2 * ad[1]).cross(&c3);
+    let w = h * ad;
+    let wd = h * add + c2d * ad[1] + c3d * ad[2];
+    Ok((a_p, w, wd))
+}
+
+/// `Q` from `φ = ½ vee(Q - Qᵀ) = sin θ · n` for θ ≤ π/2 (Rodrigues with `cos θ = √(1 - |φ|²)`):
+/// `Q = cos θ I + φ̃ + φφᵀ / (1 + cos θ)`.
+fn rotation_from_vee(phi: &Vec3) -> Mat3 {
+    let c = (1.0 - phi.norm_squared()).max(0.0).sqrt();
+    Mat3::identity() * c + phi.cross_matrix() + phi * phi.transpose() / (1.0 + c)
+}
+
 /// Position stage of the constraints: `phi` (m) and `G` (m × nu) at the last
 /// [`crate::kinematics::positions`]; `b` (m) receives the velocity right-hand side `G u = b`.
 pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Callbacks) -> Result<()> {
-    data.g.fill(0.0);
+    data.g.as_mut_slice().fill(0.0); // a memset; DMatrix::fill walks element by element
     for c in &model.constraints {
         let r = c.row;
         match &c.kind {
@@ -601,10 +841,57 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 data.g[(r, *iu_b)] -= ratio;
             }
             ConstraintKind::Prescribed { iq, iu, function } => {
-                let (f, fd, _) = function_derivatives(function, t, cb)?;
+                let (f, fd, _) = function_derivatives(function, t, cb).map_err(in_constraint(c, "function"))?;
                 data.phi[r] = q[*iq] - f;
                 data.b[r] = fd;
                 data.g[(r, *iu)] += 1.0;
+            }
+            ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
+                let x = data.x_abs[*body].compose(frame);
+                // Φ = r_f - p(t): Φ̇ = v_f - ṗ, a force at the frame origin along each world axis
+                let [p, pd, _] = prescribed_point(position, t, cb, c, "position")?;
+                for (k, e) in [Vec3::x(), Vec3::y(), Vec3::z()].iter().enumerate() {
+                    data.phi[r + k] = x.r[k] - p[k];
+                    data.b[r + k] = pd[k];
+                    add_wrench_row(model, &data.s, *body, &force_at(&x.r, e), 1.0, &mut data.g, r + k);
+                }
+                if let Some(angles) = orientation {
+                    // Q = A_f A_pᵀ, Q̇ = (ω_f - Q ω_p)~ Q: Φ̇ = E(Q) ω_f - E(Q) Q ω_p; the row k
+                    // of E(Q) is a moment
+                    let (a_p, w_p, _) = prescribed_rotation(angles, t, cb, c)?;
+                    let qm = x.a * a_p.transpose();
+                    let phi = skew_vee(&qm);
+                    let e = vee_rate_matrix(&qm);
+                    let b = e * (qm * w_p);
+                    for k in 0..3 {
+                        data.phi[r + 3 + k] = phi[k];
+                        data.b[r + 3 + k] = b[k];
+                        let m = moment(&e.row(k).transpose());
+                        add_wrench_row(model, &data.s, *body, &m, 1.0, &mut data.g, r + 3 + k);
+                    }
+                }
+            }
+            ConstraintKind::Velocity { rows, w_matrix, w_offset, .. } => {
+                let (rows, nu) = (*rows, model.nu);
+                let mut w = vec![0.0; rows * nu];
+                cb.velocity_constraint(*w_matrix, VelocityArray::W, t, q, &[], rows, &mut w)
+                    .map_err(in_constraint(c, ""))?;
+                for k in 0..rows {
+                    data.phi[r + k] = 0.0;
+                    for i in 0..nu {
+                        data.g[(r + k, i)] += w[k * nu + i];
+                    }
+                }
+                // G u = b with b = -w(q, t)
+                let b = &mut data.b[r..r + rows];
+                match w_offset {
+                    Some(id) => {
+                        cb.velocity_constraint(*id, VelocityArray::Offset, t, q, &[], rows, b)
+                            .map_err(in_constraint(c, ""))?;
+                        b.iter_mut().for_each(|v| *v = -*v);
+                    }
+                    None => b.fill(0.0),
+                }
             }
             _ => {
                 let rows = body_rows(c, data, t)?.expect("a body constraint kind");
@@ -620,12 +907,24 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
     Ok(())
 }
 
-/// Acceleration right-hand side `γ` of `G u̇ = γ` (m). Requires the velocities of the state and
-/// `data.a` holding the velocity-product accelerations (accelerations at u̇ = 0, no gravity).
-pub fn accelerations(model: &Model, data: &mut Data, t: f64, cb: &dyn Callbacks) -> Result<()> {
+/// Acceleration right-hand side `γ` of `G u̇ = γ` (m) at the state (t, q, u) of the last
+/// kinematics (a user velocity constraint evaluates its callbacks there). Requires the velocities
+/// of the state and `data.a` holding the velocity-product accelerations (u̇ = 0, no gravity).
+pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
     for c in &model.constraints {
         let r = c.row;
         match &c.kind {
+            ConstraintKind::Velocity { rows, w_matrix, w_offset, w_rate } => {
+                let gamma = &mut data.gamma[r..r + rows];
+                match w_rate {
+                    Some(id) => {
+                        cb.velocity_constraint(*id, VelocityArray::Rate, t, q, u, *rows, gamma)
+                            .map_err(in_constraint(c, ""))?;
+                        gamma.iter_mut().for_each(|v| *v = -*v);
+                    }
+                    None => velocity_rate_by_differences(model, c, (*w_matrix, *w_offset), t, q, u, cb, gamma)?,
+                }
+            }
             ConstraintKind::Point { body1, p1, body2, p2 } => {
                 let a = point_acceleration(data, *body1, p1) - point_acceleration(data, *body2, p2);
                 for k in 0..3 {
@@ -643,7 +942,30 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, cb: &dyn Callbacks)
             }
             ConstraintKind::Coupler { .. } => data.gamma[r] = 0.0,
             ConstraintKind::Prescribed { function, .. } => {
-                data.gamma[r] = function_derivatives(function, t, cb)?.2;
+                data.gamma[r] = function_derivatives(function, t, cb).map_err(in_constraint(c, "function"))?.2;
+            }
+            ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
+                let x = data.x_abs[*body].compose(frame);
+                // Φ̈ = a_f - p̈
+                let [_, _, pdd] = prescribed_point(position, t, cb, c, "position")?;
+                let acc = acceleration_at(data, *body, &x.r);
+                for k in 0..3 {
+                    data.gamma[r + k] = pdd[k] - acc[k];
+                }
+                if let Some(angles) = orientation {
+                    // Φ̇ = E(Q) w, w = ω_f - Q ω_p, Q̇ = w̃ Q: Φ̈ = E(Q̇) w + E(Q) ẇ with
+                    // ẇ = ω̇_f - w × (Q ω_p) - Q ω̇_p
+                    let (a_p, w_p, wd_p) = prescribed_rotation(angles, t, cb, c)?;
+                    let qm = x.a * a_p.transpose();
+                    let qw = qm * w_p;
+                    let w = data.v[*body].w - qw;
+                    let qm_d = w.cross_matrix() * qm;
+                    let wd = data.a[*body].w - w.cross(&qw) - qm * wd_p;
+                    let phidd = vee_rate_matrix(&qm_d) * w + vee_rate_matrix(&qm) * wd;
+                    for k in 0..3 {
+                        data.gamma[r + 3 + k] = -phidd[k];
+                    }
+                }
             }
             _ => {
                 let mut rate = [0.0; MAX_ROWS];
@@ -684,6 +1006,28 @@ fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
                 data.tau_applied[*iu_b] -= ratio * data.lambda[r];
             }
             ConstraintKind::Prescribed { iu, .. } => data.tau_applied[*iu] += data.lambda[r],
+            ConstraintKind::Velocity { rows, .. } => {
+                // W λ, with W from the last position stage
+                for k in r..r + rows {
+                    for i in 0..model.nu {
+                        data.tau_applied[i] += data.g[(k, i)] * data.lambda[k];
+                    }
+                }
+            }
+            ConstraintKind::PrescribedBody { body, frame, orientation, .. } => {
+                let x = data.x_abs[*body].compose(frame);
+                let f = Vec3::new(data.lambda[r], data.lambda[r + 1], data.lambda[r + 2]);
+                let mut w = Force::new(x.r.cross(&f), f);
+                if orientation.is_some() {
+                    // the moment rows are those of E(Q); t is not at hand here, but Q follows
+                    // from the violation of the last position stage (exact while θ ≤ π/2)
+                    let phi = Vec3::new(data.phi[r + 3], data.phi[r + 4], data.phi[r + 5]);
+                    let e = vee_rate_matrix(&rotation_from_vee(&phi));
+                    let l = Vec3::new(data.lambda[r + 3], data.lambda[r + 4], data.lambda[r + 5]);
+                    w.n += e.transpose() * l;
+                }
+                data.f_ext[*body] += w;
+            }
             _ => {
                 let rows = body_rows(c, data, f64::NAN)?.expect("a body constraint kind");
                 for k in 0..rows.n {

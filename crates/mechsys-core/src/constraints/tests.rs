@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::data::Data;
-use crate::forces::NoCallbacks;
+use crate::forces::{Callbacks, NoCallbacks};
 use crate::model::description::*;
 use crate::model::Model;
 
@@ -101,17 +101,17 @@ fn model_with_all_kinds() -> Model {
 }
 
 /// Per row: (finite-difference dΦ/dt along q ⊕ u s, G u - b) at (q, t).
-pub(super) fn velocity_pairs(model: &Model, q: &[f64], u: &[f64], t: f64) -> Vec<(f64, f64)> {
+pub(super) fn velocity_pairs(model: &Model, cb: &dyn Callbacks, q: &[f64], u: &[f64], t: f64) -> Vec<(f64, f64)> {
     let mut data = Data::new(model);
     crate::kinematics::positions(model, &mut data, q);
-    positions(model, &mut data, t, q, &NoCallbacks).unwrap();
+    positions(model, &mut data, t, q, cb).unwrap();
     let (g, b) = (data.g.clone(), data.b.clone());
     let h = 1e-6;
     let mut phi_at = |s: f64| {
         let mut qs = q.to_vec();
         model.integrate(q, u, s, &mut qs);
         crate::kinematics::positions(model, &mut data, &qs);
-        positions(model, &mut data, t + s, &qs, &NoCallbacks).unwrap();
+        positions(model, &mut data, t + s, &qs, cb).unwrap();
         data.phi.clone()
     };
     let (pp, pm) = (phi_at(h), phi_at(-h));
@@ -121,13 +121,20 @@ pub(super) fn velocity_pairs(model: &Model, q: &[f64], u: &[f64], t: f64) -> Vec
 }
 
 /// Per row: (finite-difference d(G u - b)/dt along q' = H*(q) u, u' = u̇, and G u̇ - γ) at (q, u, t).
-pub(super) fn acceleration_pairs(model: &Model, q: &[f64], u: &[f64], udot: &[f64], t: f64) -> Vec<(f64, f64)> {
+pub(super) fn acceleration_pairs(
+    model: &Model,
+    cb: &dyn Callbacks,
+    q: &[f64],
+    u: &[f64],
+    udot: &[f64],
+    t: f64,
+) -> Vec<(f64, f64)> {
     let mut data = Data::new(model);
     crate::kinematics::forward_kinematics(model, &mut data, q, u);
-    positions(model, &mut data, t, q, &NoCallbacks).unwrap();
+    positions(model, &mut data, t, q, cb).unwrap();
     data.a[0] = crate::spatial::Motion::ZERO;
     crate::kinematics::accelerations(model, &mut data, &vec![0.0; model.nu]);
-    accelerations(model, &mut data, t, &NoCallbacks).unwrap();
+    accelerations(model, &mut data, t, q, u, cb).unwrap();
     let (g, gamma) = (data.g.clone(), data.gamma.clone());
     let h = 1e-6;
     let mut residual_at = |s: f64| {
@@ -135,8 +142,10 @@ pub(super) fn acceleration_pairs(model: &Model, q: &[f64], u: &[f64], udot: &[f6
         model.integrate(q, u, s, &mut qs);
         let us: Vec<f64> = u.iter().zip(udot).map(|(a, b)| a + b * s).collect();
         crate::kinematics::positions(model, &mut data, &qs);
-        positions(model, &mut data, t + s, &qs, &NoCallbacks).unwrap();
-        (0..model.nc).map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r]).collect::<Vec<f64>>()
+        positions(model, &mut data, t + s, &qs, cb).unwrap();
+        (0..model.nc)
+            .map(|r| (0..model.nu).map(|i| data.g[(r, i)] * us[i]).sum::<f64>() - data.b[r])
+            .collect::<Vec<f64>>()
     };
     let (rp, rm) = (residual_at(h), residual_at(-h));
     (0..model.nc)
@@ -149,7 +158,7 @@ fn velocity_rows_are_the_time_derivative_of_the_violation() {
     let model = model_with_all_kinds();
     assert_eq!(model.nc, 3 + 1 + 1 + 1);
     let u: Vec<f64> = (0..model.nu).map(|i| 0.3 - 0.07 * i as f64).collect();
-    for (r, (fd, gu)) in velocity_pairs(&model, &model.q0(), &u, 0.4).into_iter().enumerate() {
+    for (r, (fd, gu)) in velocity_pairs(&model, &NoCallbacks, &model.q0(), &u, 0.4).into_iter().enumerate() {
         assert!((fd - gu).abs() < 1e-7, "row {r}: dΦ/dt {fd} vs G u - b {gu}");
     }
 }
@@ -159,7 +168,9 @@ fn acceleration_rows_are_the_second_derivative_of_the_violation() {
     let model = model_with_all_kinds();
     let u: Vec<f64> = (0..model.nu).map(|i| 0.2 + 0.05 * i as f64).collect();
     let udot: Vec<f64> = (0..model.nu).map(|i| -0.4 + 0.1 * i as f64).collect();
-    for (r, (fd, expected)) in acceleration_pairs(&model, &model.q0(), &u, &udot, 0.3).into_iter().enumerate() {
+    for (r, (fd, expected)) in
+        acceleration_pairs(&model, &NoCallbacks, &model.q0(), &u, &udot, 0.3).into_iter().enumerate()
+    {
         assert!((fd - expected).abs() < 1e-6, "row {r}: d(Gu - b)/dt {fd} vs G u̇ - γ {expected}");
     }
 }

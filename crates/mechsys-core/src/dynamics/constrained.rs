@@ -41,7 +41,7 @@ pub fn forward_dynamics(
     let zero = std::mem::take(&mut data.zero_u);
     crate::kinematics::accelerations(model, data, &zero);
     data.zero_u = zero;
-    constraints::accelerations(model, data, t, cb)?;
+    constraints::accelerations(model, data, t, q, u, cb)?;
     // the bias forces from the same velocity-product accelerations: M u̇_free = τ - c
     let mut c = std::mem::take(&mut data.udot);
     super::rnea::rnea_inward(model, data, &mut c);

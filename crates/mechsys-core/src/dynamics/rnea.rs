@@ -62,7 +62,14 @@ pub use inverse_dynamics as rnea;
 
 /// `h(q, u, t)`, all forces of the model in generalized components (`-rnea` at zero acceleration);
 /// stores it in `data.h`.
-pub fn nonlinear_effects(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
+pub fn nonlinear_effects(
+    model: &Model,
+    data: &mut Data,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+) -> Result<()> {
     super::prepare(model, data, t, q, u, cb)?;
     let mut tmp = std::mem::take(&mut data.scratch_u);
     let zero = std::mem::take(&mut data.zero_u);

@@ -21,23 +21,28 @@ fn mixed_tree() -> Model {
         ejection_point: None,
         mass_final: None,
     };
-    let joint = |name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis: Option<[f64; 3]>| JointDescription {
-        name: name.into(),
-        kind: kind.into(),
-        parent: parent.into(),
-        child: child.into(),
-        axis,
-        axis2: None,
-        parent_frame: FrameDescription {
-            position: pos,
-            rotation: Some(RotationDescription::Angles(AnglesDescription { cardan: Some([0.1, -0.2, 0.3]), euler: None, rotvec: None })),
-        },
-        child_frame: FrameDescription { position: [-0.05, 0.02, 0.01], rotation: None },
-        q0: None,
-        u0: None,
-        spring: None,
-        damper: None,
-    };
+    let joint =
+        |name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis: Option<[f64; 3]>| JointDescription {
+            name: name.into(),
+            kind: kind.into(),
+            parent: parent.into(),
+            child: child.into(),
+            axis,
+            axis2: None,
+            parent_frame: FrameDescription {
+                position: pos,
+                rotation: Some(RotationDescription::Angles(AnglesDescription {
+                    cardan: Some([0.1, -0.2, 0.3]),
+                    euler: None,
+                    rotvec: None,
+                })),
+            },
+            child_frame: FrameDescription { position: [-0.05, 0.02, 0.01], rotation: None },
+            q0: None,
+            u0: None,
+            spring: None,
+            damper: None,
+        };
     let names = ["free", "rev", "pri", "uni", "sph", "pla", "cyl", "rev2"];
     let mut bodies = vec![];
     for (k, n) in names.iter().enumerate() {
@@ -157,7 +162,9 @@ fn mass_matrix_is_hessian_of_kinetic_energy() {
             ump[j] += e;
             umm[i] -= e;
             umm[j] -= e;
-            hess[(i, j)] = (t_of(&mut data, &upp) - t_of(&mut data, &upm) - t_of(&mut data, &ump) + t_of(&mut data, &umm)) / (4.0 * e * e);
+            hess[(i, j)] = (t_of(&mut data, &upp) - t_of(&mut data, &upm) - t_of(&mut data, &ump)
+                + t_of(&mut data, &umm))
+                / (4.0 * e * e);
         }
     }
     assert!((&hess - &m).norm() < 1e-10 * m.norm(), "{}", (&hess - &m).norm());

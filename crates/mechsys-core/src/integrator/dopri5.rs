@@ -103,7 +103,12 @@ pub fn integrate<S: OdeSystem>(
         }
         sys.rhs(t + h0, &tmp, &mut k[1])?;
         stats.evaluations += 1;
-        let d2 = k[1].iter().zip(&k[0]).zip(&y).map(|((a, b), yy)| ((a - b) / (atol + rtol * yy.abs())).powi(2)).sum::<f64>();
+        let d2 = k[1]
+            .iter()
+            .zip(&k[0])
+            .zip(&y)
+            .map(|((a, b), yy)| ((a - b) / (atol + rtol * yy.abs())).powi(2))
+            .sum::<f64>();
         let d2 = (d2 / n.max(1) as f64).sqrt() / h0;
         let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
         (100.0 * h0).min(h1).min(hmax)

@@ -37,7 +37,15 @@ fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
 }
 
 /// One step of size h from (t, y) into `y` (in place); Err on Newton failure.
-fn step<S: OdeSystem>(sys: &mut S, w: &mut Work, t: f64, y: &mut [f64], h: f64, tol: f64, stats: &mut Stats) -> Result<bool> {
+fn step<S: OdeSystem>(
+    sys: &mut S,
+    w: &mut Work,
+    t: f64,
+    y: &mut [f64],
+    h: f64,
+    tol: f64,
+    stats: &mut Stats,
+) -> Result<bool> {
     let n = w.n;
     let (a, c) = coefficients();
     // Jacobian ∂f/∂y by forward differences
@@ -113,7 +121,16 @@ fn step<S: OdeSystem>(sys: &mut S, w: &mut Work, t: f64, y: &mut [f64], h: f64, 
     Ok(false)
 }
 
-fn advance<S: OdeSystem>(sys: &mut S, w: &mut Work, t: f64, y: &mut [f64], h: f64, tol: f64, depth: u32, stats: &mut Stats) -> Result<()> {
+fn advance<S: OdeSystem>(
+    sys: &mut S,
+    w: &mut Work,
+    t: f64,
+    y: &mut [f64],
+    h: f64,
+    tol: f64,
+    depth: u32,
+    stats: &mut Stats,
+) -> Result<()> {
     w.backup.copy_from_slice(y);
     if step(sys, w, t, y, h, tol, stats)? {
         stats.steps += 1;

@@ -18,7 +18,8 @@ pub fn integrate<S: OdeSystem>(
     }
     let n = sys.dim();
     let mut y = y0.to_vec();
-    let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut k1, mut k2, mut k3, mut k4, mut tmp) =
+        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut stats = Stats::default();
     // output index at each step number
     let mut next = 0usize;

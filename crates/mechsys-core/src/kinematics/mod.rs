@@ -97,7 +97,8 @@ fn inertia_step(b: &crate::model::Body, data: &mut Data, i: usize, t: f64) {
         // A diag(d) Aᵀ = Σ d_k a_k a_kᵀ over the columns a_k of A, symmetric: 6 entries
         let a = &x.a;
         let (d0, d1, d2) = (i_c[(0, 0)], i_c[(1, 1)], i_c[(2, 2)]);
-        let e = |r: usize, c: usize| d0 * a[(r, 0)] * a[(c, 0)] + d1 * a[(r, 1)] * a[(c, 1)] + d2 * a[(r, 2)] * a[(c, 2)];
+        let e =
+            |r: usize, c: usize| d0 * a[(r, 0)] * a[(c, 0)] + d1 * a[(r, 1)] * a[(c, 1)] + d2 * a[(r, 2)] * a[(c, 2)];
         let (xx, xy, xz, yy, yz, zz) = (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2));
         Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
     } else {
@@ -188,7 +189,14 @@ pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
 /// Jacobians of a body-fixed point (translational `jt`, 3 × nu) and of the body's angular velocity
 /// (`jr`, 3 × nu), both I components, so that `v_P = jt u` and `ω_I = jr u` (eq. 2.69 with j = 0).
 /// Requires [`positions`].
-pub fn point_jacobian(model: &Model, data: &Data, body: usize, p_b: &Vec3, jt: &mut DMatrix<f64>, jr: &mut DMatrix<f64>) {
+pub fn point_jacobian(
+    model: &Model,
+    data: &Data,
+    body: usize,
+    p_b: &Vec3,
+    jt: &mut DMatrix<f64>,
+    jr: &mut DMatrix<f64>,
+) {
     jt.fill(0.0);
     jr.fill(0.0);
     let p = point_position(data, body, p_b);

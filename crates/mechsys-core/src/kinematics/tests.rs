@@ -86,7 +86,8 @@ fn world_inertias_match_rotation_and_steiner() {
         let b = &model.bodies[i];
         let x = &data.x_abs[i];
         let c = x.r + x.a * b.com;
-        let expected = x.a * b.inertia * x.a.transpose() + (Mat3::identity() * c.norm_squared() - c * c.transpose()) * b.mass;
+        let expected =
+            x.a * b.inertia * x.a.transpose() + (Mat3::identity() * c.norm_squared() - c * c.transpose()) * b.mass;
         assert!((data.inertia[i].i_o - expected).norm() < 1e-13, "body {i}");
         assert!((data.inertia[i].h - c * b.mass).norm() < 1e-14);
     }

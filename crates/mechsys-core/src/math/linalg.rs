@@ -59,7 +59,6 @@ pub fn lu_solve(a: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
     }
 }
 
-
 /// Cholesky factorization with diagonal pivoting of the symmetric positive semidefinite row-major
 /// `n × n` matrix `a`, in place (lower factor). Pivots smaller than `tol` times the largest are
 /// treated as zero: their rows are dependent on the others (redundant constraints). Returns the rank;

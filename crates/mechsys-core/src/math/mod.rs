@@ -6,8 +6,8 @@ use nalgebra::{Matrix3, Vector3};
 
 pub mod frames;
 pub mod linalg;
-pub mod trig;
 pub mod rotation;
+pub mod trig;
 
 /// 3-vector of `f64`.
 pub type Vec3 = Vector3<f64>;

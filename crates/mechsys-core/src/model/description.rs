@@ -179,6 +179,106 @@ pub enum ConstraintDescription {
         #[serde(default)]
         frame2: FrameDescription,
     },
+    /// Loop-closing prismatic joint along the z-axis of `frame2`: the origin of `frame1` stays on
+    /// that axis and the orientations coincide (5 rows).
+    LoopPrismatic {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Loop-closing cylindrical joint: the origin of `frame1` stays on the z-axis of `frame2` and
+    /// the z-axes stay parallel (4 rows).
+    LoopCylindrical {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Loop-closing universal (Hooke) joint: the origins coincide and the x-axis of `frame1`
+    /// stays perpendicular to the y-axis of `frame2` (4 rows).
+    LoopUniversal {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Loop-closing planar joint: the z-axes stay parallel and the origin of `frame1` stays in the
+    /// x-y plane of `frame2` (3 rows).
+    LoopPlanar {
+        /// Constraint name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body (`ground` allowed).
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+    },
+    /// Prescribed motion of a frame on a body (a driving constraint): its origin follows three
+    /// time functions (world x, y, z) and, if given, its orientation three time functions of the
+    /// Cardan angles x-y-z (3 or 6 rows).
+    PrescribedBody {
+        /// Constraint name.
+        name: String,
+        /// The driven body.
+        body: String,
+        /// The driven frame on the body (default: the body frame).
+        #[serde(default)]
+        frame: FrameDescription,
+        /// World x, y, z of the frame origin: exactly 3 time functions.
+        position: Vec<TimeFunctionDescription>,
+        /// Cardan angles x-y-z of the frame's orientation: 3 time functions, or absent.
+        #[serde(default)]
+        orientation: Option<Vec<TimeFunctionDescription>>,
+    },
+    /// A user-given non-holonomic constraint `W(q, t)ᵀ u + w(q, t) = 0` (eq. 2.70) from Python
+    /// callables (`rows` velocity rows). The arrays are callback indices (see
+    /// `mechsys.constraints.Velocity`); a TOML model file cannot define the callables.
+    Velocity {
+        /// Constraint name.
+        name: String,
+        /// Number of rows, ≥ 1.
+        rows: usize,
+        /// Callback index of `W(t, q) -> (rows, nu)` (the transposed W of eq. 2.70).
+        #[serde(rename = "W")]
+        w_matrix: usize,
+        /// Callback index of `w(t, q) -> (rows,)`; zero if absent.
+        #[serde(rename = "w", default)]
+        w_offset: Option<usize>,
+        /// Callback index of `Wdot(t, q, u) -> (rows,)` = `d(Wᵀ)/dt u + ẇ`; central differences
+        /// if absent.
+        #[serde(rename = "Wdot", default)]
+        w_rate: Option<usize>,
+    },
     /// Knife edge (sledge, skate): the velocity of `point` of `body` along the body-fixed
     /// `direction` is zero (1 non-holonomic row).
     KnifeEdge {
@@ -235,7 +335,9 @@ impl<'de> Deserialize<'de> for ConstraintDescription {
             // locate a misspelt key inside a nested table (frame1, frame2) by its name
             if let Some(key) = msg.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
                 if let Some(obj) = v.as_object().filter(|o| !o.contains_key(key)) {
-                    if let Some((outer, _)) = obj.iter().find(|(_, x)| x.as_object().is_some_and(|o| o.contains_key(key))) {
+                    if let Some((outer, _)) =
+                        obj.iter().find(|(_, x)| x.as_object().is_some_and(|o| o.contains_key(key)))
+                    {
                         path = outer.clone();
                     }
                 }
@@ -259,6 +361,12 @@ impl ConstraintDescription {
             | ConstraintDescription::LoopSpherical { name, .. }
             | ConstraintDescription::LoopRevolute { name, .. }
             | ConstraintDescription::LoopFixed { name, .. }
+            | ConstraintDescription::LoopPrismatic { name, .. }
+            | ConstraintDescription::LoopCylindrical { name, .. }
+            | ConstraintDescription::LoopUniversal { name, .. }
+            | ConstraintDescription::LoopPlanar { name, .. }
+            | ConstraintDescription::PrescribedBody { name, .. }
+            | ConstraintDescription::Velocity { name, .. }
             | ConstraintDescription::KnifeEdge { name, .. }
             | ConstraintDescription::RollingDisc { name, .. } => name,
         }
@@ -591,7 +699,8 @@ fn clean_message(m: &str) -> String {
     } else if m.contains("untagged enum InertiaDescription") {
         "expected a 3x3 matrix, 3 diagonal values or 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]".to_string()
     } else if m.contains("untagged enum RotationDescription") {
-        "expected a 3x3 rotation matrix, a quaternion [w, x, y, z] or a table with one of cardan, euler, rotvec".to_string()
+        "expected a 3x3 rotation matrix, a quaternion [w, x, y, z] or a table with one of cardan, euler, rotvec"
+            .to_string()
     } else {
         m.to_string()
     }

@@ -9,7 +9,6 @@ use super::description::*;
 use super::*;
 use crate::error::{Error, Result};
 
-
 fn err(msg: String) -> Error {
     Error::Model(msg)
 }
@@ -95,16 +94,16 @@ pub(crate) fn inertia(desc: &InertiaDescription, what: &str) -> Result<Mat3> {
         InertiaDescription::List(v) => match v.len() {
             3 => Mat3::from_diagonal(&Vec3::new(v[0], v[1], v[2])),
             6 => Mat3::new(v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2]),
-            n => return Err(err(format!("{what}: give 3 (diagonal), 6 (Ixx Iyy Izz Ixy Ixz Iyz) or 3×3 values, got {n}"))),
+            n => {
+                return Err(err(format!(
+                    "{what}: give 3 (diagonal), 6 (Ixx Iyy Izz Ixy Ixz Iyz) or 3×3 values, got {n}"
+                )))
+            }
         },
     };
     crate::ensure!(m.iter().all(|x| x.is_finite()), Model, "{what}: must be finite, got {m:?}");
     let scale = m.abs().max().max(f64::MIN_POSITIVE);
-    crate::ensure!(
-        (m - m.transpose()).abs().max() <= 1e-9 * scale,
-        Model,
-        "{what}: inertia tensor must be symmetric"
-    );
+    crate::ensure!((m - m.transpose()).abs().max() <= 1e-9 * scale, Model, "{what}: inertia tensor must be symmetric");
     let mut eig: Vec<f64> = SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
     eig.sort_by(|x, y| x.total_cmp(y));
     let (a, b, c) = (eig[0], eig[1], eig[2]);
@@ -162,13 +161,7 @@ fn time_function(f: &Option<TimeFunctionDescription>, what: &str, n_cb: &mut usi
 
 fn table(x: &[f64], y: &[f64], what: &str, kx: &str, ky: &str) -> Result<()> {
     crate::ensure!(!x.is_empty(), Model, "{what}.{kx}: table must not be empty");
-    crate::ensure!(
-        x.len() == y.len(),
-        Model,
-        "{what}: {kx} has {} entries but {ky} has {}",
-        x.len(),
-        y.len()
-    );
+    crate::ensure!(x.len() == y.len(), Model, "{what}: {kx} has {} entries but {ky} has {}", x.len(), y.len());
     crate::ensure!(x.iter().chain(y).all(|v| v.is_finite()), Model, "{what}: table entries must be finite");
     crate::ensure!(x.windows(2).all(|w| w[1] > w[0]), Model, "{what}.{kx}: must be strictly increasing");
     Ok(())
@@ -217,12 +210,8 @@ impl Model {
             let what = format!("joints[{i}] '{}'", j.name);
             crate::ensure!(!j.name.trim().is_empty(), Model, "joints[{i}]: name must not be empty");
             crate::ensure!(joint_names.insert(j.name.clone()), Model, "{what}: duplicate joint name '{}'", j.name);
-            let p = *names
-                .get(&j.parent)
-                .ok_or_else(|| err(format!("{what}.parent: unknown body '{}'", j.parent)))?;
-            let c = *names
-                .get(&j.child)
-                .ok_or_else(|| err(format!("{what}.child: unknown body '{}'", j.child)))?;
+            let p = *names.get(&j.parent).ok_or_else(|| err(format!("{what}.parent: unknown body '{}'", j.parent)))?;
+            let c = *names.get(&j.child).ok_or_else(|| err(format!("{what}.child: unknown body '{}'", j.child)))?;
             crate::ensure!(c != 0, Model, "{what}.child: the ground cannot be a child");
             crate::ensure!(p != c, Model, "{what}: parent and child are the same body '{}'", j.child);
             if let Some(other) = parent_joint.insert(c, i) {
@@ -255,12 +244,8 @@ impl Model {
                 }
             }
             if order.len() == before {
-                let stuck: Vec<&str> = desc
-                    .joints
-                    .iter()
-                    .filter(|j| !placed[names[&j.child]])
-                    .map(|j| j.name.as_str())
-                    .collect();
+                let stuck: Vec<&str> =
+                    desc.joints.iter().filter(|j| !placed[names[&j.child]]).map(|j| j.name.as_str()).collect();
                 return Err(err(format!(
                     "joints {stuck:?} form a cycle not connected to the ground; joints must form a tree rooted at 'ground'"
                 )));
@@ -290,12 +275,7 @@ impl Model {
             let bi = names[&desc.joints[ji].child] - 1;
             let b = &desc.bodies[bi];
             let what = format!("bodies[{bi}] '{}'", b.name);
-            crate::ensure!(
-                b.mass.is_finite() && b.mass > 0.0,
-                Model,
-                "{what}.mass: must be > 0, got {}",
-                b.mass
-            );
+            crate::ensure!(b.mass.is_finite() && b.mass > 0.0, Model, "{what}.mass: must be > 0, got {}", b.mass);
             let com = finite3(&b.com, &format!("{what}.com"))?;
             let i_c = inertia(&b.inertia, &format!("{what}.inertia"))?;
             crate::ensure!(b.mass_rate.is_finite(), Model, "{what}.mass_rate: must be finite");
@@ -364,7 +344,13 @@ impl Model {
                     )))
                 }
             };
-            if !matches!(kind, JointKind::Revolute { .. } | JointKind::Prismatic { .. } | JointKind::Cylindrical { .. } | JointKind::Universal { .. }) {
+            if !matches!(
+                kind,
+                JointKind::Revolute { .. }
+                    | JointKind::Prismatic { .. }
+                    | JointKind::Cylindrical { .. }
+                    | JointKind::Universal { .. }
+            ) {
                 crate::ensure!(j.axis.is_none(), Model, "{what}.axis: a {} joint has no axis", kind.type_name());
             }
             if !matches!(kind, JointKind::Universal { .. }) {
@@ -374,7 +360,13 @@ impl Model {
             let mut q0 = vec![0.0; nq];
             kind.neutral(&mut q0);
             if let Some(v) = &j.q0 {
-                crate::ensure!(v.len() == nq, Model, "{what}.q0: a {} joint has {nq} coordinates, got {}", kind.type_name(), v.len());
+                crate::ensure!(
+                    v.len() == nq,
+                    Model,
+                    "{what}.q0: a {} joint has {nq} coordinates, got {}",
+                    kind.type_name(),
+                    v.len()
+                );
                 crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}.q0: must be finite, got {v:?}");
                 q0.copy_from_slice(v);
                 if kind.has_quaternion() {
@@ -386,7 +378,13 @@ impl Model {
             }
             let u0 = match &j.u0 {
                 Some(v) => {
-                    crate::ensure!(v.len() == nu, Model, "{what}.u0: a {} joint has {nu} velocities, got {}", kind.type_name(), v.len());
+                    crate::ensure!(
+                        v.len() == nu,
+                        Model,
+                        "{what}.u0: a {} joint has {nu} velocities, got {}",
+                        kind.type_name(),
+                        v.len()
+                    );
                     crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}.u0: must be finite, got {v:?}");
                     v.clone()
                 }
@@ -444,13 +442,9 @@ impl Model {
 
         // ---- force elements ------------------------------------------------------------------------
         let body = |n: &str, what: &str| -> Result<usize> {
-            names
-                .get(n)
-                .map(|&i| new_index[i])
-                .ok_or_else(|| err(format!("{what}: unknown body '{n}'")))
+            names.get(n).map(|&i| new_index[i]).ok_or_else(|| err(format!("{what}: unknown body '{n}'")))
         };
-        let joint_index: HashMap<String, usize> =
-            joints.iter().enumerate().map(|(i, j)| (j.name.clone(), i)).collect();
+        let joint_index: HashMap<String, usize> = joints.iter().enumerate().map(|(i, j)| (j.name.clone(), i)).collect();
         let mut n_callbacks = 0usize;
         let mut force_names = HashSet::new();
         let mut forces = Vec::with_capacity(desc.forces.len());
@@ -465,7 +459,17 @@ impl Model {
             crate::ensure!(force_names.insert(name.clone()), Model, "{what}: duplicate force element name");
             forces.push(match f {
                 ForceDescription::SpringDamper {
-                    body1, point1, body2, point2, k, k3, d, l0, table_deflection, table_force, ..
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                    k,
+                    k3,
+                    d,
+                    l0,
+                    table_deflection,
+                    table_force,
+                    ..
                 } => {
                     for (x, key) in [(k, "k"), (k3, "k3"), (d, "d"), (l0, "l0")] {
                         crate::ensure!(x.is_finite(), Model, "{what}.{key}: must be finite, got {x}");
@@ -514,9 +518,8 @@ impl Model {
                     }
                 }
                 ForceDescription::JointForce { joint, value, function, .. } => {
-                    let ji = *joint_index
-                        .get(joint)
-                        .ok_or_else(|| err(format!("{what}.joint: unknown joint '{joint}'")))?;
+                    let ji =
+                        *joint_index.get(joint).ok_or_else(|| err(format!("{what}.joint: unknown joint '{joint}'")))?;
                     let n = joints[ji].nu();
                     crate::ensure!(n > 0, Model, "{what}.joint: joint '{joint}' has no degrees of freedom");
                     ForceElement::JointForce {
@@ -565,7 +568,11 @@ impl Model {
                     let b1 = body(body1, &format!("{what}.body1"))?;
                     let b2 = body(body2, &format!("{what}.body2"))?;
                     crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
-                    crate::ensure!(length.is_finite() && *length > 0.0, Model, "{what}.length: must be > 0, got {length}");
+                    crate::ensure!(
+                        length.is_finite() && *length > 0.0,
+                        Model,
+                        "{what}.length: must be > 0, got {length}"
+                    );
                     ConstraintKind::Distance {
                         body1: b1,
                         p1: finite3(point1, &format!("{what}.point1"))?,
@@ -587,7 +594,11 @@ impl Model {
                             j.kind.type_name()
                         );
                     }
-                    crate::ensure!(ratio.is_finite() && offset.is_finite(), Model, "{what}: ratio and offset must be finite");
+                    crate::ensure!(
+                        ratio.is_finite() && offset.is_finite(),
+                        Model,
+                        "{what}: ratio and offset must be finite"
+                    );
                     ConstraintKind::Coupler {
                         iq_a: joints[ja].iq,
                         iu_a: joints[ja].iu,
@@ -616,7 +627,11 @@ impl Model {
                     ConstraintKind::Prescribed {
                         iq: j.iq + index,
                         iu: j.iu + index,
-                        function: time_function(&Some(function.clone()), &format!("{what}.function"), &mut n_callbacks)?,
+                        function: time_function(
+                            &Some(function.clone()),
+                            &format!("{what}.function"),
+                            &mut n_callbacks,
+                        )?,
                     }
                 }
                 ConstraintDescription::PointOnLine { body1, point1, body2, point2, direction, .. }
@@ -624,7 +639,8 @@ impl Model {
                     let b1 = body(body1, &format!("{what}.body1"))?;
                     let b2 = body(body2, &format!("{what}.body2"))?;
                     crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
-                    let (p1, p2) = (finite3(point1, &format!("{what}.point1"))?, finite3(point2, &format!("{what}.point2"))?);
+                    let (p1, p2) =
+                        (finite3(point1, &format!("{what}.point1"))?, finite3(point2, &format!("{what}.point2"))?);
                     if let ConstraintDescription::PointOnLine { .. } = c {
                         let d = nonzero_direction(direction, &format!("{what}.direction"))?;
                         // two unit normals of the line, fixed in body2
@@ -638,21 +654,77 @@ impl Model {
                 }
                 ConstraintDescription::LoopSpherical { body1, frame1, body2, frame2, .. }
                 | ConstraintDescription::LoopRevolute { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopFixed { body1, frame1, body2, frame2, .. } => {
+                | ConstraintDescription::LoopFixed { body1, frame1, body2, frame2, .. }
+                | ConstraintDescription::LoopPrismatic { body1, frame1, body2, frame2, .. }
+                | ConstraintDescription::LoopCylindrical { body1, frame1, body2, frame2, .. }
+                | ConstraintDescription::LoopUniversal { body1, frame1, body2, frame2, .. }
+                | ConstraintDescription::LoopPlanar { body1, frame1, body2, frame2, .. } => {
                     use crate::constraints::LoopJoint;
                     let b1 = body(body1, &format!("{what}.body1"))?;
                     let b2 = body(body2, &format!("{what}.body2"))?;
                     crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
                     let frame = |f: &FrameDescription, key: &str| -> Result<Pose> {
                         let w = format!("{what}.{key}");
-                        Ok(Pose::new(rotation(&f.rotation, &format!("{w}.rotation"))?, finite3(&f.position, &format!("{w}.position"))?))
+                        Ok(Pose::new(
+                            rotation(&f.rotation, &format!("{w}.rotation"))?,
+                            finite3(&f.position, &format!("{w}.position"))?,
+                        ))
                     };
                     let joint = match c {
                         ConstraintDescription::LoopSpherical { .. } => LoopJoint::Spherical,
                         ConstraintDescription::LoopRevolute { .. } => LoopJoint::Revolute,
+                        ConstraintDescription::LoopPrismatic { .. } => LoopJoint::Prismatic,
+                        ConstraintDescription::LoopCylindrical { .. } => LoopJoint::Cylindrical,
+                        ConstraintDescription::LoopUniversal { .. } => LoopJoint::Universal,
+                        ConstraintDescription::LoopPlanar { .. } => LoopJoint::Planar,
                         _ => LoopJoint::Fixed,
                     };
-                    ConstraintKind::Loop { joint, body1: b1, f1: frame(frame1, "frame1")?, body2: b2, f2: frame(frame2, "frame2")? }
+                    ConstraintKind::Loop {
+                        joint,
+                        body1: b1,
+                        f1: frame(frame1, "frame1")?,
+                        body2: b2,
+                        f2: frame(frame2, "frame2")?,
+                    }
+                }
+                ConstraintDescription::PrescribedBody { body: b, frame: f, position, orientation, .. } => {
+                    let bi = body(b, &format!("{what}.body"))?;
+                    crate::ensure!(
+                        bi != 0,
+                        Model,
+                        "{what}.body: a prescribed body motion needs a moving body, got 'ground'"
+                    );
+                    let mut three = |list: &[TimeFunctionDescription], key: &str, meaning: &str| {
+                        crate::ensure!(
+                            list.len() == 3,
+                            Model,
+                            "{what}.{key}: expected 3 time functions ({meaning}), got {}",
+                            list.len()
+                        );
+                        let mut out = [0, 1, 2].map(|_| TimeFunction::Constant(0.0));
+                        for (k, fk) in list.iter().enumerate() {
+                            let w = format!("{what}.{key}[{k}]");
+                            out[k] = time_function(&Some(fk.clone()), &w, &mut n_callbacks)?;
+                        }
+                        Ok(out)
+                    };
+                    let position = three(position, "position", "world x, y, z of the frame origin")?;
+                    let orientation = match orientation {
+                        Some(o) => Some(three(o, "orientation", "Cardan angles x-y-z")?),
+                        None => None,
+                    };
+                    let frame = frame(f, &format!("{what}.frame"))?;
+                    ConstraintKind::PrescribedBody { body: bi, frame, position, orientation }
+                }
+                ConstraintDescription::Velocity { rows, w_matrix, w_offset, w_rate, .. } => {
+                    crate::ensure!(*rows >= 1, Model, "{what}.rows: must be >= 1, got {rows}");
+                    for (id, key) in [(Some(*w_matrix), "W"), (*w_offset, "w"), (*w_rate, "Wdot")] {
+                        if let Some(id) = id {
+                            crate::ensure!(id < 1 << 32, Model, "{what}.{key}: callback index {id} is out of range");
+                            n_callbacks = n_callbacks.max(id + 1);
+                        }
+                    }
+                    ConstraintKind::Velocity { rows: *rows, w_matrix: *w_matrix, w_offset: *w_offset, w_rate: *w_rate }
                 }
                 ConstraintDescription::KnifeEdge { body: b, point, direction, .. } => {
                     let bi = body(b, &format!("{what}.body"))?;
@@ -666,7 +738,11 @@ impl Model {
                 ConstraintDescription::RollingDisc { body: b, center, axis, radius, .. } => {
                     let bi = body(b, &format!("{what}.body"))?;
                     crate::ensure!(bi != 0, Model, "{what}.body: a rolling disc needs a moving body, got 'ground'");
-                    crate::ensure!(radius.is_finite() && *radius > 0.0, Model, "{what}.radius: must be > 0, got {radius}");
+                    crate::ensure!(
+                        radius.is_finite() && *radius > 0.0,
+                        Model,
+                        "{what}.radius: must be > 0, got {radius}"
+                    );
                     ConstraintKind::RollingDisc {
                         body: bi,
                         center: finite3(center, &format!("{what}.center"))?,
@@ -716,4 +792,3 @@ fn markers(list: &[MarkerDescription], what: &str) -> Result<Vec<Marker>> {
         })
         .collect()
 }
-
