@@ -804,7 +804,8 @@ fn rotation_from_vee(phi: &Vec3) -> Mat3 {
 /// Position stage of the constraints: `phi` (m) and `G` (m × nu) at the last
 /// [`crate::kinematics::positions`]; `b` (m) receives the velocity right-hand side `G u = b`.
 pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Callbacks) -> Result<()> {
-    data.g.as_mut_slice().fill(0.0); // a memset; DMatrix::fill walks element by element
+    // rows write only on their planned pattern (`reach`), so clearing that is enough
+    data.saddle.clear_pattern(&mut data.g);
     for c in &model.constraints {
         let r = c.row;
         match &c.kind {

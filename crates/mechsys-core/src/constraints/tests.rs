@@ -48,7 +48,7 @@ pub(super) fn joint(
 
 /// A spatial two-link arm with a free third body tied to its tip by a point and a distance
 /// constraint, plus a coupler and a drive: every kind at once.
-fn model_with_all_kinds() -> Model {
+pub(super) fn model_with_all_kinds() -> Model {
     let desc = ModelDescription {
         name: "all".into(),
         gravity: [0.0, 0.0, -9.81],

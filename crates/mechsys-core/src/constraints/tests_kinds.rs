@@ -161,6 +161,8 @@ pub(super) fn check_apply_forces(model: &Model, cb: &dyn Callbacks, t: f64) {
     let q = model.q0();
     crate::kinematics::positions(model, &mut data, &q);
     positions(model, &mut data, t, &q, cb).unwrap();
+    // the sparse solve sees only the planned pattern: every nonzero of G must lie on it
+    assert_eq!(data.saddle.outside_pattern(&data.g), None, "a constraint writes outside its reach");
     for r in 0..model.nc {
         data.lambda[r] = 0.3 + 0.17 * r as f64 - 0.01 * (r * r) as f64;
     }
@@ -736,4 +738,9 @@ fn user_velocity_errors_name_the_constraint() {
     }];
     let e = Model::from_description(d).unwrap_err().to_string();
     assert!(e.contains("'none'.rows") && e.contains(">= 1"), "{e}");
+}
+
+#[test]
+fn first_kinds_apply_forces_equal_g_transpose_lambda_on_the_planned_pattern() {
+    check_apply_forces(&super::tests::model_with_all_kinds(), &NoCallbacks, 0.0);
 }

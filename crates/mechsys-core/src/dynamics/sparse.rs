@@ -330,6 +330,30 @@ impl Saddle {
         }
     }
 
+    /// Zeroes the entries of the dense `G` on the row pattern: the only ones the constraint rows
+    /// ever write, so G is cleared in O(nonzeros) instead of O(nc · nu).
+    pub fn clear_pattern(&self, g: &mut nalgebra::DMatrix<f64>) {
+        for r in 0..self.nc {
+            for p in self.row_ptr[r]..self.row_ptr[r + 1] {
+                g[(r, self.row_idx[p])] = 0.0;
+            }
+        }
+    }
+
+    /// The first nonzero of the dense `G` outside the row pattern (row, velocity), if any: a
+    /// constraint kind whose [`crate::constraints::ConstraintKind::reach`] is too small.
+    pub fn outside_pattern(&self, g: &nalgebra::DMatrix<f64>) -> Option<(usize, usize)> {
+        for r in 0..self.nc {
+            let pat = &self.row_idx[self.row_ptr[r]..self.row_ptr[r + 1]];
+            for i in 0..self.nu {
+                if g[(r, i)] != 0.0 && pat.binary_search(&i).is_err() {
+                    return Some((r, i));
+                }
+            }
+        }
+        None
+    }
+
     /// Zeroes the rows `rows` of the gathered G (rows left out of a projection).
     pub fn clear_rows(&mut self, rows: std::ops::Range<usize>) {
         let (s, e) = (self.row_ptr[rows.start], self.row_ptr[rows.end]);
@@ -370,9 +394,13 @@ impl Saddle {
             let pos = &self.col_pos[self.col_ptr[i]..self.col_ptr[i + 1]];
             for (x, &a) in pos.iter().enumerate() {
                 let ya = self.y_val[a] * w;
-                for &b in &pos[x..] {
-                    self.s_val[self.assemble[t] as usize] += ya * self.y_val[b];
-                    t += 1;
+                let targets = &self.assemble[t..t + pos.len() - x];
+                t += pos.len() - x;
+                // rows that vanish here (the out-of-plane rows of a planar loop) add nothing
+                if ya != 0.0 {
+                    for (&b, &tgt) in pos[x..].iter().zip(targets) {
+                        self.s_val[tgt as usize] += ya * self.y_val[b];
+                    }
                 }
             }
         }
@@ -411,10 +439,12 @@ impl Saddle {
             let inv_d = 1.0 / d;
             for a in s + 1..e {
                 let la = self.s_val[a] * inv_d;
-                for b in a..e {
-                    let tgt = self.update[t] as usize;
-                    self.s_val[tgt] -= la * self.s_val[b];
-                    t += 1;
+                let targets = &self.update[t..t + e - a];
+                t += e - a;
+                if la != 0.0 {
+                    for (b, &tgt) in (a..e).zip(targets) {
+                        self.s_val[tgt as usize] -= la * self.s_val[b];
+                    }
                 }
             }
             for a in s + 1..e {
