@@ -136,3 +136,15 @@ def test_constraints_in_model_files_and_on_the_command_line(tmp_path):
     out = runner.invoke(cli, ["info", str(path)])
     assert out.exit_code == 2
     assert "constraints[0]" in out.output and "pont1" in out.output
+
+
+def test_rolling_coin_example_runs_from_the_command_line(tmp_path):
+    """The non-holonomic example as a model file: steady rolling keeps its lean and its energy."""
+    h5 = tmp_path / "coin.h5"
+    out = CliRunner().invoke(cli, ["run", str(EXAMPLES / "rolling_disc.py"), "--t-end", "1.0", "--out", str(h5), "--quiet"])
+    assert out.exit_code == 0, out.output
+    res = ms.load(h5)
+    lean = np.arcsin(np.array([ms.kinematics.quat_to_matrix(q)[2, 2] for q in res["body/coin/orientation"]]))
+    assert np.abs(lean - 0.3).max() < 1e-8
+    e = res["energy/total"]
+    assert np.ptp(e) < 1e-9 * np.abs(e).max()
