@@ -66,8 +66,8 @@ def test_slider_crank_driven_at_constant_speed_follows_the_closed_form():
         - (r**4 * omega**2 * np.sin(th) ** 2 * np.cos(th) ** 2) / root**3
     )
     np.testing.assert_allclose(res["joint/guide/q"], x, rtol=0, atol=1e-10)
-    np.testing.assert_allclose(res["joint/guide/u"], xd, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(res["joint/guide/udot"], xdd, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(res["joint/guide/u"], xd, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(res["joint/guide/udot"], xdd, rtol=0, atol=1e-10)
     # the motor's work equals the change of mechanical energy
     balance = res["energy/total"] - res["energy/external_work"]
     assert np.ptp(balance) < 1e-6 * np.abs(res["energy/kinetic"]).max()
