@@ -74,34 +74,34 @@ fn model_with_new_kinds() -> Model {
                 point2: [0.1, 0.0, 0.2],
                 normal: [0.3, -1.0, 2.0],
             },
-            ConstraintDescription::LoopSpherical {
+            ConstraintDescription::LoopSpherical(LoopFrames {
                 name: s("ball"),
                 body1: s("b"),
                 frame1: frame([0.1, 0.0, 0.05], [0.2, -0.3, 0.4]),
                 body2: s("c"),
                 frame2: frame([0.0, 0.1, 0.0], [0.0; 3]),
-            },
-            ConstraintDescription::LoopRevolute {
+            }),
+            ConstraintDescription::LoopRevolute(LoopFrames {
                 name: s("hinge"),
                 body1: s("c"),
                 frame1: frame([0.05, 0.0, 0.1], [0.3, 0.1, -0.2]),
                 body2: s("d"),
                 frame2: frame([0.0, -0.1, 0.0], [-0.4, 0.2, 0.7]),
-            },
-            ConstraintDescription::LoopFixed {
+            }),
+            ConstraintDescription::LoopFixed(LoopFrames {
                 name: s("weld"),
                 body1: s("d"),
                 frame1: frame([0.1, 0.1, 0.0], [0.5, -0.2, 0.1]),
                 body2: s("a"),
                 frame2: frame([0.3, 0.0, 0.0], [0.1, 0.6, -0.3]),
-            },
-            ConstraintDescription::LoopFixed {
+            }),
+            ConstraintDescription::LoopFixed(LoopFrames {
                 name: s("weld_ground"),
                 body1: s("c"),
                 frame1: frame([0.0, 0.0, 0.1], [1.0, 0.3, 0.2]),
                 body2: s("ground"),
                 frame2: frame([0.4, 0.1, 0.0], [0.2, 0.1, 2.0]),
-            },
+            }),
             ConstraintDescription::KnifeEdge {
                 name: s("blade"),
                 body: s("d"),
@@ -214,62 +214,62 @@ fn model_with_loop_joints() -> Model {
     let mut desc = model_with_new_kinds().description.clone();
     let f = frame;
     desc.constraints = vec![
-        ConstraintDescription::LoopPrismatic {
+        ConstraintDescription::LoopPrismatic(LoopFrames {
             name: s("slider"),
             body1: s("c"),
             frame1: f([0.05, 0.02, 0.1], [0.3, 0.1, -0.2]),
             body2: s("b"),
             frame2: f([0.1, -0.1, 0.0], [-0.4, 0.2, 0.7]),
-        },
-        ConstraintDescription::LoopPrismatic {
+        }),
+        ConstraintDescription::LoopPrismatic(LoopFrames {
             name: s("slider_ground"),
             body1: s("disc"),
             frame1: f([0.0, 0.1, 0.0], [0.2, 0.0, 0.5]),
             body2: s("ground"),
             frame2: f([0.4, 0.1, 0.2], [0.1, -0.3, 0.2]),
-        },
-        ConstraintDescription::LoopCylindrical {
+        }),
+        ConstraintDescription::LoopCylindrical(LoopFrames {
             name: s("sleeve"),
             body1: s("d"),
             frame1: f([0.1, 0.0, 0.05], [0.5, -0.2, 0.1]),
             body2: s("c"),
             frame2: f([0.0, 0.2, -0.1], [0.1, 0.6, -0.3]),
-        },
-        ConstraintDescription::LoopCylindrical {
+        }),
+        ConstraintDescription::LoopCylindrical(LoopFrames {
             name: s("sleeve_ground"),
             body1: s("ground"),
             frame1: f([0.1, 0.2, 0.0], [0.0, 0.4, 0.0]),
             body2: s("d"),
             frame2: f([0.05, 0.0, 0.0], [0.3, 0.0, 0.2]),
-        },
-        ConstraintDescription::LoopUniversal {
+        }),
+        ConstraintDescription::LoopUniversal(LoopFrames {
             name: s("hooke"),
             body1: s("b"),
             frame1: f([0.2, 0.0, 0.1], [0.2, -0.3, 0.4]),
             body2: s("disc"),
             frame2: f([0.0, 0.1, 0.0], [0.7, 0.1, 0.0]),
-        },
-        ConstraintDescription::LoopUniversal {
+        }),
+        ConstraintDescription::LoopUniversal(LoopFrames {
             name: s("hooke_ground"),
             body1: s("c"),
             frame1: f([0.0, 0.0, 0.2], [0.0; 3]),
             body2: s("ground"),
             frame2: f([0.3, 0.3, 0.3], [0.4, 0.2, 0.1]),
-        },
-        ConstraintDescription::LoopPlanar {
+        }),
+        ConstraintDescription::LoopPlanar(LoopFrames {
             name: s("table"),
             body1: s("disc"),
             frame1: f([0.1, 0.0, 0.0], [0.3, 0.2, 0.1]),
             body2: s("a"),
             frame2: f([0.2, 0.1, 0.0], [-0.2, 0.4, 0.3]),
-        },
-        ConstraintDescription::LoopPlanar {
+        }),
+        ConstraintDescription::LoopPlanar(LoopFrames {
             name: s("floor"),
             body1: s("d"),
             frame1: f([0.0, 0.05, 0.1], [0.1, 0.1, 0.1]),
             body2: s("ground"),
             frame2: f([0.0, 0.0, -0.2], [0.2, -0.1, 0.0]),
-        },
+        }),
     ];
     Model::from_description(desc).unwrap()
 }
@@ -310,11 +310,11 @@ fn loop_joint_rows_at_zero_violation_mean_what_the_docs_say() {
     let fr = |p: [f64; 3], c: [f64; 3]| frame(p, c);
     let (f1, f2) = (fr([0.05, 0.02, 0.1], [0.3, 0.1, -0.2]), fr([0.4, 0.1, 0.2], [0.1, -0.3, 0.2]));
     let mk = |name: &str, f1: FrameDescription, f2: FrameDescription| {
-        let (name, body1, body2) = (name.to_string(), "c".to_string(), "ground".to_string());
-        match name.as_str() {
-            "p" => ConstraintDescription::LoopPrismatic { name, body1, frame1: f1, body2, frame2: f2 },
-            "u" => ConstraintDescription::LoopUniversal { name, body1, frame1: f1, body2, frame2: f2 },
-            _ => ConstraintDescription::LoopPlanar { name, body1, frame1: f1, body2, frame2: f2 },
+        let frames = LoopFrames { name: name.into(), body1: "c".into(), frame1: f1, body2: "ground".into(), frame2: f2 };
+        match name {
+            "p" => ConstraintDescription::LoopPrismatic(frames),
+            "u" => ConstraintDescription::LoopUniversal(frames),
+            _ => ConstraintDescription::LoopPlanar(frames),
         }
     };
     desc.constraints =

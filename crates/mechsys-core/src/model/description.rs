@@ -135,114 +135,23 @@ pub enum ConstraintDescription {
     },
     /// Loop-closing spherical joint: the origins of `frame1` (on body1) and `frame2` (on body2)
     /// coincide (3 rows).
-    LoopSpherical {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopSpherical(LoopFrames),
     /// Loop-closing revolute joint about the common z-axis of `frame1` and `frame2` (5 rows).
-    LoopRevolute {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopRevolute(LoopFrames),
     /// Loop-closing fixed joint: `frame1` and `frame2` coincide (6 rows).
-    LoopFixed {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopFixed(LoopFrames),
     /// Loop-closing prismatic joint along the z-axis of `frame2`: the origin of `frame1` stays on
     /// that axis and the orientations coincide (5 rows).
-    LoopPrismatic {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopPrismatic(LoopFrames),
     /// Loop-closing cylindrical joint: the origin of `frame1` stays on the z-axis of `frame2` and
     /// the z-axes stay parallel (4 rows).
-    LoopCylindrical {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopCylindrical(LoopFrames),
     /// Loop-closing universal (Hooke) joint: the origins coincide and the x-axis of `frame1`
     /// stays perpendicular to the y-axis of `frame2` (4 rows).
-    LoopUniversal {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopUniversal(LoopFrames),
     /// Loop-closing planar joint: the z-axes stay parallel and the origin of `frame1` stays in the
     /// x-y plane of `frame2` (3 rows).
-    LoopPlanar {
-        /// Constraint name.
-        name: String,
-        /// First body.
-        body1: String,
-        /// Frame on body1.
-        #[serde(default)]
-        frame1: FrameDescription,
-        /// Second body (`ground` allowed).
-        body2: String,
-        /// Frame on body2.
-        #[serde(default)]
-        frame2: FrameDescription,
-    },
+    LoopPlanar(LoopFrames),
     /// Prescribed motion of a frame on a body (a driving constraint): its origin follows three
     /// time functions (world x, y, z) and, if given, its orientation three time functions of the
     /// Cardan angles x-y-z (3 or 6 rows).
@@ -309,6 +218,24 @@ pub enum ConstraintDescription {
     },
 }
 
+/// The two frames of a loop-closing joint (every `loop_*` constraint type).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoopFrames {
+    /// Constraint name.
+    pub name: String,
+    /// First body.
+    pub body1: String,
+    /// Frame on body1.
+    #[serde(default)]
+    pub frame1: FrameDescription,
+    /// Second body (`ground` allowed).
+    pub body2: String,
+    /// Frame on body2.
+    #[serde(default)]
+    pub frame2: FrameDescription,
+}
+
 impl Serialize for ConstraintDescription {
     fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         ConstraintDescription::serialize(self, s)
@@ -358,13 +285,13 @@ impl ConstraintDescription {
             | ConstraintDescription::Prescribed { name, .. }
             | ConstraintDescription::PointOnLine { name, .. }
             | ConstraintDescription::PointOnPlane { name, .. }
-            | ConstraintDescription::LoopSpherical { name, .. }
-            | ConstraintDescription::LoopRevolute { name, .. }
-            | ConstraintDescription::LoopFixed { name, .. }
-            | ConstraintDescription::LoopPrismatic { name, .. }
-            | ConstraintDescription::LoopCylindrical { name, .. }
-            | ConstraintDescription::LoopUniversal { name, .. }
-            | ConstraintDescription::LoopPlanar { name, .. }
+            | ConstraintDescription::LoopSpherical(LoopFrames { name, .. })
+            | ConstraintDescription::LoopRevolute(LoopFrames { name, .. })
+            | ConstraintDescription::LoopFixed(LoopFrames { name, .. })
+            | ConstraintDescription::LoopPrismatic(LoopFrames { name, .. })
+            | ConstraintDescription::LoopCylindrical(LoopFrames { name, .. })
+            | ConstraintDescription::LoopUniversal(LoopFrames { name, .. })
+            | ConstraintDescription::LoopPlanar(LoopFrames { name, .. })
             | ConstraintDescription::PrescribedBody { name, .. }
             | ConstraintDescription::Velocity { name, .. }
             | ConstraintDescription::KnifeEdge { name, .. }

@@ -652,13 +652,13 @@ impl Model {
                         ConstraintKind::PointOnPlane { body1: b1, p1, body2: b2, p2, n }
                     }
                 }
-                ConstraintDescription::LoopSpherical { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopRevolute { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopFixed { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopPrismatic { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopCylindrical { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopUniversal { body1, frame1, body2, frame2, .. }
-                | ConstraintDescription::LoopPlanar { body1, frame1, body2, frame2, .. } => {
+                ConstraintDescription::LoopSpherical(LoopFrames { body1, frame1, body2, frame2, .. })
+                | ConstraintDescription::LoopRevolute(LoopFrames { body1, frame1, body2, frame2, .. })
+                | ConstraintDescription::LoopFixed(LoopFrames { body1, frame1, body2, frame2, .. })
+                | ConstraintDescription::LoopPrismatic(LoopFrames { body1, frame1, body2, frame2, .. })
+                | ConstraintDescription::LoopCylindrical(LoopFrames { body1, frame1, body2, frame2, .. })
+                | ConstraintDescription::LoopUniversal(LoopFrames { body1, frame1, body2, frame2, .. })
+                | ConstraintDescription::LoopPlanar(LoopFrames { body1, frame1, body2, frame2, .. }) => {
                     use crate::constraints::LoopJoint;
                     let b1 = body(body1, &format!("{what}.body1"))?;
                     let b2 = body(body2, &format!("{what}.body2"))?;
@@ -671,12 +671,12 @@ impl Model {
                         ))
                     };
                     let joint = match c {
-                        ConstraintDescription::LoopSpherical { .. } => LoopJoint::Spherical,
-                        ConstraintDescription::LoopRevolute { .. } => LoopJoint::Revolute,
-                        ConstraintDescription::LoopPrismatic { .. } => LoopJoint::Prismatic,
-                        ConstraintDescription::LoopCylindrical { .. } => LoopJoint::Cylindrical,
-                        ConstraintDescription::LoopUniversal { .. } => LoopJoint::Universal,
-                        ConstraintDescription::LoopPlanar { .. } => LoopJoint::Planar,
+                        ConstraintDescription::LoopSpherical(_) => LoopJoint::Spherical,
+                        ConstraintDescription::LoopRevolute(_) => LoopJoint::Revolute,
+                        ConstraintDescription::LoopPrismatic(_) => LoopJoint::Prismatic,
+                        ConstraintDescription::LoopCylindrical(_) => LoopJoint::Cylindrical,
+                        ConstraintDescription::LoopUniversal(_) => LoopJoint::Universal,
+                        ConstraintDescription::LoopPlanar(_) => LoopJoint::Planar,
                         _ => LoopJoint::Fixed,
                     };
                     ConstraintKind::Loop {
