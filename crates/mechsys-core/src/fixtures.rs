@@ -55,6 +55,7 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
         joints,
         forces: vec![],
         ground_markers: vec![],
+        contacts: vec![],
         constraints: vec![],
     }
 }

@@ -66,6 +66,7 @@ pub(super) fn model_with_all_kinds() -> Model {
         ],
         forces: vec![],
         ground_markers: vec![],
+        contacts: vec![],
         constraints: vec![
             ConstraintDescription::Point {
                 name: "pin".into(),
@@ -215,6 +216,7 @@ fn drift_control_choices() {
         joints: vec![joint("f", "planar", "ground", "b", [0.0; 3], None, Some(vec![0.5, -0.5, 0.0]))],
         forces: vec![],
         ground_markers: vec![],
+        contacts: vec![],
         constraints: vec![ConstraintDescription::Distance {
             name: "rod".into(),
             body1: "b".into(),

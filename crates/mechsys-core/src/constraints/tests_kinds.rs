@@ -57,6 +57,7 @@ fn model_with_new_kinds() -> Model {
         ],
         forces: vec![],
         ground_markers: vec![],
+        contacts: vec![],
         constraints: vec![
             ConstraintDescription::PointOnLine {
                 name: s("line"),
@@ -604,6 +605,7 @@ fn model_with_user_rows(rate: bool, offset: bool) -> Model {
         ],
         forces: vec![],
         ground_markers: vec![],
+        contacts: vec![],
         constraints: vec![
             ConstraintDescription::Velocity {
                 name: s("skate"),

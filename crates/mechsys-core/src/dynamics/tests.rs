@@ -78,6 +78,7 @@ fn mixed_tree() -> Model {
         joints,
         forces,
         ground_markers: vec![],
+        contacts: vec![],
         constraints: vec![],
     })
     .unwrap()

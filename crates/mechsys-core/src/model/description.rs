@@ -32,6 +32,9 @@ pub struct ModelDescription {
     /// Bilateral constraints beyond the tree (loop closures, couplers, driven coordinates).
     #[serde(default)]
     pub constraints: Vec<ConstraintDescription>,
+    /// Unilateral contacts between contours on bodies.
+    #[serde(default)]
+    pub contacts: Vec<super::contact_description::ContactDescription>,
 }
 
 /// A bilateral constraint. Read through a JSON value so that a malformed entry's error names the

@@ -5,6 +5,7 @@
 //! order (index 0 is the ground, each body's parent has a smaller index) and body `i > 0` is moved
 //! by joint `i - 1`, so the recursive algorithms are plain loops.
 
+pub mod contact_description;
 pub mod description;
 pub mod joint;
 mod validate;

@@ -187,6 +187,10 @@ impl Model {
     /// Validates a description and builds the model.
     pub fn from_description(desc: ModelDescription) -> Result<Model> {
         let g = finite3(&desc.gravity, "gravity")?;
+        if let Some(c) = desc.contacts.first() {
+            // the description is read, but the contact stages are not wired in yet
+            return Err(err(format!("contacts[0] '{}': unilateral contacts are not available in this build yet", c.name)));
+        }
 
         // ---- bodies ----------------------------------------------------------------------------
         let mut names: HashMap<String, usize> = HashMap::new();

@@ -1,0 +1,181 @@
+//! The description of unilateral contacts (section 2.5): a contour on each of two bodies, the
+//! friction law and the impact law, as written in model files and emitted by the Python builder.
+//!
+//! Contours in space: `point`, `sphere`, `plane` (half-space below its normal), `box`, `capsule`,
+//! `cylinder`; in the plane (the x-y plane of the body frame): `point`, `circle`, `line`
+//! (half-plane behind its normal), `polygon`. Normal contact is always Signorini's law
+//! (g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0); friction is none, Coulomb with a static and a sliding
+//! coefficient, or a Stribeck curve; impacts follow Newton's or Poisson's law.
+
+use serde::{Deserialize, Serialize};
+
+use super::description::RotationDescription;
+
+/// A contact between `contour1` on `body1` and `contour2` on `body2` (`ground` allowed).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactDescription {
+    /// Unique contact name.
+    pub name: String,
+    /// First body.
+    pub body1: String,
+    /// Contour on body1, body-frame data.
+    pub contour1: ContourDescription,
+    /// Second body.
+    pub body2: String,
+    /// Contour on body2, body-frame data.
+    pub contour2: ContourDescription,
+    /// Tangential law (frictionless if absent).
+    #[serde(default)]
+    pub friction: FrictionDescription,
+    /// Impact law (a fully plastic Newton impact, ε = 0, if absent).
+    #[serde(default)]
+    pub impact: ImpactDescription,
+}
+
+/// A contour: closed-form geometry attached to a body (all data in the body frame, m).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ContourDescription {
+    /// A single point (in space, or in the plane against a planar contour).
+    Point {
+        /// The point.
+        #[serde(default)]
+        position: [f64; 3],
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// A plane bounding the half-space below `normal` (solid side opposite the normal).
+    Plane {
+        /// A point of the plane.
+        #[serde(default)]
+        point: [f64; 3],
+        /// Outward normal (normalised when read).
+        normal: [f64; 3],
+    },
+    /// A box.
+    Box {
+        /// Centre.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Orientation of the box axes in the body frame (identity if absent).
+        #[serde(default)]
+        rotation: Option<RotationDescription>,
+        /// Half the edge lengths along the box axes, > 0.
+        half_extents: [f64; 3],
+    },
+    /// A capsule: the points within `radius` of the segment `a`–`b`.
+    Capsule {
+        /// First end of the axis segment.
+        a: [f64; 3],
+        /// Second end of the axis segment.
+        b: [f64; 3],
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// A finite solid cylinder.
+    Cylinder {
+        /// Centre.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Axis direction (normalised when read).
+        axis: [f64; 3],
+        /// Radius, > 0.
+        radius: f64,
+        /// Half the length along the axis, > 0.
+        half_length: f64,
+    },
+    /// A circle in the body's x-y plane.
+    Circle {
+        /// Centre (z ignored).
+        #[serde(default)]
+        center: [f64; 3],
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// A line in the body's x-y plane bounding the half-plane behind `normal`.
+    Line {
+        /// A point of the line (z ignored).
+        #[serde(default)]
+        point: [f64; 3],
+        /// Outward normal in the x-y plane (normalised when read).
+        normal: [f64; 3],
+    },
+    /// A convex polygon in the body's x-y plane, vertices counter-clockwise.
+    Polygon {
+        /// Vertices `[x, y]`, at least 3.
+        vertices: Vec<[f64; 2]>,
+    },
+}
+
+/// Tangential contact law.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum FrictionDescription {
+    /// Frictionless.
+    #[default]
+    None,
+    /// Coulomb's law (2.200): sliding coefficient `mu`, static coefficient `mu0` (≥ mu; = mu if absent).
+    Coulomb {
+        /// Sliding friction coefficient, ≥ 0.
+        mu: f64,
+        /// Static friction coefficient, ≥ mu.
+        #[serde(default)]
+        mu0: Option<f64>,
+    },
+    /// A Stribeck curve (2.201): µ(v) = mu + (mu0 - mu) exp(-(|v| / v_s)^exponent).
+    Stribeck {
+        /// Static coefficient µ(0), ≥ mu.
+        mu0: f64,
+        /// Coefficient at high sliding speed, ≥ 0.
+        mu: f64,
+        /// Stribeck velocity (m/s), > 0.
+        v_s: f64,
+        /// Shape exponent, > 0 (2 if absent).
+        #[serde(default = "two")]
+        exponent: f64,
+    },
+    /// µ(|v|) tabulated and interpolated linearly (constant beyond the ends).
+    Table {
+        /// Sliding speeds (m/s), ascending, starting at 0.
+        speed: Vec<f64>,
+        /// Coefficients at those speeds, ≥ 0; the first is the static coefficient.
+        mu: Vec<f64>,
+    },
+}
+
+fn two() -> f64 {
+    2.0
+}
+
+/// Impact law.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ImpactDescription {
+    /// Newton's kinematic law (2.202): ġ_N⁺ = -ε ġ_N⁻ (normal direction only).
+    Newton {
+        /// Coefficient of restitution in [0, 1].
+        eps: f64,
+    },
+    /// Poisson's kinetic law (2.203): expansion impulse = ε × compression impulse, in normal and
+    /// (with `eps_t`) tangential direction.
+    Poisson {
+        /// Normal coefficient in [0, 1].
+        eps: f64,
+        /// Tangential coefficient in [0, 1] (0 if absent).
+        #[serde(default)]
+        eps_t: f64,
+    },
+}
+
+impl Default for ImpactDescription {
+    fn default() -> Self {
+        ImpactDescription::Newton { eps: 0.0 }
+    }
+}
