@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, constraints, dynamics, forces, functions, inertia, joints, kinematics, mechanisms
+from . import analysis, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, mechanisms
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -16,6 +16,7 @@ from .errors import (
     SingularityError,
     SolverError,
 )
+from .contacts import Contact
 from .integrators import DOPRI5, RK4, Radau5
 from .joints import Frame
 from .model import Body, Model
@@ -44,6 +45,9 @@ __all__ = [
     "Radau5",
     "joints",
     "constraints",
+    "Contact",
+    "contours",
+    "laws",
     "mechanisms",
     "analysis",
     "forces",

@@ -31,6 +31,14 @@ class Body:
         self.model.add_marker(self.name, name, position, **rotation)
         return self
 
+    def contour(self, contour) -> "Any":
+        """This body carrying a contour (see :mod:`mechsys.contours`), for a :class:`mechsys.Contact`."""
+        from .contours import Contour, OnBody
+
+        if not isinstance(contour, Contour):
+            raise ModelError(f"body '{self.name}'.contour: expected a mechsys.contours contour, got {type(contour).__name__}")
+        return OnBody(self.name, contour)
+
 
 from .joints import _vec3  # noqa: E402  (one vector check for the whole builder)
 
@@ -49,6 +57,7 @@ class Model:
         self._joints: list[Joint | dict] = []
         self._forces: list[Any] = []
         self._constraints: list[Any] = []
+        self._contacts: list[Any] = []
         self._ground_markers: list[dict] = []
         self._built: tuple[str, Any, list] | None = None
         self._engine: tuple | None = None
@@ -138,6 +147,14 @@ class Model:
         self._invalidate()
         return constraint
 
+    def add_contact(self, contact) -> Any:
+        """Adds a unilateral contact (see :class:`mechsys.Contact`)."""
+        if not (hasattr(contact, "describe") or isinstance(contact, dict)):
+            raise ModelError(f"add_contact: expected a mechsys.Contact, got {type(contact).__name__}")
+        self._contacts.append(contact)
+        self._invalidate()
+        return contact
+
     # ---- description and engine model -----------------------------------------------------------
     def describe(self) -> tuple[dict, list]:
         """The plain-data description (as in a model file) and the Python callbacks it refers to."""
@@ -154,6 +171,9 @@ class Model:
         }
         if constraints:
             desc["constraints"] = constraints
+        contacts = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._contacts]
+        if contacts:
+            desc["contacts"] = contacts
         return desc, callbacks
 
     def to_dict(self) -> dict:
@@ -202,7 +222,8 @@ class Model:
         m._forces = seq("forces")
         m._ground_markers = seq("ground_markers")
         m._constraints = seq("constraints")
-        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers", "constraints"}
+        m._contacts = seq("contacts")
+        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts"}
         extra = set(desc) - known
         if extra:
             # let the engine produce the canonical message for a misspelt top-level key
