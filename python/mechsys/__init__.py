@@ -17,7 +17,7 @@ from .errors import (
     SolverError,
 )
 from .contacts import Contact
-from .integrators import DOPRI5, RK4, Radau5
+from .integrators import DOPRI5, RK4, Lemke, MoreauJean, Newton, NSGS, Radau5
 from .joints import Frame
 from .model import Body, Model
 from .results import Results, load
@@ -43,6 +43,10 @@ __all__ = [
     "RK4",
     "DOPRI5",
     "Radau5",
+    "MoreauJean",
+    "NSGS",
+    "Newton",
+    "Lemke",
     "joints",
     "constraints",
     "Contact",

@@ -1,4 +1,6 @@
-"""Integration schemes for smooth dynamics.
+"""Integration schemes: smooth dynamics (RK4, DOPRI5, Radau5) and, for models with unilateral
+contacts, Moreau-Jean time-stepping (:class:`MoreauJean`) with a choice of contact solver
+(:class:`NSGS`, :class:`Newton`, :class:`Lemke`).
 
 - :class:`RK4` — classical Runge-Kutta, fixed step: cheap, predictable, 4th order.
 - :class:`DOPRI5` — Dormand-Prince 5(4), adaptive with error control and dense output (the default).
@@ -47,6 +49,53 @@ class Radau5:
         return {"type": "radau5", "dt": float(self.dt), "newton_tol": float(self.newton_tol)}
 
 
+@dataclass(frozen=True)
+class NSGS:
+    """Nonsmooth Gauss-Seidel with exact local cone solves (the default contact solver)."""
+
+    tol: float = 1e-10
+    max_iter: int = 10_000
+    relaxation: float = 1.0
+
+    def describe(self) -> dict:
+        return {"type": "nsgs", "tol": float(self.tol), "max_iter": int(self.max_iter), "relaxation": float(self.relaxation)}
+
+
+@dataclass(frozen=True)
+class Newton:
+    """Semismooth Newton on the Alart-Curnier function."""
+
+    tol: float = 1e-10
+    max_iter: int = 200
+
+    def describe(self) -> dict:
+        return {"type": "newton", "tol": float(self.tol), "max_iter": int(self.max_iter)}
+
+
+@dataclass(frozen=True)
+class Lemke:
+    """Lemke's pivoting on the LCP form (exact for planar friction; a pyramid of ``facets`` sides in 3-D)."""
+
+    facets: int = 8
+    pivot_tol: float = 1e-12
+
+    def describe(self) -> dict:
+        return {"type": "lemke", "facets": int(self.facets), "pivot_tol": float(self.pivot_tol)}
+
+
+@dataclass(frozen=True)
+class MoreauJean:
+    """Moreau-Jean time-stepping with step ``dt`` (s): impulses and velocities, so impacts,
+    stick-slip and accumulations of impacts need no event detection; ``solver`` solves each
+    step's friction-contact problem."""
+
+    dt: float
+    solver: NSGS | Newton | Lemke = NSGS()
+
+    def describe(self) -> dict:
+        return {"type": "moreau_jean", "dt": float(self.dt), "solver": self.solver.describe()}
+
+
 def from_name(name: str, dt: float | None = None, rtol: float | None = None, atol: float | None = None):
     """An integrator from its name (command line): rk4, dopri5, radau5."""
     from .errors import SettingsError
@@ -62,7 +111,11 @@ def from_name(name: str, dt: float | None = None, rtol: float | None = None, ato
         if dt is None:
             raise SettingsError("integrator radau5 needs a step: give --dt")
         return Radau5(dt)
-    raise SettingsError(f"integrator: unknown name '{name}' (expected rk4, dopri5 or radau5)")
+    if n in ("moreau_jean", "moreaujean", "mj"):
+        if dt is None:
+            raise SettingsError("integrator moreau_jean needs a step: give --dt")
+        return MoreauJean(dt)
+    raise SettingsError(f"integrator: unknown name '{name}' (expected rk4, dopri5, radau5 or moreau_jean)")
 
 
-__all__ = ["RK4", "DOPRI5", "Radau5"]
+__all__ = ["RK4", "DOPRI5", "Radau5", "MoreauJean", "NSGS", "Newton", "Lemke"]

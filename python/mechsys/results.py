@@ -28,6 +28,12 @@ joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint ori
                                                      access from the recorded state)
 ==============================  ===========  =============================================
 
+Models with contacts (Moreau-Jean) add, per contact (shape (n,) for one candidate point, (n, k)
+for k points; tangential ones (n, [k,] 2) in 3-D): ``contact/<c>/g_n`` (m), ``gd_n``, ``gd_t``
+(m/s), ``lambda_n``, ``lambda_t`` (N, the step's impulse over the step), ``impulse_n``,
+``impulse_t`` (N s), ``state`` (0 open, 1 stick, 2 slip), ``friction_reserve`` (mu0 lambda_N -
+|lambda_T|, N), and ``energy/dissipated_impact``, ``energy/dissipated_friction`` (J).
+
 ``constraint/<c>/velocity_violation`` (the violation's unit per second, same shape as
 ``violation``) is ``G u - b`` for every row, the velocity-only (non-holonomic) rows included.
 """
@@ -108,7 +114,9 @@ class Results:
         put("energy/kinetic", raw["kinetic"], "J")
         put("energy/potential", raw["potential"], "J")
         put("energy/total", raw["kinetic"] + raw["potential"], "J")
-        put("energy/dissipated", raw["dissipated"], "J")
+        # with contacts, what the impulses dissipate counts too (its parts are signals of their own)
+        contact_loss = raw["dissipated_impact"] + raw["dissipated_friction"] if "dissipated_impact" in raw else 0.0
+        put("energy/dissipated", raw["dissipated"] + contact_loss, "J")
         put("energy/external_work", raw["external_work"], "J")
         put("momentum/linear", raw["momentum_linear"], "N s")
         put("momentum/angular", raw["momentum_angular"], "N m s")
@@ -122,6 +130,22 @@ class Results:
                     vv = raw["constraint_velocity_violation"]
                     put(f"constraint/{c['name']}/velocity_violation", vv[:, sl] if c["rows"] > 1 else vv[:, c["row"]],
                         _rate_unit(c["violation_unit"]))
+        if engine is not None and "contact_gap" in raw:
+            put("energy/dissipated_impact", raw["dissipated_impact"], "J")
+            put("energy/dissipated_friction", raw["dissipated_friction"], "J")
+            for c in engine.contacts():
+                k, n, nt = c["first"], c["points"], c["tangents"]
+                sl = slice(k, k + n) if n > 1 else k
+                pre = f"contact/{c['name']}"
+                put(f"{pre}/g_n", raw["contact_gap"][:, sl], "m")
+                put(f"{pre}/gd_n", raw["contact_gd_n"][:, sl], "m/s")
+                put(f"{pre}/gd_t", raw["contact_gd_t"][:, sl, :nt] if nt > 1 else raw["contact_gd_t"][:, sl, 0], "m/s")
+                put(f"{pre}/lambda_n", raw["contact_lambda_n"][:, sl], "N")
+                put(f"{pre}/lambda_t", raw["contact_lambda_t"][:, sl, :nt] if nt > 1 else raw["contact_lambda_t"][:, sl, 0], "N")
+                put(f"{pre}/impulse_n", raw["contact_impulse_n"][:, sl], "N s")
+                put(f"{pre}/impulse_t", raw["contact_impulse_t"][:, sl, :nt] if nt > 1 else raw["contact_impulse_t"][:, sl, 0], "N s")
+                put(f"{pre}/state", raw["contact_state"][:, sl], "0 open, 1 stick, 2 slip")
+                put(f"{pre}/friction_reserve", raw["contact_reserve"][:, sl], "N")
         lazy = {}
         if engine is not None and joints:
             group = _reaction_group(engine, callbacks, joints, raw)

@@ -14,6 +14,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod constraints;
+pub mod contact;
 pub mod data;
 pub mod dynamics;
 pub mod error;

@@ -110,6 +110,28 @@ pub struct Recording {
     pub constraint_velocity_violation: Vec<f64>,
     /// Notes on the run that did not stop it (near-singular configurations), in time order.
     pub warnings: Vec<String>,
+    /// Contact gaps g_N per candidate point (n_out × n_points), m.
+    pub contact_gap: Vec<f64>,
+    /// Relative normal velocities ġ_N (n_out × n_points), m/s.
+    pub contact_gd_n: Vec<f64>,
+    /// Relative tangential velocities ġ_T (n_out × n_points × 2), m/s.
+    pub contact_gd_t: Vec<f64>,
+    /// Normal contact force λ_N: the step's impulse over the step (n_out × n_points), N.
+    pub contact_lambda_n: Vec<f64>,
+    /// Tangential contact forces λ_T (n_out × n_points × 2), N.
+    pub contact_lambda_t: Vec<f64>,
+    /// Normal impulses Λ_N of the last step (n_out × n_points), N s.
+    pub contact_impulse_n: Vec<f64>,
+    /// Tangential impulses Λ_T of the last step (n_out × n_points × 2), N s.
+    pub contact_impulse_t: Vec<f64>,
+    /// Contact state (0 open, 1 stick, 2 slip) (n_out × n_points).
+    pub contact_state: Vec<f64>,
+    /// Friction reserve µ0 λ_N − |λ_T| (n_out × n_points), N.
+    pub contact_reserve: Vec<f64>,
+    /// Energy dissipated by normal impulses since t0 (n_out), J.
+    pub dissipated_impact: Vec<f64>,
+    /// Energy dissipated by friction since t0 (n_out), J.
+    pub dissipated_friction: Vec<f64>,
     /// Integrator counters.
     pub stats: Stats,
 }
@@ -366,6 +388,7 @@ pub fn simulate(
         constraint_velocity_violation: Vec::with_capacity(n_out * model.nc),
         warnings: Vec::new(),
         stats: Stats::default(),
+        ..Default::default()
     };
     match settings.stabilization {
         Stabilization::Baumgarte { alpha, beta } => crate::ensure!(
@@ -375,6 +398,16 @@ pub fn simulate(
         ),
         _ => {}
     }
+    let contacts = !model.contacts.is_empty();
+    if let IntegratorKind::MoreauJean { dt, solver } = settings.integrator {
+        return time_stepping(model, settings, cb, progress, &t_out, y0, dt, solver, rec);
+    }
+    crate::ensure!(
+        !contacts,
+        Settings,
+        "integrator: the model has unilateral contacts ('{}'); use the time-stepping scheme MoreauJean",
+        model.contacts[0].name
+    );
     let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization);
     // a consistent initial state: on the constraint manifolds (assembly from the given q0, u0)
     // (always by projection, whatever the drift control during the run)
@@ -401,6 +434,113 @@ pub fn simulate(
     let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
     rec.stats = stats;
     rec.warnings = std::mem::take(&mut sys.warnings);
+    Ok(rec)
+}
+
+/// The Moreau–Jean run: steps of `dt`, a sample after every `output_dt / dt` steps.
+#[allow(clippy::too_many_arguments)]
+fn time_stepping(
+    model: &Model,
+    settings: &Settings,
+    cb: &dyn Callbacks,
+    progress: Option<&Progress>,
+    t_out: &[f64],
+    y0: Vec<f64>,
+    dt: f64,
+    solver: crate::solver::Method,
+    mut rec: Recording,
+) -> Result<Recording> {
+    use crate::integrator::moreau_jean::MoreauJean;
+    let (nq, nu, np) = (model.nq, model.nu, model.n_contact_points);
+    let ratio = settings.output_dt / dt;
+    crate::ensure!(
+        (ratio - ratio.round()).abs() < 1e-9 * ratio.max(1.0) && ratio.round() >= 1.0,
+        Settings,
+        "output_dt: must be a whole multiple of the time step dt = {dt} s, got {}",
+        settings.output_dt
+    );
+    let every = ratio.round() as u64;
+    let mut stepper = MoreauJean::new(model, dt, solver)?;
+    let mut data = Data::new(model);
+    let mut y = y0;
+    model.normalize(&mut y[..nq]);
+    if model.nc > 0 {
+        let (q, rest) = y.split_at_mut(nq);
+        crate::dynamics::constrained::project(model, &mut data, settings.t0, q, &mut rest[..nu], cb)?;
+    }
+    for v in [&mut rec.contact_gap, &mut rec.contact_gd_n, &mut rec.contact_lambda_n, &mut rec.contact_impulse_n, &mut rec.contact_state, &mut rec.contact_reserve] {
+        v.reserve(t_out.len() * np);
+    }
+    let mut udot = vec![0.0; nu];
+    let mut step = 0u64;
+    let mut stats = crate::integrator::Stats::default();
+    for (k, &t_rec) in t_out.iter().enumerate() {
+        if k > 0 {
+            for _ in 0..every {
+                let t = settings.t0 + step as f64 * dt;
+                let (q, rest) = y.split_at_mut(nq);
+                let (u, energy) = rest.split_at_mut(nu);
+                let u0 = u.to_vec();
+                let (work, diss) = stepper.step(model, &mut data, t, q, u, cb)?;
+                energy[0] += diss;
+                energy[1] += work;
+                for i in 0..nu {
+                    udot[i] = (u[i] - u0[i]) / dt;
+                }
+                crate::integrator::check_finite(t + dt, &y)?;
+                step += 1;
+                stats.steps += 1;
+            }
+        }
+        // the sample: kinematics and forces at the state, averaged accelerations of the last step
+        let (q, rest) = y.split_at(nq);
+        let u = &rest[..nu];
+        crate::dynamics::prepare(model, &mut data, t_rec, q, u, cb)?;
+        if model.nc > 0 {
+            crate::constraints::positions(model, &mut data, t_rec, q, cb)?;
+            data.saddle.gather_g(&data.g);
+            for (l, mu) in data.lambda.iter_mut().zip(&stepper.bilateral_impulse) {
+                *l = mu / dt;
+            }
+        }
+        data.udot.copy_from_slice(&udot);
+        data.a[0] = crate::spatial::Motion::ZERO;
+        let ud = std::mem::take(&mut data.udot);
+        crate::kinematics::accelerations(model, &mut data, &ud);
+        data.udot = ud;
+        record(model, &data, t_rec, &y, &mut rec);
+        stepper.measure(model, &data)?;
+        for (pt, kk) in stepper.kinematics().iter().enumerate() {
+            let r = &stepper.results[pt];
+            rec.contact_gap.push(kk.point.g_n);
+            rec.contact_gd_n.push(kk.gd_n);
+            rec.contact_gd_t.extend_from_slice(&kk.gd_t);
+            rec.contact_impulse_n.push(r.impulse_n);
+            rec.contact_impulse_t.extend_from_slice(&r.impulse_t);
+            rec.contact_lambda_n.push(r.impulse_n / dt);
+            rec.contact_lambda_t.extend_from_slice(&[r.impulse_t[0] / dt, r.impulse_t[1] / dt]);
+            rec.contact_state.push(r.state);
+            let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+            let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
+            rec.contact_reserve.push((con.friction.mu0() * r.impulse_n - lt) / dt);
+        }
+        rec.dissipated_impact.push(stepper.dissipated_impact);
+        rec.dissipated_friction.push(stepper.dissipated_friction);
+        if let Some(p) = progress {
+            p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
+            if p.cancel.load(Ordering::Relaxed) {
+                return Err(Error::Solver(format!("simulation cancelled at t = {t_rec:.6} s")));
+            }
+        }
+    }
+    if stepper.unconverged.0 > 0 {
+        rec.warnings.push(format!(
+            "the contact solver did not reach its tolerance in {} of {} steps (worst residual {:.1e}); tighten the solver or shorten dt",
+            stepper.unconverged.0, stats.steps, stepper.unconverged.1
+        ));
+    }
+    stats.evaluations = stats.steps as usize;
+    rec.stats = stats;
     Ok(rec)
 }
 

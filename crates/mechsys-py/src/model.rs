@@ -96,6 +96,22 @@ impl PyModel {
         self.model.nc
     }
     /// One dict per constraint: name, type, row, rows, unit (of λ), violation_unit.
+    /// Contacts: name, bodies, first candidate point, number of points, tangent directions.
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut out = vec![];
+        for c in &self.model.contacts {
+            let d = PyDict::new(py);
+            d.set_item("name", &c.name)?;
+            d.set_item("body1", &self.model.bodies[c.body1].name)?;
+            d.set_item("body2", &self.model.bodies[c.body2].name)?;
+            d.set_item("first", c.first)?;
+            d.set_item("points", c.points())?;
+            d.set_item("tangents", c.pair.tangent_dim())?;
+            out.push(d);
+        }
+        Ok(out)
+    }
+
     fn constraints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         use mechsys_core::constraints::ConstraintKind as K;
         use mechsys_core::constraints::LoopJoint;

@@ -234,6 +234,20 @@ fn simulate<'py>(
     put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
     put("constraint_velocity_violation", rec.constraint_velocity_violation, &[n, m.nc])?;
     d.set_item("warnings", rec.warnings)?;
+    let np = m.n_contact_points;
+    if !m.contacts.is_empty() {
+        put("contact_gap", rec.contact_gap, &[n, np])?;
+        put("contact_gd_n", rec.contact_gd_n, &[n, np])?;
+        put("contact_gd_t", rec.contact_gd_t, &[n, np, 2])?;
+        put("contact_lambda_n", rec.contact_lambda_n, &[n, np])?;
+        put("contact_lambda_t", rec.contact_lambda_t, &[n, np, 2])?;
+        put("contact_impulse_n", rec.contact_impulse_n, &[n, np])?;
+        put("contact_impulse_t", rec.contact_impulse_t, &[n, np, 2])?;
+        put("contact_state", rec.contact_state, &[n, np])?;
+        put("contact_reserve", rec.contact_reserve, &[n, np])?;
+        put("dissipated_impact", rec.dissipated_impact, &[n])?;
+        put("dissipated_friction", rec.dissipated_friction, &[n])?;
+    }
     let st = PyDict::new(py);
     st.set_item("steps", rec.stats.steps)?;
     st.set_item("rejected", rec.stats.rejected)?;

@@ -288,7 +288,7 @@ impl ConstraintKind {
 /// Adds `sign · dirᵀ J_T(point)` (or all three rows of `sign · J_T` when `dir` is None) of the
 /// world point `p` attached to `body` into the rows of `g` starting at `row`.
 #[allow(clippy::too_many_arguments)]
-fn add_point_rows(
+pub(crate) fn add_point_rows(
     model: &Model,
     s_all: &[[Motion; 6]],
     body: usize,

@@ -73,12 +73,10 @@ fn path_velocities(model: &Model, body: usize, out: &mut Vec<usize>) {
 }
 
 impl Saddle {
-    /// Plans the solve for `model` (structure only).
+    /// Plans the solve for `model` (structure only; without constraints only the tree factor of M,
+    /// which the time-stepping schemes use).
     pub fn new(model: &Model) -> Self {
         let (nu, nc) = (model.nu, model.nc);
-        if nc == 0 {
-            return Saddle::default();
-        }
         // velocity tree: within a joint each velocity hangs on the previous one; a joint's first
         // velocity hangs on the last velocity of the nearest ancestor joint that has any
         let mut parent = vec![usize::MAX; nu];

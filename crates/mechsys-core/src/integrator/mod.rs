@@ -4,9 +4,12 @@
 //! (unit quaternions); a scheme advances it and calls an observer at each requested output time.
 //! - [`rk4`]: classical fixed-step Runge–Kutta of order 4;
 //! - [`dopri5`]: Dormand–Prince 5(4) with step-size control and dense output;
-//! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable), fixed step, for stiff systems.
+//! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable), fixed step, for stiff systems;
+//! - [`moreau_jean`]: time-stepping at velocity/impulse level for models with unilateral contacts
+//!   (not an [`OdeSystem`] scheme: [`crate::simulate`] runs it directly).
 
 pub mod dopri5;
+pub mod moreau_jean;
 pub mod radau5;
 pub mod rk4;
 
@@ -62,6 +65,14 @@ pub enum IntegratorKind {
         #[serde(default = "default_newton_tol")]
         newton_tol: f64,
     },
+    /// Moreau–Jean time-stepping for unilateral contacts, impacts and friction ([`moreau_jean`]).
+    MoreauJean {
+        /// Step size (s).
+        dt: f64,
+        /// The contact solver.
+        #[serde(default = "crate::solver::Method::nsgs")]
+        solver: crate::solver::Method,
+    },
 }
 
 fn default_rtol() -> f64 {
@@ -102,6 +113,9 @@ pub fn integrate<S: OdeSystem>(
             dopri5::integrate(sys, t0, y0, t_out, *rtol, *atol, *max_step, *first_step, obs)
         }
         IntegratorKind::Radau5 { dt, newton_tol } => radau5::integrate(sys, t0, y0, *dt, *newton_tol, t_out, obs),
+        IntegratorKind::MoreauJean { .. } => Err(crate::error::Error::Settings(
+            "integrator: Moreau–Jean is a time-stepping scheme for contact models; simulate() runs it".into(),
+        )),
     }
 }
 

@@ -5,6 +5,7 @@
 //! order (index 0 is the ground, each body's parent has a smaller index) and body `i > 0` is moved
 //! by joint `i - 1`, so the recursive algorithms are plain loops.
 
+pub mod contact;
 pub mod contact_description;
 pub mod description;
 pub mod joint;
@@ -272,6 +273,10 @@ pub struct Model {
     pub forces: Vec<ForceElement>,
     /// Bilateral constraints beyond the tree.
     pub constraints: Vec<crate::constraints::Constraint>,
+    /// Unilateral contacts.
+    pub contacts: Vec<contact::Contact>,
+    /// Number of candidate contact points over all contacts.
+    pub n_contact_points: usize,
     /// Total number of constraint equations.
     pub nc: usize,
     /// Total number of coordinates.

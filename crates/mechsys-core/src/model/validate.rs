@@ -187,10 +187,6 @@ impl Model {
     /// Validates a description and builds the model.
     pub fn from_description(desc: ModelDescription) -> Result<Model> {
         let g = finite3(&desc.gravity, "gravity")?;
-        if let Some(c) = desc.contacts.first() {
-            // the description is read, but the contact stages are not wired in yet
-            return Err(err(format!("contacts[0] '{}': unilateral contacts are not available in this build yet", c.name)));
-        }
 
         // ---- bodies ----------------------------------------------------------------------------
         let mut names: HashMap<String, usize> = HashMap::new();
@@ -760,6 +756,17 @@ impl Model {
             row += rows;
         }
 
+        // ---- contacts ------------------------------------------------------------------------------
+        let mut contacts = Vec::with_capacity(desc.contacts.len());
+        let mut contact_names = HashSet::new();
+        let mut n_contact_points = 0;
+        for (i, d) in desc.contacts.iter().enumerate() {
+            crate::ensure!(contact_names.insert(d.name.clone()), Model, "contacts[{i}] '{}': duplicate contact name", d.name);
+            let c = super::contact::validate(d, i, n_contact_points, body, rotation)?;
+            n_contact_points += c.points();
+            contacts.push(c);
+        }
+
         let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
         Ok(Model {
@@ -769,6 +776,8 @@ impl Model {
             joints,
             forces,
             constraints,
+            contacts,
+            n_contact_points,
             nc: row,
             nq: iq,
             nu: iu,

@@ -1,2 +1,346 @@
 //! Complementarity problems of contact mechanics (section 2.5): linear complementarity problems
 //! and friction-contact problems, with the solvers that time-stepping and event-driven schemes share.
+//!
+//! # Problems
+//!
+//! - [`Lcp`]: find `z ≥ 0` with `w = M z + q ≥ 0` and `zᵀw = 0`. Event-driven schemes pose their
+//!   normal-contact transition problems this way (`λ_N ≥ 0 ⊥ g̈_N ≥ 0`, Signorini's corner law of
+//!   fig. 2.33 on acceleration level).
+//! - [`FrictionContact`]: `n` contacts in dimension `d = 2` (normal, tangent) or `d = 3` (normal, two
+//!   tangents) with local velocities `u = W r + q`, `W` the Delassus matrix (symmetric positive
+//!   semidefinite), `r = [r_N, r_T]` per contact (impulses for Moreau–Jean, forces on acceleration
+//!   level) and a friction coefficient `μ` per contact. A solution has `r` in the Coulomb cone
+//!   `K_μ = {|r_T| ≤ μ r_N}` and, per contact, one of
+//!   - open: `r = 0`, `u_N ≥ 0` (Signorini, fig. 2.33);
+//!   - stick: `u_N = 0`, `|r_T| ≤ μ r_N`, `u_T = 0` (eq. 2.200, first line);
+//!   - slip: `u_N = 0`, `r_T = -μ r_N u_T/|u_T|` (eq. 2.200, sliding lines; in 3-D the friction force
+//!     opposes the sliding velocity).
+//!
+//!   Equivalently (De Saxcé) `K_μ ∋ r ⊥ û ∈ K_μ*` with the modified velocity
+//!   `û = u + μ |u_T| e_N`. The text's friction reserve `μ λ_N − |λ_T|` is
+//!   [`FrictionContact::friction_reserve`]; the open/stick/slip classification is
+//!   [`FrictionContact::contact_state`]. Which `μ` a caller puts in (the static `μ0` of a sticking
+//!   contact or the sliding `μ`, eq. 2.201) is the caller's decision; the solver sees one coefficient.
+//!
+//! # Solvers
+//!
+//! One call, [`solve`]`(problem, method, x, warm_start, workspace)`, with the method chosen by
+//! [`Method`]:
+//!
+//! | method | [`Lcp`] | [`FrictionContact`] |
+//! | --- | --- | --- |
+//! | [`Method::Lemke`] | complementary pivoting ([`lemke`]), exact | `d = 2`: exact through the LCP of [`friction_lcp`]; `d = 3`: pyramid with `facets` sides |
+//! | [`Method::Nsgs`] | projected Gauss–Seidel | nonsmooth Gauss–Seidel with exact local solves ([`nsgs`]) |
+//! | [`Method::Newton`] | — | semismooth Newton on the Alart–Curnier function ([`newton`]) |
+//!
+//! Every solve returns a [`Report`]; its residual is recomputed from the returned solution with
+//! the merit described at [`Report::residual`], whatever the method. Failing to reach the
+//! tolerance is reported (`converged: false`), not raised; what raises is bad input and Lemke's
+//! ray termination (no solution).
+//!
+//! All scratch lives in a [`Workspace`], sized once with [`Workspace::reserve`] for the largest
+//! problem and method a caller will use; a solve allocates nothing.
+//!
+//! # Example
+//!
+//! ```
+//! use mechsys_core::solver::{solve, Delassus, FrictionContact, Method, Workspace, ContactState};
+//! // one planar contact: a block of 1 kg pushed sideways (u_T = 2 m/s) while pressed down
+//! let problem = FrictionContact::new(2, Delassus::Dense(vec![1.0, 0.0, 0.0, 1.0]), vec![-1.0, 2.0], vec![0.5])?;
+//! let method = Method::nsgs();
+//! let mut ws = Workspace::for_problem(&problem, &method)?;
+//! let mut r = vec![0.0; 2];
+//! let report = solve(&problem, &method, &mut r, false, &mut ws)?;
+//! assert!(report.converged);
+//! assert!((r[0] - 1.0).abs() < 1e-12 && (r[1] + 0.5).abs() < 1e-12); // slips: r_T = -μ r_N
+//! assert_eq!(problem.contact_state(0, &r, 1e-9)?, ContactState::Slip);
+//! # Ok::<(), mechsys_core::Error>(())
+//! ```
+//!
+//! Literature (for the methods, not the code): Cottle, Pang & Stone, *The Linear Complementarity
+//! Problem* (Lemke's method, lexicographic degeneracy resolution); Stewart & Trinkle (1996) and
+//! Anitescu & Potra (1997) for the friction LCP; Moreau (1988) and Jean (1999) for nonsmooth
+//! Gauss–Seidel; Alart & Curnier (1991) for the augmented-Lagrangian Newton; De Saxcé & Feng (1991)
+//! for the modified velocity; Acary & Brogliato, *Numerical Methods for Nonsmooth Dynamical Systems*
+//! (2008), for the merit function.
+
+pub mod fixtures;
+pub mod friction_lcp;
+pub mod lemke;
+pub mod newton;
+pub mod nsgs;
+mod problem;
+mod workspace;
+
+pub use problem::{
+    project_onto_cone, BlockDelassus, BlockDelassusBuilder, ContactState, Delassus, FrictionContact, Lcp,
+};
+pub use workspace::Workspace;
+
+use workspace::Needs;
+
+use serde::{Deserialize, Serialize};
+
+use crate::ensure;
+use crate::error::Result;
+
+/// Outcome of a solve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Pivots (Lemke), sweeps (Gauss–Seidel) or Newton iterations.
+    pub iterations: usize,
+    /// Scale-aware merit of the returned solution, recomputed after solving.
+    ///
+    /// For an LCP, `‖min(M_ii z_i, w_i)‖₂ / (1 + ‖q‖₂)` (the natural map in `w` units; `M_ii` is
+    /// replaced by 1 where it is not positive). For a friction-contact problem,
+    /// `‖(r_i − proj_{K_μi}(r_i − ρ_i û_i)) / ρ_i‖₂ / (1 + ‖q‖₂)` with `ρ_i = 1/W_NN,i` and the
+    /// modified velocity `û`, i.e. the violation of the Signorini–Coulomb conditions in velocity
+    /// units relative to the free velocity. Zero exactly at a solution.
+    pub residual: f64,
+    /// Whether the method's stopping test was met. Gauss–Seidel and Newton: `residual ≤ tol`.
+    /// Lemke: the pivoting ended in a complementary basis (for `d = 3` this solves the pyramid
+    /// approximation exactly; `residual` then measures the facet error against the round cone).
+    pub converged: bool,
+}
+
+/// Lemke's method ([`lemke`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LemkeOptions {
+    /// Pivot-column entries `≤ pivot_tol · max(1, max|M_ij|)` count as zero.
+    pub pivot_tol: f64,
+    /// Cap on pivots; `None` means `50 (n + 1)` for an LCP of size `n`.
+    pub max_pivots: Option<usize>,
+    /// Sides of the friction pyramid that replaces the cone for `d = 3` (3 to
+    /// [`friction_lcp::MAX_FACETS`]).
+    pub facets: usize,
+}
+
+impl Default for LemkeOptions {
+    fn default() -> Self {
+        Self { pivot_tol: 1e-12, max_pivots: None, facets: 8 }
+    }
+}
+
+/// (Nonsmooth) projected Gauss–Seidel ([`nsgs`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NsgsOptions {
+    /// Stop when the residual of [`Report::residual`] is at most this.
+    pub tol: f64,
+    /// Cap on sweeps.
+    pub max_iter: usize,
+    /// Under-relaxation `ω ∈ (0, 1]`: `r_i ← ω r_i,local + (1 − ω) r_i`.
+    pub relaxation: f64,
+}
+
+impl Default for NsgsOptions {
+    fn default() -> Self {
+        Self { tol: 1e-10, max_iter: 10_000, relaxation: 1.0 }
+    }
+}
+
+/// Semismooth Newton on the Alart–Curnier function ([`newton`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NewtonOptions {
+    /// Stop when the residual of [`Report::residual`] is at most this.
+    pub tol: f64,
+    /// Cap on Newton iterations (a fallback Gauss–Seidel sweep counts as one).
+    pub max_iter: usize,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self { tol: 1e-10, max_iter: 200 }
+    }
+}
+
+/// The solver and its settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Method {
+    /// Lemke's complementary pivoting (LCPs; planar friction exactly, spatial with a pyramid).
+    Lemke(LemkeOptions),
+    /// Projected Gauss–Seidel (LCP) or nonsmooth Gauss–Seidel (friction contact).
+    Nsgs(NsgsOptions),
+    /// Semismooth Newton (friction contact only).
+    Newton(NewtonOptions),
+}
+
+impl Method {
+    /// Lemke with default options.
+    pub fn lemke() -> Self {
+        Method::Lemke(LemkeOptions::default())
+    }
+    /// Gauss–Seidel with default options.
+    pub fn nsgs() -> Self {
+        Method::Nsgs(NsgsOptions::default())
+    }
+    /// Newton with default options.
+    pub fn newton() -> Self {
+        Method::Newton(NewtonOptions::default())
+    }
+
+    fn validate(&self) -> Result<()> {
+        match self {
+            Method::Lemke(o) => {
+                ensure!(
+                    o.pivot_tol >= 0.0 && o.pivot_tol < 1.0,
+                    Settings,
+                    "Lemke: pivot_tol must be in [0, 1), got {}",
+                    o.pivot_tol
+                );
+                ensure!(o.max_pivots != Some(0), Settings, "Lemke: max_pivots must be > 0");
+                ensure!(
+                    (3..=friction_lcp::MAX_FACETS).contains(&o.facets),
+                    Settings,
+                    "Lemke: facets must be in 3..={}, got {}",
+                    friction_lcp::MAX_FACETS,
+                    o.facets
+                );
+            }
+            Method::Nsgs(o) => {
+                ensure!(o.tol > 0.0, Settings, "NSGS: tol must be > 0, got {}", o.tol);
+                ensure!(o.max_iter > 0, Settings, "NSGS: max_iter must be > 0");
+                ensure!(
+                    o.relaxation > 0.0 && o.relaxation <= 1.0,
+                    Settings,
+                    "NSGS: relaxation must be in (0, 1], got {}",
+                    o.relaxation
+                );
+            }
+            Method::Newton(o) => {
+                ensure!(o.tol > 0.0, Settings, "Newton: tol must be > 0, got {}", o.tol);
+                ensure!(o.max_iter > 0, Settings, "Newton: max_iter must be > 0");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A problem [`solve`] accepts: [`Lcp`] or [`FrictionContact`].
+pub trait Problem: sealed::Sealed {
+    /// Number of unknowns (`n` for an LCP, `d·n` for a friction-contact problem).
+    fn unknowns(&self) -> usize;
+    /// Checks sizes and values; the message names the offending entry.
+    fn validate(&self) -> Result<()>;
+}
+
+mod sealed {
+    /// Dispatch to the problem's solvers; outside the public API so that only this module's
+    /// problems implement [`super::Problem`].
+    pub trait Sealed {
+        fn needs(&self, method: &super::Method) -> crate::error::Result<super::Needs>;
+        fn run(
+            &self,
+            method: &super::Method,
+            x: &mut [f64],
+            ws: &mut super::Workspace,
+        ) -> crate::error::Result<super::Report>;
+    }
+}
+
+impl Problem for Lcp {
+    fn unknowns(&self) -> usize {
+        self.size()
+    }
+    fn validate(&self) -> Result<()> {
+        self.check()
+    }
+}
+
+impl sealed::Sealed for Lcp {
+    fn needs(&self, method: &Method) -> Result<Needs> {
+        let n = self.size();
+        match method {
+            Method::Lemke(_) => Ok(Needs { u: n, lemke: n, ..Needs::default() }),
+            Method::Nsgs(_) => Ok(Needs { u: n, ..Needs::default() }),
+            Method::Newton(_) => Err(newton_is_not_for_lcps()),
+        }
+    }
+    fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
+        match method {
+            Method::Lemke(o) => lemke::solve_lcp(self, o, x, ws),
+            Method::Nsgs(o) => nsgs::solve_lcp(self, o, x, ws),
+            Method::Newton(_) => Err(newton_is_not_for_lcps()),
+        }
+    }
+}
+
+impl Problem for FrictionContact {
+    fn unknowns(&self) -> usize {
+        self.dim * self.contacts()
+    }
+    fn validate(&self) -> Result<()> {
+        self.check()
+    }
+}
+
+impl sealed::Sealed for FrictionContact {
+    fn needs(&self, method: &Method) -> Result<Needs> {
+        let n = self.contacts();
+        let m = self.dim * n;
+        Ok(match method {
+            Method::Lemke(o) => {
+                let nl = (friction_lcp::directions(self.dim, o) + 2) * n;
+                let dense = if matches!(self.w, Delassus::Blocks(_)) { m } else { 0 };
+                Needs { u: m, diag: n, lemke: nl, lcp: nl, dense, newton: 0 }
+            }
+            Method::Nsgs(_) => Needs { u: m, diag: n, ..Needs::default() },
+            Method::Newton(_) => Needs { u: m, diag: n, newton: m, ..Needs::default() },
+        })
+    }
+    fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
+        match method {
+            Method::Lemke(o) => friction_lcp::solve(self, o, x, ws),
+            Method::Nsgs(o) => nsgs::solve_fc(self, o, x, ws),
+            Method::Newton(o) => newton::solve(self, o, x, ws),
+        }
+    }
+}
+
+fn newton_is_not_for_lcps() -> crate::Error {
+    crate::Error::Settings("solver: Newton solves friction-contact problems; solve an LCP with Lemke or Nsgs".into())
+}
+
+/// Solves `problem` with `method` into `x`.
+///
+/// `x` has [`Problem::unknowns`] entries; with `warm_start` it holds the initial guess (e.g. the
+/// previous step's impulses; Lemke ignores it), otherwise it is zeroed first. `workspace` must have
+/// been sized for this problem size and method ([`Workspace::reserve`]); no allocation happens here.
+///
+/// Errors: invalid input (sizes, non-finite values, `μ < 0`, `W_NN ≤ 0`, a method that does not
+/// apply to the problem, a workspace too small) and Lemke's ray termination. Not reaching the
+/// tolerance is not an error: see [`Report::converged`].
+pub fn solve<P: Problem + ?Sized>(
+    problem: &P,
+    method: &Method,
+    x: &mut [f64],
+    warm_start: bool,
+    workspace: &mut Workspace,
+) -> Result<Report> {
+    method.validate()?;
+    problem.validate()?;
+    let n = problem.unknowns();
+    ensure!(
+        x.len() == n,
+        Settings,
+        "solver: the solution vector has {} entries, the problem has {n} unknowns",
+        x.len()
+    );
+    if warm_start {
+        if let Some(k) = x.iter().position(|v| !v.is_finite()) {
+            return Err(crate::Error::Settings(format!("solver: warm start entry {k} is not finite ({})", x[k])));
+        }
+    } else {
+        x.fill(0.0);
+    }
+    workspace.check(&problem.needs(method)?)?;
+    problem.run(method, x, workspace)
+}
+
+#[cfg(test)]
+mod bank;
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,187 @@
+//! Timings of the contact geometry: narrow phase and broad phase over the "spheres in a box"
+//! fixture.
+//!
+//! Groups:
+//! - `narrow/sphere_plane_evaluate/1000`: [`evaluate`] for 1000 sphere–ground pairs (gap,
+//!   normal, points, tangents);
+//! - `narrow/sphere_plane_kinematics/1000`: [`contact_kinematics`] for the same pairs, moving
+//!   (adds `ġ_N`, `ġ_T`, `w̄_N`, `w̄_T`);
+//! - `broad/sap/N`, N = 1000, 10000: one step of the broad phase for N spheres in a unit box (volume
+//!   fraction 0.3) plus its six walls: world boxes from the poses ([`Contour::aabb`]) and
+//!   [`SweepAndPrune::update`], alternating between two configurations one small step apart, as
+//!   in a simulation (the insertion-sort path);
+//! - `broad/sap_cold/N`: the same from an empty broad phase (full sort);
+//! - `broad/brute_force/1000`: the O(n²) test of every pair, for comparison.
+//!
+//! Run with `cargo bench -p mechsys-core --bench contact` (about a minute; `-- --quick` for a
+//! rough figure).
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+
+use mechsys_core::contact::{
+    contact_kinematics, evaluate, Aabb, BodyMotion, ContactKinematics, ContactPair, ContactPoint, Contour,
+    SweepAndPrune,
+};
+use mechsys_core::math::{Mat3, Vec3};
+use mechsys_core::spatial::{Motion, Pose};
+
+/// A small deterministic generator (xorshift64*).
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self, a: f64, b: f64) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        a + (b - a) * ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+/// N spheres in the unit box at volume fraction 0.3: centres, radius, and the six walls.
+fn spheres_in_a_box(n: usize, rng: &mut Rng) -> (Vec<Vec3>, f64, Vec<Contour>) {
+    let r = (0.3 * 3.0 / (4.0 * std::f64::consts::PI * n as f64)).cbrt();
+    let c =
+        (0..n).map(|_| Vec3::new(rng.uniform(r, 1.0 - r), rng.uniform(r, 1.0 - r), rng.uniform(r, 1.0 - r))).collect();
+    let mut walls = Vec::new();
+    for k in 0..3 {
+        let mut e = Vec3::zeros();
+        e[k] = 1.0;
+        // solid outside the unit box
+        walls.push(Contour::Plane { point: Vec3::zeros(), normal: e });
+        walls.push(Contour::Plane { point: e, normal: -e });
+    }
+    (c, r, walls)
+}
+
+fn bench_narrow(c: &mut Criterion) {
+    let n = 1000;
+    let mut rng = Rng(0x1234_5678_9abc_def1);
+    let ground = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
+    let pairs: Vec<ContactPair> = (0..n)
+        .map(|i| {
+            let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.05 + 1e-5 * i as f64 };
+            ContactPair::new("ball", ball, ground.clone()).expect("valid pair")
+        })
+        .collect();
+    let bodies: Vec<BodyMotion> = (0..n)
+        .map(|_| {
+            let a = nalgebra::Rotation3::from_euler_angles(
+                rng.uniform(-3.0, 3.0),
+                rng.uniform(-1.5, 1.5),
+                rng.uniform(-3.0, 3.0),
+            )
+            .into_inner();
+            let r = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(0.0, 0.1));
+            let w = Vec3::new(rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0));
+            let v = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)) - w.cross(&r);
+            BodyMotion {
+                pose: Pose::new(a, r),
+                twist: Motion::new(w, v),
+                acc: Motion::new(Vec3::zeros(), Vec3::new(0.0, 0.0, -9.81)),
+            }
+        })
+        .collect();
+    let mut g = c.benchmark_group("narrow");
+    g.throughput(Throughput::Elements(n as u64));
+    let mut points = vec![ContactPoint::default(); n];
+    g.bench_with_input(BenchmarkId::new("sphere_plane_evaluate", n), &n, |b, _| {
+        b.iter(|| {
+            for ((p, body), out) in pairs.iter().zip(&bodies).zip(points.iter_mut()) {
+                evaluate(p, &body.pose, &Pose::IDENTITY, std::slice::from_mut(out)).expect("room for 1");
+            }
+            black_box(&points);
+        })
+    });
+    let mut kin = vec![ContactKinematics::default(); n];
+    g.bench_with_input(BenchmarkId::new("sphere_plane_kinematics", n), &n, |b, _| {
+        b.iter(|| {
+            for ((p, body), out) in pairs.iter().zip(&bodies).zip(kin.iter_mut()) {
+                contact_kinematics(p, body, &BodyMotion::GROUND, std::slice::from_mut(out)).expect("room for 1");
+            }
+            black_box(&kin);
+        })
+    });
+    g.finish();
+}
+
+fn boxes_into(centres: &[Vec3], ball: &Contour, walls: &[Contour], out: &mut [Aabb]) {
+    for (o, c) in out.iter_mut().zip(centres) {
+        *o = ball.aabb(&Pose::new(Mat3::identity(), *c));
+    }
+    for (o, w) in out[centres.len()..].iter_mut().zip(walls) {
+        *o = w.aabb(&Pose::IDENTITY);
+    }
+}
+
+fn bench_broad(c: &mut Criterion) {
+    let mut g = c.benchmark_group("broad");
+    for n in [1000usize, 10000] {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ n as u64);
+        let (centres, r, walls) = spheres_in_a_box(n, &mut rng);
+        // one step later: every sphere moved by up to 0.1 r per axis
+        let moved: Vec<Vec3> = centres
+            .iter()
+            .map(|c| c + Vec3::new(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)) * r)
+            .collect();
+        let ball = Contour::Sphere { center: Vec3::zeros(), radius: r };
+        let mut boxes = vec![Aabb::EMPTY; n + walls.len()];
+        let mut sap = SweepAndPrune::with_capacity(boxes.len());
+        let mut pairs = Vec::with_capacity(8 * n);
+        boxes_into(&centres, &ball, &walls, &mut boxes);
+        sap.update(&boxes, &mut pairs);
+        g.throughput(Throughput::Elements(n as u64));
+        let mut flip = false;
+        g.bench_with_input(BenchmarkId::new("sap", n), &n, |b, _| {
+            b.iter(|| {
+                flip = !flip;
+                boxes_into(if flip { &moved } else { &centres }, &ball, &walls, &mut boxes);
+                sap.update(&boxes, &mut pairs);
+                black_box(pairs.len())
+            })
+        });
+        g.bench_with_input(BenchmarkId::new("sap_cold", n), &n, |b, _| {
+            b.iter(|| {
+                let mut cold = SweepAndPrune::with_capacity(boxes.len());
+                boxes_into(&centres, &ball, &walls, &mut boxes);
+                cold.update(&boxes, &mut pairs);
+                black_box(pairs.len())
+            })
+        });
+        if n == 1000 {
+            g.bench_with_input(BenchmarkId::new("brute_force", n), &n, |b, _| {
+                b.iter(|| {
+                    boxes_into(&centres, &ball, &walls, &mut boxes);
+                    pairs.clear();
+                    for i in 0..boxes.len() {
+                        for j in i + 1..boxes.len() {
+                            if boxes[i].overlaps(&boxes[j]) {
+                                pairs.push((i, j));
+                            }
+                        }
+                    }
+                    black_box(pairs.len())
+                })
+            });
+        }
+        eprintln!("broad/{n}: {} candidate pairs (spheres of radius {r:.4})", pairs.len());
+    }
+    g.finish();
+}
+
+fn config() -> Criterion {
+    // small samples: shared 2-core machine
+    Criterion::default()
+        .sample_size(30)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2))
+        .noise_threshold(0.05)
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = bench_narrow, bench_broad
+}
+criterion_main!(benches);

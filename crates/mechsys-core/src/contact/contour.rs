@@ -1,0 +1,544 @@
+//! Contours: the contact geometry a body carries, given in the body frame.
+//!
+//! Spatial contours are solids (a point, a sphere, a half-space, a box, a capsule, a cylinder).
+//! Planar contours live in the body's x-y plane and are extruded along the body's z axis: a circle
+//! is an infinite cylinder, a line a half-space whose normal lies in the x-y plane, a polygon an
+//! infinite prism. They model plane motion, where every body moves in the common x-y plane.
+
+use crate::ensure;
+use crate::error::Result;
+use crate::math::{Mat3, Vec3};
+use crate::spatial::Pose;
+
+use super::broad::Aabb;
+
+/// 2-vector of `f64` (the coordinates of planar contours in the body's x-y plane).
+pub type Vec2 = nalgebra::Vector2<f64>;
+
+/// A contour on a body; every parameter is in the body frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Contour {
+    /// A single point (a vertex, a pin, the tip of a rod).
+    Point {
+        /// The point.
+        p: Vec3,
+    },
+    /// A ball.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// The half-space `(x - point)·normal ≤ 0`; the solid lies below the normal.
+    Plane {
+        /// A point on the boundary plane.
+        point: Vec3,
+        /// Outward normal (nonzero; normalized when a pair is built).
+        normal: Vec3,
+    },
+    /// A rectangular box.
+    Box {
+        /// Centre.
+        center: Vec3,
+        /// Rotation box frame → body frame (orthonormal, determinant +1).
+        rotation: Mat3,
+        /// Half the edge lengths along the box axes (> 0).
+        half_extents: Vec3,
+    },
+    /// The points within `radius` of the segment `a`–`b`.
+    Capsule {
+        /// First end of the axis segment.
+        a: Vec3,
+        /// Second end (≠ `a`; a capsule of zero length is a [`Contour::Sphere`]).
+        b: Vec3,
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// A solid circular cylinder with flat ends.
+    Cylinder {
+        /// Centre (midpoint of the axis).
+        center: Vec3,
+        /// Axis direction (nonzero; normalized when a pair is built).
+        axis: Vec3,
+        /// Radius (> 0).
+        radius: f64,
+        /// Half the length along the axis (> 0).
+        half_length: f64,
+    },
+    /// Planar: a point of the x-y plane.
+    Point2 {
+        /// The point.
+        p: Vec2,
+    },
+    /// Planar: a disc (an infinite cylinder along the body z axis).
+    Circle {
+        /// Centre.
+        center: Vec2,
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// Planar: the half-plane `(x - point)·normal ≤ 0`, solid behind the normal.
+    Line {
+        /// A point on the boundary line.
+        point: Vec2,
+        /// Outward normal (nonzero; normalized when a pair is built).
+        normal: Vec2,
+    },
+    /// Planar: a convex polygon, vertices counter-clockwise about the body z axis. The `Vec` is
+    /// built with the model; the per-step functions only read it.
+    Polygon {
+        /// Vertices (at least 3, convex, counter-clockwise; collinear vertices are allowed).
+        vertices: Vec<Vec2>,
+    },
+}
+
+/// The kind of a contour, for dispatch tables and messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ContourKind {
+    /// [`Contour::Point`]
+    Point,
+    /// [`Contour::Sphere`]
+    Sphere,
+    /// [`Contour::Plane`]
+    Plane,
+    /// [`Contour::Box`]
+    Box,
+    /// [`Contour::Capsule`]
+    Capsule,
+    /// [`Contour::Cylinder`]
+    Cylinder,
+    /// [`Contour::Point2`]
+    Point2,
+    /// [`Contour::Circle`]
+    Circle,
+    /// [`Contour::Line`]
+    Line,
+    /// [`Contour::Polygon`]
+    Polygon,
+}
+
+impl ContourKind {
+    /// Lower-case name used in messages ("sphere", "plane", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            ContourKind::Point => "point",
+            ContourKind::Sphere => "sphere",
+            ContourKind::Plane => "plane",
+            ContourKind::Box => "box",
+            ContourKind::Capsule => "capsule",
+            ContourKind::Cylinder => "cylinder",
+            ContourKind::Point2 => "point2",
+            ContourKind::Circle => "circle",
+            ContourKind::Line => "line",
+            ContourKind::Polygon => "polygon",
+        }
+    }
+
+    /// Whether the contour lives in the body's x-y plane.
+    pub fn is_planar(self) -> bool {
+        matches!(self, ContourKind::Point2 | ContourKind::Circle | ContourKind::Line | ContourKind::Polygon)
+    }
+}
+
+impl std::fmt::Display for ContourKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+fn finite3(v: &Vec3, what: &str, key: &str) -> Result<()> {
+    ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: {key} must be finite, got {:?}", v.as_slice());
+    Ok(())
+}
+
+fn finite2(v: &Vec2, what: &str, key: &str) -> Result<()> {
+    ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: {key} must be finite, got {:?}", v.as_slice());
+    Ok(())
+}
+
+fn positive(x: f64, what: &str, key: &str) -> Result<()> {
+    // `!(x > 0)` also rejects NaN; the upper bound rejects infinity
+    ensure!(x > 0.0 && x.is_finite(), Model, "{what}: {key} must be > 0 and finite, got {x}");
+    Ok(())
+}
+
+/// Direction vectors shorter than this are rejected as zero.
+const MIN_DIRECTION: f64 = 1e-12;
+
+impl Contour {
+    /// The contour's kind.
+    pub fn kind(&self) -> ContourKind {
+        match self {
+            Contour::Point { .. } => ContourKind::Point,
+            Contour::Sphere { .. } => ContourKind::Sphere,
+            Contour::Plane { .. } => ContourKind::Plane,
+            Contour::Box { .. } => ContourKind::Box,
+            Contour::Capsule { .. } => ContourKind::Capsule,
+            Contour::Cylinder { .. } => ContourKind::Cylinder,
+            Contour::Point2 { .. } => ContourKind::Point2,
+            Contour::Circle { .. } => ContourKind::Circle,
+            Contour::Line { .. } => ContourKind::Line,
+            Contour::Polygon { .. } => ContourKind::Polygon,
+        }
+    }
+
+    /// Checks the parameters; errors start with `what` (e.g. "contact 'tip': contour 1").
+    ///
+    /// # Example
+    /// ```
+    /// use mechsys_core::contact::Contour;
+    /// use mechsys_core::math::Vec3;
+    /// let bad = Contour::Sphere { center: Vec3::zeros(), radius: -1.0 };
+    /// let e = bad.validate("contact 'ball'").unwrap_err();
+    /// assert!(e.to_string().contains("contact 'ball': sphere radius must be > 0"));
+    /// ```
+    pub fn validate(&self, what: &str) -> Result<()> {
+        match self {
+            Contour::Point { p } => finite3(p, what, "point p"),
+            Contour::Sphere { center, radius } => {
+                finite3(center, what, "sphere center")?;
+                positive(*radius, what, "sphere radius")
+            }
+            Contour::Plane { point, normal } => {
+                finite3(point, what, "plane point")?;
+                finite3(normal, what, "plane normal")?;
+                ensure!(
+                    normal.norm() > MIN_DIRECTION,
+                    Model,
+                    "{what}: plane normal must not be the zero vector, got {:?}",
+                    normal.as_slice()
+                );
+                Ok(())
+            }
+            Contour::Box { center, rotation, half_extents } => {
+                finite3(center, what, "box center")?;
+                ensure!(rotation.iter().all(|x| x.is_finite()), Model, "{what}: box rotation must be finite");
+                let e = (rotation.transpose() * rotation - Mat3::identity()).norm();
+                ensure!(
+                    e < 1e-6 && rotation.determinant() > 0.0,
+                    Model,
+                    "{what}: box rotation must be orthonormal with determinant +1 (|AᵀA - E| = {e:.2e})"
+                );
+                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                    positive(half_extents[k], what, &format!("box half extent along {axis}"))?;
+                }
+                Ok(())
+            }
+            Contour::Capsule { a, b, radius } => {
+                finite3(a, what, "capsule end a")?;
+                finite3(b, what, "capsule end b")?;
+                positive(*radius, what, "capsule radius")?;
+                ensure!(
+                    (b - a).norm() > MIN_DIRECTION,
+                    Model,
+                    "{what}: capsule ends a and b must differ (a capsule of zero length is a sphere), got {:?}",
+                    a.as_slice()
+                );
+                Ok(())
+            }
+            Contour::Cylinder { center, axis, radius, half_length } => {
+                finite3(center, what, "cylinder center")?;
+                finite3(axis, what, "cylinder axis")?;
+                ensure!(
+                    axis.norm() > MIN_DIRECTION,
+                    Model,
+                    "{what}: cylinder axis must not be the zero vector, got {:?}",
+                    axis.as_slice()
+                );
+                positive(*radius, what, "cylinder radius")?;
+                positive(*half_length, what, "cylinder half_length")
+            }
+            Contour::Point2 { p } => finite2(p, what, "point2 p"),
+            Contour::Circle { center, radius } => {
+                finite2(center, what, "circle center")?;
+                positive(*radius, what, "circle radius")
+            }
+            Contour::Line { point, normal } => {
+                finite2(point, what, "line point")?;
+                finite2(normal, what, "line normal")?;
+                ensure!(
+                    normal.norm() > MIN_DIRECTION,
+                    Model,
+                    "{what}: line normal must not be the zero vector, got {:?}",
+                    normal.as_slice()
+                );
+                Ok(())
+            }
+            Contour::Polygon { vertices } => validate_polygon(vertices, what),
+        }
+    }
+
+    /// A copy with unit normals and axes and an exactly orthonormal box rotation (what a pair
+    /// stores, so the per-step code never normalizes). Call after [`Contour::validate`].
+    pub fn normalized(&self) -> Contour {
+        match self {
+            Contour::Plane { point, normal } => Contour::Plane { point: *point, normal: normal.normalize() },
+            Contour::Line { point, normal } => Contour::Line { point: *point, normal: normal.normalize() },
+            Contour::Cylinder { center, axis, radius, half_length } => Contour::Cylinder {
+                center: *center,
+                axis: axis.normalize(),
+                radius: *radius,
+                half_length: *half_length,
+            },
+            Contour::Box { center, rotation, half_extents } => {
+                // Gram–Schmidt on the columns; the third is the cross product so det = +1
+                let x = rotation.column(0).normalize();
+                let y = rotation.column(1) - x * x.dot(&rotation.column(1));
+                let y = y.normalize();
+                let z = x.cross(&y);
+                Contour::Box { center: *center, rotation: Mat3::from_columns(&[x, y, z]), half_extents: *half_extents }
+            }
+            other => other.clone(),
+        }
+    }
+
+    /// The world axis-aligned bounding box of the contour on a body at `pose`.
+    ///
+    /// Half-spaces are unbounded except along a world axis their normal is aligned with; planar
+    /// contours are unbounded along every world axis the body's z axis has a component on.
+    pub fn aabb(&self, pose: &Pose) -> Aabb {
+        match self {
+            Contour::Point { p } => Aabb::point(&pose.point_to_parent(p)),
+            Contour::Sphere { center, radius } => Aabb::point(&pose.point_to_parent(center)).inflated(*radius),
+            Contour::Plane { point, normal } => half_space_aabb(&pose.point_to_parent(point), &(pose.a * normal)),
+            Contour::Box { center, rotation, half_extents } => {
+                // the extent along world axis k is Σ_j |A_kj| h_j
+                let a = pose.a * rotation;
+                let c = pose.point_to_parent(center);
+                let e = a.abs() * half_extents;
+                Aabb { min: c - e, max: c + e }
+            }
+            Contour::Capsule { a, b, radius } => {
+                let (pa, pb) = (pose.point_to_parent(a), pose.point_to_parent(b));
+                Aabb { min: pa.inf(&pb), max: pa.sup(&pb) }.inflated(*radius)
+            }
+            Contour::Cylinder { center, axis, radius, half_length } => {
+                let c = pose.point_to_parent(center);
+                let u = pose.a * axis.normalize();
+                // a disc of radius R with unit normal u spans R √(1 - u_k²) along axis k
+                let e = Vec3::from_fn(|k, _| u[k].abs() * half_length + radius * (1.0 - u[k] * u[k]).max(0.0).sqrt());
+                Aabb { min: c - e, max: c + e }
+            }
+            Contour::Point2 { p } => extruded(pose, Aabb::point(&lift(p))),
+            Contour::Circle { center, radius } => {
+                let c = lift(center);
+                extruded(
+                    pose,
+                    Aabb { min: c - Vec3::new(*radius, *radius, 0.0), max: c + Vec3::new(*radius, *radius, 0.0) },
+                )
+            }
+            Contour::Line { point, normal } => {
+                half_space_aabb(&pose.point_to_parent(&lift(point)), &(pose.a * lift(normal)))
+            }
+            Contour::Polygon { vertices } => {
+                let mut b = Aabb::EMPTY;
+                for v in vertices {
+                    b = b.union(&Aabb::point(&lift(v)));
+                }
+                extruded(pose, b)
+            }
+        }
+    }
+}
+
+/// A planar vector as a 3-vector of the body's x-y plane.
+#[inline]
+pub(crate) fn lift(v: &Vec2) -> Vec3 {
+    Vec3::new(v.x, v.y, 0.0)
+}
+
+/// World box of a body-frame box swept along the body z axis without bound.
+fn extruded(pose: &Pose, b: Aabb) -> Aabb {
+    let c = (b.min + b.max) * 0.5;
+    let h = (b.max - b.min) * 0.5;
+    let w = pose.point_to_parent(&c);
+    let e = pose.a.abs() * h;
+    let mut out = Aabb { min: w - e, max: w + e };
+    let z = pose.a.column(2);
+    for k in 0..3 {
+        if z[k].abs() > 1e-12 {
+            out.min[k] = f64::NEG_INFINITY;
+            out.max[k] = f64::INFINITY;
+        }
+    }
+    out
+}
+
+fn half_space_aabb(p: &Vec3, n: &Vec3) -> Aabb {
+    let mut b = Aabb::EVERYTHING;
+    let nn = n.norm();
+    for k in 0..3 {
+        // solid below the normal: bounded above along +axis k, below along -axis k
+        if (n[k].abs() - nn).abs() <= 1e-12 * nn {
+            if n[k] > 0.0 {
+                b.max[k] = p[k];
+            } else {
+                b.min[k] = p[k];
+            }
+        }
+    }
+    b
+}
+
+fn validate_polygon(v: &[Vec2], what: &str) -> Result<()> {
+    ensure!(v.len() >= 3, Model, "{what}: polygon needs at least 3 vertices, got {}", v.len());
+    for (i, p) in v.iter().enumerate() {
+        finite2(p, what, &format!("polygon vertex {i}"))?;
+    }
+    let n = v.len();
+    let scale = v.iter().map(|p| p.norm()).fold(0.0, f64::max).max(1e-300);
+    for i in 0..n {
+        ensure!(
+            (v[(i + 1) % n] - v[i]).norm() > 1e-12 * scale,
+            Model,
+            "{what}: polygon vertices {i} and {} coincide",
+            (i + 1) % n
+        );
+    }
+    let mut turning = 0.0;
+    let mut area2 = 0.0;
+    for i in 0..n {
+        let (a, b, c) = (v[i], v[(i + 1) % n], v[(i + 2) % n]);
+        let (e1, e2) = (b - a, c - b);
+        let cross = e1.x * e2.y - e1.y * e2.x;
+        let dot = e1.dot(&e2);
+        // left turns only; a straight continuation (collinear, same direction) is allowed
+        let straight = cross.abs() <= 1e-12 * e1.norm() * e2.norm() && dot > 0.0;
+        ensure!(
+            cross > 0.0 || straight,
+            Model,
+            "{what}: polygon must be convex and counter-clockwise, but it turns clockwise or back at vertex {}",
+            (i + 1) % n
+        );
+        turning += cross.atan2(dot);
+        area2 += a.x * b.y - a.y * b.x;
+    }
+    // a star winding twice around turns left everywhere too; one turn is 2π
+    ensure!(
+        (turning - std::f64::consts::TAU).abs() < 1e-6 && area2 > 0.0,
+        Model,
+        "{what}: polygon must wind once counter-clockwise (total turning {turning:.4} rad, expected 2π)"
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(c: &Contour) -> String {
+        c.validate("contact 'c'").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn validation_names_item_and_value() {
+        let z = Vec3::zeros();
+        assert!(err(&Contour::Sphere { center: z, radius: 0.0 }).contains("contact 'c': sphere radius must be > 0"));
+        assert!(err(&Contour::Sphere { center: z, radius: f64::NAN }).contains("sphere radius"));
+        assert!(err(&Contour::Sphere { center: Vec3::new(f64::INFINITY, 0.0, 0.0), radius: 1.0 })
+            .contains("sphere center must be finite"));
+        assert!(err(&Contour::Plane { point: z, normal: z }).contains("plane normal must not be the zero vector"));
+        assert!(err(&Contour::Line { point: Vec2::zeros(), normal: Vec2::zeros() }).contains("line normal"));
+        assert!(err(&Contour::Capsule { a: z, b: z, radius: 1.0 }).contains("capsule ends a and b must differ"));
+        assert!(err(&Contour::Cylinder { center: z, axis: z, radius: 1.0, half_length: 1.0 })
+            .contains("cylinder axis must not be the zero vector"));
+        assert!(err(&Contour::Cylinder { center: z, axis: Vec3::z(), radius: 1.0, half_length: -1.0 })
+            .contains("cylinder half_length must be > 0"));
+        let bad_rot = Mat3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0);
+        assert!(err(&Contour::Box { center: z, rotation: bad_rot, half_extents: Vec3::repeat(1.0) })
+            .contains("determinant +1"));
+        assert!(err(&Contour::Box { center: z, rotation: Mat3::identity(), half_extents: Vec3::new(1.0, 0.0, 1.0) })
+            .contains("box half extent along y must be > 0"));
+        assert!(err(&Contour::Circle { center: Vec2::zeros(), radius: -2.0 }).contains("got -2"));
+        // valid ones pass
+        for c in [
+            Contour::Point { p: z },
+            Contour::Sphere { center: z, radius: 1.0 },
+            Contour::Plane { point: z, normal: Vec3::new(0.0, 0.0, 3.0) },
+            Contour::Box { center: z, rotation: Mat3::identity(), half_extents: Vec3::repeat(0.5) },
+            Contour::Capsule { a: z, b: Vec3::x(), radius: 0.1 },
+            Contour::Cylinder { center: z, axis: Vec3::y(), radius: 0.1, half_length: 0.2 },
+            Contour::Point2 { p: Vec2::zeros() },
+            Contour::Circle { center: Vec2::zeros(), radius: 1.0 },
+            Contour::Line { point: Vec2::zeros(), normal: Vec2::new(0.0, 2.0) },
+        ] {
+            c.validate("c").unwrap();
+        }
+    }
+
+    #[test]
+    fn polygon_must_be_convex_ccw_and_simple() {
+        let sq =
+            |pts: &[(f64, f64)]| Contour::Polygon { vertices: pts.iter().map(|&(x, y)| Vec2::new(x, y)).collect() };
+        sq(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]).validate("p").unwrap();
+        // a collinear mid-edge vertex is allowed (more support points along an edge)
+        sq(&[(0.0, 0.0), (0.5, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]).validate("p").unwrap();
+        assert!(err(&sq(&[(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)])).contains("counter-clockwise"));
+        assert!(err(&sq(&[(0.0, 0.0), (1.0, 0.0), (0.2, 0.2), (0.0, 1.0)])).contains("turns clockwise"));
+        assert!(err(&sq(&[(0.0, 0.0), (1.0, 0.0)])).contains("at least 3"));
+        assert!(err(&sq(&[(0.0, 0.0), (1.0, 0.0), (1.0, 0.0), (0.0, 1.0)])).contains("coincide"));
+        // back and forth along a line
+        assert!(err(&sq(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)])).contains("turns clockwise or back"));
+        // a pentagram turns left at every vertex but winds twice
+        let star: Vec<(f64, f64)> = (0..5)
+            .map(|k| {
+                let a = std::f64::consts::TAU * (2 * k) as f64 / 5.0;
+                (a.cos(), a.sin())
+            })
+            .collect();
+        assert!(err(&sq(&star)).contains("wind once"));
+    }
+
+    #[test]
+    fn normalized_has_unit_directions_and_rotation() {
+        let c = Contour::Plane { point: Vec3::zeros(), normal: Vec3::new(0.0, 3.0, 4.0) };
+        let Contour::Plane { normal, .. } = c.normalized() else { unreachable!() };
+        assert!((normal - Vec3::new(0.0, 0.6, 0.8)).norm() < 1e-15);
+        let r = nalgebra::Rotation3::from_euler_angles(0.3, 0.2, 0.1).into_inner() + Mat3::repeat(1e-8);
+        let b = Contour::Box { center: Vec3::zeros(), rotation: r, half_extents: Vec3::repeat(1.0) };
+        let Contour::Box { rotation, .. } = b.normalized() else { unreachable!() };
+        assert!((rotation.transpose() * rotation - Mat3::identity()).norm() < 1e-14);
+        assert!((rotation.determinant() - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn aabbs_contain_the_contour() {
+        let pose =
+            Pose::new(nalgebra::Rotation3::from_euler_angles(0.4, -0.3, 1.2).into_inner(), Vec3::new(1.0, 2.0, 3.0));
+        let cyl = Contour::Cylinder {
+            center: Vec3::new(0.1, 0.0, 0.2),
+            axis: Vec3::new(1.0, 1.0, 0.0),
+            radius: 0.3,
+            half_length: 0.5,
+        };
+        let b = cyl.aabb(&pose);
+        // sample the rims: every point inside, and the box tight to 1e-3 on each side
+        let (c, u) = (pose.point_to_parent(&Vec3::new(0.1, 0.0, 0.2)), pose.a * Vec3::new(1.0, 1.0, 0.0).normalize());
+        let e1 = u.cross(&Vec3::z()).normalize();
+        let e2 = u.cross(&e1);
+        let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for s in [-0.5, 0.5] {
+            for k in 0..2000 {
+                let phi = std::f64::consts::TAU * k as f64 / 2000.0;
+                let p = c + u * s + (e1 * phi.cos() + e2 * phi.sin()) * 0.3;
+                assert!(b.contains_point(&p));
+                lo = lo.inf(&p);
+                hi = hi.sup(&p);
+            }
+        }
+        assert!((lo - b.min).norm() < 1e-3 && (hi - b.max).norm() < 1e-3);
+        let bx =
+            Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(1.0, 2.0, 3.0) };
+        let bb = bx.aabb(&Pose::IDENTITY);
+        assert_eq!(bb.min, Vec3::new(-1.0, -2.0, -3.0));
+        // a ground plane z ≤ 0 is bounded above in z only
+        let pl = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() }.aabb(&Pose::IDENTITY);
+        assert_eq!(pl.max.z, 0.0);
+        assert!(pl.min.z == f64::NEG_INFINITY && pl.max.x == f64::INFINITY);
+        // planar contours are unbounded along z
+        let ci = Contour::Circle { center: Vec2::new(1.0, 0.0), radius: 0.5 }.aabb(&Pose::IDENTITY);
+        assert_eq!((ci.min.x, ci.max.x), (0.5, 1.5));
+        assert!(ci.min.z == f64::NEG_INFINITY && ci.max.z == f64::INFINITY);
+    }
+}

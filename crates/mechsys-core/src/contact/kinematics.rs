@@ -1,0 +1,145 @@
+//! Relative contact kinematics (section 2.2.7): relative velocities `ġ_N`, `ġ_T` of the two
+//! bodies at each candidate and the velocity-product parts `w̄_N`, `w̄_T` of their derivatives.
+//!
+//! With `v_i(x) = v_i + ω_i × x` the velocity of body i's material point at `x` and
+//! `a_i(x) = a_i + α_i × x + ω_i × v_i(x)` its acceleration (world convention, see
+//! [`crate::kinematics`]):
+//!
+//! - `ġ_N = n·(v_1(P1) - v_2(P2))` (eqs. 2.110, 2.122) — exactly `d g_N/dt`, because
+//!   `P1 - P2 = g_N n` and the contact points slide tangentially over their contours;
+//! - `ġ_T,k = t_k·(v_1(P1) - v_2(P2))` — body 1's sliding velocity relative to body 2;
+//! - `g̈_N = n·(a_1(P1) - a_2(P2)) + ṅ·Δv + n·(ω_1 × σ_1 - ω_2 × σ_2)`, where `Δv` is the relative
+//!   velocity above and `σ_i = Ṗ_i - v_i(P_i)` the velocity of the contact point over contour i
+//!   (the `κ ṡ` terms of eqs. 2.100–2.101, 2.115, from the closed-form rates of each pair: the
+//!   rotation of the normal and the motion of the contact points over the surfaces);
+//! - `d ġ_T,k/dt` likewise with `t_k` and `ṫ_k`.
+//!
+//! **W-part.** The only term that depends on the body accelerations is
+//! `n·(a_1(P1) - a_2(P2))`, the relative acceleration of the material points at the contact. In
+//! a multibody system `a_i(P_i) = J_Pi u̇ + (velocity-product part)` with `J_Pi` the translational
+//! Jacobian of the body point at `P_i` ([`crate::kinematics::point_jacobian`]), so
+//! `g̈_N = w_Nᵀ u̇ + w̄_N` with `w_N = J_P1ᵀ n - J_P2ᵀ n`, `W_T = [J_P1ᵀ t_k - J_P2ᵀ t_k]`
+//! (eqs. 2.112–2.114, 2.131, 2.132). [`contact_kinematics`] is affine in the body accelerations
+//! it is given: given the velocity-product accelerations (the tree's accelerations at `u̇ = 0`,
+//! see [`BodyMotion::from_data`]) it returns `w̄_N`, `w̄_T`; given the full accelerations it
+//! returns `g̈_N` and `d ġ_T/dt` themselves.
+//!
+//! Exactness: the rates are the time derivatives of the narrow phase's closed forms wherever
+//! those are smooth (a fixed face/edge/corner region of a box, fixed clamping of capsule segment
+//! parameters). Not exact: at the degenerate configurations listed in [`super::narrow`] (the
+//! normal is then taken as turning with body 2) and for exactly parallel capsule axes, where the
+//! overlap-midpoint rule fixes the parameter on segment 1.
+
+use crate::data::Data;
+use crate::error::Result;
+use crate::math::Vec3;
+use crate::spatial::{Motion, Pose};
+
+use super::narrow::{ContactPair, ContactPoint};
+
+/// Placement, twist and spatial acceleration of a body, world convention (about the origin).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyMotion {
+    /// Placement `A_IB`, `r`.
+    pub pose: Pose,
+    /// Twist `(ω, v)`: the material point at world `x` moves with `v + ω × x`.
+    pub twist: Motion,
+    /// Spatial acceleration `(α, a)`: full, or the velocity-product part for `w̄`.
+    pub acc: Motion,
+}
+
+impl BodyMotion {
+    /// The ground: identity placement, at rest.
+    pub const GROUND: BodyMotion = BodyMotion { pose: Pose::IDENTITY, twist: Motion::ZERO, acc: Motion::ZERO };
+
+    /// Body `body` from the workspace: `x_abs`, `v`, and `a` as the last
+    /// [`crate::kinematics::accelerations`] left it (with `u̇ = 0` and `a[0] = 0` that is the
+    /// velocity-product part).
+    pub fn from_data(data: &Data, body: usize) -> BodyMotion {
+        BodyMotion { pose: data.x_abs[body], twist: data.v[body], acc: data.a[body] }
+    }
+
+    /// Velocity of the material point at world `p`.
+    #[inline]
+    pub fn point_velocity(&self, p: &Vec3) -> Vec3 {
+        self.twist.v + self.twist.w.cross(p)
+    }
+
+    /// Acceleration of the material point at world `p` (eq. 2.41 with ṙ = r̈ = 0).
+    #[inline]
+    pub fn point_acceleration(&self, p: &Vec3) -> Vec3 {
+        self.acc.v + self.acc.w.cross(p) + self.twist.w.cross(&self.point_velocity(p))
+    }
+}
+
+/// Relative kinematics of one candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactKinematics {
+    /// Geometry (gap, normal, points, tangents).
+    pub point: ContactPoint,
+    /// `ġ_N`, relative normal velocity (< 0 approaching).
+    pub gd_n: f64,
+    /// `ġ_T` along `t1`, `t2` (planar pairs: only the first is a friction direction).
+    pub gd_t: [f64; 2],
+    /// `w̄_N` (`g̈_N` if the full accelerations were given).
+    pub wbar_n: f64,
+    /// `w̄_T` (`d ġ_T/dt` if the full accelerations were given).
+    pub wbar_t: [f64; 2],
+}
+
+/// Fills `out[..pair.candidates()]` for body 1 in state `b1` and body 2 in `b2`. No allocation;
+/// an error only when `out` is too short.
+///
+/// # Example
+/// ```
+/// use mechsys_core::contact::{contact_kinematics, BodyMotion, ContactKinematics, ContactPair, Contour};
+/// use mechsys_core::math::Vec3;
+/// use mechsys_core::spatial::{Motion, Pose};
+/// let pair = ContactPair::new(
+///     "ball",
+///     Contour::Sphere { center: Vec3::zeros(), radius: 0.1 },
+///     Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() },
+/// )?;
+/// // falling at 2 m/s while sliding along x at 1 m/s
+/// let ball = BodyMotion {
+///     pose: Pose::new(nalgebra::Matrix3::identity(), Vec3::new(0.0, 0.0, 0.1)),
+///     twist: Motion::new(Vec3::zeros(), Vec3::new(1.0, 0.0, -2.0)),
+///     acc: Motion::ZERO,
+/// };
+/// let mut out = [ContactKinematics::default(); 1];
+/// contact_kinematics(&pair, &ball, &BodyMotion::GROUND, &mut out)?;
+/// assert!((out[0].gd_n + 2.0).abs() < 1e-15);
+/// assert!((out[0].gd_t[0].abs() - 1.0).abs() < 1e-15 || (out[0].gd_t[1].abs() - 1.0).abs() < 1e-15);
+/// # Ok::<(), mechsys_core::Error>(())
+/// ```
+pub fn contact_kinematics(
+    pair: &ContactPair,
+    b1: &BodyMotion,
+    b2: &BodyMotion,
+    out: &mut [ContactKinematics],
+) -> Result<()> {
+    pair.check_len(out.len())?;
+    let (tw1, tw2) = (&b1.twist, &b2.twist);
+    for (k, o) in out[..pair.candidates()].iter_mut().enumerate() {
+        let r = pair.candidate(k, &b1.pose, &b2.pose, Some((tw1, tw2)));
+        let t = pair.tangents(&b2.pose, &r.n, Some((&tw2.w, &r.nd)));
+        let (v1, v2) = (b1.point_velocity(&r.p1), b2.point_velocity(&r.p2));
+        let dv = v1 - v2;
+        // σ_i: motion of the contact point over contour i
+        let (s1, s2) = (r.p1d - v1, r.p2d - v2);
+        // d/dt v_i(P_i(t)) = a_i(P_i) + ω_i × σ_i
+        let da = b1.point_acceleration(&r.p1) - b2.point_acceleration(&r.p2) + tw1.w.cross(&s1) - tw2.w.cross(&s2);
+        *o = ContactKinematics {
+            point: ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 },
+            gd_n: r.n.dot(&dv),
+            gd_t: [t.t1.dot(&dv), t.t2.dot(&dv)],
+            // eqs. 2.114, 2.115 / 2.128
+            wbar_n: r.nd.dot(&dv) + r.n.dot(&da),
+            wbar_t: [t.t1d.dot(&dv) + t.t1.dot(&da), t.t2d.dot(&dv) + t.t2.dot(&da)],
+        };
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,668 @@
+//! Narrow phase: closed-form contact geometry per contour pair, a fixed number of candidate
+//! contact points per pair (known when the model is built).
+//!
+//! For each candidate: the gap `g_N`, the unit normal `n` pointing from contour 2 towards
+//! contour 1 (so `g_N` grows when body 1 moves along `n` relative to body 2), the points `P1` on
+//! contour 1's surface and `P2` on contour 2's surface with `P1 - P2 = g_N n` exactly, and
+//! tangents `t1`, `t2` with `(t1, t2, n)` right-handed orthonormal.
+//!
+//! | pair (either order) | candidates | rule |
+//! | --- | --- | --- |
+//! | point, sphere – plane | 1 | the centre projected on the plane |
+//! | box – plane | 8 | the corners |
+//! | capsule – plane | 2 | the two end spheres |
+//! | cylinder – plane | 2 | the lowest point of each rim circle (below) |
+//! | point, sphere – sphere | 1 | along the centre line |
+//! | point, sphere, capsule – capsule | 1 | closest points of the axis segments |
+//! | point, sphere – box | 1 | closest point of the box (deepest face when the centre is inside) |
+//! | point2, circle, polygon – line | 1, 1, vertices | as the spatial point/sphere – plane |
+//! | point2, circle – circle | 1 | along the centre line in the x-y plane |
+//!
+//! Planar pairs are evaluated in body 2's x-y plane: contours are extruded along body 2's z axis
+//! `e_z`, `n ⟂ e_z`, and `t1 = e_z × n / |e_z × n|` (the one friction direction; `t2 = n × t1` is
+//! the out-of-plane direction). In 3-D, `t1` is the projection onto the tangent plane of a fixed
+//! reference axis `e` of body 2: the plane's first in-plane axis, a capsule's or cylinder's axis,
+//! a box's first axis, else body 2's x axis; when `|e·n| > 0.9` a second fixed axis of body 2
+//! perpendicular to `e` takes over (no field of tangents is continuous on the whole sphere of
+//! normals; against a plane or along a capsule the switch never happens).
+//!
+//! Degenerate configurations give defined values, never NaN: coincident centres (sphere–sphere,
+//! circle–circle) or intersecting capsule axes give the true (negative) gap with a normal fixed
+//! in body 2 (`d1 × d2` for crossing capsule axes); a sphere centre inside a box uses the nearest
+//! face; a cylinder standing exactly upright on the plane uses a fixed rim point.
+//!
+//! Capsule–plane: the lowest points of the two end spheres. When the capsule is tilted, the
+//! upper end's point lies inside the capsule (its gap exceeds the lower end's, so it never closes
+//! first); lying flat, both are on the surface and both touch.
+//!
+//! Cylinder–plane: each rim circle touches a half-space first at its point farthest along `-n`;
+//! these two points are exact for a cylinder on its edge or lying on its side. Standing on a flat
+//! end, the whole rim touches but the pair has one point per rim: model a resting flat end with a
+//! box or extra point contours.
+
+use crate::ensure;
+use crate::error::{Error, Result};
+use crate::math::{Mat3, Vec3};
+use crate::spatial::{Motion, Pose};
+
+use super::contour::{lift, Contour, ContourKind};
+
+/// One candidate contact: gap, frame and the two surface points, world components.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactPoint {
+    /// Gap `g_N` (> 0 open, < 0 penetrating).
+    pub g_n: f64,
+    /// Unit normal from contour 2 towards contour 1.
+    pub n: Vec3,
+    /// Contact point on contour 1's surface.
+    pub p1: Vec3,
+    /// Contact point on contour 2's surface (`p1 - p2 = g_n n`).
+    pub p2: Vec3,
+    /// First tangent (for planar pairs `e_z × n`).
+    pub t1: Vec3,
+    /// Second tangent, `n × t1` (out of plane for planar pairs).
+    pub t2: Vec3,
+}
+
+/// The closed-form geometry of a pair, parameters in the body frames of the canonical order
+/// (the order of the table in the module docs; the caller's order may be the reverse).
+#[derive(Debug, Clone, PartialEq)]
+enum Geometry {
+    /// Body-fixed centres on body 1, each with `radius`, against the half-space of body 2.
+    PointsHalfSpace { centers: Vec<Vec3>, radius: f64, point: Vec3, normal: Vec3 },
+    /// The two rim circles of a cylinder on body 1 against the half-space of body 2; `across` is a
+    /// unit vector ⟂ axis for the upright case.
+    CylinderHalfSpace {
+        center: Vec3,
+        axis: Vec3,
+        across: Vec3,
+        radius: f64,
+        half_length: f64,
+        point: Vec3,
+        normal: Vec3,
+    },
+    /// Swept segments `a + s d`, `s ∈ [0, 1]` (a point when `d = 0`) with radii; `across` ⟂ d2.
+    Swept { a1: Vec3, d1: Vec3, r1: f64, a2: Vec3, d2: Vec3, r2: f64, across: Vec3 },
+    /// A sphere (or point, radius 0) on body 1 against a box on body 2.
+    SphereBox { center: Vec3, radius: f64, box_center: Vec3, box_rotation: Mat3, half: Vec3 },
+    /// Planar: circles (or points, radius 0) extruded along body 2's z axis.
+    CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
+}
+
+/// A contour pair prepared for per-step evaluation.
+///
+/// # Example
+/// ```
+/// use mechsys_core::contact::{evaluate, ContactPair, ContactPoint, Contour};
+/// use mechsys_core::math::Vec3;
+/// use mechsys_core::spatial::Pose;
+/// // a ball of radius 0.1 on body 1, the ground plane z ≤ 0 on body 2
+/// let pair = ContactPair::new(
+///     "ball",
+///     Contour::Sphere { center: Vec3::zeros(), radius: 0.1 },
+///     Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() },
+/// )?;
+/// let mut out = [ContactPoint::default(); 1];
+/// let x1 = Pose::new(nalgebra::Matrix3::identity(), Vec3::new(0.0, 0.0, 0.5));
+/// evaluate(&pair, &x1, &Pose::IDENTITY, &mut out)?;
+/// assert!((out[0].g_n - 0.4).abs() < 1e-15);
+/// assert_eq!(out[0].n, Vec3::z());
+/// # Ok::<(), mechsys_core::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactPair {
+    kinds: (ContourKind, ContourKind),
+    geometry: Geometry,
+    swapped: bool,
+    count: usize,
+    planar: bool,
+    /// Tangent reference axes, body 2 frame (the caller's body 2).
+    tangent_ref: [Vec3; 2],
+}
+
+/// Raw candidate: geometry and, when asked, rates (zero otherwise).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Raw {
+    pub g: f64,
+    pub n: Vec3,
+    pub p1: Vec3,
+    pub p2: Vec3,
+    /// `ṅ`
+    pub nd: Vec3,
+    /// `Ṗ1`, the rate of the contact point (material motion plus sliding over contour 1).
+    pub p1d: Vec3,
+    /// `Ṗ2`
+    pub p2d: Vec3,
+}
+
+/// Tangents and their rates.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Tangents {
+    pub t1: Vec3,
+    pub t2: Vec3,
+    pub t1d: Vec3,
+    pub t2d: Vec3,
+}
+
+/// Whether `(first, second)` is a canonical order of the dispatch table.
+fn canonical(a: ContourKind, b: ContourKind) -> bool {
+    use ContourKind as K;
+    match b {
+        K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder),
+        K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon),
+        K::Sphere => matches!(a, K::Point | K::Sphere),
+        K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
+        K::Box => matches!(a, K::Point | K::Sphere),
+        K::Circle => matches!(a, K::Point2 | K::Circle),
+        _ => false,
+    }
+}
+
+/// Whether the caller's order must be reversed; an error naming both kinds if unsupported.
+fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
+    if canonical(a, b) {
+        Ok(false)
+    } else if canonical(b, a) {
+        Ok(true)
+    } else {
+        Err(Error::Model(format!(
+            "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder–plane, \
+             point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere–box, \
+             point2/circle–circle, in either order)"
+        )))
+    }
+}
+
+/// Number of candidate contact points of the pair (either order); an error naming both contour
+/// kinds when the pair is not supported, or the contour when one is invalid.
+pub fn candidates(c1: &Contour, c2: &Contour) -> Result<usize> {
+    let swapped = orientation(c1.kind(), c2.kind())?;
+    c1.validate(&format!("contour 1 ({})", c1.kind()))?;
+    c2.validate(&format!("contour 2 ({})", c2.kind()))?;
+    let first = if swapped { c2 } else { c1 };
+    let against_plane = matches!(c1.kind(), ContourKind::Plane) || matches!(c2.kind(), ContourKind::Plane);
+    Ok(match first {
+        Contour::Box { .. } => 8,
+        // end spheres and rim circles; a capsule against a capsule has one closest pair
+        Contour::Capsule { .. } | Contour::Cylinder { .. } if against_plane => 2,
+        Contour::Polygon { vertices } => vertices.len(),
+        _ => 1,
+    })
+}
+
+/// A unit vector perpendicular to the unit vector `v`.
+fn perpendicular(v: &Vec3) -> Vec3 {
+    let k = v.iamin();
+    let mut e = Vec3::zeros();
+    e[k] = 1.0;
+    (e - v * v.dot(&e)).normalize()
+}
+
+#[inline]
+fn vel(t: &Motion, p: &Vec3) -> Vec3 {
+    t.v + t.w.cross(p)
+}
+
+/// Lengths below this are treated as zero (coincident centres, crossing axes).
+const TINY: f64 = 1e-12;
+
+impl ContactPair {
+    /// Validates both contours and prepares the pair; `name` appears in every message.
+    pub fn new(name: &str, contour1: Contour, contour2: Contour) -> Result<Self> {
+        let (k1, k2) = (contour1.kind(), contour2.kind());
+        contour1.validate(&format!("contact '{name}': contour 1 ({k1})"))?;
+        contour2.validate(&format!("contact '{name}': contour 2 ({k2})"))?;
+        let swapped = orientation(k1, k2).map_err(|e| Error::Model(format!("contact '{name}': {e}")))?;
+        let count = candidates(&contour1, &contour2)?;
+        let (c1, c2) = (contour1.normalized(), contour2.normalized());
+        let (f, s) = if swapped { (&c2, &c1) } else { (&c1, &c2) };
+        let geometry = build_geometry(f, s);
+        let planar = k1.is_planar();
+        let tangent_ref = match &c2 {
+            Contour::Plane { normal, .. } => {
+                let t = perpendicular(normal);
+                [t, normal.cross(&t)]
+            }
+            Contour::Capsule { a, b, .. } => {
+                let d = (b - a).normalize();
+                [d, perpendicular(&d)]
+            }
+            Contour::Cylinder { axis, .. } => [*axis, perpendicular(axis)],
+            Contour::Box { rotation, .. } => [rotation.column(0).into_owned(), rotation.column(1).into_owned()],
+            _ => [Vec3::x(), Vec3::y()],
+        };
+        Ok(ContactPair { kinds: (k1, k2), geometry, swapped, count, planar, tangent_ref })
+    }
+
+    /// Number of candidate points (the length `evaluate` fills).
+    pub fn candidates(&self) -> usize {
+        self.count
+    }
+
+    /// The contour kinds in the caller's order.
+    pub fn kinds(&self) -> (ContourKind, ContourKind) {
+        self.kinds
+    }
+
+    /// Friction directions per candidate: 1 for planar pairs, 2 in 3-D.
+    pub fn tangent_dim(&self) -> usize {
+        if self.planar {
+            1
+        } else {
+            2
+        }
+    }
+
+    /// Whether the pair is planar.
+    pub fn is_planar(&self) -> bool {
+        self.planar
+    }
+
+    pub(crate) fn check_len(&self, len: usize) -> Result<()> {
+        ensure!(
+            len >= self.count,
+            Settings,
+            "contact pair {}–{}: output has room for {len} candidates, needs {}",
+            self.kinds.0,
+            self.kinds.1,
+            self.count
+        );
+        Ok(())
+    }
+
+    /// Candidate `k` in the caller's order; rates when `twists` are given.
+    #[inline]
+    pub(crate) fn candidate(&self, k: usize, x1: &Pose, x2: &Pose, twists: Option<(&Motion, &Motion)>) -> Raw {
+        if !self.swapped {
+            return self.raw(k, x1, x2, twists);
+        }
+        // canonical body 1 is the caller's body 2: flip the normal, exchange the points
+        let r = self.raw(k, x2, x1, twists.map(|(a, b)| (b, a)));
+        Raw { g: r.g, n: -r.n, p1: r.p2, p2: r.p1, nd: -r.nd, p1d: r.p2d, p2d: r.p1d }
+    }
+
+    /// Tangents at normal `n` for body 2 at `x2`; rates from body 2's `ω` and `ṅ` when given.
+    #[inline]
+    pub(crate) fn tangents(&self, x2: &Pose, n: &Vec3, rates: Option<(&Vec3, &Vec3)>) -> Tangents {
+        // d/dt (u/|u|) = (u̇ - t (t·u̇)) / |u|
+        let unit_rate = |ud: &Vec3, t: &Vec3, len: f64| (ud - t * t.dot(ud)) / len;
+        if self.planar {
+            // t1 = e_z × n / |e_z × n|
+            let e = x2.a.column(2).into_owned();
+            let u = e.cross(n);
+            let len = u.norm();
+            if len > 1e-6 {
+                let t1 = u / len;
+                let t2 = n.cross(&t1);
+                let mut out = Tangents { t1, t2, ..Default::default() };
+                if let Some((w2, nd)) = rates {
+                    let ud = w2.cross(&e).cross(n) + e.cross(nd);
+                    out.t1d = unit_rate(&ud, &t1, len);
+                    out.t2d = nd.cross(&t1) + n.cross(&out.t1d);
+                }
+                return out;
+            }
+        }
+        // t1 ∥ e - (e·n) n for a body-2 axis e
+        let mut e = x2.a * self.tangent_ref[0];
+        if e.dot(n).abs() > 0.9 {
+            e = x2.a * self.tangent_ref[1];
+        }
+        let en = e.dot(n);
+        let u = e - n * en;
+        let len = u.norm();
+        let t1 = u / len;
+        let t2 = n.cross(&t1);
+        let mut out = Tangents { t1, t2, ..Default::default() };
+        if let Some((w2, nd)) = rates {
+            let ed = w2.cross(&e);
+            let ud = ed - n * (ed.dot(n) + e.dot(nd)) - nd * en;
+            out.t1d = unit_rate(&ud, &t1, len);
+            out.t2d = nd.cross(&t1) + n.cross(&out.t1d);
+        }
+        out
+    }
+
+    /// Candidate `k` in the canonical order.
+    fn raw(&self, k: usize, x1: &Pose, x2: &Pose, tw: Option<(&Motion, &Motion)>) -> Raw {
+        match &self.geometry {
+            Geometry::PointsHalfSpace { centers, radius, point, normal } => {
+                let c = x1.point_to_parent(&centers[k]);
+                half_space(&c, tw.map(|(t1, _)| vel(t1, &c)), *radius, x2, point, normal, tw.map(|t| t.1))
+            }
+            Geometry::CylinderHalfSpace { center, axis, across, radius, half_length, point, normal } => {
+                let a = x1.a * axis;
+                let m = x2.a * normal;
+                let k_vec = m - a * m.dot(&a);
+                let kn = k_vec.norm();
+                // lowest rim direction u = -(m projected on the rim plane), normalized
+                let (u, upright) = if kn > TINY { (-k_vec / kn, false) } else { (x1.a * across, true) };
+                let side = if k == 0 { 1.0 } else { -1.0 };
+                let c = x1.point_to_parent(&(center + axis * (side * half_length)));
+                let q = c + u * *radius;
+                let qd = tw.map(|(t1, t2)| {
+                    let ud = if upright {
+                        t1.w.cross(&u)
+                    } else {
+                        let ad = t1.w.cross(&a);
+                        let md = t2.w.cross(&m);
+                        let kd = md - ad * m.dot(&a) - a * (md.dot(&a) + m.dot(&ad));
+                        -(kd - u * u.dot(&kd)) / kn
+                    };
+                    vel(t1, &c) + ud * *radius
+                });
+                half_space(&q, qd, 0.0, x2, point, normal, tw.map(|t| t.1))
+            }
+            Geometry::Swept { a1, d1, r1, a2, d2, r2, across } => swept(x1, x2, tw, a1, d1, *r1, a2, d2, *r2, across),
+            Geometry::SphereBox { center, radius, box_center, box_rotation, half } => {
+                sphere_box(x1, x2, tw, center, *radius, box_center, box_rotation, half)
+            }
+            Geometry::CircleCircle { c1, r1, c2, r2 } => circle_circle(x1, x2, tw, c1, *r1, c2, *r2),
+        }
+    }
+}
+
+fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
+    // the second contour's half-space (plane or line), body 2 frame
+    let half_space = |s: &Contour| match s {
+        Contour::Plane { point, normal } => Some((*point, *normal)),
+        Contour::Line { point, normal } => Some((lift(point), lift(normal))),
+        _ => None,
+    };
+    if let Some((point, normal)) = half_space(s) {
+        let (centers, radius) = match f {
+            Contour::Point { p } => (vec![*p], 0.0),
+            Contour::Sphere { center, radius } => (vec![*center], *radius),
+            Contour::Box { center, rotation, half_extents } => {
+                let mut v = Vec::with_capacity(8);
+                for i in 0..8 {
+                    let sgn = |b: usize| if i & (1 << b) != 0 { 1.0 } else { -1.0 };
+                    let local = Vec3::new(sgn(0) * half_extents.x, sgn(1) * half_extents.y, sgn(2) * half_extents.z);
+                    v.push(center + rotation * local);
+                }
+                (v, 0.0)
+            }
+            Contour::Capsule { a, b, radius } => (vec![*a, *b], *radius),
+            Contour::Cylinder { center, axis, radius, half_length } => {
+                return Geometry::CylinderHalfSpace {
+                    center: *center,
+                    axis: *axis,
+                    across: perpendicular(axis),
+                    radius: *radius,
+                    half_length: *half_length,
+                    point,
+                    normal,
+                };
+            }
+            Contour::Point2 { p } => (vec![lift(p)], 0.0),
+            Contour::Circle { center, radius } => (vec![lift(center)], *radius),
+            Contour::Polygon { vertices } => (vertices.iter().map(lift).collect(), 0.0),
+            Contour::Plane { .. } | Contour::Line { .. } => unreachable!("excluded by the dispatch table"),
+        };
+        return Geometry::PointsHalfSpace { centers, radius, point, normal };
+    }
+    let segment = |c: &Contour| match c {
+        Contour::Point { p } => (*p, Vec3::zeros(), 0.0),
+        Contour::Sphere { center, radius } => (*center, Vec3::zeros(), *radius),
+        Contour::Capsule { a, b, radius } => (*a, b - a, *radius),
+        _ => unreachable!("excluded by the dispatch table"),
+    };
+    match s {
+        Contour::Sphere { .. } | Contour::Capsule { .. } => {
+            let ((a1, d1, r1), (a2, d2, r2)) = (segment(f), segment(s));
+            let across = if d2.norm() > 0.0 { perpendicular(&d2.normalize()) } else { Vec3::x() };
+            Geometry::Swept { a1, d1, r1, a2, d2, r2, across }
+        }
+        Contour::Box { center: bc, rotation, half_extents } => {
+            let (center, _, radius) = segment(f);
+            Geometry::SphereBox { center, radius, box_center: *bc, box_rotation: *rotation, half: *half_extents }
+        }
+        Contour::Circle { center: c2, radius: r2 } => {
+            let (c1, r1) = match f {
+                Contour::Point2 { p } => (lift(p), 0.0),
+                Contour::Circle { center, radius } => (lift(center), *radius),
+                _ => unreachable!("excluded by the dispatch table"),
+            };
+            Geometry::CircleCircle { c1, r1, c2: lift(c2), r2: *r2 }
+        }
+        _ => unreachable!("excluded by the dispatch table"),
+    }
+}
+
+/// A centre `c` (rate `cd`) inflated by `radius` against the half-space `(point, normal)` of
+/// body 2: `n = m`, `P1 = c - R m`, `P2 = c - h m` with `h = m·(c - p)`, `g_N = h - R`.
+#[inline]
+fn half_space(
+    c: &Vec3,
+    cd: Option<Vec3>,
+    radius: f64,
+    x2: &Pose,
+    point: &Vec3,
+    normal: &Vec3,
+    t2: Option<&Motion>,
+) -> Raw {
+    let m = x2.a * normal;
+    let p = x2.point_to_parent(point);
+    let h = m.dot(&(c - p));
+    let mut r = Raw { g: h - radius, n: m, p1: c - m * radius, p2: c - m * h, ..Default::default() };
+    if let (Some(cd), Some(t2)) = (cd, t2) {
+        // the normal turns with body 2; P2 is the foot of c on the moving plane
+        let md = t2.w.cross(&m);
+        let hd = md.dot(&(c - p)) + m.dot(&(cd - vel(t2, &p)));
+        r.nd = md;
+        r.p1d = cd - md * radius;
+        r.p2d = cd - m * hd - md * h;
+    }
+    r
+}
+
+/// Closest points of two segments `a + s d` (either may be a point), with radii. Parameters on
+/// the interior satisfy `d·(X1 - X2) = 0`; their rates follow from differentiating those
+/// conditions (the general closest-point formula, cf. eqs. 2.102–2.109).
+#[allow(clippy::too_many_arguments)]
+fn swept(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    a1b: &Vec3,
+    d1b: &Vec3,
+    r1: f64,
+    a2b: &Vec3,
+    d2b: &Vec3,
+    r2: f64,
+    across: &Vec3,
+) -> Raw {
+    let (a1, d1) = (x1.point_to_parent(a1b), x1.a * d1b);
+    let (a2, d2) = (x2.point_to_parent(a2b), x2.a * d2b);
+    let r = a1 - a2;
+    let (aa, ee, bb, cc, ff) = (d1.dot(&d1), d2.dot(&d2), d1.dot(&d2), d1.dot(&r), d2.dot(&r));
+    let clamp01 = |x: f64| x.clamp(0.0, 1.0);
+    // minimize |r + s d1 - u d2|² over the unit square
+    // the overlap-midpoint rule fixes s by fiat, so s has no stationarity condition there
+    let mut midpoint = false;
+    let (s, u) = if aa == 0.0 && ee == 0.0 {
+        (0.0, 0.0)
+    } else if aa == 0.0 {
+        (0.0, clamp01(ff / ee))
+    } else if ee == 0.0 {
+        (clamp01(-cc / aa), 0.0)
+    } else {
+        let den = aa * ee - bb * bb;
+        let s0 = if den > 1e-12 * aa * ee {
+            clamp01((bb * ff - cc * ee) / den)
+        } else {
+            // parallel: the middle of the overlap of the two segments along segment 1
+            midpoint = true;
+            let (sa, sb) = (-cc / aa, (bb - cc) / aa);
+            let (lo, hi) = (sa.min(sb).max(0.0), sa.max(sb).min(1.0));
+            if lo <= hi {
+                0.5 * (lo + hi)
+            } else if sa.max(sb) < 0.0 {
+                0.0
+            } else {
+                1.0
+            }
+        };
+        let u0 = (bb * s0 + ff) / ee;
+        if u0 < 0.0 {
+            midpoint = false;
+            (clamp01(-cc / aa), 0.0)
+        } else if u0 > 1.0 {
+            midpoint = false;
+            (clamp01((bb - cc) / aa), 1.0)
+        } else {
+            (s0, u0)
+        }
+    };
+    let x1p = a1 + d1 * s;
+    let x2p = a2 + d2 * u;
+    let dd = x1p - x2p;
+    let len = dd.norm();
+    let scale = 1.0 + r1 + r2;
+    let degenerate = !(len > TINY * scale);
+    let n = if !degenerate {
+        dd / len
+    } else {
+        let c = d1.cross(&d2);
+        let cn = c.norm();
+        if cn > TINY * scale * scale {
+            c / cn
+        } else {
+            x2.a * across
+        }
+    };
+    let mut out = Raw { g: len - r1 - r2, n, p1: x1p - n * r1, p2: x2p + n * r2, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        // s free: d1·(X1 - X2) = 0; u free: d2·(X1 - X2) = 0; differentiated with
+        // Ẋ1 = v1(X1) + ṡ d1, Ẋ2 = v2(X2) + u̇ d2, ḋ1 = ω1 × d1, ḋ2 = ω2 × d2
+        let dv = vel(t1, &x1p) - vel(t2, &x2p);
+        let (d1d, d2d) = (t1.w.cross(&d1), t2.w.cross(&d2));
+        let s_free = aa > 0.0 && s > 0.0 && s < 1.0 && !midpoint;
+        let u_free = ee > 0.0 && u > 0.0 && u < 1.0;
+        let b1 = -(d1d.dot(&dd) + d1.dot(&dv));
+        let b2 = -(d2d.dot(&dd) + d2.dot(&dv));
+        let (sd, ud) = match (s_free, u_free) {
+            // [A -B; B -E] [ṡ; u̇] = [b1; b2]
+            (true, true) => {
+                let det = bb * bb - aa * ee;
+                ((-ee * b1 + bb * b2) / det, (-bb * b1 + aa * b2) / det)
+            }
+            (true, false) => (b1 / aa, 0.0),
+            (false, true) => (0.0, -b2 / ee),
+            (false, false) => (0.0, 0.0),
+        };
+        let x1d = vel(t1, &x1p) + d1 * sd;
+        let x2d = vel(t2, &x2p) + d2 * ud;
+        let ddd = x1d - x2d;
+        out.nd = if degenerate { t2.w.cross(&n) } else { (ddd - n * n.dot(&ddd)) / len };
+        out.p1d = x1d - out.nd * r1;
+        out.p2d = x2d + out.nd * r2;
+    }
+    out
+}
+
+/// A sphere (centre on body 1) against a box of body 2. Outside: the closest box point (face,
+/// edge or corner region); inside: the nearest face, as a plane.
+#[allow(clippy::too_many_arguments)]
+fn sphere_box(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    center: &Vec3,
+    radius: f64,
+    box_center: &Vec3,
+    box_rotation: &Mat3,
+    half: &Vec3,
+) -> Raw {
+    let c = x1.point_to_parent(center);
+    let ab = x2.a * box_rotation;
+    let ob = x2.point_to_parent(box_center);
+    let cl = ab.transpose() * (c - ob);
+    let q_out = Vec3::from_fn(|k, _| cl[k].clamp(-half[k], half[k]));
+    let dl = cl - q_out;
+    let len = dl.norm();
+    let outside = len > TINY * (1.0 + half.max());
+    let (n, q, g) = if outside {
+        (ab * (dl / len), q_out, len - radius)
+    } else {
+        // deepest penetration is through the face nearest to the centre
+        let depth = Vec3::from_fn(|k, _| half[k] - cl[k].abs());
+        let k = depth.imin();
+        let sgn = if cl[k] >= 0.0 { 1.0 } else { -1.0 };
+        let mut q = cl;
+        q[k] = sgn * half[k];
+        (ab.column(k) * sgn, q, -depth[k] - radius)
+    };
+    let p2 = ob + ab * q;
+    let mut out = Raw { g, n, p1: c - n * radius, p2, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        // rate of the centre in box coordinates: its velocity relative to body 2's point there
+        let cld = ab.transpose() * (vel(t1, &c) - vel(t2, &c));
+        let qd = if outside {
+            Vec3::from_fn(|k, _| if cl[k].abs() < half[k] { cld[k] } else { 0.0 })
+        } else {
+            let k = Vec3::from_fn(|k, _| half[k] - cl[k].abs()).imin();
+            let mut v = cld;
+            v[k] = 0.0;
+            v
+        };
+        out.nd = if outside {
+            let dw = ab * dl;
+            let ddw = t2.w.cross(&dw) + ab * (cld - qd);
+            (ddw - n * n.dot(&ddw)) / len
+        } else {
+            t2.w.cross(&n)
+        };
+        out.p1d = vel(t1, &c) - out.nd * radius;
+        out.p2d = vel(t2, &p2) + ab * qd;
+    }
+    out
+}
+
+/// Planar circles: the centre line projected on body 2's x-y plane; `P2` is taken at the height
+/// of circle 1's centre on the extruded circle 2, so `P1 - P2 = g_N n`.
+fn circle_circle(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    c1b: &Vec3,
+    r1: f64,
+    c2b: &Vec3,
+    r2: f64,
+) -> Raw {
+    let c1 = x1.point_to_parent(c1b);
+    let c2 = x2.point_to_parent(c2b);
+    let e = x2.a.column(2).into_owned();
+    let d = c1 - c2;
+    let dp = d - e * d.dot(&e);
+    let len = dp.norm();
+    let degenerate = !(len > TINY * (1.0 + r1 + r2));
+    let n = if degenerate { x2.a.column(0).into_owned() } else { dp / len };
+    let mut out = Raw { g: len - r1 - r2, n, p1: c1 - n * r1, p2: c1 - n * (len - r2), ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        let c1d = vel(t1, &c1);
+        let dd = c1d - vel(t2, &c2);
+        let ed = t2.w.cross(&e);
+        let dpd = dd - e * (dd.dot(&e) + d.dot(&ed)) - ed * d.dot(&e);
+        let lend = n.dot(&dpd);
+        out.nd = if degenerate { t2.w.cross(&n) } else { (dpd - n * lend) / len };
+        out.p1d = c1d - out.nd * r1;
+        out.p2d = c1d - n * lend - out.nd * (len - r2);
+    }
+    out
+}
+
+/// Fills `out[..pair.candidates()]` with the candidates of `pair` for body 1 at `x1` and body 2
+/// at `x2` (world placements). No allocation; an error only when `out` is too short.
+pub fn evaluate(pair: &ContactPair, x1: &Pose, x2: &Pose, out: &mut [ContactPoint]) -> Result<()> {
+    pair.check_len(out.len())?;
+    for (k, o) in out[..pair.count].iter_mut().enumerate() {
+        let r = pair.candidate(k, x1, x2, None);
+        let t = pair.tangents(x2, &r.n, None);
+        *o = ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 };
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

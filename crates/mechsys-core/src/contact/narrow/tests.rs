@@ -1,0 +1,322 @@
+//! Narrow phase against independent geometry: signed distances of the contours, brute-force
+//! minima, concrete configurations with known answers, and the swapped order.
+
+use super::*;
+use crate::contact::contour::Vec2;
+use crate::contact::test_util::{random_poses, rot, sample, sdf, Rng, PAIRS};
+
+fn eval(pair: &ContactPair, x1: &Pose, x2: &Pose) -> Vec<ContactPoint> {
+    let mut out = vec![ContactPoint::default(); pair.candidates()];
+    evaluate(pair, x1, x2, &mut out).unwrap();
+    out
+}
+
+fn pose(r: Vec3) -> Pose {
+    Pose::new(Mat3::identity(), r)
+}
+
+/// Numerical gradient of the signed distance (central differences).
+fn grad(c: &Contour, x: &Pose, p: &Vec3) -> Vec3 {
+    let h = 1e-7;
+    Vec3::from_fn(|k, _| {
+        let mut e = Vec3::zeros();
+        e[k] = h;
+        (sdf(c, x, &(p + e)) - sdf(c, x, &(p - e))) / (2.0 * h)
+    })
+}
+
+/// Contours whose surface is smooth at every contact point they produce.
+fn smooth(c: &Contour) -> bool {
+    matches!(
+        c,
+        Contour::Sphere { .. }
+            | Contour::Capsule { .. }
+            | Contour::Circle { .. }
+            | Contour::Plane { .. }
+            | Contour::Line { .. }
+    )
+}
+
+/// Minimum of a function convex on [0, 1] (golden-section search).
+fn argmin01(f: impl Fn(f64) -> f64) -> f64 {
+    let (mut a, mut b) = (0.0, 1.0);
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..200 {
+        let (c, d) = (b - g * (b - a), a + g * (b - a));
+        if f(c) < f(d) {
+            b = d;
+        } else {
+            a = c;
+        }
+    }
+    f(0.5 * (a + b))
+}
+
+#[test]
+fn candidate_counts_and_unsupported_pairs() {
+    let expect = [1, 1, 8, 2, 2, 1, 1, 5, 1, 1, 1, 1, 1, 1, 1, 1, 1];
+    for ((a, b), n) in PAIRS.iter().zip(expect) {
+        let (c1, c2) = (sample(a), sample(b));
+        assert_eq!(candidates(&c1, &c2).unwrap(), n, "{a}–{b}");
+        assert_eq!(candidates(&c2, &c1).unwrap(), n, "{b}–{a}");
+    }
+    for (a, b) in [
+        ("box", "box"),
+        ("plane", "plane"),
+        ("circle", "plane"),
+        ("sphere", "line"),
+        ("polygon", "circle"),
+        ("point", "point"),
+    ] {
+        let e = candidates(&sample(a), &sample(b)).unwrap_err().to_string();
+        assert!(e.contains(&format!("{}–{}", sample(a).kind(), sample(b).kind())), "{e}");
+    }
+    let e = ContactPair::new("c", sample("box"), sample("cylinder")).unwrap_err().to_string();
+    assert!(e.starts_with("contact 'c': no contact geometry for the contour pair box–cylinder"), "{e}");
+    let e = ContactPair::new("tip", Contour::Circle { center: Vec2::zeros(), radius: 0.0 }, sample("line"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("contact 'tip': contour 1 (circle): circle radius must be > 0"), "{e}");
+    let pair = ContactPair::new("c", sample("box"), sample("plane")).unwrap();
+    let mut short = [ContactPoint::default(); 7];
+    let e = evaluate(&pair, &Pose::IDENTITY, &Pose::IDENTITY, &mut short).unwrap_err().to_string();
+    assert!(e.contains("room for 7 candidates, needs 8"), "{e}");
+}
+
+/// Known answers with signs: each would flip under a sign error in n, g or the points.
+#[test]
+fn concrete_configurations() {
+    let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.5 };
+    let ground = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
+    let pair = ContactPair::new("b", ball.clone(), ground.clone()).unwrap();
+    let c = eval(&pair, &pose(Vec3::new(1.0, 2.0, 3.0)), &Pose::IDENTITY)[0];
+    assert_eq!((c.g_n, c.n, c.p1, c.p2), (2.5, Vec3::z(), Vec3::new(1.0, 2.0, 2.5), Vec3::new(1.0, 2.0, 0.0)));
+    // the plane on body 1: n points from the ball (contour 2) to the plane (contour 1)
+    let flipped = ContactPair::new("b", ground, ball.clone()).unwrap();
+    let c = eval(&flipped, &Pose::IDENTITY, &pose(Vec3::new(1.0, 2.0, 3.0)))[0];
+    assert_eq!((c.g_n, c.n, c.p1, c.p2), (2.5, -Vec3::z(), Vec3::new(1.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 2.5)));
+    // two balls on the x axis, overlapping by 0.25
+    let b2 = Contour::Sphere { center: Vec3::zeros(), radius: 0.25 };
+    let pair = ContactPair::new("bb", ball.clone(), b2).unwrap();
+    let c = eval(&pair, &pose(Vec3::new(0.5, 0.0, 0.0)), &Pose::IDENTITY)[0];
+    assert!((c.g_n + 0.25).abs() < 1e-15 && c.n == Vec3::x());
+    assert_eq!((c.p1, c.p2), (Vec3::zeros(), Vec3::new(0.25, 0.0, 0.0)));
+    // a unit cube resting 0.1 above the ground, turned about z: four corners at 0.1, four at 1.1
+    let cube = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::repeat(0.5) };
+    let pair =
+        ContactPair::new("cube", cube.clone(), Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() }).unwrap();
+    let mut g: Vec<f64> = eval(&pair, &Pose::new(rot(&Vec3::z(), 0.3), Vec3::new(0.0, 0.0, 0.6)), &Pose::IDENTITY)
+        .iter()
+        .map(|c| c.g_n)
+        .collect();
+    g.sort_by(f64::total_cmp);
+    for (k, gk) in g.iter().enumerate() {
+        assert!((gk - if k < 4 { 0.1 } else { 1.1 }).abs() < 1e-14);
+    }
+    // a ball beside a box face, at an edge and at a corner
+    let pair = ContactPair::new("sb", ball.clone(), cube).unwrap();
+    let c = eval(&pair, &pose(Vec3::new(2.0, 0.1, 0.2)), &Pose::IDENTITY)[0];
+    assert!((c.g_n - 1.0).abs() < 1e-15 && c.n == Vec3::x() && c.p2 == Vec3::new(0.5, 0.1, 0.2));
+    let c = eval(&pair, &pose(Vec3::new(1.5, 1.5, 0.0)), &Pose::IDENTITY)[0];
+    assert!((c.g_n - (2f64.sqrt() - 0.5)).abs() < 1e-15 && c.p2 == Vec3::new(0.5, 0.5, 0.0));
+    // centre inside, nearest face -y: n = -y, depth 0.2 + radius
+    let c = eval(&pair, &pose(Vec3::new(0.1, -0.3, 0.0)), &Pose::IDENTITY)[0];
+    assert!((c.g_n + 0.7).abs() < 1e-15 && c.n == -Vec3::y() && c.p2 == Vec3::new(0.1, -0.5, 0.0));
+    // crossing capsules, one above the other by 1: g = 1 - 0.2 - 0.3
+    let cx = Contour::Capsule { a: Vec3::new(-1.0, 0.0, 0.0), b: Vec3::new(1.0, 0.0, 0.0), radius: 0.2 };
+    let cy = Contour::Capsule { a: Vec3::new(0.0, -1.0, 0.0), b: Vec3::new(0.0, 1.0, 0.0), radius: 0.3 };
+    let pair = ContactPair::new("cc", cx, cy).unwrap();
+    let c = eval(&pair, &pose(Vec3::new(0.2, 0.3, 1.0)), &Pose::IDENTITY)[0];
+    assert!((c.g_n - 0.5).abs() < 1e-15 && (c.n - Vec3::z()).norm() < 1e-15, "{c:?}");
+    assert!((c.p1 - Vec3::new(0.0, 0.3, 0.8)).norm() < 1e-15 && (c.p2 - Vec3::new(0.0, 0.3, 0.3)).norm() < 1e-15);
+    // a cylinder lying on its side (axis x) 0.1 above the ground: both rims touch at 0.1
+    let cyl = Contour::Cylinder { center: Vec3::zeros(), axis: Vec3::x(), radius: 0.3, half_length: 0.5 };
+    let pair =
+        ContactPair::new("cyl", cyl.clone(), Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() }).unwrap();
+    let cs = eval(&pair, &pose(Vec3::new(0.0, 0.0, 0.4)), &Pose::IDENTITY);
+    assert!(cs.iter().all(|c| (c.g_n - 0.1).abs() < 1e-15));
+    assert!(
+        (cs[0].p1 - Vec3::new(0.5, 0.0, 0.1)).norm() < 1e-15 && (cs[1].p1 - Vec3::new(-0.5, 0.0, 0.1)).norm() < 1e-15
+    );
+    // tilted by 0.2 about y: each rim's lowest point, 1 + (±h) a_z - R √(1 - a_z²)
+    let tilt = rot(&Vec3::y(), 0.2);
+    let cs = eval(&pair, &Pose::new(tilt, Vec3::new(0.0, 0.0, 1.0)), &Pose::IDENTITY);
+    let a = tilt * Vec3::x();
+    let low = |s: f64| 1.0 + s * 0.5 * a.z - 0.3 * (1.0 - a.z * a.z).sqrt();
+    assert!((cs[0].g_n - low(1.0)).abs() < 1e-15 && (cs[1].g_n - low(-1.0)).abs() < 1e-15);
+    // planar: a disc of radius 0.5 at (2, 1) against the wall x ≤ 0.3 (normal +x): n = +x,
+    // t1 = e_z × n = +y
+    let disc = Contour::Circle { center: Vec2::zeros(), radius: 0.5 };
+    let wall = Contour::Line { point: Vec2::new(0.3, 0.0), normal: Vec2::new(1.0, 0.0) };
+    let pair = ContactPair::new("tip", disc, wall).unwrap();
+    assert_eq!(pair.tangent_dim(), 1);
+    let c = eval(&pair, &pose(Vec3::new(2.0, 1.0, 0.0)), &Pose::IDENTITY)[0];
+    assert!((c.g_n - 1.2).abs() < 1e-15 && c.n == Vec3::x() && c.t1 == Vec3::y() && c.t2 == Vec3::z());
+    assert!((c.p1 - Vec3::new(1.5, 1.0, 0.0)).norm() < 1e-15 && (c.p2 - Vec3::new(0.3, 1.0, 0.0)).norm() < 1e-15);
+}
+
+/// At random configurations of every pair: P1 on contour 1, P2 on contour 2, P1 - P2 = g n,
+/// n the surface normal, an orthonormal right-handed frame, g the true (signed) distance.
+#[test]
+fn geometry_matches_signed_distances() {
+    let mut rng = Rng::new(42);
+    let mut box_regions = [0usize; 4];
+    for (a, b) in PAIRS {
+        let (c1, c2) = (sample(a), sample(b));
+        let planar = c1.kind().is_planar();
+        let pair = ContactPair::new("p", c1.clone(), c2.clone()).unwrap();
+        for it in 0..30 {
+            let (x1, x2) = random_poses(&mut rng, planar);
+            let cs = eval(&pair, &x1, &x2);
+            for (k, c) in cs.iter().enumerate() {
+                let tag = format!("{a}–{b} #{it} candidate {k}");
+                assert!((c.n.norm() - 1.0).abs() < 1e-12, "{tag}");
+                assert!((c.p1 - c.p2 - c.n * c.g_n).norm() < 1e-12, "{tag}: P1 - P2 = g n");
+                let gmin = cs.iter().map(|c| c.g_n).fold(f64::INFINITY, f64::min);
+                let d1 = sdf(&c1, &x1, &c.p1);
+                if matches!(c1, Contour::Capsule { .. }) && matches!(c2, Contour::Plane { .. }) && c.g_n > gmin {
+                    // the upper end sphere's lowest point may lie inside the capsule
+                    assert!(d1 < 1e-12, "{tag}: P1 outside contour 1 by {d1}");
+                } else {
+                    assert!(d1.abs() < 1e-12, "{tag}: P1 off contour 1 by {d1}");
+                }
+                assert!(sdf(&c2, &x2, &c.p2).abs() < 1e-12, "{tag}: P2 off contour 2 by {}", sdf(&c2, &x2, &c.p2));
+                let frame = Mat3::from_columns(&[c.t1, c.t2, c.n]);
+                assert!((frame.transpose() * frame - Mat3::identity()).norm() < 1e-12, "{tag}: frame");
+                assert!((frame.determinant() - 1.0).abs() < 1e-12, "{tag}: right-handed");
+                if smooth(&c2) {
+                    let g2 = grad(&c2, &x2, &(c.p2 + c.n * 1e-3));
+                    assert!((g2 - c.n).norm() < 1e-6, "{tag}: n is contour 2's normal");
+                }
+                if smooth(&c1) && d1.abs() < 1e-12 {
+                    let g1 = grad(&c1, &x1, &(c.p1 - c.n * 1e-3));
+                    assert!((g1 + c.n).norm() < 1e-6, "{tag}: -n is contour 1's normal");
+                }
+                if planar {
+                    let ez = x2.a.column(2).into_owned();
+                    assert!(c.n.dot(&ez).abs() < 1e-12, "{tag}: planar n ⟂ e_z");
+                    assert!((c.t1 - ez.cross(&c.n).normalize()).norm() < 1e-12, "{tag}: t1 = e_z × n");
+                }
+            }
+            // g as the distance between the contours from independent formulas
+            let g = cs[0].g_n;
+            let centre = match &c1 {
+                Contour::Sphere { center, radius } => Some((x1.point_to_parent(center), *radius)),
+                Contour::Circle { center, radius } => Some((x1.point_to_parent(&lift(center)), *radius)),
+                Contour::Point { p } => Some((x1.point_to_parent(p), 0.0)),
+                Contour::Point2 { p } => Some((x1.point_to_parent(&lift(p)), 0.0)),
+                _ => None,
+            };
+            if let Some((c, r)) = centre {
+                assert!((g - (sdf(&c2, &x2, &c) - r)).abs() < 1e-12, "{a}–{b}: g vs sdf");
+            }
+            match (&c1, &c2) {
+                (Contour::Capsule { a: a1, b: b1, radius: r1 }, Contour::Capsule { a: a2, b: b2, radius: r2 }) => {
+                    let (p1, q1) = (x1.point_to_parent(a1), x1.point_to_parent(b1));
+                    let (p2, q2) = (x2.point_to_parent(a2), x2.point_to_parent(b2));
+                    let dist = |s: f64| argmin01(|u| (p1 + (q1 - p1) * s - p2 - (q2 - p2) * u).norm());
+                    let d = argmin01(dist);
+                    assert!((g - (d - r1 - r2)).abs() < 1e-9, "{a}–{b}: g {g} vs brute force {}", d - r1 - r2);
+                }
+                (Contour::Cylinder { center, axis, radius, half_length }, _) => {
+                    // the lowest rim point of each end by sampling the rim
+                    for (k, s) in [1.0, -1.0].iter().enumerate() {
+                        let ax = axis.normalize();
+                        let u = if ax.x.abs() < 0.9 {
+                            ax.cross(&Vec3::x()).normalize()
+                        } else {
+                            ax.cross(&Vec3::y()).normalize()
+                        };
+                        let w = ax.cross(&u);
+                        let min = (0..20000)
+                            .map(|i| {
+                                let phi = std::f64::consts::TAU * i as f64 / 20000.0;
+                                let p = center + ax * (s * half_length) + (u * phi.cos() + w * phi.sin()) * *radius;
+                                sdf(&c2, &x2, &x1.point_to_parent(&p))
+                            })
+                            .fold(f64::INFINITY, f64::min);
+                        assert!(cs[k].g_n <= min + 1e-12 && min - cs[k].g_n < 1e-6, "{a}–{b}: rim {k}");
+                    }
+                }
+                _ => {}
+            }
+            if let (
+                Contour::Sphere { center, .. } | Contour::Point { p: center },
+                Contour::Box { center: bc, rotation, half_extents },
+            ) = (&c1, &c2)
+            {
+                let cl = rotation.transpose() * (x2.a.transpose() * (x1.point_to_parent(center) - x2.r) - bc);
+                let out = (0..3).filter(|&k| cl[k].abs() > half_extents[k]).count();
+                box_regions[out] += 1;
+            }
+        }
+    }
+    // the sphere–box cases met the inside, face, edge and corner regions
+    assert!(box_regions.iter().all(|&n| n > 0), "{box_regions:?}");
+}
+
+/// Reversing the contours gives the same gap, the opposite normal and exchanged points.
+#[test]
+fn reversed_order_flips_the_normal() {
+    let mut rng = Rng::new(5);
+    for (a, b) in PAIRS {
+        let (c1, c2) = (sample(a), sample(b));
+        let fwd = ContactPair::new("f", c1.clone(), c2.clone()).unwrap();
+        let rev = ContactPair::new("r", c2, c1).unwrap();
+        for _ in 0..5 {
+            let (x1, x2) = random_poses(&mut rng, fwd.is_planar());
+            let (f, r) = (eval(&fwd, &x1, &x2), eval(&rev, &x2, &x1));
+            for (f, r) in f.iter().zip(&r) {
+                assert!((f.g_n - r.g_n).abs() < 1e-14, "{a}–{b}");
+                assert!((f.n + r.n).norm() < 1e-14 && (f.p1 - r.p2).norm() < 1e-14 && (f.p2 - r.p1).norm() < 1e-14);
+            }
+        }
+    }
+}
+
+/// Degenerate configurations give finite values and the documented normal and gap.
+#[test]
+fn degenerate_configurations_are_defined() {
+    let finite = |c: &ContactPoint| {
+        [c.g_n]
+            .iter()
+            .chain(c.n.iter())
+            .chain(c.p1.iter())
+            .chain(c.p2.iter())
+            .chain(c.t1.iter())
+            .chain(c.t2.iter())
+            .all(|v| v.is_finite())
+    };
+    let s = |r| Contour::Sphere { center: Vec3::zeros(), radius: r };
+    let x = Pose::new(rot(&Vec3::new(1.0, 2.0, 3.0), 0.7), Vec3::new(0.3, 0.2, 0.1));
+    // coincident centres: g = -(R1 + R2), n = body 2's x axis
+    let c = eval(&ContactPair::new("d", s(0.5), s(0.25)).unwrap(), &x, &x)[0];
+    assert!(finite(&c) && (c.g_n + 0.75).abs() < 1e-15 && (c.n - x.a.column(0)).norm() < 1e-15);
+    // crossing capsule axes: n along d1 × d2
+    let cx = Contour::Capsule { a: Vec3::new(-1.0, 0.0, 0.0), b: Vec3::new(1.0, 0.0, 0.0), radius: 0.2 };
+    let cy = Contour::Capsule { a: Vec3::new(0.0, -1.0, 0.0), b: Vec3::new(0.0, 1.0, 0.0), radius: 0.3 };
+    let c = eval(&ContactPair::new("d", cx.clone(), cy).unwrap(), &Pose::IDENTITY, &Pose::IDENTITY)[0];
+    assert!(finite(&c) && (c.g_n + 0.5).abs() < 1e-15 && c.n == Vec3::z());
+    // coaxial capsules: any normal ⟂ the axis
+    let c = eval(&ContactPair::new("d", cx.clone(), cx).unwrap(), &Pose::IDENTITY, &Pose::IDENTITY)[0];
+    assert!(finite(&c) && c.n.x.abs() < 1e-15 && (c.g_n + 0.4).abs() < 1e-15);
+    // sphere centre at the box centre (all faces... the thinnest one), upright cylinder, circles
+    let cube =
+        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(1.0, 0.5, 2.0) };
+    let c = eval(&ContactPair::new("d", s(0.1), cube).unwrap(), &Pose::IDENTITY, &Pose::IDENTITY)[0];
+    assert!(finite(&c) && (c.g_n + 0.6).abs() < 1e-15 && c.n == Vec3::y());
+    let cyl = Contour::Cylinder { center: Vec3::zeros(), axis: Vec3::z(), radius: 0.3, half_length: 0.5 };
+    let ground = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
+    let cs = eval(&ContactPair::new("d", cyl, ground).unwrap(), &pose(Vec3::new(0.0, 0.0, 0.5)), &Pose::IDENTITY);
+    assert!(cs.iter().all(finite) && cs[1].g_n.abs() < 1e-15 && (cs[0].g_n - 1.0).abs() < 1e-15);
+    let ci = Contour::Circle { center: Vec2::zeros(), radius: 0.5 };
+    let c = eval(&ContactPair::new("d", ci.clone(), ci).unwrap(), &Pose::IDENTITY, &Pose::IDENTITY)[0];
+    assert!(finite(&c) && c.g_n == -1.0 && c.n == Vec3::x() && c.t1 == Vec3::y());
+    // NaN poses propagate NaN but do not panic
+    let nan = Pose::new(Mat3::repeat(f64::NAN), Vec3::repeat(f64::NAN));
+    for (a, b) in PAIRS {
+        let pair = ContactPair::new("n", sample(a), sample(b)).unwrap();
+        let _ = eval(&pair, &nan, &Pose::IDENTITY);
+        let _ = eval(&pair, &Pose::IDENTITY, &nan);
+    }
+}

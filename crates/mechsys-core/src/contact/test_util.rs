@@ -1,0 +1,266 @@
+//! Test helpers: a seeded generator and prescribed smooth body motions with analytic twists and
+//! accelerations, against which the contact kinematics are differenced.
+
+use nalgebra::{Rotation3, Unit};
+
+use super::kinematics::BodyMotion;
+use crate::math::{Mat3, Vec3};
+use crate::spatial::{Motion, Pose};
+
+/// xorshift64* — deterministic, no dependency.
+pub(crate) struct Rng(u64);
+
+impl Rng {
+    pub(crate) fn new(seed: u64) -> Self {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    pub(crate) fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    pub(crate) fn uniform(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+    pub(crate) fn vec3(&mut self, s: f64) -> Vec3 {
+        Vec3::new(self.uniform(-s, s), self.uniform(-s, s), self.uniform(-s, s))
+    }
+    pub(crate) fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = self.vec3(1.0);
+            let n = v.norm();
+            if n > 0.1 && n < 1.0 {
+                return v / n;
+            }
+        }
+    }
+    pub(crate) fn rotation(&mut self) -> Mat3 {
+        let axis = self.unit();
+        rot(&axis, self.uniform(-3.0, 3.0))
+    }
+}
+
+pub(crate) fn rot(axis: &Vec3, angle: f64) -> Mat3 {
+    Rotation3::from_axis_angle(&Unit::new_normalize(*axis), angle).into_inner()
+}
+
+/// A smooth rigid motion `A(t) = R(k1, θ1(t)) R(k2, θ2(t)) A0`, `r(t) = r0 + r1 t + r2 t²`,
+/// `θi = ci0 + ci1 t + ci2 t²`, with its twist and acceleration in the world convention.
+#[derive(Clone, Copy)]
+pub(crate) struct Trajectory {
+    k1: Vec3,
+    k2: Vec3,
+    th1: [f64; 3],
+    th2: [f64; 3],
+    a0: Mat3,
+    r: [Vec3; 3],
+    /// Restrict to plane motion: rotation about z, translation in x-y.
+    pub(crate) planar: bool,
+}
+
+impl Trajectory {
+    /// A random motion about `pose` with angular rates ~`rate` and speeds ~`speed`.
+    pub(crate) fn random(rng: &mut Rng, pose: &Pose, rate: f64, speed: f64) -> Self {
+        Trajectory {
+            k1: rng.unit(),
+            k2: rng.unit(),
+            th1: [0.0, rng.uniform(-rate, rate), rng.uniform(-rate, rate)],
+            th2: [0.0, rng.uniform(-rate, rate), rng.uniform(-rate, rate)],
+            a0: pose.a,
+            r: [pose.r, rng.vec3(speed), rng.vec3(speed)],
+            planar: false,
+        }
+    }
+    /// A random plane motion (about z, in x-y) about `pose`.
+    pub(crate) fn random_planar(rng: &mut Rng, pose: &Pose, rate: f64, speed: f64) -> Self {
+        let mut t = Self::random(rng, pose, rate, speed);
+        t.k1 = Vec3::z();
+        t.k2 = Vec3::z();
+        t.r[1].z = 0.0;
+        t.r[2].z = 0.0;
+        t.planar = true;
+        t
+    }
+    /// At rest at `pose` (the ground).
+    pub(crate) fn fixed(pose: &Pose) -> Self {
+        Trajectory {
+            k1: Vec3::z(),
+            k2: Vec3::x(),
+            th1: [0.0; 3],
+            th2: [0.0; 3],
+            a0: pose.a,
+            r: [pose.r, Vec3::zeros(), Vec3::zeros()],
+            planar: false,
+        }
+    }
+
+    pub(crate) fn at(&self, t: f64) -> BodyMotion {
+        let q = |c: &[f64; 3]| (c[0] + c[1] * t + c[2] * t * t, c[1] + 2.0 * c[2] * t, 2.0 * c[2]);
+        let (q1, q1d, q1dd) = q(&self.th1);
+        let (q2, q2d, q2dd) = q(&self.th2);
+        let r1 = rot(&self.k1, q1);
+        let a = r1 * rot(&self.k2, q2) * self.a0;
+        let k2w = r1 * self.k2;
+        // ω = θ̇1 k1 + θ̇2 R1 k2; the second axis turns with θ̇1 k1
+        let w = self.k1 * q1d + k2w * q2d;
+        let al = self.k1 * q1dd + k2w * q2dd + self.k1.cross(&k2w) * (q1d * q2d);
+        let r = self.r[0] + self.r[1] * t + self.r[2] * (t * t);
+        let rd = self.r[1] + self.r[2] * (2.0 * t);
+        let rdd = self.r[2] * 2.0;
+        // world convention: ṙ = v + ω × r, r̈ = a + α × r + ω × ṙ
+        let v = rd - w.cross(&r);
+        let acc = rdd - al.cross(&r) - w.cross(&rd);
+        BodyMotion { pose: Pose::new(a, r), twist: Motion::new(w, v), acc: Motion::new(al, acc) }
+    }
+}
+
+/// `|a - b| ≤ tol · max(1, |b|)`.
+pub(crate) fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * b.abs().max(1.0)
+}
+
+#[test]
+fn trajectory_twist_and_acceleration_match_finite_differences() {
+    let mut rng = Rng::new(3);
+    for _ in 0..5 {
+        let x = Pose::new(rng.rotation(), rng.vec3(1.0));
+        let tr = Trajectory::random(&mut rng, &x, 1.0, 1.0);
+        let pb = rng.vec3(1.0);
+        let pos = |t: f64| tr.at(t).pose.point_to_parent(&pb);
+        let (t, h) = (0.3, 1e-4);
+        let m = tr.at(t);
+        let p = pos(t);
+        let v = m.point_velocity(&p);
+        let a = m.point_acceleration(&p);
+        let vfd = (pos(t + h) - pos(t - h)) / (2.0 * h);
+        let afd = (pos(t + h) - 2.0 * p + pos(t - h)) / (h * h);
+        assert!((v - vfd).norm() < 1e-7, "{v} {vfd}");
+        assert!((a - afd).norm() < 1e-5, "{a} {afd}");
+        // ω from Ȧ Aᵀ
+        let ad = (tr.at(t + h).pose.a - tr.at(t - h).pose.a) / (2.0 * h);
+        let w = crate::math::untilde(&(ad * m.pose.a.transpose()));
+        assert!((w - m.twist.w).norm() < 1e-7);
+        let wd = (tr.at(t + h).twist.w - tr.at(t - h).twist.w) / (2.0 * h);
+        assert!((wd - m.acc.w).norm() < 1e-7);
+    }
+}
+
+use super::contour::{lift, Contour, Vec2};
+
+/// One contour of every kind, with offsets from the body origin (and unnormalized directions,
+/// so the pair's normalization is exercised).
+pub(crate) fn sample(kind: &str) -> Contour {
+    match kind {
+        "point" => Contour::Point { p: Vec3::new(0.1, -0.2, 0.05) },
+        "sphere" => Contour::Sphere { center: Vec3::new(0.1, 0.05, -0.1), radius: 0.4 },
+        "sphere_b" => Contour::Sphere { center: Vec3::new(-0.05, 0.1, 0.02), radius: 0.25 },
+        "plane" => Contour::Plane { point: Vec3::new(0.0, 0.0, -0.2), normal: Vec3::new(0.1, 0.2, 1.0) },
+        "box" => Contour::Box {
+            center: Vec3::new(0.05, 0.0, 0.1),
+            rotation: rot(&Vec3::new(1.0, 2.0, 0.5), 0.5),
+            half_extents: Vec3::new(0.3, 0.5, 0.2),
+        },
+        "capsule" => Contour::Capsule { a: Vec3::new(-0.3, 0.1, 0.0), b: Vec3::new(0.4, -0.1, 0.1), radius: 0.2 },
+        "capsule_b" => Contour::Capsule { a: Vec3::new(0.0, -0.4, 0.1), b: Vec3::new(0.1, 0.5, -0.2), radius: 0.15 },
+        "cylinder" => Contour::Cylinder {
+            center: Vec3::new(0.1, 0.0, 0.0),
+            axis: Vec3::new(0.2, 0.1, 1.0),
+            radius: 0.3,
+            half_length: 0.4,
+        },
+        "point2" => Contour::Point2 { p: Vec2::new(0.2, -0.1) },
+        "circle" => Contour::Circle { center: Vec2::new(0.1, 0.2), radius: 0.35 },
+        "circle_b" => Contour::Circle { center: Vec2::new(-0.1, 0.05), radius: 0.2 },
+        "line" => Contour::Line { point: Vec2::new(0.0, -0.1), normal: Vec2::new(0.3, 1.0) },
+        "polygon" => Contour::Polygon {
+            vertices: [(-0.3, -0.2), (0.2, -0.25), (0.35, 0.1), (0.0, 0.3), (-0.25, 0.15)]
+                .iter()
+                .map(|&(x, y)| Vec2::new(x, y))
+                .collect(),
+        },
+        _ => unreachable!("unknown sample {kind}"),
+    }
+}
+
+/// Every supported pair in canonical order (sample names).
+pub(crate) const PAIRS: [(&str, &str); 17] = [
+    ("point", "plane"),
+    ("sphere", "plane"),
+    ("box", "plane"),
+    ("capsule", "plane"),
+    ("cylinder", "plane"),
+    ("point2", "line"),
+    ("circle", "line"),
+    ("polygon", "line"),
+    ("point", "sphere"),
+    ("sphere_b", "sphere"),
+    ("point", "capsule"),
+    ("sphere", "capsule"),
+    ("capsule_b", "capsule"),
+    ("point", "box"),
+    ("sphere", "box"),
+    ("point2", "circle"),
+    ("circle_b", "circle"),
+];
+
+/// Random placements of two bodies near each other (plane motion: rotations about z, z = 0).
+pub(crate) fn random_poses(rng: &mut Rng, planar: bool) -> (Pose, Pose) {
+    let rotation = |rng: &mut Rng| if planar { rot(&Vec3::z(), rng.uniform(-3.0, 3.0)) } else { rng.rotation() };
+    let mut r2 = rng.vec3(0.3);
+    let dir =
+        if planar { Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 0.0).normalize() } else { rng.unit() };
+    let mut r1 = r2 + dir * rng.uniform(0.2, 1.2);
+    if planar {
+        r1.z = 0.0;
+        r2.z = 0.0;
+    }
+    (Pose::new(rotation(rng), r1), Pose::new(rotation(rng), r2))
+}
+
+/// Signed distance of world point `x` to the contour on a body at `pose` (planar contours
+/// extruded along the body z axis; points and polygons give the distance to the point set or
+/// the largest edge distance, which is zero on the boundary).
+pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
+    let xl = pose.a.transpose() * (x - pose.r);
+    let seg = |a: &Vec3, b: &Vec3, p: &Vec3| {
+        let d = b - a;
+        let s = ((p - a).dot(&d) / d.dot(&d)).clamp(0.0, 1.0);
+        (p - a - d * s).norm()
+    };
+    match c {
+        Contour::Point { p } => (xl - p).norm(),
+        Contour::Sphere { center, radius } => (xl - center).norm() - radius,
+        Contour::Plane { point, normal } => normal.normalize().dot(&(xl - point)),
+        Contour::Box { center, rotation, half_extents } => {
+            let q = (rotation.transpose() * (xl - center)).abs() - half_extents;
+            q.sup(&Vec3::zeros()).norm() + q.max().min(0.0)
+        }
+        Contour::Capsule { a, b, radius } => seg(a, b, &xl) - radius,
+        Contour::Cylinder { center, axis, radius, half_length } => {
+            let a = axis.normalize();
+            let y = xl - center;
+            let za = y.dot(&a);
+            let rho = (y - a * za).norm();
+            let d = nalgebra::Vector2::new(rho - radius, za.abs() - half_length);
+            d.sup(&nalgebra::Vector2::zeros()).norm() + d.max().min(0.0)
+        }
+        Contour::Point2 { p } => (xl - lift(p)).norm(),
+        Contour::Circle { center, radius } => {
+            let d = xl - lift(center);
+            (d.x * d.x + d.y * d.y).sqrt() - radius
+        }
+        Contour::Line { point, normal } => lift(&normal.normalize()).dot(&(xl - lift(point))),
+        Contour::Polygon { vertices } => {
+            let n = vertices.len();
+            (0..n)
+                .map(|i| {
+                    let (a, b) = (vertices[i], vertices[(i + 1) % n]);
+                    let e = (b - a).normalize();
+                    let out = Vec2::new(e.y, -e.x);
+                    out.dot(&(Vec2::new(xl.x, xl.y) - a))
+                })
+                .fold(f64::NEG_INFINITY, f64::max)
+        }
+    }
+}

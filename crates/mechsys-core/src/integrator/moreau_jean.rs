@@ -1,0 +1,425 @@
+//! Moreau–Jean time-stepping (section 2.5): velocities and impulses instead of accelerations and
+//! forces, so impacts, stick–slip transitions and accumulations of impacts need no event
+//! detection.
+//!
+//! One step of size h from (q_k, u_k), the midpoint rule of Moreau:
+//! 1. `q_m = q_k + h/2 · q̇(u_k)`; at (t_k + h/2, q_m, u_k) the mass matrix, the smooth forces and
+//!    the contact geometry are evaluated once;
+//! 2. free velocity `u_free = u_k + h M⁻¹ (τ - c)`, made to satisfy the bilateral constraints at
+//!    velocity level (`G u_free = b`) by an impulse;
+//! 3. the contact points with `g_N(q_m) ≤` [`CONTACT_MARGIN`] are active (a positive gap lets the
+//!    point approach by at most that gap within the step); with `W = [w_N, W_T]` at q_m and the
+//!    inverse mass `M̃⁻¹` restricted by the bilateral constraints, the local velocities after the
+//!    step are `ġ⁺ = Wᵀ u_free + (Wᵀ M̃⁻¹ W) Λ`;
+//! 4. the friction-contact problem in the impulses Λ: Signorini–Coulomb between `Λ` and the
+//!    Newton-restituted velocity `ġ_N⁺ + ε min(ġ_N⁻, 0)` (eq. 2.202 at velocity level), Coulomb's
+//!    cone with µ0 for a contact that was sticking and µ(|ġ_T⁻|) for one that was sliding
+//!    (eqs. 2.200, 2.201), solved by one of [`crate::solver`]'s methods, warm-started;
+//! 5. `u_{k+1} = u_free + M̃⁻¹ W Λ`, `q_{k+1} = q_m + h/2 · q̇(u_{k+1})`, then the bilateral
+//!    constraints are projected as in the smooth schemes.
+//!
+//! Energy: with M frozen over the step, the kinetic energy changes by `h fᵀ ū + Λᵀ Wᵀ ū`
+//! (ū = (u_k + u_{k+1})/2), so `-Λᵀ ½(ġ⁻ + ġ⁺)` is what the contacts dissipate in the step, split
+//! into its normal (impact) and tangential (friction) parts. Poisson's law is applied with its
+//! normal coefficient as Newton's (they agree for a single frictionless impact); its tangential
+//! coefficient needs the event-driven scheme.
+
+use nalgebra::DMatrix;
+
+use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::forces::Callbacks;
+use crate::model::contact::FrictionLaw;
+use crate::model::joint::quat_matrix;
+use crate::model::JointKind;
+use crate::model::Model;
+use crate::solver::{self, ContactState, Delassus, FrictionContact, Method, Workspace};
+use crate::spatial::Motion;
+
+/// Candidate points with a midpoint gap up to this (m) join the step's contact problem, so that
+/// resting contacts whose gap is a rounding error above zero (a box on four corners) are not
+/// dropped and picked up in turn.
+pub const CONTACT_MARGIN: f64 = 1e-9;
+
+/// Contact state code in the recorded signal `contact/<c>/state`.
+pub const OPEN: f64 = 0.0;
+/// Sticking (closed, no sliding).
+pub const STICK: f64 = 1.0;
+/// Slipping (closed, sliding on the cone).
+pub const SLIP: f64 = 2.0;
+
+/// Per contact point results of the last step.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PointResult {
+    /// Normal impulse Λ_N over the step (N s).
+    pub impulse_n: f64,
+    /// Tangential impulses (N s).
+    pub impulse_t: [f64; 2],
+    /// State code ([`OPEN`], [`STICK`], [`SLIP`]).
+    pub state: f64,
+}
+
+/// The workspace of the scheme, sized for the model.
+pub struct MoreauJean {
+    /// Step size (s).
+    pub h: f64,
+    method: Method,
+    /// Contact dimension of the local problem (2 if every contact is planar, else 3).
+    dim: usize,
+    kin: Vec<ContactKinematics>,
+    /// Local rows of every candidate (dim × nu per point), world-Jacobian projections.
+    w_rows: DMatrix<f64>,
+    active: Vec<usize>,
+    x_cols: Vec<f64>,
+    problem: FrictionContact,
+    ws: Workspace,
+    r: Vec<f64>,
+    /// Last impulses per candidate, for warm starts and records.
+    pub results: Vec<PointResult>,
+    u_free: Vec<f64>,
+    u_prev: Vec<f64>,
+    q_mid: Vec<f64>,
+    q_pred: Vec<f64>,
+    /// Joints whose velocities are components in their moving child frame (free: v and ω,
+    /// spherical: ω): (coordinate offset of the quaternion, velocity offset, number of 3-blocks).
+    rotating: Vec<(usize, usize, usize)>,
+    tmp_u: Vec<f64>,
+    gd_before: Vec<f64>,
+    /// Energy dissipated so far by normal impulses (J).
+    pub dissipated_impact: f64,
+    /// Energy dissipated so far by tangential impulses (J).
+    pub dissipated_friction: f64,
+    /// Bilateral constraint impulse of the last step (nc), N s.
+    pub bilateral_impulse: Vec<f64>,
+    /// Steps whose contact problem did not reach the solver tolerance, and the worst residual.
+    pub unconverged: (usize, f64),
+}
+
+impl MoreauJean {
+    /// A stepper for `model` with step `h` and contact solver `method`.
+    pub fn new(model: &Model, h: f64, method: Method) -> Result<Self> {
+        crate::ensure!(h.is_finite() && h > 0.0, Settings, "integrator.dt: must be > 0, got {h}");
+        let (nu, np) = (model.nu, model.n_contact_points);
+        let dim = if model.contacts.iter().all(|c| c.pair.is_planar()) { 2 } else { 3 };
+        let problem = FrictionContact { dim, w: Delassus::Dense(Vec::with_capacity(dim * dim * np * np)), q: Vec::with_capacity(dim * np), mu: Vec::with_capacity(np) };
+        Ok(MoreauJean {
+            h,
+            method,
+            dim,
+            kin: vec![ContactKinematics::default(); np],
+            w_rows: DMatrix::zeros(dim * np.max(1), nu),
+            active: Vec::with_capacity(np),
+            x_cols: vec![0.0; dim * np * nu],
+            problem,
+            ws: Workspace::new(),
+            r: Vec::with_capacity(dim * np),
+            results: vec![PointResult::default(); np],
+            u_free: vec![0.0; nu],
+            u_prev: vec![0.0; nu],
+            q_mid: vec![0.0; model.nq],
+            q_pred: vec![0.0; model.nq],
+            rotating: model
+                .joints
+                .iter()
+                .filter_map(|j| match j.kind {
+                    JointKind::Free => Some((j.iq + 3, j.iu, 2)),
+                    JointKind::Spherical => Some((j.iq, j.iu, 1)),
+                    _ => None,
+                })
+                .collect(),
+            tmp_u: vec![0.0; nu],
+            gd_before: vec![0.0; dim * np],
+            dissipated_impact: 0.0,
+            dissipated_friction: 0.0,
+            bilateral_impulse: vec![0.0; model.nc],
+            unconverged: (0, 0.0),
+        })
+    }
+
+    /// Advances (q, u) from t by one step; returns the work of the smooth external loads and the
+    /// energy dissipated by the smooth dampers over the step (J).
+    pub fn step(&mut self, model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f64], cb: &dyn Callbacks) -> Result<(f64, f64)> {
+        let (nu, nc, h) = (model.nu, model.nc, self.h);
+        let tm = t + 0.5 * h;
+        model.integrate(q, u, 0.5 * h, &mut self.q_mid);
+        model.normalize(&mut self.q_mid);
+        // ---- smooth part at the midpoint: u_free = u + h M⁻¹ (τ - c(ū)), with the velocity-
+        // dependent forces at ū = (u + u_free)/2 (one predictor pass at u): explicit Euler on them
+        // would inflate rotating velocity components by (ω h)²/2 per step, e.g. a body-frame
+        // velocity turning with the body of a rolling ball
+        let mut p = crate::forces::Powers::default();
+        for pass in 0..2 {
+            if pass == 1 {
+                for i in 0..nu {
+                    self.u_free[i] = 0.5 * (u[i] + self.u_free[i]);
+                }
+            }
+            let ubar = if pass == 0 { &*u } else { &self.u_free };
+            p = crate::dynamics::prepare(model, data, tm, &self.q_mid, ubar, cb)?;
+            data.a[0] = Motion::ZERO;
+            let zero = std::mem::take(&mut data.zero_u);
+            crate::kinematics::accelerations(model, data, &zero);
+            data.zero_u = zero;
+            let mut c = std::mem::take(&mut self.tmp_u);
+            crate::dynamics::rnea::rnea_inward(model, data, &mut c);
+            if pass == 0 {
+                let Data { inertia, s, ic, saddle, .. } = &mut *data;
+                crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| saddle.put_mass(r, col, v));
+                if !data.saddle.factor_mass() {
+                    return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s")));
+                }
+            }
+            for v in c.iter_mut() {
+                *v = -*v * h;
+            }
+            data.saddle.solve_mass(&mut c);
+            for i in 0..nu {
+                self.u_free[i] = u[i] + c[i];
+            }
+            self.tmp_u = c;
+        }
+        // everything from here on is written in the joint frames of the midpoint: u_free (meant
+        // for the end of the step) and u_k (for ġ⁻) are carried there
+        let (q_mid, mut q_pred) = (std::mem::take(&mut self.q_mid), std::mem::take(&mut self.q_pred));
+        model.integrate(&q_mid, &self.u_free, 0.5 * h, &mut q_pred);
+        let mut uf = std::mem::take(&mut self.u_free);
+        self.reframe(&q_pred, &q_mid, &mut uf);
+        self.u_free = uf;
+        self.u_prev.copy_from_slice(u);
+        let mut up = std::mem::take(&mut self.u_prev);
+        self.reframe(q, &q_mid, &mut up);
+        self.u_prev = up;
+        self.q_mid = q_mid;
+        self.q_pred = q_pred;
+        if nc > 0 {
+            // bilateral rows at velocity level: G u_free = b(t + h), by the impulse μ
+            crate::constraints::positions(model, data, t + h, &self.q_mid, cb)?;
+            data.saddle.gather_g(&data.g);
+            data.saddle.assemble_schur(true);
+            data.saddle.factor_schur(1e-12);
+            let mut mu = std::mem::take(&mut self.bilateral_impulse);
+            data.saddle.g_times(&self.u_free, &mut mu);
+            for k in 0..nc {
+                mu[k] = data.b[k] - mu[k];
+            }
+            data.saddle.solve_schur(&mut mu);
+            data.saddle.add_constraint_accelerations(&mu, &mut self.u_free);
+            self.bilateral_impulse = mu;
+        }
+        // ---- contacts at the midpoint
+        let (d, np) = (self.dim, model.n_contact_points);
+        self.active.clear();
+        for con in &model.contacts {
+            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
+            let k = &mut self.kin[con.first..con.first + con.points()];
+            contact_kinematics(&con.pair, &b1, &b2, k).map_err(|e| Error::Solver(format!("contact '{}' at t = {tm:.6} s: {e}", con.name)))?;
+            for (j, kk) in k.iter().enumerate() {
+                if kk.point.g_n <= CONTACT_MARGIN {
+                    self.active.push(con.first + j);
+                }
+            }
+        }
+        let m = self.active.len();
+        let (mut dw_n, mut dw_t) = (0.0, 0.0);
+        if m > 0 {
+            self.assemble_rows(model, data);
+            // X = M̃⁻¹ W, column by column (restricted to the bilateral constraints' tangent space)
+            let dm = d * m;
+            for col in 0..dm {
+                let x = &mut self.x_cols[col * nu..(col + 1) * nu];
+                for i in 0..nu {
+                    x[i] = self.w_rows[(col, i)];
+                }
+                data.saddle.solve_mass(x);
+                if nc > 0 {
+                    let mut y = std::mem::take(&mut data.lambda);
+                    data.saddle.g_times(x, &mut y);
+                    for v in y.iter_mut() {
+                        *v = -*v;
+                    }
+                    data.saddle.solve_schur(&mut y);
+                    data.saddle.add_constraint_accelerations(&y, x);
+                    data.lambda = y;
+                }
+            }
+            // the local problem
+            let Delassus::Dense(w) = &mut self.problem.w else { unreachable!("dense Delassus") };
+            w.clear();
+            w.resize(dm * dm, 0.0);
+            for a in 0..dm {
+                for b in 0..dm {
+                    let mut s = 0.0;
+                    for i in 0..nu {
+                        s += self.w_rows[(a, i)] * self.x_cols[b * nu + i];
+                    }
+                    w[a * dm + b] = s;
+                }
+            }
+            // a tangent along which nothing can move (the out-of-plane tangent of a planar
+            // mechanism) has a zero row: give it a positive diagonal so that its impulse is zero
+            // instead of taking up the friction cone
+            for a in 0..dm {
+                if a % d != 0 && (0..nu).all(|i| self.w_rows[(a, i)] == 0.0) {
+                    let n = a - a % d;
+                    w[a * dm + a] = w[n * dm + n].max(f64::MIN_POSITIVE);
+                }
+            }
+            self.problem.dim = d;
+            self.problem.q.clear();
+            self.problem.mu.clear();
+            self.r.clear();
+            for (ai, &pt) in self.active.iter().enumerate() {
+                let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+                let kk = &self.kin[pt];
+                let mut gd = [0.0; 3];
+                for (row, g) in gd.iter_mut().enumerate().take(d) {
+                    let a = ai * d + row;
+                    let mut s = 0.0;
+                    let mut s0 = 0.0;
+                    for i in 0..nu {
+                        s += self.w_rows[(a, i)] * self.u_free[i];
+                        s0 += self.w_rows[(a, i)] * self.u_prev[i];
+                    }
+                    *g = s;
+                    self.gd_before[a] = s0;
+                }
+                let eps = con.impact.eps();
+                // a point still open by less than the margin may close within the step, not beyond
+                let gap_allowance = kk.point.g_n.max(0.0) / h;
+                self.problem.q.push(gd[0] + eps * self.gd_before[ai * d].min(0.0) + gap_allowance);
+                for g in gd.iter().take(d).skip(1) {
+                    self.problem.q.push(*g);
+                }
+                let slip_speed = (kk.gd_t[0].powi(2) + if d == 3 { kk.gd_t[1].powi(2) } else { 0.0 }).sqrt();
+                let mu = match (&con.friction, self.results[pt].state) {
+                    (FrictionLaw::None, _) => 0.0,
+                    (law, s) if s == SLIP => law.mu(slip_speed.max(f64::MIN_POSITIVE)),
+                    (law, _) => law.mu0(),
+                };
+                self.problem.mu.push(mu);
+                let prev = &self.results[pt];
+                self.r.push(prev.impulse_n);
+                self.r.extend_from_slice(&prev.impulse_t[..d - 1]);
+            }
+            self.ws.reserve(&self.problem, &self.method)?;
+            let warm = self.r.iter().any(|v| *v != 0.0);
+            let report = solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws).map_err(|e| {
+                let names: Vec<&str> = self.active.iter().map(|&pt| model.contacts.iter().rfind(|c| c.first <= pt).map_or("?", |c| c.name.as_str())).collect();
+                Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
+            })?;
+            if !report.converged {
+                self.unconverged.0 += 1;
+                self.unconverged.1 = self.unconverged.1.max(report.residual);
+            }
+            // u⁺ = u_free + X Λ, states, dissipation
+            u.copy_from_slice(&self.u_free);
+            for (col, lam) in self.r.iter().enumerate() {
+                if *lam != 0.0 {
+                    for i in 0..nu {
+                        u[i] += self.x_cols[col * nu + i] * lam;
+                    }
+                }
+            }
+            for (ai, &pt) in self.active.iter().enumerate() {
+                let state = self.problem.contact_state(ai, &self.r, 1e-9 * (1.0 + self.r[ai * d].abs()))?;
+                let res = &mut self.results[pt];
+                res.impulse_n = self.r[ai * d];
+                res.impulse_t = [0.0; 2];
+                res.impulse_t[..d - 1].copy_from_slice(&self.r[ai * d + 1..ai * d + d]);
+                res.state = match state {
+                    ContactState::Open => OPEN,
+                    ContactState::Stick => STICK,
+                    ContactState::Slip => SLIP,
+                };
+                for row in 0..d {
+                    let a = ai * d + row;
+                    let mut after = 0.0;
+                    for i in 0..nu {
+                        after += self.w_rows[(a, i)] * u[i];
+                    }
+                    let de = -self.r[a] * 0.5 * (after + self.gd_before[a]);
+                    if row == 0 {
+                        dw_n += de;
+                    } else {
+                        dw_t += de;
+                    }
+                }
+            }
+        } else {
+            u.copy_from_slice(&self.u_free);
+        }
+        // points that are not active carry no impulse and are open
+        let mut next_active = 0;
+        for pt in 0..np {
+            if next_active < m && self.active[next_active] == pt {
+                next_active += 1;
+            } else {
+                self.results[pt] = PointResult::default();
+            }
+        }
+        self.dissipated_impact += dw_n;
+        self.dissipated_friction += dw_t;
+        // ---- positions at the end of the step, and u in the end's joint frames
+        model.integrate(&self.q_mid, u, 0.5 * h, q);
+        model.normalize(q);
+        self.reframe(&self.q_mid, q, u);
+        if nc > 0 {
+            crate::dynamics::constrained::project(model, data, t + h, q, u, cb)?;
+        }
+        Ok((p.external * h, p.dissipated * h))
+    }
+
+    /// Re-expresses the child-frame velocity blocks of `u`, given in the joint frames of `q_from`,
+    /// in those of `q_to`: `u ← A(q_to)ᵀ A(q_from) u` per block. The contact rows are built at
+    /// the midpoint, so velocities meant for other configurations are carried there first (without
+    /// it a body rotating at ω gains a spurious slip of order ω h per step).
+    fn reframe(&self, q_from: &[f64], q_to: &[f64], u: &mut [f64]) {
+        for &(iq, iu, blocks) in &self.rotating {
+            let a = |q: &[f64]| quat_matrix(q[iq], q[iq + 1], q[iq + 2], q[iq + 3]);
+            let d = a(q_to).transpose() * a(q_from);
+            for b in 0..blocks {
+                let k = iu + 3 * b;
+                let v = d * crate::math::Vec3::new(u[k], u[k + 1], u[k + 2]);
+                u[k..k + 3].copy_from_slice(v.as_slice());
+            }
+        }
+    }
+
+    /// Rows `n`, `t1` (, `t2`) of every active point into `w_rows` (the generalized directions of
+    /// the contact forces: `w_N = J_P1ᵀ n - J_P2ᵀ n`, eq. 2.110 ff.).
+    fn assemble_rows(&mut self, model: &Model, data: &Data) {
+        let d = self.dim;
+        let rows = d * self.active.len();
+        for r in 0..rows {
+            for i in 0..model.nu {
+                self.w_rows[(r, i)] = 0.0;
+            }
+        }
+        for (ai, &pt) in self.active.iter().enumerate() {
+            let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+            let k = &self.kin[pt].point;
+            let dirs = [k.n, k.t1, k.t2];
+            for (row, dir) in dirs.iter().enumerate().take(d) {
+                let r = ai * d + row;
+                crate::constraints::add_point_rows(model, &data.s, con.body1, &k.p1, 1.0, Some(dir), &mut self.w_rows, r);
+                crate::constraints::add_point_rows(model, &data.s, con.body2, &k.p2, -1.0, Some(dir), &mut self.w_rows, r);
+            }
+        }
+    }
+
+    /// Contact geometry and relative velocities of every candidate at the state in `data`
+    /// (after a kinematics pass), for the records.
+    pub fn measure(&mut self, model: &Model, data: &Data) -> Result<()> {
+        for con in &model.contacts {
+            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
+            contact_kinematics(&con.pair, &b1, &b2, &mut self.kin[con.first..con.first + con.points()])?;
+        }
+        Ok(())
+    }
+
+    /// The candidates' kinematics of the last [`MoreauJean::measure`] (or step midpoint).
+    pub fn kinematics(&self) -> &[ContactKinematics] {
+        &self.kin
+    }
+}

@@ -1,0 +1,227 @@
+//! Validated unilateral contacts: the pair of contours (prepared once for the narrow phase), the
+//! friction law (eqs. 2.200, 2.201) and the impact law (eqs. 2.202, 2.203).
+
+use crate::contact::{Contour, ContactPair, Vec2};
+use crate::error::{Error, Result};
+use crate::math::Vec3;
+
+use super::contact_description::{ContactDescription, ContourDescription, FrictionDescription, ImpactDescription};
+
+/// Tangential law with its coefficients.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FrictionLaw {
+    /// No friction.
+    None,
+    /// Coulomb: sliding `mu`, static `mu0` (≥ mu).
+    Coulomb {
+        /// Sliding coefficient.
+        mu: f64,
+        /// Static coefficient.
+        mu0: f64,
+    },
+    /// µ(v) = mu + (mu0 - mu) exp(-(|v| / v_s)^exponent).
+    Stribeck {
+        /// Static coefficient.
+        mu0: f64,
+        /// High-speed coefficient.
+        mu: f64,
+        /// Stribeck velocity (m/s).
+        v_s: f64,
+        /// Shape exponent.
+        exponent: f64,
+    },
+    /// µ(|v|) piecewise linear, constant beyond the ends.
+    Table {
+        /// Speeds (m/s), ascending from 0.
+        speed: Vec<f64>,
+        /// Coefficients.
+        mu: Vec<f64>,
+    },
+}
+
+impl FrictionLaw {
+    /// Sliding coefficient at relative speed `v` (m/s), eq. 2.201; `mu(0)` is the static one.
+    pub fn mu(&self, v: f64) -> f64 {
+        let v = v.abs();
+        match self {
+            FrictionLaw::None => 0.0,
+            FrictionLaw::Coulomb { mu, mu0 } => {
+                if v == 0.0 {
+                    *mu0
+                } else {
+                    *mu
+                }
+            }
+            FrictionLaw::Stribeck { mu0, mu, v_s, exponent } => mu + (mu0 - mu) * (-(v / v_s).powf(*exponent)).exp(),
+            FrictionLaw::Table { speed, mu } => {
+                let k = speed.partition_point(|s| *s <= v);
+                if k == 0 {
+                    mu[0]
+                } else if k >= speed.len() {
+                    mu[mu.len() - 1]
+                } else {
+                    let w = (v - speed[k - 1]) / (speed[k] - speed[k - 1]);
+                    mu[k - 1] + w * (mu[k] - mu[k - 1])
+                }
+            }
+        }
+    }
+
+    /// Static coefficient µ0 (the limit of µ at zero sliding speed).
+    pub fn mu0(&self) -> f64 {
+        self.mu(0.0)
+    }
+}
+
+/// Impact law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ImpactLaw {
+    /// Newton (2.202): ġ_N⁺ = -ε ġ_N⁻.
+    Newton {
+        /// Restitution.
+        eps: f64,
+    },
+    /// Poisson (2.203): expansion impulse = ε × compression impulse, normal and tangential.
+    Poisson {
+        /// Normal coefficient.
+        eps: f64,
+        /// Tangential coefficient.
+        eps_t: f64,
+    },
+}
+
+impl ImpactLaw {
+    /// The normal coefficient.
+    pub fn eps(&self) -> f64 {
+        match self {
+            ImpactLaw::Newton { eps } | ImpactLaw::Poisson { eps, .. } => *eps,
+        }
+    }
+}
+
+/// A validated contact between two bodies.
+#[derive(Debug, Clone)]
+pub struct Contact {
+    /// Unique name.
+    pub name: String,
+    /// Body carrying contour 1.
+    pub body1: usize,
+    /// Body carrying contour 2.
+    pub body2: usize,
+    /// The prepared pair of contours.
+    pub pair: ContactPair,
+    /// Friction law.
+    pub friction: FrictionLaw,
+    /// Impact law.
+    pub impact: ImpactLaw,
+    /// Index of its first candidate point among all contact points of the model.
+    pub first: usize,
+}
+
+impl Contact {
+    /// Number of candidate points.
+    pub fn points(&self) -> usize {
+        self.pair.candidates()
+    }
+}
+
+fn finite(x: f64, what: &str) -> Result<f64> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(Error::Model(format!("{what}: must be finite, got {x}")))
+    }
+}
+
+fn vec3(v: &[f64; 3]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+fn planar(c: &ContourDescription) -> bool {
+    matches!(c, ContourDescription::Circle { .. } | ContourDescription::Line { .. } | ContourDescription::Polygon { .. })
+}
+
+/// The engine contour of a description; a `point` is planar when its partner is.
+fn contour(c: &ContourDescription, partner_planar: bool, what: &str, rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3>) -> Result<Contour> {
+    Ok(match c {
+        ContourDescription::Point { position } if partner_planar => Contour::Point2 { p: Vec2::new(position[0], position[1]) },
+        ContourDescription::Point { position } => Contour::Point { p: vec3(position) },
+        ContourDescription::Sphere { center, radius } => Contour::Sphere { center: vec3(center), radius: *radius },
+        ContourDescription::Plane { point, normal } => Contour::Plane { point: vec3(point), normal: vec3(normal) },
+        ContourDescription::Box { center, rotation: r, half_extents } => Contour::Box {
+            center: vec3(center),
+            rotation: rotation(r, &format!("{what}.rotation"))?,
+            half_extents: vec3(half_extents),
+        },
+        ContourDescription::Capsule { a, b, radius } => Contour::Capsule { a: vec3(a), b: vec3(b), radius: *radius },
+        ContourDescription::Cylinder { center, axis, radius, half_length } => {
+            Contour::Cylinder { center: vec3(center), axis: vec3(axis), radius: *radius, half_length: *half_length }
+        }
+        ContourDescription::Circle { center, radius } => Contour::Circle { center: Vec2::new(center[0], center[1]), radius: *radius },
+        ContourDescription::Line { point, normal } => {
+            Contour::Line { point: Vec2::new(point[0], point[1]), normal: Vec2::new(normal[0], normal[1]) }
+        }
+        ContourDescription::Polygon { vertices } => Contour::Polygon { vertices: vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect() },
+    })
+}
+
+/// Validates one contact description (body indices resolved by `body`).
+pub(super) fn validate(
+    d: &ContactDescription,
+    index: usize,
+    first: usize,
+    body: impl Fn(&str, &str) -> Result<usize>,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
+) -> Result<Contact> {
+    let what = format!("contacts[{index}] '{}'", d.name);
+    crate::ensure!(!d.name.trim().is_empty(), Model, "contacts[{index}]: name must not be empty");
+    let b1 = body(&d.body1, &format!("{what}.body1"))?;
+    let b2 = body(&d.body2, &format!("{what}.body2"))?;
+    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{}'", d.body1);
+    let c1 = contour(&d.contour1, planar(&d.contour2), &format!("{what}.contour1"), rotation)?;
+    let c2 = contour(&d.contour2, planar(&d.contour1), &format!("{what}.contour2"), rotation)?;
+    let pair = ContactPair::new(&d.name, c1, c2)?;
+    let friction = match &d.friction {
+        FrictionDescription::None => FrictionLaw::None,
+        FrictionDescription::Coulomb { mu, mu0 } => {
+            let mu = finite(*mu, &format!("{what}.friction.mu"))?;
+            let mu0 = finite(mu0.unwrap_or(mu), &format!("{what}.friction.mu0"))?;
+            crate::ensure!(mu >= 0.0, Model, "{what}.friction.mu: must be >= 0, got {mu}");
+            crate::ensure!(mu0 >= mu, Model, "{what}.friction.mu0: the static coefficient must be >= mu = {mu}, got {mu0}");
+            FrictionLaw::Coulomb { mu, mu0 }
+        }
+        FrictionDescription::Stribeck { mu0, mu, v_s, exponent } => {
+            let w = format!("{what}.friction");
+            let (mu0, mu) = (finite(*mu0, &format!("{w}.mu0"))?, finite(*mu, &format!("{w}.mu"))?);
+            crate::ensure!(mu >= 0.0, Model, "{w}.mu: must be >= 0, got {mu}");
+            crate::ensure!(mu0 >= mu, Model, "{w}.mu0: the static coefficient must be >= mu = {mu}, got {mu0}");
+            crate::ensure!(v_s.is_finite() && *v_s > 0.0, Model, "{w}.v_s: must be > 0, got {v_s}");
+            crate::ensure!(exponent.is_finite() && *exponent > 0.0, Model, "{w}.exponent: must be > 0, got {exponent}");
+            FrictionLaw::Stribeck { mu0, mu, v_s: *v_s, exponent: *exponent }
+        }
+        FrictionDescription::Table { speed, mu } => {
+            let w = format!("{what}.friction");
+            crate::ensure!(!speed.is_empty() && speed.len() == mu.len(), Model, "{w}: speed and mu need the same nonzero length, got {} and {}", speed.len(), mu.len());
+            crate::ensure!(speed[0] == 0.0, Model, "{w}.speed[0]: the table starts at speed 0, got {}", speed[0]);
+            for k in 1..speed.len() {
+                crate::ensure!(speed[k].is_finite() && speed[k] > speed[k - 1], Model, "{w}.speed[{k}]: must be finite and ascending, got {}", speed[k]);
+            }
+            for (k, m) in mu.iter().enumerate() {
+                crate::ensure!(m.is_finite() && *m >= 0.0, Model, "{w}.mu[{k}]: must be finite and >= 0, got {m}");
+            }
+            FrictionLaw::Table { speed: speed.clone(), mu: mu.clone() }
+        }
+    };
+    let impact = match d.impact {
+        ImpactDescription::Newton { eps } => ImpactLaw::Newton { eps },
+        ImpactDescription::Poisson { eps, eps_t } => ImpactLaw::Poisson { eps, eps_t },
+    };
+    let (eps, eps_t) = match impact {
+        ImpactLaw::Newton { eps } => (eps, 0.0),
+        ImpactLaw::Poisson { eps, eps_t } => (eps, eps_t),
+    };
+    for (k, e) in [("eps", eps), ("eps_t", eps_t)] {
+        crate::ensure!(e.is_finite() && (0.0..=1.0).contains(&e), Model, "{what}.impact.{k}: must be in [0, 1], got {e}");
+    }
+    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, friction, impact, first })
+}

@@ -1,0 +1,381 @@
+//! Projected Gauss–Seidel for the LCP and nonsmooth Gauss–Seidel (NSGS) for friction contact.
+//!
+//! A sweep visits the unknowns (LCP) or contacts (friction) in order and solves each one's
+//! problem exactly with the others frozen at their newest values. For contact `i` the local
+//! problem is `u_i = W_ii r_i + b_i`, `b_i = q_i + Σ_{j≠i} W_ij r_j`, with the Signorini–Coulomb
+//! conditions; [`local_solve`] finds its solution by cases:
+//!
+//! - open: `b_N ≥ 0` ⇒ `r = 0`;
+//! - stick: `r = −W_ii⁻¹ b` if it lies in the cone;
+//! - slip: `u_N = 0`, `r_T = −μ r_N t` with the unit sliding direction `t`. In the plane
+//!   `t = ±1` and `r_N = −b_N/(W_NN ∓ μ W_NT)`, tried in both signs. In space `t = (cos θ, sin θ)`
+//!   and `u_N = 0` gives `r_N(θ) = −b_N/(W_NN − μ W_NT t)`; the tangential velocity
+//!   `u_T(θ) = r_N (W_TN − μ W_TT t) + b_T` must be parallel to `t`, i.e. the scalar equation
+//!   `F(θ) = (W_NN − μ W_NT t) · (t^⊥ · u_T(θ)) = 0`, a trigonometric polynomial of degree 2,
+//!   solved by Newton from the previous sliding direction, or by bracketing all its roots if that
+//!   fails; a root counts if `r_N > 0` and `t · u_T ≥ 0` (the friction force opposes sliding).
+//!
+//! If no case holds to round-off (a singular or strongly non-symmetric block), a projected
+//! fixed-point iteration on the De Saxcé map `r ← proj_K(r − ρ (u + μ|u_T| e_N))` finishes the
+//! local problem. Sweeps stop when the velocity-weighted change `‖W_NN,i Δr_i‖` falls below the
+//! tolerance and the full residual of [`Report::residual`] confirms it; after a failed
+//! confirmation the next one waits 1, 2, 4, … up to 64 sweeps, so the reported sweep count can
+//! exceed the first sweep that met the tolerance by that much.
+
+use super::problem::{dot, fc_residual, lcp_residual, lcp_w, norm, project_onto_cone, FrictionContact, Lcp};
+use super::{NsgsOptions, Report, Workspace};
+use crate::ensure;
+use crate::error::Result;
+
+/// Projected Gauss–Seidel for an LCP with positive diagonal:
+/// `z_i ← max(0, z_i − w_i / M_ii)`.
+pub(crate) fn solve_lcp(p: &Lcp, o: &NsgsOptions, z: &mut [f64], ws: &mut Workspace) -> Result<Report> {
+    let n = p.size();
+    for i in 0..n {
+        let mii = p.m[i * n + i];
+        ensure!(mii > 0.0, Settings, "LCP: projected Gauss–Seidel needs M_ii > 0, but M[{i}, {i}] = {mii}; use Lemke");
+    }
+    let qn = 1.0 + norm(&p.q);
+    let w = &mut ws.u[..n];
+    let mut residual = f64::INFINITY;
+    let mut check = CheckSchedule::new();
+    for it in 1..=o.max_iter {
+        let mut change = 0.0;
+        for i in 0..n {
+            let row = &p.m[i * n..(i + 1) * n];
+            let wi = p.q[i] + dot(row, z);
+            let new = (z[i] - wi / row[i]).max(0.0);
+            let new = o.relaxation * new + (1.0 - o.relaxation) * z[i];
+            change += (row[i] * (new - z[i])).powi(2);
+            z[i] = new;
+        }
+        if check.due(it, change.sqrt() / qn <= o.tol) || it == o.max_iter {
+            lcp_w(&p.m, &p.q, z, w);
+            residual = lcp_residual(&p.m, &p.q, z, w);
+            if residual <= o.tol {
+                return Ok(Report { iterations: it, residual, converged: true });
+            }
+        }
+    }
+    Ok(Report { iterations: o.max_iter, residual, converged: false })
+}
+
+/// Nonsmooth Gauss–Seidel for a friction-contact problem.
+pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: &mut Workspace) -> Result<Report> {
+    let n = p.contacts();
+    let m = p.dim * n;
+    cache_diagonal(p, &mut ws.diag[..n]);
+    let qn = 1.0 + norm(&p.q);
+    let mut residual = f64::INFINITY;
+    let mut check = CheckSchedule::new();
+    for it in 1..=o.max_iter {
+        let change = sweep(p, &ws.diag[..n], r, o.relaxation);
+        if check.due(it, change.sqrt() / qn <= o.tol) || it == o.max_iter {
+            let u = &mut ws.u[..m];
+            p.w.velocity(p.dim, r, &p.q, u);
+            residual = fc_residual(p, r, u);
+            if residual <= o.tol {
+                return Ok(Report { iterations: it, residual, converged: true });
+            }
+        }
+    }
+    Ok(Report { iterations: o.max_iter, residual, converged: false })
+}
+
+/// When to recompute the full residual (one extra product with `W`): once the change of a sweep
+/// is below the tolerance, but after a check that fails the next waits 1, 2, 4, … up to 64 sweeps,
+/// because with a warm start the change can be small long before the residual is.
+struct CheckSchedule {
+    next: usize,
+    gap: usize,
+}
+
+impl CheckSchedule {
+    fn new() -> Self {
+        Self { next: 1, gap: 1 }
+    }
+
+    /// Whether to check at sweep `it`; assumes the check is made (and failed, if the caller goes on).
+    fn due(&mut self, it: usize, small_change: bool) -> bool {
+        if small_change && it >= self.next {
+            self.next = it + self.gap;
+            self.gap = (2 * self.gap).min(64);
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// Copies each contact's diagonal block of `W` (row-major `d × d`).
+pub(crate) fn cache_diagonal(p: &FrictionContact, diag: &mut [[f64; 9]]) {
+    for (i, blk) in diag.iter_mut().enumerate() {
+        p.w.diag_block(p.dim, i, blk);
+    }
+}
+
+/// One Gauss–Seidel sweep over the contacts; returns `Σ_i ‖W_NN,i Δr_i‖²`.
+pub(crate) fn sweep(p: &FrictionContact, diag: &[[f64; 9]], r: &mut [f64], relaxation: f64) -> f64 {
+    let d = p.dim;
+    let mut change = 0.0;
+    for i in 0..p.contacts() {
+        let mut b = [0.0; 3];
+        p.w.add_row_product(d, i, r, true, &mut b);
+        let mut old = [0.0; 3];
+        for a in 0..d {
+            b[a] += p.q[i * d + a];
+            old[a] = r[i * d + a];
+        }
+        let mut new = old;
+        local_solve(d, &diag[i], p.mu[i], &b, &mut new);
+        for a in 0..d {
+            let v = relaxation * new[a] + (1.0 - relaxation) * old[a];
+            change += (diag[i][0] * (v - old[a])).powi(2);
+            r[i * d + a] = v;
+        }
+    }
+    change
+}
+
+/// Solves the one-contact problem `u = A r + b` (A row-major `d × d` in the first `d²` entries,
+/// `A_NN > 0`) with the Signorini–Coulomb conditions. On entry `r` is the previous value, used
+/// as the first guess of the 3-D sliding direction; on exit the solution.
+pub(crate) fn local_solve(d: usize, a: &[f64; 9], mu: f64, b: &[f64; 3], r: &mut [f64; 3]) {
+    *r = if d == 2 { local_2d(a, mu, b) } else { local_3d(a, mu, b, r) };
+}
+
+/// Relative slack of the stick and slip sign tests, so that a solution on the cone's edge is
+/// accepted by the case that is exact to round-off.
+const SLACK: f64 = 1e-12;
+
+fn local_2d(a: &[f64; 9], mu: f64, b: &[f64; 3]) -> [f64; 3] {
+    let (ann, ant, atn, att) = (a[0], a[1], a[2], a[3]);
+    let (bn, bt) = (b[0], b[1]);
+    if bn >= 0.0 {
+        return [0.0; 3];
+    }
+    if mu == 0.0 {
+        return [-bn / ann, 0.0, 0.0];
+    }
+    // stick: A r = −b (Cramer)
+    let det = ann * att - ant * atn;
+    let mut slip_sign;
+    if att > 0.0 && det > 1e-13 * ann * att {
+        let rn = (-bn * att + bt * ant) / det;
+        let rt = (-ann * bt + atn * bn) / det;
+        if rn > 0.0 && rt.abs() <= mu * rn * (1.0 + SLACK) {
+            return [rn, rt, 0.0];
+        }
+        slip_sign = -rt.signum();
+    } else {
+        // no tangential mobility of its own: r_T = 0 sticks iff the coupling leaves u_T = 0
+        let rn = -bn / ann;
+        let ut = atn * rn + bt;
+        if ut.abs() <= SLACK * (bt.abs() + (atn * rn).abs()) {
+            return [rn, 0.0, 0.0];
+        }
+        slip_sign = ut.signum();
+    }
+    if slip_sign == 0.0 {
+        slip_sign = 1.0;
+    }
+    // slip with s = sign(u_T): r_T = −s μ r_N, u_N = 0
+    for s in [slip_sign, -slip_sign] {
+        let den = ann - s * mu * ant;
+        if den <= 0.0 {
+            continue;
+        }
+        let rn = -bn / den;
+        let rt = -s * mu * rn;
+        let ut = atn * rn + att * rt + bt;
+        if s * ut >= -SLACK * (bt.abs() + (atn * rn).abs() + (att * rt).abs()) {
+            return [rn, rt, 0.0];
+        }
+    }
+    fixed_point(2, a, mu, b, [-bn / ann, 0.0, 0.0])
+}
+
+fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
+    let bn = b[0];
+    if bn >= 0.0 {
+        return [0.0; 3];
+    }
+    let ann = a[0];
+    if mu == 0.0 {
+        return [-bn / ann, 0.0, 0.0];
+    }
+    // stick
+    let stick = solve3(a, &[-b[0], -b[1], -b[2]]);
+    let guess_dir = match stick {
+        Some(x) => {
+            if x[0] > 0.0 && x[1].hypot(x[2]) <= mu * x[0] * (1.0 + SLACK) {
+                return x;
+            }
+            [-x[1], -x[2]]
+        }
+        None => {
+            let rn = -bn / ann;
+            let ut = [a[3] * rn + b[1], a[6] * rn + b[2]];
+            if ut[0].hypot(ut[1]) <= SLACK * (b[1].hypot(b[2]) + rn * a[3].hypot(a[6])) {
+                return [rn, 0.0, 0.0];
+            }
+            ut
+        }
+    };
+    // the previous sliding direction is the better guess inside a Gauss–Seidel loop
+    let theta0 = if prev[0] > 0.0 && prev[1].hypot(prev[2]) > 0.0 {
+        (-prev[2]).atan2(-prev[1])
+    } else {
+        guess_dir[1].atan2(guess_dir[0])
+    };
+    match slip_3d(a, mu, b, theta0) {
+        Some(x) => x,
+        None => fixed_point(3, a, mu, b, [-bn / ann, 0.0, 0.0]),
+    }
+}
+
+/// `A x = y` for a 3×3 row-major `A` by Cramer's rule; `None` if nearly singular.
+fn solve3(a: &[f64; 9], y: &[f64; 3]) -> Option<[f64; 3]> {
+    let c0 = a[4] * a[8] - a[5] * a[7];
+    let c1 = a[5] * a[6] - a[3] * a[8];
+    let c2 = a[3] * a[7] - a[4] * a[6];
+    let det = a[0] * c0 + a[1] * c1 + a[2] * c2;
+    let scale = (a[0] * a[4] * a[8]).abs();
+    if !(det.abs() > 1e-13 * scale) {
+        return None;
+    }
+    let x0 = (y[0] * c0 + a[1] * (a[5] * y[2] - y[1] * a[8]) + a[2] * (y[1] * a[7] - a[4] * y[2])) / det;
+    let x1 = (a[0] * (y[1] * a[8] - a[5] * y[2]) + y[0] * c1 + a[2] * (a[3] * y[2] - y[1] * a[6])) / det;
+    let x2 = (a[0] * (a[4] * y[2] - y[1] * a[7]) + a[1] * (y[1] * a[6] - a[3] * y[2]) + y[0] * c2) / det;
+    Some([x0, x1, x2])
+}
+
+/// Sliding solution of the 3-D local problem (see the module documentation), `b_N < 0`, `μ > 0`.
+fn slip_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], theta0: f64) -> Option<[f64; 3]> {
+    let ann = a[0];
+    let p = [a[1], a[2]]; // W_NT
+    let s = [a[3], a[6]]; // W_TN
+    let c = [a[4], a[5], a[7], a[8]]; // W_TT row-major
+    let (bn, bt) = (b[0], [b[1], b[2]]);
+    let cmul = |v: [f64; 2]| [c[0] * v[0] + c[1] * v[1], c[2] * v[0] + c[3] * v[1]];
+    let dot2 = |x: [f64; 2], y: [f64; 2]| x[0] * y[0] + x[1] * y[1];
+    let f = |th: f64| slip_function(a, mu, b, th);
+    let c_norm = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3]).sqrt();
+    let candidate = |th: f64| -> Option<[f64; 3]> {
+        let (sn, cs) = th.sin_cos();
+        let t = [cs, sn];
+        let den = ann - mu * dot2(p, t);
+        if !(den > 0.0) {
+            return None;
+        }
+        let rn = -bn / den;
+        let ct = cmul(t);
+        let ut = [rn * (s[0] - mu * ct[0]) + bt[0], rn * (s[1] - mu * ct[1]) + bt[1]];
+        let scale = bt[0].hypot(bt[1]) + rn * (s[0].hypot(s[1]) + mu * c_norm);
+        let along = dot2(t, ut);
+        let across = ut[1] * t[0] - ut[0] * t[1];
+        if along >= -SLACK * scale && across.abs() <= 1e-9 * scale {
+            Some([rn, -mu * rn * t[0], -mu * rn * t[1]])
+        } else {
+            None
+        }
+    };
+    // Newton from the guess
+    let mut th = theta0;
+    for _ in 0..40 {
+        let (fv, fd) = f(th);
+        if fv == 0.0 || fd == 0.0 || !fd.is_finite() {
+            break;
+        }
+        let step = (fv / fd).clamp(-0.5, 0.5);
+        th -= step;
+        if step.abs() <= 1e-14 {
+            break;
+        }
+    }
+    if let Some(x) = candidate(th) {
+        return Some(x);
+    }
+    // bracket every sign change of F on a grid and bisect
+    const GRID: usize = 72;
+    let h = 2.0 * std::f64::consts::PI / GRID as f64;
+    let (mut lo, mut flo) = (0.0, f(0.0).0);
+    for k in 1..=GRID {
+        let hi = h * k as f64;
+        let fhi = f(hi).0;
+        if flo == 0.0 {
+            if let Some(x) = candidate(lo) {
+                return Some(x);
+            }
+        } else if flo * fhi < 0.0 {
+            let (mut l, mut u, mut fl) = (lo, hi, flo);
+            for _ in 0..60 {
+                let mid = 0.5 * (l + u);
+                let fm = f(mid).0;
+                if fm == 0.0 {
+                    l = mid;
+                    u = mid;
+                    break;
+                }
+                if (fm < 0.0) == (fl < 0.0) {
+                    l = mid;
+                    fl = fm;
+                } else {
+                    u = mid;
+                }
+            }
+            if let Some(x) = candidate(0.5 * (l + u)) {
+                return Some(x);
+            }
+        }
+        lo = hi;
+        flo = fhi;
+    }
+    None
+}
+
+/// `F(θ)` of the module documentation and `dF/dθ` (using `dt/dθ = t^⊥`, `dt^⊥/dθ = −t`).
+pub(crate) fn slip_function(a: &[f64; 9], mu: f64, b: &[f64; 3], theta: f64) -> (f64, f64) {
+    let ann = a[0];
+    let p = [a[1], a[2]]; // W_NT
+    let s = [a[3], a[6]]; // W_TN
+    let cmul = |v: [f64; 2]| [a[4] * v[0] + a[5] * v[1], a[7] * v[0] + a[8] * v[1]];
+    let dot2 = |x: [f64; 2], y: [f64; 2]| x[0] * y[0] + x[1] * y[1];
+    let (bn, bt) = (b[0], [b[1], b[2]]);
+    let (sn, cs) = theta.sin_cos();
+    let t = [cs, sn];
+    let np = [-sn, cs];
+    let (ct, cn) = (cmul(t), cmul(np));
+    let den = ann - mu * dot2(p, t);
+    let fv = -bn * dot2(np, s) + mu * bn * dot2(np, ct) + den * dot2(np, bt);
+    let fd =
+        bn * dot2(t, s) + mu * bn * (dot2(np, cn) - dot2(t, ct)) - mu * dot2(p, np) * dot2(np, bt) - den * dot2(t, bt);
+    (fv, fd)
+}
+
+/// Projected fixed point on the De Saxcé map with `ρ = 1/‖A‖_F`; the last resort of the local
+/// solve.
+fn fixed_point(d: usize, a: &[f64; 9], mu: f64, b: &[f64; 3], mut r: [f64; 3]) -> [f64; 3] {
+    let rho = 1.0 / a[..d * d].iter().map(|v| v * v).sum::<f64>().sqrt();
+    for _ in 0..2000 {
+        let mut u = [0.0; 3];
+        for i in 0..d {
+            u[i] = b[i] + dot(&a[i * d..(i + 1) * d], &r[..d]);
+        }
+        let ut = if d == 3 { u[1].hypot(u[2]) } else { u[1].abs() };
+        let mut x = [0.0; 3];
+        x[0] = r[0] - rho * (u[0] + mu * ut);
+        for i in 1..d {
+            x[i] = r[i] - rho * u[i];
+        }
+        let mut next = [0.0; 3];
+        project_onto_cone(mu, &x[..d], &mut next[..d]);
+        let delta: f64 = (0..d).map(|i| (next[i] - r[i]).abs()).sum();
+        let size: f64 = (0..d).map(|i| next[i].abs()).sum();
+        r = next;
+        if delta <= 1e-15 * size {
+            break;
+        }
+    }
+    r
+}

@@ -1,0 +1,707 @@
+use super::bank::{cases, Known};
+use super::fixtures::{dense_copy, disk_stack, random_friction_contact, sphere_pile, Rng};
+use super::nsgs::local_solve;
+use super::*;
+use crate::Error;
+
+// ---------- helpers ----------
+
+fn run_lcp(p: &Lcp, method: Method) -> Result<(Vec<f64>, Report)> {
+    let mut ws = Workspace::for_problem(p, &method)?;
+    let mut z = vec![0.0; p.size()];
+    let rep = solve(p, &method, &mut z, false, &mut ws)?;
+    Ok((z, rep))
+}
+
+fn run_fc(p: &FrictionContact, method: Method) -> Result<(Vec<f64>, Report)> {
+    let mut ws = Workspace::for_problem(p, &method)?;
+    let mut r = vec![0.0; p.unknowns()];
+    let rep = solve(p, &method, &mut r, false, &mut ws)?;
+    Ok((r, rep))
+}
+
+fn nsgs(tol: f64) -> Method {
+    Method::Nsgs(NsgsOptions { tol, max_iter: 100_000, ..Default::default() })
+}
+
+fn newton(tol: f64) -> Method {
+    Method::Newton(NewtonOptions { tol, ..Default::default() })
+}
+
+/// z ≥ 0, w ≥ 0, z_i w_i = 0 to `tol` relative to the data's scale.
+fn assert_complementary(p: &Lcp, z: &[f64], tol: f64, what: &str) {
+    let mut w = vec![0.0; p.size()];
+    p.w(z, &mut w).unwrap();
+    let scale = 1.0 + p.q.iter().fold(0.0f64, |a, v| a.max(v.abs())) + z.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for i in 0..p.size() {
+        assert!(z[i] >= -tol * scale, "{what}: z[{i}] = {}", z[i]);
+        assert!(w[i] >= -tol * scale, "{what}: w[{i}] = {}", w[i]);
+        assert!((z[i] * w[i]).abs() <= tol * scale * scale, "{what}: z[{i}] w[{i}] = {}", z[i] * w[i]);
+    }
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+fn max_abs(a: &[f64]) -> f64 {
+    a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+fn states(p: &FrictionContact, r: &[f64]) -> Vec<ContactState> {
+    (0..p.contacts()).map(|i| p.contact_state(i, r, 1e-9).unwrap()).collect()
+}
+
+// ---------- cone ----------
+
+#[test]
+fn cone_projection_hand_values_and_moreau_decomposition() {
+    let mut p = [0.0; 3];
+    // μ = 1, x = (0, 1): nearest boundary point (1/2, 1/2)
+    project_onto_cone(1.0, &[0.0, 1.0], &mut p[..2]);
+    assert!((p[0] - 0.5).abs() < 1e-15 && (p[1] - 0.5).abs() < 1e-15);
+    // negative tangential side maps to the negative boundary ray
+    project_onto_cone(1.0, &[0.0, -1.0], &mut p[..2]);
+    assert!((p[0] - 0.5).abs() < 1e-15 && (p[1] + 0.5).abs() < 1e-15);
+    // inside stays, polar cone goes to 0
+    project_onto_cone(0.5, &[2.0, 0.3, -0.4], &mut p);
+    assert_eq!(p, [2.0, 0.3, -0.4]);
+    project_onto_cone(0.5, &[-3.0, 0.3, -0.4], &mut p);
+    assert_eq!(p, [0.0; 3]);
+    // μ = 0: the cone is the normal half-line
+    project_onto_cone(0.0, &[2.0, 5.0, 1.0], &mut p);
+    assert_eq!(p, [2.0, 0.0, 0.0]);
+    project_onto_cone(0.0, &[-2.0, 0.0, 0.0], &mut p);
+    assert_eq!(p, [0.0; 3]);
+    // Moreau: x = P_K x + P_K° x with P_K x ⊥ P_K° x, P_K° x = −P_K*(−x), K* the cone of slope 1/μ
+    let mut rng = Rng::new(7);
+    for _ in 0..200 {
+        let mu = rng.uniform(0.05, 2.0);
+        let x = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+        let mut pk = [0.0; 3];
+        project_onto_cone(mu, &x, &mut pk);
+        let rest = [x[0] - pk[0], x[1] - pk[1], x[2] - pk[2]];
+        // rest is in the polar cone: μ|rest_T| ≤ −rest_N
+        assert!(mu * rest[1].hypot(rest[2]) <= -rest[0] + 1e-14, "mu {mu} x {x:?}");
+        assert!(pk[1].hypot(pk[2]) <= mu * pk[0] + 1e-14);
+        assert!((pk[0] * rest[0] + pk[1] * rest[1] + pk[2] * rest[2]).abs() < 1e-14);
+    }
+}
+
+// ---------- LCP ----------
+
+#[test]
+fn lcp_bank_through_lemke() {
+    for c in cases() {
+        let p = Lcp::new(c.m.clone(), c.q.clone()).unwrap();
+        let res = run_lcp(&p, Method::lemke());
+        match &c.known {
+            Known::None => {
+                let err = res.expect_err(c.name);
+                let Error::Solver(msg) = &err else { panic!("{}: wrong error kind {err:?}", c.name) };
+                assert!(msg.contains("no solution") && msg.contains("ray termination after"), "{}: {msg}", c.name);
+            }
+            known => {
+                let (z, rep) = res.unwrap_or_else(|e| panic!("{}: {e}", c.name));
+                assert!(rep.converged, "{}", c.name);
+                assert!(rep.residual < 1e-14, "{}: residual {}", c.name, rep.residual);
+                assert_complementary(&p, &z, 1e-14, c.name);
+                if let Known::Unique(zs) = known {
+                    assert!(max_diff(&z, zs) < 1e-14, "{}: z = {z:?}, expected {zs:?}", c.name);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn lcp_bank_through_projected_gauss_seidel() {
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-13, ..Default::default() });
+    let mut ran = 0;
+    for c in cases().into_iter().filter(|c| c.pgs) {
+        let p = Lcp::new(c.m.clone(), c.q.clone()).unwrap();
+        let (z, rep) = run_lcp(&p, method).unwrap();
+        assert!(rep.converged && rep.residual <= 1e-13, "{}: {rep:?}", c.name);
+        assert_complementary(&p, &z, 1e-12, c.name);
+        if let Known::Unique(zs) = &c.known {
+            assert!(max_diff(&z, zs) < 1e-12, "{}: z = {z:?}", c.name);
+        }
+        ran += 1;
+    }
+    assert!(ran >= 8);
+}
+
+#[test]
+fn lemke_solves_random_p_matrix_lcps() {
+    let mut rng = Rng::new(11);
+    for (t, &n) in [5usize, 8, 13, 20, 35, 50].iter().enumerate() {
+        for rep_i in 0..3 {
+            // M = S + K + 0.1 I with S = A Aᵀ/n ⪰ 0 and K skew: positive definite, hence a P-matrix
+            let a: Vec<f64> = (0..n * n).map(|_| rng.uniform(-1.0, 1.0)).collect();
+            let k: Vec<f64> = (0..n * n).map(|_| rng.uniform(-1.0, 1.0)).collect();
+            let mut m = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..n {
+                    let s: f64 = (0..n).map(|l| a[i * n + l] * a[j * n + l]).sum::<f64>() / n as f64;
+                    m[i * n + j] = s + 0.5 * (k[i * n + j] - k[j * n + i]) + if i == j { 0.1 } else { 0.0 };
+                }
+            }
+            let q: Vec<f64> = (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect();
+            let p = Lcp::new(m, q).unwrap();
+            let (z, rep) = run_lcp(&p, Method::lemke()).unwrap();
+            let what = format!("n = {n}, case {t}.{rep_i}");
+            assert!(rep.converged && rep.residual < 1e-10, "{what}: {rep:?}");
+            assert!(rep.iterations >= 1, "{what}: q has negative entries, so at least one pivot");
+            assert!(z.iter().any(|&v| v > 0.0), "{what}: a nontrivial solution");
+            assert_complementary(&p, &z, 1e-10, &what);
+        }
+    }
+}
+
+#[test]
+fn lemke_pivot_cap_is_reported_not_raised() {
+    let p = Lcp::new(vec![2.0, 1.0, 0.0, 1.0, 2.0, 1.0, 0.0, 1.0, 2.0], vec![-1.0, -2.0, -1.0]).unwrap();
+    let full = run_lcp(&p, Method::lemke()).unwrap().1;
+    assert!(full.converged && full.iterations >= 2);
+    let capped = Method::Lemke(LemkeOptions { max_pivots: Some(1), ..Default::default() });
+    let (_, rep) = run_lcp(&p, capped).unwrap();
+    assert!(!rep.converged);
+    assert_eq!(rep.iterations, 1);
+    assert!(rep.residual > 1e-3);
+}
+
+#[test]
+fn lcp_residual_vanishes_only_at_the_solution() {
+    let p = Lcp::new(vec![2.0, 1.0, 1.0, 2.0], vec![-1.0, 2.0]).unwrap();
+    assert!(p.residual(&[0.5, 0.0]).unwrap() < 1e-16);
+    // w1 = 0 but z2 negative; z1 too large (w1 > 0 with z1 > 0); sign-flipped z1
+    for z in [[0.5, -0.1], [0.6, 0.0], [-0.5, 0.0]] {
+        assert!(p.residual(&z).unwrap() > 0.01, "{z:?}");
+    }
+    // hand value at z = (0.6, 0): w = (0.2, 2.6), min(M11 z1, w1) = 0.2, min(0, 2.6) = 0
+    let expect = 0.2 / (1.0 + 5f64.sqrt());
+    assert!((p.residual(&[0.6, 0.0]).unwrap() - expect).abs() < 1e-15);
+}
+
+// ---------- single contacts with closed-form answers ----------
+
+fn planar(w: [f64; 4], q: [f64; 2], mu: f64) -> FrictionContact {
+    FrictionContact::new(2, Delassus::Dense(w.to_vec()), q.to_vec(), vec![mu]).unwrap()
+}
+
+fn all_methods() -> [Method; 3] {
+    [Method::lemke(), nsgs(1e-12), newton(1e-12)]
+}
+
+#[test]
+fn block_pushed_below_the_friction_limit_sticks() {
+    // block of 2 kg: W = diag(1/2, 1/2); q_N = -1 presses, r_N = 2; limit μ r_N = 0.8
+    let p = planar([0.5, 0.0, 0.0, 0.5], [-1.0, 0.3], 0.4);
+    for method in all_methods() {
+        let (r, rep) = run_fc(&p, method).unwrap();
+        assert!(rep.converged && rep.residual <= 1e-12, "{method:?}: {rep:?}");
+        // r_T = −q_T/W_TT = −0.6, opposite to the push
+        assert!((r[0] - 2.0).abs() < 1e-12 && (r[1] + 0.6).abs() < 1e-12, "{method:?}: {r:?}");
+        assert_eq!(p.contact_state(0, &r, 1e-9).unwrap(), ContactState::Stick);
+        assert!((p.friction_reserve(0, &r).unwrap() - 0.2).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn block_pushed_above_the_friction_limit_slips() {
+    for (qt, rt) in [(0.6, -0.8), (-0.6, 0.8)] {
+        let p = planar([0.5, 0.0, 0.0, 0.5], [-1.0, qt], 0.4);
+        for method in all_methods() {
+            let (r, rep) = run_fc(&p, method).unwrap();
+            assert!(rep.converged && rep.residual <= 1e-12, "{method:?}: {rep:?}");
+            // |r_T| = μ r_N = 0.8 against the push; u_T = q_T + r_T/2 keeps the push's sign
+            assert!((r[0] - 2.0).abs() < 1e-12 && (r[1] - rt).abs() < 1e-12, "{method:?} q_T {qt}: {r:?}");
+            let mut u = [0.0; 2];
+            p.velocity(&r, &mut u).unwrap();
+            assert!(u[0].abs() < 1e-12 && (u[1] - (qt + 0.5 * rt)).abs() < 1e-12);
+            assert_eq!(p.contact_state(0, &r, 1e-9).unwrap(), ContactState::Slip);
+            assert!(p.friction_reserve(0, &r).unwrap().abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn separating_contact_stays_open() {
+    let p = planar([0.5, 0.1, 0.1, 0.5], [0.5, 3.0], 0.4);
+    for method in all_methods() {
+        let (r, rep) = run_fc(&p, method).unwrap();
+        assert!(rep.converged, "{method:?}");
+        assert_eq!(r, vec![0.0, 0.0], "{method:?}");
+        assert_eq!(p.contact_state(0, &r, 1e-9).unwrap(), ContactState::Open);
+    }
+}
+
+#[test]
+fn coupled_planar_contact_slips_with_the_coupled_normal_impulse() {
+    // W_NT = 0.3 couples: slipping with u_T > 0, r_T = −μ r_N and u_N = 0 give
+    // r_N = −q_N/(W_NN − μ W_NT) = 1/0.85 (a sign error would give 1/1.15)
+    let p = planar([1.0, 0.3, 0.3, 2.0], [-1.0, 1.5], 0.5);
+    for method in all_methods() {
+        let (r, rep) = run_fc(&p, method).unwrap();
+        assert!(rep.converged && rep.residual < 1e-12, "{method:?}");
+        assert!((r[0] - 1.0 / 0.85).abs() < 1e-12 && (r[1] + 0.5 / 0.85).abs() < 1e-12, "{method:?}: {r:?}");
+        let mut u = [0.0; 2];
+        p.velocity(&r, &mut u).unwrap();
+        assert!((u[1] - (0.3 / 0.85 - 2.0 * 0.5 / 0.85 + 1.5)).abs() < 1e-12 && u[1] > 0.0);
+    }
+    // the stick candidate −W⁻¹q = (1.2827, −0.9424) lies outside the cone, so stick must not be returned
+    let det = 2.0 - 0.09;
+    assert!(((1.0 * 1.5 + 0.3) / det) > 0.5 * ((2.0 + 0.45) / det));
+}
+
+/// A ball (2 kg, R = 0.1 m, I = 2mR²/5) on a plane: W = diag(1/m, 1/m + R²/I, 1/m + R²/I).
+fn ball(q: [f64; 3], mu: f64) -> FrictionContact {
+    let (m, rr) = (2.0, 0.1);
+    let i = 0.4 * m * rr * rr;
+    let wt = 1.0 / m + rr * rr / i;
+    let w = vec![1.0 / m, 0.0, 0.0, 0.0, wt, 0.0, 0.0, 0.0, wt];
+    FrictionContact::new(3, Delassus::Dense(w), q.to_vec(), vec![mu]).unwrap()
+}
+
+#[test]
+fn ball_on_plane_slips_opposite_to_its_sliding_velocity() {
+    // r_N = 2, μ r_N = 0.6, sticking would need |q_T|/W_TT = 2/1.75 > 0.6
+    let p = ball([-1.0, 1.2, 1.6], 0.3);
+    for method in [nsgs(1e-12), newton(1e-12)] {
+        let (r, rep) = run_fc(&p, method).unwrap();
+        assert!(rep.converged && rep.residual < 1e-12, "{method:?}: {rep:?}");
+        // r_T = −μ r_N q_T/|q_T| = −0.6 (0.6, 0.8)
+        assert!(max_diff(&r, &[2.0, -0.36, -0.48]) < 1e-12, "{method:?}: {r:?}");
+        let mut u = [0.0; 3];
+        p.velocity(&r, &mut u).unwrap();
+        // the sliding velocity keeps its direction: u_T = q_T − 1.75·0.6 (0.6, 0.8)
+        assert!(max_diff(&u, &[0.0, 1.2 - 0.63, 1.6 - 0.84]) < 1e-12, "{u:?}");
+        assert_eq!(p.contact_state(0, &r, 1e-9).unwrap(), ContactState::Slip);
+    }
+    // below the limit it rolls without slipping: r_T = −q_T/W_TT
+    let p = ball([-1.0, 0.6, 0.8], 0.3);
+    for method in [nsgs(1e-12), newton(1e-12)] {
+        let (r, _) = run_fc(&p, method).unwrap();
+        assert!(max_diff(&r, &[2.0, -0.6 / 1.75, -0.8 / 1.75]) < 1e-12, "{method:?}: {r:?}");
+        assert_eq!(p.contact_state(0, &r, 1e-9).unwrap(), ContactState::Stick);
+    }
+}
+
+#[test]
+fn lemke_pyramid_is_exact_along_a_facet_and_converges_to_the_cone() {
+    // sliding along t1: −t1 is a pyramid direction for an even number of facets
+    let p = ball([-1.0, 2.0, 0.0], 0.3);
+    let (r, rep) = run_fc(&p, Method::Lemke(LemkeOptions { facets: 8, ..Default::default() })).unwrap();
+    assert!(rep.converged && rep.residual < 1e-14, "{rep:?}");
+    assert!(max_diff(&r, &[2.0, -0.6, 0.0]) < 1e-14, "{r:?}");
+    // an oblique direction: the force sits on a pyramid edge at most π/k from the exact direction,
+    // so |Δr_T| ≤ 2 μ r_N sin(π/2k)
+    let p = ball([-1.0, 1.2, 1.6], 0.3);
+    let mut errors = Vec::new();
+    for facets in [4, 8, 16, 32] {
+        let (r, rep) = run_fc(&p, Method::Lemke(LemkeOptions { facets, ..Default::default() })).unwrap();
+        assert!(rep.converged);
+        let err = max_diff(&r, &[2.0, -0.36, -0.48]);
+        assert!(err <= 1.2 * (std::f64::consts::PI / (2 * facets) as f64).sin() + 1e-12, "k = {facets}: {err}");
+        errors.push(err);
+    }
+    assert!(errors[3] < errors[1] && errors[1] < errors[0] && errors[3] < 0.03, "{errors:?}");
+}
+
+#[test]
+fn spatial_contact_with_coupled_block_slips_against_the_sliding_velocity() {
+    // an anisotropic, coupled diagonal block: the slip direction is not that of q_T
+    let w = [1.0, 0.2, -0.1, 0.2, 1.5, 0.4, -0.1, 0.4, 0.8];
+    let mut rng = Rng::new(3);
+    let mut slipped = 0;
+    for _ in 0..40 {
+        let q = [rng.uniform(-1.0, -0.1), rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0)];
+        let mu = rng.uniform(0.1, 0.8);
+        let p = FrictionContact::new(3, Delassus::Dense(w.to_vec()), q.to_vec(), vec![mu]).unwrap();
+        let (r1, rep1) = run_fc(&p, nsgs(1e-13)).unwrap();
+        let (r2, rep2) = run_fc(&p, newton(1e-13)).unwrap();
+        assert!(rep1.converged && rep2.converged, "{q:?}");
+        assert!(max_diff(&r1, &r2) < 1e-10, "{q:?}: {r1:?} vs {r2:?}");
+        let mut u = [0.0; 3];
+        p.velocity(&r1, &mut u).unwrap();
+        assert!(u[0].abs() < 1e-12, "closed contact: u_N = 0");
+        if p.contact_state(0, &r1, 1e-9).unwrap() == ContactState::Slip {
+            slipped += 1;
+            let (rt, ut) = ([r1[1], r1[2]], [u[1], u[2]]);
+            assert!((rt[0].hypot(rt[1]) - mu * r1[0]).abs() < 1e-12, "on the cone");
+            // antiparallel: r_T = −μ r_N u_T/|u_T|
+            let un = ut[0].hypot(ut[1]);
+            assert!((rt[0] + mu * r1[0] * ut[0] / un).abs() < 1e-10 && (rt[1] + mu * r1[0] * ut[1] / un).abs() < 1e-10);
+        } else {
+            assert!(u[1].hypot(u[2]) < 1e-10);
+        }
+    }
+    assert!(slipped >= 10, "the sample must exercise sliding: {slipped}");
+}
+
+#[test]
+fn local_solver_covers_all_cases_exactly() {
+    // 3-D local problems against the brute-force conditions, including large μ and strong coupling
+    let mut rng = Rng::new(99);
+    let mut counts = [0usize; 3];
+    for _ in 0..2000 {
+        // random SPD block
+        let l = [
+            rng.uniform(0.5, 1.5),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(0.5, 1.5),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(0.2, 1.5),
+        ];
+        let lm = [[l[0], 0.0, 0.0], [l[1], l[2], 0.0], [l[3], l[4], l[5]]];
+        let mut a = [0.0; 9];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i * 3 + j] = (0..3).map(|k| lm[i][k] * lm[j][k]).sum();
+            }
+        }
+        let b = [rng.uniform(-1.0, 0.3), rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0)];
+        let mu = rng.uniform(0.0, 1.5);
+        let mut r = [0.0; 3];
+        local_solve(3, &a, mu, &b, &mut r);
+        let u: Vec<f64> = (0..3).map(|i| b[i] + (0..3).map(|j| a[i * 3 + j] * r[j]).sum::<f64>()).collect();
+        let res = super::problem::contact_residual_sq(3, mu, a[0], &r, &u).sqrt();
+        assert!(res < 1e-11, "a {a:?} b {b:?} mu {mu}: r {r:?} residual {res}");
+        let p = FrictionContact::new(3, Delassus::Dense(a.to_vec()), b.to_vec(), vec![mu]).unwrap();
+        counts[p.contact_state(0, &r, 1e-9).unwrap() as usize] += 1;
+    }
+    assert!(counts.iter().all(|&c| c > 100), "open/stick/slip counts {counts:?}");
+}
+
+// ---------- coupled problems: the solvers agree ----------
+
+#[test]
+fn disk_stack_three_solvers_agree() {
+    let p = disk_stack(6, 0.3, 0.6, 5).unwrap();
+    let (r_lemke, rep) = run_fc(&p, Method::lemke()).unwrap();
+    assert!(rep.converged && rep.residual < 1e-13, "Lemke {rep:?}");
+    let (r_nsgs, rep) = run_fc(&p, nsgs(1e-13)).unwrap();
+    assert!(rep.converged && rep.residual <= 1e-13, "NSGS {rep:?}");
+    let (r_newton, rep) = run_fc(&p, newton(1e-13)).unwrap();
+    assert!(rep.converged && rep.residual <= 1e-13, "Newton {rep:?}");
+    let scale = max_abs(&r_lemke);
+    assert!(scale > 0.05);
+    assert!(max_diff(&r_lemke, &r_nsgs) < 1e-8 * scale, "{r_lemke:?}\n{r_nsgs:?}");
+    assert!(max_diff(&r_lemke, &r_newton) < 1e-8 * scale, "{r_lemke:?}\n{r_newton:?}");
+    // the case is not trivial: some contacts stick and some slip
+    let s = states(&p, &r_lemke);
+    assert!(s.contains(&ContactState::Stick) && s.contains(&ContactState::Slip), "{s:?}");
+}
+
+#[test]
+fn random_planar_problems_three_solvers_agree() {
+    let mut seen = [false; 3];
+    for seed in 1..=12 {
+        let p = random_friction_contact(2, 8, 0.2, seed).unwrap();
+        let (r_lemke, rep) = run_fc(&p, Method::lemke()).unwrap();
+        assert!(rep.converged && rep.residual < 1e-12, "seed {seed}: Lemke {rep:?}");
+        let (r_nsgs, rep) = run_fc(&p, nsgs(1e-13)).unwrap();
+        assert!(rep.converged && rep.residual <= 1e-13, "seed {seed}: NSGS {rep:?}");
+        let (r_newton, rep) = run_fc(&p, newton(1e-13)).unwrap();
+        assert!(rep.converged && rep.residual <= 1e-13, "seed {seed}: Newton {rep:?}");
+        let scale = 1.0 + max_abs(&r_lemke);
+        assert!(max_diff(&r_lemke, &r_nsgs) < 1e-8 * scale, "seed {seed}");
+        assert!(max_diff(&r_lemke, &r_newton) < 1e-8 * scale, "seed {seed}");
+        for s in states(&p, &r_lemke) {
+            seen[s as usize] = true;
+        }
+    }
+    assert_eq!(seen, [true; 3], "open, stick and slip all occur");
+}
+
+#[test]
+fn random_spatial_problems_nsgs_and_newton_agree() {
+    let mut seen = [false; 3];
+    for seed in 1..=8 {
+        let p = random_friction_contact(3, 10, 0.3, 100 + seed).unwrap();
+        let (r_nsgs, rep) = run_fc(&p, nsgs(1e-13)).unwrap();
+        assert!(rep.converged && rep.residual <= 1e-13, "seed {seed}: NSGS {rep:?}");
+        let (r_newton, rep) = run_fc(&p, newton(1e-13)).unwrap();
+        assert!(rep.converged && rep.residual <= 1e-13, "seed {seed}: Newton {rep:?}");
+        assert!(max_diff(&r_nsgs, &r_newton) < 1e-8 * (1.0 + max_abs(&r_nsgs)), "seed {seed}");
+        for s in states(&p, &r_nsgs) {
+            seen[s as usize] = true;
+        }
+        // the pyramid (32 facets) is close to the cone
+        let (r_lemke, rep) = run_fc(&p, Method::Lemke(LemkeOptions { facets: 32, ..Default::default() })).unwrap();
+        assert!(rep.converged);
+        assert!(max_diff(&r_lemke, &r_nsgs) < 0.05 * (1.0 + max_abs(&r_nsgs)), "seed {seed}");
+    }
+    assert_eq!(seen, [true; 3], "open, stick and slip all occur");
+}
+
+#[test]
+fn warm_start_reduces_nsgs_sweeps() {
+    let p = random_friction_contact(3, 20, 0.3, 42).unwrap();
+    let method = nsgs(1e-10);
+    let mut ws = Workspace::for_problem(&p, &method).unwrap();
+    let mut r = vec![0.0; p.unknowns()];
+    let cold = solve(&p, &method, &mut r, false, &mut ws).unwrap();
+    assert!(cold.converged && cold.iterations > 5, "{cold:?}");
+    // the next step's problem differs a little
+    let mut p2 = p.clone();
+    for (k, v) in p2.q.iter_mut().enumerate() {
+        *v *= 1.0 + 0.01 * ((k % 5) as f64 - 2.0) / 2.0;
+    }
+    let mut r_cold = vec![0.0; p.unknowns()];
+    let cold2 = solve(&p2, &method, &mut r_cold, false, &mut ws).unwrap();
+    let warm = solve(&p2, &method, &mut r, true, &mut ws).unwrap();
+    assert!(cold2.converged && warm.converged);
+    assert!(warm.iterations < cold2.iterations, "warm {} vs cold {}", warm.iterations, cold2.iterations);
+    assert!(max_diff(&r, &r_cold) < 1e-7 * (1.0 + max_abs(&r)));
+    // starting from the solution itself: one sweep confirms it
+    let again = solve(&p2, &method, &mut r, true, &mut ws).unwrap();
+    assert_eq!(again.iterations, 1);
+}
+
+#[test]
+fn sphere_pile_is_well_posed_and_block_storage_matches_dense() {
+    let p = sphere_pile(60, 0.4, 1).unwrap();
+    assert_eq!(p.contacts(), 60);
+    let Delassus::Blocks(bw) = &p.w else { panic!("block storage expected") };
+    assert!(bw.off_diagonal_blocks() > 60, "contacts are coupled");
+    let dense = dense_copy(&p);
+    let Delassus::Dense(w) = &dense.w else { unreachable!() };
+    let m = 3 * p.contacts();
+    // symmetric and positive definite (full rank)
+    for a in 0..m {
+        for b in 0..m {
+            assert!((w[a * m + b] - w[b * m + a]).abs() < 1e-12);
+        }
+    }
+    let mut f = w.clone();
+    let mut perm = vec![0; m];
+    assert_eq!(crate::math::linalg::cholesky_semidefinite(&mut f, m, &mut perm, 1e-10), m);
+    // the same answers from both storages and both iterative methods
+    let (r_blk, rep) = run_fc(&p, nsgs(1e-12)).unwrap();
+    assert!(rep.converged, "{rep:?}");
+    let (r_den, _) = run_fc(&dense, nsgs(1e-12)).unwrap();
+    assert!(max_diff(&r_blk, &r_den) < 1e-12 * (1.0 + max_abs(&r_blk)));
+    let (r_newton, rep) = run_fc(&p, newton(1e-12)).unwrap();
+    assert!(rep.converged, "{rep:?}");
+    assert!(max_diff(&r_blk, &r_newton) < 1e-8 * (1.0 + max_abs(&r_blk)));
+    // velocities agree too
+    let (mut u1, mut u2) = (vec![0.0; m], vec![0.0; m]);
+    p.velocity(&r_blk, &mut u1).unwrap();
+    dense.velocity(&r_blk, &mut u2).unwrap();
+    assert!(max_diff(&u1, &u2) < 1e-13);
+    let s = states(&p, &r_blk);
+    assert!(
+        s.contains(&ContactState::Stick) && s.contains(&ContactState::Slip) && s.contains(&ContactState::Open),
+        "{s:?}"
+    );
+}
+
+#[test]
+fn block_builder_sums_duplicates_and_mirrors() {
+    let mut b = BlockDelassusBuilder::new(2, 3).unwrap();
+    b.add(0, 0, &[1.0, 0.5, 0.5, 2.0]).unwrap();
+    b.add(0, 0, &[1.0, 0.0, 0.0, 1.0]).unwrap();
+    b.add(2, 0, &[0.1, 0.2, 0.3, 0.4]).unwrap(); // W_20; W_02 = W_20ᵀ
+    b.add(0, 2, &[0.1, 0.3, 0.2, 0.4]).unwrap(); // the same coupling added from the other side
+    b.add(1, 1, &[1.0, 0.0, 0.0, 1.0]).unwrap();
+    b.add(2, 2, &[1.0, 0.0, 0.0, 1.0]).unwrap();
+    let w = b.build();
+    assert_eq!(w.off_diagonal_blocks(), 2);
+    let d = w.to_dense();
+    let at = |r: usize, c: usize| d[r * 6 + c];
+    assert_eq!((at(0, 0), at(0, 1), at(1, 1)), (2.0, 0.5, 3.0));
+    // W_02 = 2 W_20ᵀ: row 0 of W_02 is (0.2, 0.6)
+    assert_eq!((at(0, 4), at(0, 5), at(1, 4), at(1, 5)), (0.2, 0.6, 0.4, 0.8));
+    assert_eq!((at(4, 0), at(5, 0), at(4, 1)), (0.2, 0.6, 0.4));
+    let mut bad = BlockDelassusBuilder::new(2, 3).unwrap();
+    assert!(bad.add(0, 3, &[0.0; 4]).unwrap_err().to_string().contains("(0, 3)"));
+    assert!(bad.add(0, 1, &[0.0; 3]).unwrap_err().to_string().contains("expected 4"));
+    assert!(bad.add(1, 0, &[0.0, f64::NAN, 0.0, 0.0]).unwrap_err().to_string().contains("not finite"));
+}
+
+// ---------- API, states, errors ----------
+
+#[test]
+fn contact_states_and_reserve_from_a_mixed_solution() {
+    // three uncoupled planar contacts: open, stick, slip
+    let mut w = vec![0.0; 36];
+    for k in 0..6 {
+        w[k * 6 + k] = 1.0;
+    }
+    let p = FrictionContact::new(2, Delassus::Dense(w), vec![0.5, 1.0, -1.0, 0.2, -1.0, 2.0], vec![0.5; 3]).unwrap();
+    let (r, rep) = run_fc(&p, nsgs(1e-14)).unwrap();
+    assert!(rep.converged);
+    assert_eq!(states(&p, &r), vec![ContactState::Open, ContactState::Stick, ContactState::Slip]);
+    assert!((p.friction_reserve(1, &r).unwrap() - 0.3).abs() < 1e-14);
+    assert!(p.friction_reserve(2, &r).unwrap().abs() < 1e-14);
+    assert_eq!(ContactState::Slip.as_str(), "slip");
+    // the residual flags a friction force pointing the wrong way
+    let mut wrong = r.clone();
+    wrong[5] = -wrong[5];
+    assert!(p.residual(&wrong).unwrap() > 0.1);
+    assert!(p.contact_state(3, &r, 1e-9).unwrap_err().to_string().contains("contact 3"));
+}
+
+#[test]
+fn bad_input_is_an_error_naming_the_item() {
+    let good = planar([0.5, 0.0, 0.0, 0.5], [-1.0, 0.3], 0.4);
+    let msg = |e: Error| e.to_string();
+    assert!(msg(FrictionContact::new(4, good.w.clone(), vec![0.0; 4], vec![0.1]).unwrap_err()).contains("dimension"));
+    assert!(msg(FrictionContact::new(2, good.w.clone(), vec![0.0; 3], vec![0.1]).unwrap_err()).contains("q has 3"));
+    assert!(
+        msg(FrictionContact::new(2, good.w.clone(), vec![-1.0, 0.3], vec![-0.1]).unwrap_err()).contains("contact 0: μ")
+    );
+    assert!(msg(FrictionContact::new(2, good.w.clone(), vec![f64::NAN, 0.3], vec![0.1]).unwrap_err()).contains("q[0]"));
+    let zero_n = Delassus::Dense(vec![0.0, 0.0, 0.0, 1.0]);
+    assert!(msg(FrictionContact::new(2, zero_n, vec![-1.0, 0.3], vec![0.1]).unwrap_err()).contains("contact 0: W_NN"));
+    assert!(msg(Lcp::new(vec![1.0; 3], vec![1.0, 2.0]).unwrap_err()).contains("M has 3 entries"));
+    assert!(msg(Lcp::new(vec![1.0, f64::INFINITY, 0.0, 1.0], vec![1.0, 2.0]).unwrap_err()).contains("M[0, 1]"));
+    // problems edited in place are checked at solve time
+    let mut edited = good.clone();
+    edited.mu[0] = f64::NAN;
+    let mut ws = Workspace::for_problem(&good, &Method::nsgs()).unwrap();
+    let mut r = vec![0.0; 2];
+    assert!(msg(solve(&edited, &Method::nsgs(), &mut r, false, &mut ws).unwrap_err()).contains("μ"));
+    // wrong solution length, non-finite warm start, bad options
+    assert!(msg(solve(&good, &Method::nsgs(), &mut [0.0; 3], false, &mut ws).unwrap_err()).contains("3 entries"));
+    assert!(msg(solve(&good, &Method::nsgs(), &mut [f64::NAN, 0.0], true, &mut ws).unwrap_err())
+        .contains("warm start entry 0"));
+    let bad = Method::Nsgs(NsgsOptions { relaxation: 1.5, ..Default::default() });
+    assert!(msg(solve(&good, &bad, &mut r, false, &mut ws).unwrap_err()).contains("relaxation"));
+    let bad = Method::Lemke(LemkeOptions { facets: 2, ..Default::default() });
+    assert!(msg(solve(&good, &bad, &mut r, false, &mut ws).unwrap_err()).contains("facets"));
+    // Newton on an LCP, PGS with a zero diagonal
+    let lcp = Lcp::new(vec![0.0, 1.0, 1.0, 1.0], vec![-1.0, -1.0]).unwrap();
+    assert!(msg(Workspace::for_problem(&lcp, &Method::newton()).unwrap_err()).contains("Newton"));
+    assert!(msg(run_lcp(&lcp, Method::nsgs()).unwrap_err()).contains("M[0, 0] = 0"));
+}
+
+#[test]
+fn workspace_must_fit_and_reserving_again_is_free() {
+    let small = random_friction_contact(2, 3, 0.2, 1).unwrap();
+    let big = random_friction_contact(2, 6, 0.2, 2).unwrap();
+    let method = newton(1e-10);
+    let mut ws = Workspace::for_problem(&small, &method).unwrap();
+    let mut r = vec![0.0; big.unknowns()];
+    let err = solve(&big, &method, &mut r, false, &mut ws).unwrap_err();
+    assert!(err.to_string().contains("workspace is too small"));
+    // sized for the big one, the small one fits without touching the buffers
+    ws.reserve(&big, &method).unwrap();
+    let ptr = ws.u.as_ptr();
+    ws.reserve(&small, &method).unwrap();
+    assert_eq!(ptr, ws.u.as_ptr());
+    assert!(solve(&big, &method, &mut r, false, &mut ws).unwrap().converged);
+    let mut r = vec![0.0; small.unknowns()];
+    assert!(solve(&small, &method, &mut r, false, &mut ws).unwrap().converged);
+    // a Lemke solve needs its own buffers
+    assert!(solve(&small, &Method::lemke(), &mut r, false, &mut ws).is_err());
+}
+
+#[test]
+fn method_options_round_trip_through_json() {
+    let m = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 50, relaxation: 0.9 });
+    let s = serde_json::to_string(&m).unwrap();
+    assert_eq!(serde_json::from_str::<Method>(&s).unwrap(), m);
+    let m: Method = serde_json::from_str(r#"{"type": "lemke", "facets": 16}"#).unwrap();
+    assert_eq!(m, Method::Lemke(LemkeOptions { facets: 16, ..Default::default() }));
+}
+
+// ---------- derivatives and formulas ----------
+
+#[test]
+fn friction_residual_hand_value() {
+    // W = I, q = (−1, 0), μ = 0.5, r = (0.5, 0): u = û = (−0.5, 0), ρ = 1,
+    // r − ρû = (1, 0) is in the cone, so Φ = (−0.5, 0) and the merit is 0.5/(1 + |q|) = 0.25
+    let p = planar([1.0, 0.0, 0.0, 1.0], [-1.0, 0.0], 0.5);
+    assert!((p.residual(&[0.5, 0.0]).unwrap() - 0.25).abs() < 1e-15);
+    assert!(p.residual(&[1.0, 0.0]).unwrap() < 1e-16);
+    // ρ = 1/W_NN makes it a velocity: scaling W and q by 4 scales the violation alike
+    let p4 = planar([4.0, 0.0, 0.0, 4.0], [-4.0, 0.0], 0.5);
+    assert!((p4.residual(&[0.5, 0.0]).unwrap() - 2.0 / 5.0).abs() < 1e-15);
+}
+
+#[test]
+fn slip_equation_derivative_matches_finite_differences() {
+    let mut rng = Rng::new(5);
+    for _ in 0..200 {
+        let a: [f64; 9] = std::array::from_fn(|_| rng.uniform(-1.0, 1.0));
+        let b = [rng.uniform(-1.0, 0.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+        let (mu, th) = (rng.uniform(0.1, 1.0), rng.uniform(0.0, 6.3));
+        let h = 1e-6;
+        let (f, fd) = nsgs::slip_function(&a, mu, &b, th);
+        let num = (nsgs::slip_function(&a, mu, &b, th + h).0 - nsgs::slip_function(&a, mu, &b, th - h).0) / (2.0 * h);
+        assert!((fd - num).abs() < 1e-8 * (1.0 + fd.abs()), "{fd} vs {num}");
+        // F = den · (t^⊥ · u_T) at r = (r_N, −μ r_N t), r_N = −b_N/den
+        let t = [th.cos(), th.sin()];
+        let den = a[0] - mu * (a[1] * t[0] + a[2] * t[1]);
+        let rn = -b[0] / den;
+        let r = [rn, -mu * rn * t[0], -mu * rn * t[1]];
+        let u: Vec<f64> = (0..3).map(|i| b[i] + (0..3).map(|j| a[i * 3 + j] * r[j]).sum::<f64>()).collect();
+        assert!(u[0].abs() < 1e-12 * (1.0 + rn.abs()), "u_N = 0 by construction");
+        assert!((f - den * (-t[1] * u[1] + t[0] * u[2])).abs() < 1e-10 * (1.0 + f.abs()));
+    }
+}
+
+#[test]
+fn alart_curnier_jacobian_matches_finite_differences() {
+    for (dim, seed) in [(2, 1), (3, 2), (3, 3)] {
+        let p = random_friction_contact(dim, 4, 0.4, seed).unwrap();
+        let n = p.contacts();
+        let m = dim * n;
+        let mut diag = vec![[0.0; 9]; n];
+        nsgs::cache_diagonal(&p, &mut diag);
+        let mut rng = Rng::new(seed + 10);
+        let mut kinds = [0usize; 2];
+        for _ in 0..20 {
+            let r: Vec<f64> =
+                (0..m).map(|k| if k % dim == 0 { rng.uniform(-0.2, 1.0) } else { rng.uniform(-0.5, 0.5) }).collect();
+            let phi_at = |r: &[f64], dblk: Option<&mut [[f64; 9]]>| {
+                let mut u = vec![0.0; m];
+                p.velocity(r, &mut u).unwrap();
+                let mut phi = vec![0.0; m];
+                newton::evaluate(&p, &diag, r, &u, &mut phi, dblk);
+                phi
+            };
+            let mut dblk = vec![[0.0; 9]; n];
+            phi_at(&r, Some(&mut dblk));
+            // count contacts by projection case so that the test covers the slip branch
+            for blk in &dblk {
+                kinds[usize::from(blk[0] == 1.0 && blk[dim + 1] != 1.0)] += 1;
+            }
+            let mut jac = vec![0.0; m * m];
+            newton::assemble(&p, &diag, &dblk, &mut jac);
+            let h = 1e-7;
+            for c in 0..m {
+                let (mut rp, mut rm) = (r.clone(), r.clone());
+                rp[c] += h;
+                rm[c] -= h;
+                let (fp, fm) = (phi_at(&rp, None), phi_at(&rm, None));
+                for a in 0..m {
+                    let num = (fp[a] - fm[a]) / (2.0 * h);
+                    // a kink within h would spoil the difference; random points avoid them
+                    assert!((jac[a * m + c] - num).abs() < 1e-5, "d = {dim}: J[{a},{c}] = {} vs {num}", jac[a * m + c]);
+                }
+            }
+        }
+        assert!(kinds[1] > 0 && kinds[0] > 0, "d = {dim}: both closed-slip and other cases, {kinds:?}");
+    }
+}
+
+#[test]
+fn fixtures_have_the_free_velocities_of_their_mechanisms() {
+    // without the push the stack falls as one: only the ground contact closes (−g dt), and the
+    // bottom disk's spin of 2 rad/s slides its contact point at R ω = 0.2 m/s
+    let p = disk_stack(4, 0.3, 0.0, 9).unwrap();
+    assert!((p.q[0] + 9.81 * 0.01).abs() < 1e-15);
+    assert!((p.q[1] - 0.1 * 2.0).abs() < 1e-15);
+    for k in 1..4 {
+        assert!(p.q[2 * k].abs() < 1e-15, "contact {k}: u_N = {}", p.q[2 * k]);
+    }
+    // the spinning disk's top point moves backwards under disk 1: u_T = +R ω at contact 1 too
+    assert!((p.q[3] - 0.1 * 2.0).abs() < 1e-15);
+    // W_NN of the ground contact is 1/m_0 with m_0 in [1, 2]
+    let Delassus::Dense(w) = &p.w else { unreachable!() };
+    assert!(w[0] > 0.5 && w[0] < 1.0);
+}
