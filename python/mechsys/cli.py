@@ -123,8 +123,10 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
 @click.option("--t-end", type=float, help="End time (s); overrides simulation.t_end.")
 @click.option("--t0", type=float, help="Start time (s); overrides simulation.t0.")
-@click.option("--dt", type=float, help="Step of rk4/radau5 (s); alone it selects rk4.")
-@click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5"], case_sensitive=False), help="Integration scheme.")
+@click.option("--dt", type=float, help="Step of rk4/radau5/moreau_jean (s); alone it selects rk4.")
+@click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5", "moreau_jean"], case_sensitive=False),
+              help="Integration scheme (moreau_jean: time-stepping for models with contacts).")
+@click.option("--solver", type=click.Choice(["nsgs", "newton", "lemke"], case_sensitive=False), help="Contact solver of moreau_jean.")
 @click.option("--rtol", type=float, help="Relative tolerance of dopri5.")
 @click.option("--atol", type=float, help="Absolute tolerance of dopri5.")
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
@@ -145,6 +147,7 @@ def run(
     t0: float | None,
     dt: float | None,
     integrator: str | None,
+    solver: str | None,
     rtol: float | None,
     atol: float | None,
     output_dt: float | None,
@@ -165,7 +168,7 @@ def run(
         t_end=t_end,
         t0=t0,
         output_dt=output_dt,
-        integrator=integrator,
+        integrator={"type": integrator, "solver": solver} if integrator and solver else integrator,
         dt=dt,
         rtol=rtol,
         atol=atol,

@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import MechsysError, ModelError, SettingsError
-from .integrators import DOPRI5, RK4, Radau5
+from .integrators import DOPRI5, NSGS, RK4, Lemke, MoreauJean, Newton, Radau5
 from .model import Model
 
 #: Keys of the ``[simulation]`` table.
@@ -58,9 +58,25 @@ INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
     "rk4": ("dt",),
     "dopri5": ("rtol", "atol", "max_step", "first_step"),
     "radau5": ("dt", "newton_tol"),
+    "moreau_jean": ("dt", "solver"),
 }
 
-_INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5}
+_INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5, "moreau_jean": MoreauJean}
+_SOLVER_CLASSES = {"nsgs": NSGS, "newton": Newton, "lemke": Lemke}
+
+
+def _solver(spec: Any):
+    """A contact solver from a name or a table (``{type = "nsgs", tol = 1e-10}``)."""
+    if spec is None or hasattr(spec, "describe"):
+        return spec
+    table = {"type": spec} if isinstance(spec, str) else dict(spec) if isinstance(spec, dict) else None
+    if table is None or str(table.get("type", "")).lower() not in _SOLVER_CLASSES:
+        raise SettingsError(f"integrator.solver: expected nsgs, newton or lemke (a name or a table with type), got {spec!r}")
+    kind = str(table.pop("type")).lower()
+    try:
+        return _SOLVER_CLASSES[kind](**table)
+    except TypeError as e:
+        raise SettingsError(f"integrator.solver ({kind}): {e}") from None
 
 # top-level keys of the description that must be arrays of tables
 _LIST_KEYS = ("bodies", "joints", "forces", "ground_markers")
@@ -341,7 +357,9 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
         spec[key] = value
     if "dt" in allowed and spec.get("dt") is None:
         raise SettingsError(f"integrator {kind} needs a step: set simulation.integrator.dt or pass --dt")
-    args = {k: float(v) for k, v in spec.items() if k in allowed}
+    args = {k: (_solver(v) if k == "solver" else float(v)) for k, v in spec.items() if k in allowed}
+    if args.get("solver", "") is None:
+        args.pop("solver")
     try:
         kwargs["integrator"] = _INTEGRATOR_CLASSES[kind](**args)
     except (TypeError, ValueError) as e:

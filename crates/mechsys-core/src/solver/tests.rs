@@ -705,3 +705,87 @@ fn fixtures_have_the_free_velocities_of_their_mechanisms() {
     let Delassus::Dense(w) = &p.w else { unreachable!() };
     assert!(w[0] > 0.5 && w[0] < 1.0);
 }
+
+// ---------- redundant contacts (singular W) ----------
+
+/// `W = J M⁻¹ Jᵀ`, `q = J v` for one rigid body with diagonal `M⁻¹` and contact rows `jac`.
+fn one_body(dim: usize, jac: &[Vec<f64>], minv: &[f64], v: &[f64], mu: f64) -> FrictionContact {
+    let m = jac.len();
+    let w: Vec<f64> =
+        (0..m * m).map(|k| (0..minv.len()).map(|c| jac[k / m][c] * minv[c] * jac[k % m][c]).sum()).collect();
+    let q = jac.iter().map(|row| row.iter().zip(v).map(|(a, b)| a * b).sum()).collect();
+    FrictionContact::new(dim, Delassus::Dense(w), q, vec![mu; m / dim]).unwrap()
+}
+
+#[test]
+fn planar_box_on_two_corners_obeys_momentum_and_moment_balance() {
+    // box 2 kg, half sizes a = 0.5, b = 0.25, landing flat with v_y = −g dt and sliding at v_x;
+    // corners (∓a, −b), normal y, tangent x: rows [0, 1, c_x] and [1, 0, b]; W is 4×4 of rank 3
+    let (mass, a, b, mu, gdt) = (2.0, 0.5, 0.25, 0.5, 0.0981);
+    let inertia = mass * (a * a + b * b) / 3.0;
+    let jac = vec![vec![0.0, 1.0, -a], vec![1.0, 0.0, b], vec![0.0, 1.0, a], vec![1.0, 0.0, b]];
+    let minv = [1.0 / mass, 1.0 / mass, 1.0 / inertia];
+    for vx in [0.03, 0.2] {
+        let p = one_body(2, &jac, &minv, &[vx, -gdt, 0.0], mu);
+        for method in all_methods() {
+            let (r, rep) = run_fc(&p, method).unwrap();
+            assert!(rep.converged && rep.residual < 1e-10, "v_x {vx} {method:?}: {rep:?}");
+            let (sum_n, sum_t) = (r[0] + r[2], r[1] + r[3]);
+            // normal momentum: the box stops falling
+            assert!((sum_n - mass * gdt).abs() < 1e-9, "{method:?}: Σr_N = {sum_n}");
+            // tangential: sticks (Σr_T = −m v_x) below μ m g dt = 0.0981, else slides at the limit
+            let expect_t = if mass * vx < mu * mass * gdt { -mass * vx } else { -mu * mass * gdt };
+            assert!((sum_t - expect_t).abs() < 1e-9, "v_x {vx} {method:?}: Σr_T = {sum_t}");
+            // no rotation: a (r_N2 − r_N1) + b Σr_T = 0, the front corner carries more
+            assert!((a * (r[2] - r[0]) + b * sum_t).abs() < 1e-9, "{method:?}: {r:?}");
+            assert!(r[2] > r[0]);
+        }
+    }
+}
+
+#[test]
+fn spatial_box_on_four_corners_obeys_momentum_and_moment_balance() {
+    // box 3 kg, half sizes (a, c, b) = (0.4, 0.3, 0.2), diagonal inertia; corners (±a, ±c, −b);
+    // rows for n = z, t1 = x, t2 = y: e·v + (p × e)·ω; W is 12×12 of rank 6
+    let (mass, a, c, b, mu, gdt) = (3.0, 0.4, 0.3, 0.2, 0.4, 0.0981);
+    let inertia = [mass * (c * c + b * b) / 3.0, mass * (a * a + b * b) / 3.0, mass * (a * a + c * c) / 3.0];
+    let mut jac = Vec::new();
+    for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+        let pnt = [sx * a, sy * c, -b];
+        for e in [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            let pxe = [pnt[1] * e[2] - pnt[2] * e[1], pnt[2] * e[0] - pnt[0] * e[2], pnt[0] * e[1] - pnt[1] * e[0]];
+            jac.push(vec![e[0], e[1], e[2], pxe[0], pxe[1], pxe[2]]);
+        }
+    }
+    let minv = [1.0 / mass, 1.0 / mass, 1.0 / mass, 1.0 / inertia[0], 1.0 / inertia[1], 1.0 / inertia[2]];
+    for (vx, vy) in [(0.02, 0.01), (0.3, 0.1)] {
+        let p = one_body(3, &jac, &minv, &[vx, vy, -gdt, 0.0, 0.0, 0.0], mu);
+        for method in [nsgs(1e-11), newton(1e-11)] {
+            let (r, rep) = run_fc(&p, method).unwrap();
+            assert!(rep.converged, "{method:?}: {rep:?}");
+            // total impulse and its moment: Jᵀ r = M Δv with Δv = (−v_x…, +g dt, 0, 0, 0) or the slip share
+            let mut f = [0.0; 6];
+            for (k, row) in jac.iter().enumerate() {
+                for i in 0..6 {
+                    f[i] += row[i] * r[k];
+                }
+            }
+            assert!((f[2] - mass * gdt).abs() < 1e-8, "{method:?}: Σr_N = {}", f[2]);
+            let speed = vx.hypot(vy);
+            let (fx, fy) = if speed < mu * gdt {
+                (-mass * vx, -mass * vy)
+            } else {
+                (-mu * mass * gdt * vx / speed, -mu * mass * gdt * vy / speed)
+            };
+            assert!(
+                (f[0] - fx).abs() < 1e-8 && (f[1] - fy).abs() < 1e-8,
+                "{method:?}: ({}, {}) vs ({fx}, {fy})",
+                f[0],
+                f[1]
+            );
+            for (i, fi) in f.iter().enumerate().skip(3) {
+                assert!(fi.abs() < 1e-8, "{method:?}: moment {i} = {fi}");
+            }
+        }
+    }
+}
