@@ -116,13 +116,14 @@ pub struct Recording {
     pub contact_gd_n: Vec<f64>,
     /// Relative tangential velocities ġ_T (n_out × n_points × 2), m/s.
     pub contact_gd_t: Vec<f64>,
-    /// Normal contact force λ_N: the step's impulse over the step (n_out × n_points), N.
+    /// Normal contact force λ_N: the impulse since the previous sample over that interval
+    /// (n_out × n_points), N.
     pub contact_lambda_n: Vec<f64>,
     /// Tangential contact forces λ_T (n_out × n_points × 2), N.
     pub contact_lambda_t: Vec<f64>,
-    /// Normal impulses Λ_N of the last step (n_out × n_points), N s.
+    /// Normal impulses Λ_N summed since the previous sample (n_out × n_points), N s.
     pub contact_impulse_n: Vec<f64>,
-    /// Tangential impulses Λ_T of the last step (n_out × n_points × 2), N s.
+    /// Tangential impulses Λ_T summed since the previous sample (n_out × n_points × 2), N s.
     pub contact_impulse_t: Vec<f64>,
     /// Contact state (0 open, 1 stick, 2 slip) (n_out × n_points).
     pub contact_state: Vec<f64>,
@@ -472,6 +473,9 @@ fn time_stepping(
         v.reserve(t_out.len() * np);
     }
     let mut udot = vec![0.0; nu];
+    // impulses summed over each sample interval (so that impacts between samples are not lost)
+    let mut acc_n = vec![0.0; np];
+    let mut acc_t = vec![[0.0; 2]; np];
     let mut step = 0u64;
     let mut stats = crate::integrator::Stats::default();
     for (k, &t_rec) in t_out.iter().enumerate() {
@@ -482,6 +486,11 @@ fn time_stepping(
                 let (u, energy) = rest.split_at_mut(nu);
                 let u0 = u.to_vec();
                 let (work, diss) = stepper.step(model, &mut data, t, q, u, cb)?;
+                for (pt, r) in stepper.results.iter().enumerate() {
+                    acc_n[pt] += r.impulse_n;
+                    acc_t[pt][0] += r.impulse_t[0];
+                    acc_t[pt][1] += r.impulse_t[1];
+                }
                 energy[0] += diss;
                 energy[1] += work;
                 for i in 0..nu {
@@ -512,18 +521,24 @@ fn time_stepping(
         stepper.measure(model, &data)?;
         for (pt, kk) in stepper.kinematics().iter().enumerate() {
             let r = &stepper.results[pt];
+            // over the interval since the last sample (one step at the first sample)
+            let span = if k == 0 { dt } else { settings.output_dt };
+            let (in_, it) = (acc_n[pt], acc_t[pt]);
             rec.contact_gap.push(kk.point.g_n);
             rec.contact_gd_n.push(kk.gd_n);
             rec.contact_gd_t.extend_from_slice(&kk.gd_t);
-            rec.contact_impulse_n.push(r.impulse_n);
-            rec.contact_impulse_t.extend_from_slice(&r.impulse_t);
-            rec.contact_lambda_n.push(r.impulse_n / dt);
-            rec.contact_lambda_t.extend_from_slice(&[r.impulse_t[0] / dt, r.impulse_t[1] / dt]);
+            rec.contact_impulse_n.push(in_);
+            rec.contact_impulse_t.extend_from_slice(&it);
+            rec.contact_lambda_n.push(in_ / span);
+            rec.contact_lambda_t.extend_from_slice(&[it[0] / span, it[1] / span]);
             rec.contact_state.push(r.state);
             let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+            // the reserve of the last step (forces of that step)
             let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
             rec.contact_reserve.push((con.friction.mu0() * r.impulse_n - lt) / dt);
         }
+        acc_n.fill(0.0);
+        acc_t.fill([0.0; 2]);
         rec.dissipated_impact.push(stepper.dissipated_impact);
         rec.dissipated_friction.push(stepper.dissipated_friction);
         if let Some(p) = progress {

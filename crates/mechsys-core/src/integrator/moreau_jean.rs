@@ -19,8 +19,8 @@
 //!    constraints are projected as in the smooth schemes.
 //!
 //! Energy: with M frozen over the step, the kinetic energy changes by `h fᵀ ū + Λᵀ Wᵀ ū`
-//! (ū = (u_k + u_{k+1})/2), so `-Λᵀ ½(ġ⁻ + ġ⁺)` is what the contacts dissipate in the step, split
-//! into its normal (impact) and tangential (friction) parts. Poisson's law is applied with its
+//! (ū = (u_k + u_{k+1})/2), so `-Λᵀ ½(ġ⁻ + ġ⁺)` is what the contacts dissipate in the step; the
+//! friction share is `-Λ_Tᵀ ġ_T⁺` (never negative under Coulomb's law), the impacts' the rest. Poisson's law is applied with its
 //! normal coefficient as Newton's (they agree for a single frictionless impact); its tangential
 //! coefficient needs the event-driven scheme.
 
@@ -332,17 +332,17 @@ impl MoreauJean {
                     ContactState::Stick => STICK,
                     ContactState::Slip => SLIP,
                 };
+                // the kinetic energy the impulses take is -Λᵀ(ġ⁻ + ġ⁺)/2 in total; friction's share
+                // is -Λ_Tᵀ ġ_T⁺ (≥ 0 by Coulomb's law, zero while sticking), the rest is the impact's
                 for row in 0..d {
                     let a = ai * d + row;
                     let mut after = 0.0;
                     for i in 0..nu {
                         after += self.w_rows[(a, i)] * u[i];
                     }
-                    let de = -self.r[a] * 0.5 * (after + self.gd_before[a]);
-                    if row == 0 {
-                        dw_n += de;
-                    } else {
-                        dw_t += de;
+                    dw_n += -self.r[a] * 0.5 * (after + self.gd_before[a]);
+                    if row > 0 {
+                        dw_t += -self.r[a] * after;
                     }
                 }
             }
@@ -358,7 +358,7 @@ impl MoreauJean {
                 self.results[pt] = PointResult::default();
             }
         }
-        self.dissipated_impact += dw_n;
+        self.dissipated_impact += dw_n - dw_t;
         self.dissipated_friction += dw_t;
         // ---- positions at the end of the step, and u in the end's joint frames
         model.integrate(&self.q_mid, u, 0.5 * h, q);

@@ -3,7 +3,7 @@
 //! A sweep visits the unknowns (LCP) or contacts (friction) in order and solves each one's
 //! problem exactly with the others frozen at their newest values. For contact `i` the local
 //! problem is `u_i = W_ii r_i + b_i`, `b_i = q_i + Σ_{j≠i} W_ij r_j`, with the Signorini–Coulomb
-//! conditions; [`local_solve`] finds its solution by cases:
+//! conditions; the local solver finds its solution by cases:
 //!
 //! - open: `b_N ≥ 0` ⇒ `r = 0`;
 //! - stick: `r = −W_ii⁻¹ b` if it lies in the cone;

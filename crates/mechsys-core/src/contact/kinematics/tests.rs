@@ -162,3 +162,39 @@ fn w_part_is_the_point_jacobian_projection() {
         }
     }
 }
+
+/// At the degenerate configurations of the narrow phase, moving bodies give finite rates.
+#[test]
+fn degenerate_configurations_give_finite_rates() {
+    use crate::contact::contour::Vec2;
+    let mut rng = Rng::new(9);
+    let s = |r| Contour::Sphere { center: Vec3::zeros(), radius: r };
+    let cx = Contour::Capsule { a: Vec3::new(-1.0, 0.0, 0.0), b: Vec3::new(1.0, 0.0, 0.0), radius: 0.2 };
+    let cy = Contour::Capsule { a: Vec3::new(0.0, -1.0, 0.0), b: Vec3::new(0.0, 1.0, 0.0), radius: 0.3 };
+    let cube = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(1.0, 0.5, 2.0) };
+    let cyl = Contour::Cylinder { center: Vec3::zeros(), axis: Vec3::z(), radius: 0.3, half_length: 0.5 };
+    let ground = Contour::Plane { point: Vec3::new(0.0, 0.0, -0.5), normal: Vec3::z() };
+    let ci = Contour::Circle { center: Vec2::zeros(), radius: 0.5 };
+    let cases = [
+        (s(0.5), s(0.25)),
+        (cx.clone(), cy),
+        (cx.clone(), cx),
+        (s(0.1), cube),
+        (cyl, ground),
+        (ci.clone(), ci),
+    ];
+    for (c1, c2) in cases {
+        let tag = format!("{}–{}", c1.kind(), c2.kind());
+        let pair = ContactPair::new("d", c1, c2).unwrap();
+        let mut body = |rng: &mut Rng| BodyMotion {
+            pose: Pose::IDENTITY,
+            twist: Motion::new(rng.vec3(1.0), rng.vec3(1.0)),
+            acc: Motion::new(rng.vec3(1.0), rng.vec3(1.0)),
+        };
+        let (b1, b2) = (body(&mut rng), body(&mut rng));
+        for c in kin(&pair, &b1, &b2) {
+            let all = [c.gd_n, c.gd_t[0], c.gd_t[1], c.wbar_n, c.wbar_t[0], c.wbar_t[1], c.point.g_n];
+            assert!(all.iter().all(|v| v.is_finite()), "{tag}: {c:?}");
+        }
+    }
+}
