@@ -218,3 +218,30 @@ def test_bad_contact_objects_in_python():
         m.add_contact(ms.Contact("x", ms.Body("ball", m).contour(ms.contours.Sphere(radius=0.1)),
                                  m.ground.contour(ms.contours.Plane()), friction=0.3))
         m.build()
+
+
+def test_block_decelerates_along_the_stribeck_curve():
+    """A block pushed over a level floor slows down by mu(v) g with mu(v) = mu + (mu0 - mu)
+    exp(-(v / v_s)^2): against the same ODE solved by SciPy, to O(dt); once at rest it sticks."""
+    from scipy.integrate import solve_ivp
+
+    mu0, mu, v_s, v0 = 0.5, 0.2, 0.3, 2.0
+    m = ms.Model("stribeck", gravity=(0.0, 0.0, -G))
+    half = (0.1, 0.05, 0.05)
+    b = m.add_body("block", 1.0, ms.inertia.box(1.0, (0.2, 0.1, 0.1)))
+    m.add_joint(ms.joints.Free("free", m.ground, b, q0=[0, 0, half[2], 1, 0, 0, 0], u0=[v0, 0, 0, 0, 0, 0]))
+    m.add_contact(ms.Contact("base", b.contour(ms.contours.Box(half_extents=half)),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
+                             friction=ms.laws.Stribeck(mu0=mu0, mu=mu, v_s=v_s)))
+    res = ms.simulate(m, 1.5, ms.MoreauJean(1e-4), output_dt=1e-2)
+    law = lambda v: mu + (mu0 - mu) * np.exp(-((v / v_s) ** 2))  # noqa: E731
+    stop = lambda t, y: y[0] - 1e-9  # noqa: E731
+    stop.terminal = True
+    ref = solve_ivp(lambda t, y: [-law(y[0]) * G], (0, 1.5), [v0], rtol=1e-10, atol=1e-12, dense_output=True, events=stop)
+    t_stop = ref.t_events[0][0]
+    v = res["body/block/velocity"][:, 0]
+    moving = res.t < t_stop - 0.01
+    # mu is taken at the sliding speed of the step's start: first order, 5e-4 m/s here
+    np.testing.assert_allclose(v[moving], ref.sol(res.t[moving])[0], atol=2e-3)
+    assert np.abs(v[res.t > t_stop + 0.01]).max() < 1e-9
+    assert np.all(res["contact/base/state"][res.t > t_stop + 0.01, :4] == 1)
