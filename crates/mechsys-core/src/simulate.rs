@@ -467,6 +467,7 @@ fn time_stepping(
         v.reserve(t_out.len() * np);
     }
     let mut udot = vec![0.0; nu];
+    let mut u_start = vec![0.0; nu];
     // impulses summed over each sample interval (so that impacts between samples are not lost)
     let mut acc_n = vec![0.0; np];
     let mut acc_t = vec![[0.0; 2]; np];
@@ -478,7 +479,7 @@ fn time_stepping(
                 let t = settings.t0 + step as f64 * dt;
                 let (q, rest) = y.split_at_mut(nq);
                 let (u, energy) = rest.split_at_mut(nu);
-                let u0 = u.to_vec();
+                u_start.copy_from_slice(u);
                 let (work, diss) = stepper.step(model, &mut data, t, q, u, cb)?;
                 for (pt, r) in stepper.results.iter().enumerate() {
                     acc_n[pt] += r.impulse_n;
@@ -488,7 +489,7 @@ fn time_stepping(
                 energy[0] += diss;
                 energy[1] += work;
                 for i in 0..nu {
-                    udot[i] = (u[i] - u0[i]) / dt;
+                    udot[i] = (u[i] - u_start[i]) / dt;
                 }
                 crate::integrator::check_finite(t + dt, &y)?;
                 step += 1;
