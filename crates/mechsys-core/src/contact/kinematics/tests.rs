@@ -171,22 +171,17 @@ fn degenerate_configurations_give_finite_rates() {
     let s = |r| Contour::Sphere { center: Vec3::zeros(), radius: r };
     let cx = Contour::Capsule { a: Vec3::new(-1.0, 0.0, 0.0), b: Vec3::new(1.0, 0.0, 0.0), radius: 0.2 };
     let cy = Contour::Capsule { a: Vec3::new(0.0, -1.0, 0.0), b: Vec3::new(0.0, 1.0, 0.0), radius: 0.3 };
-    let cube = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(1.0, 0.5, 2.0) };
+    let cube =
+        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(1.0, 0.5, 2.0) };
     let cyl = Contour::Cylinder { center: Vec3::zeros(), axis: Vec3::z(), radius: 0.3, half_length: 0.5 };
     let ground = Contour::Plane { point: Vec3::new(0.0, 0.0, -0.5), normal: Vec3::z() };
     let ci = Contour::Circle { center: Vec2::zeros(), radius: 0.5 };
-    let cases = [
-        (s(0.5), s(0.25)),
-        (cx.clone(), cy),
-        (cx.clone(), cx),
-        (s(0.1), cube),
-        (cyl, ground),
-        (ci.clone(), ci),
-    ];
+    let cases =
+        [(s(0.5), s(0.25)), (cx.clone(), cy), (cx.clone(), cx), (s(0.1), cube), (cyl, ground), (ci.clone(), ci)];
     for (c1, c2) in cases {
         let tag = format!("{}–{}", c1.kind(), c2.kind());
         let pair = ContactPair::new("d", c1, c2).unwrap();
-        let mut body = |rng: &mut Rng| BodyMotion {
+        let body = |rng: &mut Rng| BodyMotion {
             pose: Pose::IDENTITY,
             twist: Motion::new(rng.vec3(1.0), rng.vec3(1.0)),
             acc: Motion::new(rng.vec3(1.0), rng.vec3(1.0)),
