@@ -181,6 +181,8 @@ impact = { type = "newton", eps = 0.5 }
     res = ms.load(h5)
     z = res["body/ball/position"][:, 2] - 0.1
     assert abs(z[res.t > 0.5].max() - 0.25) < 2e-3  # first apex eps^2 h0
+    out = CliRunner().invoke(cli, ["info", str(path)])
+    assert out.exit_code == 0 and "contacts (1" in out.output and "floor" in out.output, out.output
     # a smooth integrator refuses a contact model
     out = CliRunner().invoke(cli, ["run", str(path), "--t-end", "0.1"])
     assert out.exit_code == 2 and "MoreauJean" in out.output

@@ -286,6 +286,13 @@ def info(model_file: Path) -> None:
         if mob["redundant"]:
             names = ", ".join(f"{n}[{k}]" for n, k in mob["redundant"])
             click.echo(f"warning: {len(mob['redundant'])} redundant equation(s) at q0: {names} (their multipliers are set to zero)")
+    contacts = core.contacts()
+    if contacts:
+        click.echo("")
+        click.echo(f"contacts ({len(contacts)}; simulate with --integrator moreau_jean):")
+        rows = [(c["name"], f"{c['body1']} / {c['body2']}", str(c["points"]), "planar" if c["tangents"] == 1 else "spatial")
+                for c in contacts]
+        click.echo(_table(["name", "bodies", "points", "kind"], rows))
     if sim:
         click.echo("")
         click.echo("simulation defaults:")
