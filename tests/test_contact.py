@@ -247,3 +247,20 @@ def test_block_decelerates_along_the_stribeck_curve():
     np.testing.assert_allclose(v[moving], ref.sol(res.t[moving])[0], atol=2e-3)
     assert np.abs(v[res.t > t_stop + 0.01]).max() < 1e-9
     assert np.all(res["contact/base/state"][res.t > t_stop + 0.01, :4] == 1)
+
+
+def test_planar_ball_with_spatial_contours_takes_no_out_of_plane_friction():
+    """A ball on a planar joint (x, y, rotation about z) rolling on the plane y = 0 modelled with a
+    sphere and a plane: the second tangent (out of the plane of motion) can take no velocity, so
+    it must take no impulse either, and the slip-to-roll transition comes out exactly."""
+    r, v0, w0, mu = 0.1, 2.0, 5.0, 0.3
+    m = ms.Model("planar-ball", gravity=(0.0, -G, 0.0))
+    b = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, r))
+    m.add_joint(ms.joints.Planar("plane", m.ground, b, q0=[0, r, 0], u0=[v0, 0, w0]))
+    m.add_contact(ms.Contact("floor", b.contour(ms.contours.Sphere(radius=r)),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 1, 0))), friction=ms.laws.Coulomb(mu)))
+    res = ms.simulate(m, 1.0, ms.MoreauJean(2e-4), output_dt=1e-2)
+    s0 = v0 + r * w0  # slip of the contact point (rotation about +z moves it along +x)
+    v_f = v0 - 2 * s0 / 7
+    assert abs(res["body/ball/velocity"][-1, 0] - v_f) < 1e-12
+    assert np.abs(res["contact/floor/lambda_t"][:, 1]).max() < 1e-12
