@@ -24,7 +24,7 @@ $(BUILD): $(STAMP) $(CORE_SOURCES)
 build: $(BUILD)
 
 demo: $(BUILD)
-	$(PY) examples/heavy_top.py
+	$(PY) examples/woodpecker.py
 
 test: $(BUILD)
 	cargo test -p mechsys-core
