@@ -34,9 +34,10 @@ bench-rust:
 	cargo bench -p mechsys-core --bench dynamics
 
 bench: $(BUILD)
-	$(PY) -m pip install --quiet pin mujoco exudyn
+	$(PY) -m pip install --quiet pin mujoco exudyn pybullet
 	$(PY) benches/peers.py --out docs/benchmarks.md
 	$(PY) benches/constraints.py --out docs/benchmarks.md
+	$(PY) benches/contacts.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results
