@@ -549,7 +549,7 @@ fn time_stepping(
             stepper.unconverged.0, stats.steps, stepper.unconverged.1
         ));
     }
-    stats.evaluations = stats.steps as usize;
+    stats.evaluations = stats.steps;
     rec.stats = stats;
     Ok(rec)
 }
