@@ -312,7 +312,9 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         s.output_dt,
         span
     );
-    if let IntegratorKind::Rk4 { dt } | IntegratorKind::Radau5 { dt, .. } | IntegratorKind::MoreauJean { dt, .. } = s.integrator {
+    if let IntegratorKind::Rk4 { dt } | IntegratorKind::Radau5 { dt, .. } | IntegratorKind::MoreauJean { dt, .. } =
+        s.integrator
+    {
         crate::ensure!(dt.is_finite() && dt > 0.0, Settings, "integrator.dt: must be > 0, got {dt}");
         let ratio = s.output_dt / dt;
         crate::ensure!(
@@ -463,7 +465,14 @@ fn time_stepping(
         let (q, rest) = y.split_at_mut(nq);
         crate::dynamics::constrained::project(model, &mut data, settings.t0, q, &mut rest[..nu], cb)?;
     }
-    for v in [&mut rec.contact_gap, &mut rec.contact_gd_n, &mut rec.contact_lambda_n, &mut rec.contact_impulse_n, &mut rec.contact_state, &mut rec.contact_reserve] {
+    for v in [
+        &mut rec.contact_gap,
+        &mut rec.contact_gd_n,
+        &mut rec.contact_lambda_n,
+        &mut rec.contact_impulse_n,
+        &mut rec.contact_state,
+        &mut rec.contact_reserve,
+    ] {
         v.reserve(t_out.len() * np);
     }
     let mut udot = vec![0.0; nu];
@@ -527,7 +536,7 @@ fn time_stepping(
             rec.contact_lambda_n.push(in_ / span);
             rec.contact_lambda_t.extend_from_slice(&[it[0] / span, it[1] / span]);
             rec.contact_state.push(r.state);
-            let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+            let con = model.contact_of_point(pt);
             // the reserve of the last step (forces of that step)
             let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
             rec.contact_reserve.push((con.friction.mu0() * r.impulse_n - lt) / dt);

@@ -311,7 +311,8 @@ fn loop_joint_rows_at_zero_violation_mean_what_the_docs_say() {
     let fr = |p: [f64; 3], c: [f64; 3]| frame(p, c);
     let (f1, f2) = (fr([0.05, 0.02, 0.1], [0.3, 0.1, -0.2]), fr([0.4, 0.1, 0.2], [0.1, -0.3, 0.2]));
     let mk = |name: &str, f1: FrameDescription, f2: FrameDescription| {
-        let frames = LoopFrames { name: name.into(), body1: "c".into(), frame1: f1, body2: "ground".into(), frame2: f2 };
+        let frames =
+            LoopFrames { name: name.into(), body1: "c".into(), frame1: f1, body2: "ground".into(), frame2: f2 };
         match name {
             "p" => ConstraintDescription::LoopPrismatic(frames),
             "u" => ConstraintDescription::LoopUniversal(frames),

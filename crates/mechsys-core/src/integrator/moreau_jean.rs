@@ -102,7 +102,12 @@ impl MoreauJean {
         crate::ensure!(h.is_finite() && h > 0.0, Settings, "integrator.dt: must be > 0, got {h}");
         let (nu, np) = (model.nu, model.n_contact_points);
         let dim = if model.contacts.iter().all(|c| c.pair.is_planar()) { 2 } else { 3 };
-        let problem = FrictionContact { dim, w: Delassus::Dense(Vec::with_capacity(dim * dim * np * np)), q: Vec::with_capacity(dim * np), mu: Vec::with_capacity(np) };
+        let problem = FrictionContact {
+            dim,
+            w: Delassus::Dense(Vec::with_capacity(dim * dim * np * np)),
+            q: Vec::with_capacity(dim * np),
+            mu: Vec::with_capacity(np),
+        };
         Ok(MoreauJean {
             h,
             method,
@@ -139,7 +144,15 @@ impl MoreauJean {
 
     /// Advances (q, u) from t by one step; returns the work of the smooth external loads and the
     /// energy dissipated by the smooth dampers over the step (J).
-    pub fn step(&mut self, model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f64], cb: &dyn Callbacks) -> Result<(f64, f64)> {
+    pub fn step(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        t: f64,
+        q: &mut [f64],
+        u: &mut [f64],
+        cb: &dyn Callbacks,
+    ) -> Result<(f64, f64)> {
         let (nu, nc, h) = (model.nu, model.nc, self.h);
         let tm = t + 0.5 * h;
         model.integrate(q, u, 0.5 * h, &mut self.q_mid);
@@ -165,7 +178,9 @@ impl MoreauJean {
             crate::dynamics::rnea::rnea_inward(model, data, &mut c);
             if pass == 0 {
                 let Data { inertia, s, ic, saddle, .. } = &mut *data;
-                crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| saddle.put_mass(r, col, v));
+                crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| {
+                    saddle.put_mass(r, col, v)
+                });
                 if !data.saddle.factor_mass() {
                     return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s")));
                 }
@@ -213,7 +228,8 @@ impl MoreauJean {
         for con in &model.contacts {
             let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
             let k = &mut self.kin[con.first..con.first + con.points()];
-            contact_kinematics(&con.pair, &b1, &b2, k).map_err(|e| Error::Solver(format!("contact '{}' at t = {tm:.6} s: {e}", con.name)))?;
+            contact_kinematics(&con.pair, &b1, &b2, k)
+                .map_err(|e| Error::Solver(format!("contact '{}' at t = {tm:.6} s: {e}", con.name)))?;
             for (j, kk) in k.iter().enumerate() {
                 if kk.point.g_n <= CONTACT_MARGIN {
                     self.active.push(con.first + j);
@@ -270,7 +286,7 @@ impl MoreauJean {
             self.problem.mu.clear();
             self.r.clear();
             for (ai, &pt) in self.active.iter().enumerate() {
-                let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+                let con = model.contact_of_point(pt);
                 let kk = &self.kin[pt];
                 let mut gd = [0.0; 3];
                 for (row, g) in gd.iter_mut().enumerate().take(d) {
@@ -305,7 +321,7 @@ impl MoreauJean {
             self.ws.reserve(&self.problem, &self.method)?;
             let warm = self.r.iter().any(|v| *v != 0.0);
             let report = solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws).map_err(|e| {
-                let names: Vec<&str> = self.active.iter().map(|&pt| model.contacts.iter().rfind(|c| c.first <= pt).map_or("?", |c| c.name.as_str())).collect();
+                let names: Vec<&str> = self.active.iter().map(|&pt| model.contact_of_point(pt).name.as_str()).collect();
                 Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
             })?;
             if !report.converged {
@@ -397,13 +413,31 @@ impl MoreauJean {
             }
         }
         for (ai, &pt) in self.active.iter().enumerate() {
-            let con = model.contacts.iter().rfind(|c| c.first <= pt).expect("a contact owns every point");
+            let con = model.contact_of_point(pt);
             let k = &self.kin[pt].point;
             let dirs = [k.n, k.t1, k.t2];
             for (row, dir) in dirs.iter().enumerate().take(d) {
                 let r = ai * d + row;
-                crate::constraints::add_point_rows(model, &data.s, con.body1, &k.p1, 1.0, Some(dir), &mut self.w_rows, r);
-                crate::constraints::add_point_rows(model, &data.s, con.body2, &k.p2, -1.0, Some(dir), &mut self.w_rows, r);
+                crate::constraints::add_point_rows(
+                    model,
+                    &data.s,
+                    con.body1,
+                    &k.p1,
+                    1.0,
+                    Some(dir),
+                    &mut self.w_rows,
+                    r,
+                );
+                crate::constraints::add_point_rows(
+                    model,
+                    &data.s,
+                    con.body2,
+                    &k.p2,
+                    -1.0,
+                    Some(dir),
+                    &mut self.w_rows,
+                    r,
+                );
             }
         }
     }

@@ -1,7 +1,7 @@
 //! Validated unilateral contacts: the pair of contours (prepared once for the narrow phase), the
 //! friction law (eqs. 2.200, 2.201) and the impact law (eqs. 2.202, 2.203).
 
-use crate::contact::{Contour, ContactPair, Vec2};
+use crate::contact::{ContactPair, Contour, Vec2};
 use crate::error::{Error, Result};
 use crate::math::Vec3;
 
@@ -138,13 +138,23 @@ fn vec3(v: &[f64; 3]) -> Vec3 {
 }
 
 fn planar(c: &ContourDescription) -> bool {
-    matches!(c, ContourDescription::Circle { .. } | ContourDescription::Line { .. } | ContourDescription::Polygon { .. })
+    matches!(
+        c,
+        ContourDescription::Circle { .. } | ContourDescription::Line { .. } | ContourDescription::Polygon { .. }
+    )
 }
 
 /// The engine contour of a description; a `point` is planar when its partner is.
-fn contour(c: &ContourDescription, partner_planar: bool, what: &str, rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3>) -> Result<Contour> {
+fn contour(
+    c: &ContourDescription,
+    partner_planar: bool,
+    what: &str,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3>,
+) -> Result<Contour> {
     Ok(match c {
-        ContourDescription::Point { position } if partner_planar => Contour::Point2 { p: Vec2::new(position[0], position[1]) },
+        ContourDescription::Point { position } if partner_planar => {
+            Contour::Point2 { p: Vec2::new(position[0], position[1]) }
+        }
         ContourDescription::Point { position } => Contour::Point { p: vec3(position) },
         ContourDescription::Sphere { center, radius } => Contour::Sphere { center: vec3(center), radius: *radius },
         ContourDescription::Plane { point, normal } => Contour::Plane { point: vec3(point), normal: vec3(normal) },
@@ -157,11 +167,15 @@ fn contour(c: &ContourDescription, partner_planar: bool, what: &str, rotation: i
         ContourDescription::Cylinder { center, axis, radius, half_length } => {
             Contour::Cylinder { center: vec3(center), axis: vec3(axis), radius: *radius, half_length: *half_length }
         }
-        ContourDescription::Circle { center, radius } => Contour::Circle { center: Vec2::new(center[0], center[1]), radius: *radius },
+        ContourDescription::Circle { center, radius } => {
+            Contour::Circle { center: Vec2::new(center[0], center[1]), radius: *radius }
+        }
         ContourDescription::Line { point, normal } => {
             Contour::Line { point: Vec2::new(point[0], point[1]), normal: Vec2::new(normal[0], normal[1]) }
         }
-        ContourDescription::Polygon { vertices } => Contour::Polygon { vertices: vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect() },
+        ContourDescription::Polygon { vertices } => {
+            Contour::Polygon { vertices: vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect() }
+        }
     })
 }
 
@@ -187,7 +201,11 @@ pub(super) fn validate(
             let mu = finite(*mu, &format!("{what}.friction.mu"))?;
             let mu0 = finite(mu0.unwrap_or(mu), &format!("{what}.friction.mu0"))?;
             crate::ensure!(mu >= 0.0, Model, "{what}.friction.mu: must be >= 0, got {mu}");
-            crate::ensure!(mu0 >= mu, Model, "{what}.friction.mu0: the static coefficient must be >= mu = {mu}, got {mu0}");
+            crate::ensure!(
+                mu0 >= mu,
+                Model,
+                "{what}.friction.mu0: the static coefficient must be >= mu = {mu}, got {mu0}"
+            );
             FrictionLaw::Coulomb { mu, mu0 }
         }
         FrictionDescription::Stribeck { mu0, mu, v_s, exponent } => {
@@ -201,10 +219,21 @@ pub(super) fn validate(
         }
         FrictionDescription::Table { speed, mu } => {
             let w = format!("{what}.friction");
-            crate::ensure!(!speed.is_empty() && speed.len() == mu.len(), Model, "{w}: speed and mu need the same nonzero length, got {} and {}", speed.len(), mu.len());
+            crate::ensure!(
+                !speed.is_empty() && speed.len() == mu.len(),
+                Model,
+                "{w}: speed and mu need the same nonzero length, got {} and {}",
+                speed.len(),
+                mu.len()
+            );
             crate::ensure!(speed[0] == 0.0, Model, "{w}.speed[0]: the table starts at speed 0, got {}", speed[0]);
             for k in 1..speed.len() {
-                crate::ensure!(speed[k].is_finite() && speed[k] > speed[k - 1], Model, "{w}.speed[{k}]: must be finite and ascending, got {}", speed[k]);
+                crate::ensure!(
+                    speed[k].is_finite() && speed[k] > speed[k - 1],
+                    Model,
+                    "{w}.speed[{k}]: must be finite and ascending, got {}",
+                    speed[k]
+                );
             }
             for (k, m) in mu.iter().enumerate() {
                 crate::ensure!(m.is_finite() && *m >= 0.0, Model, "{w}.mu[{k}]: must be finite and >= 0, got {m}");
@@ -221,7 +250,11 @@ pub(super) fn validate(
         ImpactLaw::Poisson { eps, eps_t } => (eps, eps_t),
     };
     for (k, e) in [("eps", eps), ("eps_t", eps_t)] {
-        crate::ensure!(e.is_finite() && (0.0..=1.0).contains(&e), Model, "{what}.impact.{k}: must be in [0, 1], got {e}");
+        crate::ensure!(
+            e.is_finite() && (0.0..=1.0).contains(&e),
+            Model,
+            "{what}.impact.{k}: must be in [0, 1], got {e}"
+        );
     }
     Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, friction, impact, first })
 }

@@ -308,6 +308,12 @@ impl Model {
     pub fn joint_id(&self, name: &str) -> Option<usize> {
         self.joint_index.get(name).copied()
     }
+    /// The contact that owns candidate point `pt` (points are numbered contact after contact).
+    pub fn contact_of_point(&self, pt: usize) -> &contact::Contact {
+        let k = self.contacts.partition_point(|c| c.first <= pt);
+        &self.contacts[k.saturating_sub(1)]
+    }
+
     /// The initial coordinates given in the model (neutral where none were given).
     pub fn q0(&self) -> Vec<f64> {
         let mut q = vec![0.0; self.nq];

@@ -761,7 +761,12 @@ impl Model {
         let mut contact_names = HashSet::new();
         let mut n_contact_points = 0;
         for (i, d) in desc.contacts.iter().enumerate() {
-            crate::ensure!(contact_names.insert(d.name.clone()), Model, "contacts[{i}] '{}': duplicate contact name", d.name);
+            crate::ensure!(
+                contact_names.insert(d.name.clone()),
+                Model,
+                "contacts[{i}] '{}': duplicate contact name",
+                d.name
+            );
             let c = super::contact::validate(d, i, n_contact_points, body, rotation)?;
             n_contact_points += c.points();
             contacts.push(c);
