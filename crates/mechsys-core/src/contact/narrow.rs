@@ -85,6 +85,9 @@ enum Geometry {
     Swept { a1: Vec3, d1: Vec3, r1: f64, a2: Vec3, d2: Vec3, r2: f64, across: Vec3 },
     /// A sphere (or point, radius 0) on body 1 against a box on body 2.
     SphereBox { center: Vec3, radius: f64, box_center: Vec3, box_rotation: Mat3, half: Vec3 },
+    /// Two boxes: candidates 0–7 are body 1's corners against body 2's box, 8–15 body 2's corners
+    /// against body 1's box (vertex–face contacts only).
+    BoxBox { corners: [Vec<Vec3>; 2], boxes: [(Vec3, Mat3, Vec3); 2] },
     /// Planar: circles (or points, radius 0) extruded along body 2's z axis.
     CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
 }
@@ -152,7 +155,7 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
         K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon),
         K::Sphere => matches!(a, K::Point | K::Sphere),
         K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
-        K::Box => matches!(a, K::Point | K::Sphere),
+        K::Box => matches!(a, K::Point | K::Sphere | K::Box),
         K::Circle => matches!(a, K::Point2 | K::Circle),
         _ => false,
     }
@@ -167,7 +170,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
     } else {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder–plane, \
-             point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere–box, \
+             point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
              point2/circle–circle, in either order)"
         )))
     }
@@ -182,6 +185,8 @@ pub fn candidates(c1: &Contour, c2: &Contour) -> Result<usize> {
     let first = if swapped { c2 } else { c1 };
     let against_plane = matches!(c1.kind(), ContourKind::Plane) || matches!(c2.kind(), ContourKind::Plane);
     Ok(match first {
+        // each box's corners against the other box (vertex–face contacts; edge–edge ones are not seen)
+        Contour::Box { .. } if matches!((c1.kind(), c2.kind()), (ContourKind::Box, ContourKind::Box)) => 16,
         Contour::Box { .. } => 8,
         // end spheres and rim circles; a capsule against a capsule has one closest pair
         Contour::Capsule { .. } | Contour::Cylinder { .. } if against_plane => 2,
@@ -358,8 +363,29 @@ impl ContactPair {
                 sphere_box(x1, x2, tw, center, *radius, box_center, box_rotation, half)
             }
             Geometry::CircleCircle { c1, r1, c2, r2 } => circle_circle(x1, x2, tw, c1, *r1, c2, *r2),
+            Geometry::BoxBox { corners, boxes } => {
+                if k < 8 {
+                    let (bc, rot, half) = &boxes[1];
+                    sphere_box(x1, x2, tw, &corners[0][k], 0.0, bc, rot, half)
+                } else {
+                    // body 2's corner against body 1's box, then back to the pair's order
+                    let (bc, rot, half) = &boxes[0];
+                    let r = sphere_box(x2, x1, tw.map(|(a, b)| (b, a)), &corners[1][k - 8], 0.0, bc, rot, half);
+                    Raw { g: r.g, n: -r.n, p1: r.p2, p2: r.p1, nd: -r.nd, p1d: r.p2d, p2d: r.p1d }
+                }
+            }
         }
     }
+}
+
+/// The eight corners of a box, in its body's frame.
+fn box_corners(center: &Vec3, rotation: &Mat3, half: &Vec3) -> Vec<Vec3> {
+    (0..8)
+        .map(|i| {
+            let sgn = |b: usize| if i & (1 << b) != 0 { 1.0 } else { -1.0 };
+            center + rotation * Vec3::new(sgn(0) * half.x, sgn(1) * half.y, sgn(2) * half.z)
+        })
+        .collect()
 }
 
 fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
@@ -373,15 +399,7 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
         let (centers, radius) = match f {
             Contour::Point { p } => (vec![*p], 0.0),
             Contour::Sphere { center, radius } => (vec![*center], *radius),
-            Contour::Box { center, rotation, half_extents } => {
-                let mut v = Vec::with_capacity(8);
-                for i in 0..8 {
-                    let sgn = |b: usize| if i & (1 << b) != 0 { 1.0 } else { -1.0 };
-                    let local = Vec3::new(sgn(0) * half_extents.x, sgn(1) * half_extents.y, sgn(2) * half_extents.z);
-                    v.push(center + rotation * local);
-                }
-                (v, 0.0)
-            }
+            Contour::Box { center, rotation, half_extents } => (box_corners(center, rotation, half_extents), 0.0),
             Contour::Capsule { a, b, radius } => (vec![*a, *b], *radius),
             Contour::Cylinder { center, axis, radius, half_length } => {
                 return Geometry::CylinderHalfSpace {
@@ -412,6 +430,13 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             let ((a1, d1, r1), (a2, d2, r2)) = (segment(f), segment(s));
             let across = if d2.norm() > 0.0 { perpendicular(&d2.normalize()) } else { Vec3::x() };
             Geometry::Swept { a1, d1, r1, a2, d2, r2, across }
+        }
+        Contour::Box { center: bc, rotation, half_extents } if matches!(f, Contour::Box { .. }) => {
+            let Contour::Box { center: c1, rotation: r1, half_extents: h1 } = f else { unreachable!() };
+            Geometry::BoxBox {
+                corners: [box_corners(c1, r1, h1), box_corners(bc, rotation, half_extents)],
+                boxes: [(*c1, *r1, *h1), (*bc, *rotation, *half_extents)],
+            }
         }
         Contour::Box { center: bc, rotation, half_extents } => {
             let (center, _, radius) = segment(f);

@@ -162,6 +162,11 @@ pub(crate) fn sample(kind: &str) -> Contour {
             half_extents: Vec3::new(0.3, 0.5, 0.2),
         },
         "capsule" => Contour::Capsule { a: Vec3::new(-0.3, 0.1, 0.0), b: Vec3::new(0.4, -0.1, 0.1), radius: 0.2 },
+        "box_b" => Contour::Box {
+            center: Vec3::new(0.05, -0.02, 0.03),
+            rotation: nalgebra::Rotation3::from_euler_angles(0.2, -0.3, 0.5).into_inner(),
+            half_extents: Vec3::new(0.2, 0.15, 0.1),
+        },
         "capsule_b" => Contour::Capsule { a: Vec3::new(0.0, -0.4, 0.1), b: Vec3::new(0.1, 0.5, -0.2), radius: 0.15 },
         "cylinder" => Contour::Cylinder {
             center: Vec3::new(0.1, 0.0, 0.0),

@@ -60,8 +60,10 @@ fn candidate_counts_and_unsupported_pairs() {
         assert_eq!(candidates(&c1, &c2).unwrap(), n, "{a}–{b}");
         assert_eq!(candidates(&c2, &c1).unwrap(), n, "{b}–{a}");
     }
+    // box–box: each box's eight corners against the other box
+    assert_eq!(candidates(&sample("box"), &sample("box_b")).unwrap(), 16);
     for (a, b) in [
-        ("box", "box"),
+        ("cylinder", "box"),
         ("plane", "plane"),
         ("circle", "plane"),
         ("sphere", "line"),
