@@ -141,10 +141,17 @@ def test_newtons_cradle_conserves_momentum_and_follows_the_simultaneous_impact_l
 
 
 @pytest.mark.parametrize("method", [ms.NSGS(), ms.Newton(), ms.Lemke()])
-def test_every_contact_solver_gives_the_same_sliding_block(method):
-    res = ms.simulate(block(0.3, 0.2, 0.25), 0.2, ms.MoreauJean(1e-3, solver=method), output_dt=1e-2)
-    ref = ms.simulate(block(0.3, 0.2, 0.25), 0.2, ms.MoreauJean(1e-3), output_dt=1e-2)
-    np.testing.assert_allclose(res["body/block/position"], ref["body/block/position"], atol=1e-9)
+def test_every_contact_solver_gives_the_sliding_block_of_the_closed_form(method):
+    """Each solver (NSGS, Newton, Lemke on the 8-facet pyramid, whose facets include the slip
+    direction) against x = a t^2 / 2, a = g (sin alpha - mu cos alpha), and all four bottom
+    corners sliding."""
+    alpha, mu, dt = 0.3, 0.2, 1e-3
+    a = G * (np.sin(alpha) - mu * np.cos(alpha))
+    res = ms.simulate(block(alpha, mu, 0.25), 0.2, ms.MoreauJean(dt, solver=method), output_dt=1e-2)
+    x = res["body/block/position"][:, 0]
+    np.testing.assert_allclose(x, 0.5 * a * res.t**2, rtol=0, atol=a * dt * 0.2)
+    assert not np.any(res["contact/base/state"][2:] == 1)
+    np.testing.assert_allclose(res["contact/base/lambda_n"][2:].sum(axis=1), 2.0 * G * np.cos(alpha), rtol=1e-8)
 
 
 def test_contacts_in_a_model_file_and_on_the_command_line(tmp_path):
@@ -276,7 +283,7 @@ def test_woodpecker_toy_pecks_its_way_down_in_a_repeating_cycle():
     from pathlib import Path
 
     ns = runpy.run_path(str(Path(__file__).resolve().parents[1] / "examples" / "woodpecker.py"))
-    res = ms.simulate(ns["model"], 2.0, ms.MoreauJean(1e-5), output_dt=1e-4)
+    res = ms.simulate(ns["model"], 2.0, ms.MoreauJean(1e-5, solver=ms.NSGS(tol=1e-13)), output_dt=1e-4)
     r0, rm, hm = ns["R_0"], ns["R_M"], ns["H_M"]
     phi_jam = np.arctan2(hm, rm) - np.arccos(r0 / np.hypot(rm, hm))
     phi = res["joint/sleeve/q"][:, 2]
@@ -284,8 +291,7 @@ def test_woodpecker_toy_pecks_its_way_down_in_a_repeating_cycle():
     assert jammed.mean() > 0.1
     # jammed: at the jam angle (to the few µm the impacts press in: 1e-3 rad) and at rest
     assert np.abs(phi[jammed] - phi_jam).max() < 1e-3
-    # at rest to the contact solver's tolerance (NSGS, 1e-10 relative to the free velocity)
-    assert np.abs(res["joint/sleeve/u"][jammed]).max() < 1e-8
+    assert np.abs(res["joint/sleeve/u"][jammed]).max() < 1e-9
     burst = ns["pecks"](res)
     assert len(burst) >= 10
     period = np.diff(burst)[-5:]
@@ -294,7 +300,7 @@ def test_woodpecker_toy_pecks_its_way_down_in_a_repeating_cycle():
     np.testing.assert_allclose(drop[2:], drop[:-2], rtol=0.05)
     assert np.all(drop > 0) and abs(period[-1] - period[-2]) > 0.02  # two different pecks
     e = res["energy/total"] + res["energy/dissipated"] - res["energy/external_work"]
-    assert np.ptp(e) < 1e-6 * res["energy/dissipated"][-1] * 1e3
+    assert np.ptp(e) < 1e-3 * res["energy/dissipated"][-1]
     assert res["energy/dissipated_friction"][-1] > res["energy/dissipated_impact"][-1] > 0
 
 

@@ -90,7 +90,7 @@ pub struct Data {
     pub work2: Vec<f64>,
     /// constrained solve: scratch configuration (nq).
     pub q_tmp: Vec<f64>,
-    /// constraints: numerical rank of G at the last solve.
+    /// constraints: numerical rank of the last dense pivoted factorization (redundant rows only).
     pub constraint_rank: usize,
     /// constraints: Baumgarte feedback (α, β) when that drift control is chosen.
     pub baumgarte: Option<(f64, f64)>,

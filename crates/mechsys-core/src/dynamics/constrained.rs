@@ -108,7 +108,6 @@ fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f6
     }
     sp.solve_schur(&mut data.lambda);
     sp.add_constraint_accelerations(&data.lambda, &mut data.udot);
-    data.constraint_rank = sp.rank();
     data.dependent.copy_from_slice(&sp.dependent);
     Ok(true)
 }

@@ -452,12 +452,6 @@ impl Saddle {
         only_zero_rows
     }
 
-    /// Size of the plan: (nonzeros of G's row pattern, of the factor of S with fill, assembly
-    /// products, factorization updates), for benchmarks and profiles.
-    pub fn size(&self) -> (usize, usize, usize, usize) {
-        (self.row_idx.len(), self.s_row.len(), self.assemble.len(), self.update.len())
-    }
-
     /// Pivots `D_S` of the last factorization in elimination order (0 for dependent rows) and
     /// the constraint row of each: a pivot that shrinks by orders of magnitude during a run marks
     /// a row that vanishes or turns dependent (a singular configuration).
