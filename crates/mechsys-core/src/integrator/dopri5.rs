@@ -45,6 +45,123 @@ const D5: f64 = 701980252875.0 / 199316789632.0;
 const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
 
+/// One Dormand–Prince step with its stages and dense-output coefficients, reusable by drivers
+/// that need more than [`integrate`] (the event-driven scheme locates roots on the dense output).
+pub(crate) struct Step {
+    n: usize,
+    /// Stages; `k[0]` must hold `f(t, y)` before [`Step::attempt`], `k[6]` holds `f(t + h, y_new)`
+    /// after it (first same as last).
+    pub k: Vec<Vec<f64>>,
+    tmp: Vec<f64>,
+    /// The 5th-order solution of the last attempt.
+    pub ynew: Vec<f64>,
+    r: Vec<Vec<f64>>,
+}
+
+impl Step {
+    pub fn new(n: usize) -> Self {
+        Step { n, k: vec![vec![0.0; n]; 7], tmp: vec![0.0; n], ynew: vec![0.0; n], r: vec![vec![0.0; n]; 5] }
+    }
+
+    /// Tries the step `[t, t + h]` from `y`; returns the scaled error norm (≤ 1 accepts).
+    pub fn attempt<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64], h: f64, rtol: f64, atol: f64) -> Result<f64> {
+        let n = self.n;
+        let (k, tmp) = (&mut self.k, &mut self.tmp);
+        macro_rules! stage {
+            ($dst:expr, $c:expr, $($a:expr => $ki:expr),+) => {{
+                for i in 0..n {
+                    tmp[i] = y[i] + h * (0.0 $(+ $a * k[$ki][i])+);
+                }
+                let (_, tail) = k.split_at_mut($dst);
+                sys.rhs(t + $c * h, tmp, &mut tail[0])?;
+            }};
+        }
+        stage!(1, C2, A21 => 0);
+        stage!(2, C3, A31 => 0, A32 => 1);
+        stage!(3, C4, A41 => 0, A42 => 1, A43 => 2);
+        stage!(4, C5, A51 => 0, A52 => 1, A53 => 2, A54 => 3);
+        stage!(5, 1.0, A61 => 0, A62 => 1, A63 => 2, A64 => 3, A65 => 4);
+        for i in 0..n {
+            self.ynew[i] = y[i] + h * (A71 * k[0][i] + A73 * k[2][i] + A74 * k[3][i] + A75 * k[4][i] + A76 * k[5][i]);
+        }
+        sys.rhs(t + h, &self.ynew, &mut k[6])?;
+        let mut err = 0.0;
+        for i in 0..n {
+            let e = h * (E1 * k[0][i] + E3 * k[2][i] + E4 * k[3][i] + E5 * k[4][i] + E6 * k[5][i] + E7 * k[6][i]);
+            let sc = atol + rtol * y[i].abs().max(self.ynew[i].abs());
+            err += (e / sc).powi(2);
+        }
+        Ok((err / n.max(1) as f64).sqrt())
+    }
+
+    /// Dense-output coefficients of the accepted step `[t, t + h]` from `y` (before [`Step::fsal`]).
+    pub fn prepare_dense(&mut self, y: &[f64], h: f64) {
+        let (k, r) = (&self.k, &mut self.r);
+        for i in 0..self.n {
+            let ydiff = self.ynew[i] - y[i];
+            let bspl = h * k[0][i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * k[6][i] - bspl;
+            r[4][i] = h * (D1 * k[0][i] + D3 * k[2][i] + D4 * k[3][i] + D5 * k[4][i] + D6 * k[5][i] + D7 * k[6][i]);
+        }
+    }
+
+    /// The continuous extension at `θ ∈ [0, 1]` of the step prepared by [`Step::prepare_dense`].
+    pub fn dense(&self, th: f64, out: &mut [f64]) {
+        let (r, th1) = (&self.r, 1.0 - th);
+        for i in 0..self.n {
+            out[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
+        }
+    }
+
+    /// Makes the last stage the first of the next step (first same as last).
+    pub fn fsal(&mut self) {
+        self.k.swap(0, 6);
+    }
+}
+
+/// Hairer's starting step from the sizes of y and f (`k0 = f(t, y)`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn starting_step<S: OdeSystem>(
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    k0: &[f64],
+    rtol: f64,
+    atol: f64,
+    hmax: f64,
+    scratch: (&mut [f64], &mut [f64]),
+) -> Result<f64> {
+    let n = y.len();
+    let norm = |v: &[f64]| -> f64 {
+        (v.iter().zip(y).map(|(a, b)| (a / (atol + rtol * b.abs())).powi(2)).sum::<f64>() / n.max(1) as f64).sqrt()
+    };
+    let (d0, d1) = (norm(y), norm(k0));
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+    let h0 = h0.min(hmax);
+    let (tmp, k1) = scratch;
+    for i in 0..n {
+        tmp[i] = y[i] + h0 * k0[i];
+    }
+    sys.rhs(t + h0, tmp, k1)?;
+    let d2 = k1.iter().zip(k0).zip(y).map(|((a, b), yy)| ((a - b) / (atol + rtol * yy.abs())).powi(2)).sum::<f64>();
+    let d2 = (d2 / n.max(1) as f64).sqrt() / h0;
+    let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
+    Ok((100.0 * h0).min(h1).min(hmax))
+}
+
+/// The PI controller's factor for the next step (β = 0.04) after an accepted step with error `err`.
+pub(crate) fn next_factor(err: f64, err_old: f64, rejected: bool) -> f64 {
+    let fac = (0.9 * err.max(1e-10).powf(-0.17) * err_old.powf(0.04)).clamp(0.2, 10.0);
+    if rejected {
+        fac.min(1.0)
+    } else {
+        fac
+    }
+}
+
 /// Adaptive integration; `max_step = 0` means unlimited, `first_step = 0` means automatic.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate<S: OdeSystem>(
@@ -69,15 +186,13 @@ pub fn integrate<S: OdeSystem>(
     let hmax = if max_step > 0.0 { max_step } else { (t_end - t0).abs().max(f64::MIN_POSITIVE) };
     let mut stats = Stats::default();
     let mut y = y0.to_vec();
-    let mut k = vec![vec![0.0; n]; 7];
-    let mut ynew = vec![0.0; n];
+    let mut st = Step::new(n);
     let mut tmp = vec![0.0; n];
     let mut yout = vec![0.0; n];
-    let mut r = vec![vec![0.0; n]; 5]; // dense-output coefficients
     let mut t = t0;
     let mut next = 0usize;
 
-    sys.rhs(t, &y, &mut k[0])?;
+    sys.rhs(t, &y, &mut st.k[0])?;
     stats.evaluations += 1;
     while next < t_out.len() && t_out[next] <= t {
         obs(sys, t, &y, true)?;
@@ -86,32 +201,12 @@ pub fn integrate<S: OdeSystem>(
     if next >= t_out.len() {
         return Ok(stats);
     }
-
-    let norm = |v: &[f64], y: &[f64]| -> f64 {
-        (v.iter().zip(y).map(|(a, b)| (a / (atol + rtol * b.abs())).powi(2)).sum::<f64>() / n.max(1) as f64).sqrt()
-    };
     let mut h = if first_step > 0.0 {
         first_step
     } else {
-        // starting step from the size of y and f (Hairer's heuristic)
-        let d0 = norm(&y, &y);
-        let d1 = norm(&k[0], &y);
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
-        let h0 = h0.min(hmax);
-        for i in 0..n {
-            tmp[i] = y[i] + h0 * k[0][i];
-        }
-        sys.rhs(t + h0, &tmp, &mut k[1])?;
         stats.evaluations += 1;
-        let d2 = k[1]
-            .iter()
-            .zip(&k[0])
-            .zip(&y)
-            .map(|((a, b), yy)| ((a - b) / (atol + rtol * yy.abs())).powi(2))
-            .sum::<f64>();
-        let d2 = (d2 / n.max(1) as f64).sqrt() / h0;
-        let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
-        (100.0 * h0).min(h1).min(hmax)
+        let (k0, rest) = st.k.split_at_mut(1);
+        starting_step(sys, t, &y, &k0[0], rtol, atol, hmax, (&mut tmp, &mut rest[0]))?
     };
     let mut err_old: f64 = 1e-4;
     let mut reject = false;
@@ -134,33 +229,8 @@ pub fn integrate<S: OdeSystem>(
         if t + h > t_end {
             h = t_end - t;
         }
-        macro_rules! stage {
-            ($dst:expr, $c:expr, $($a:expr => $ki:expr),+) => {{
-                for i in 0..n {
-                    tmp[i] = y[i] + h * (0.0 $(+ $a * k[$ki][i])+);
-                }
-                let (head, tail) = k.split_at_mut($dst);
-                let _ = head;
-                sys.rhs(t + $c * h, &tmp, &mut tail[0])?;
-            }};
-        }
-        stage!(1, C2, A21 => 0);
-        stage!(2, C3, A31 => 0, A32 => 1);
-        stage!(3, C4, A41 => 0, A42 => 1, A43 => 2);
-        stage!(4, C5, A51 => 0, A52 => 1, A53 => 2, A54 => 3);
-        stage!(5, 1.0, A61 => 0, A62 => 1, A63 => 2, A64 => 3, A65 => 4);
-        for i in 0..n {
-            ynew[i] = y[i] + h * (A71 * k[0][i] + A73 * k[2][i] + A74 * k[3][i] + A75 * k[4][i] + A76 * k[5][i]);
-        }
-        sys.rhs(t + h, &ynew, &mut k[6])?;
+        let err = st.attempt(sys, t, &y, h, rtol, atol)?;
         stats.evaluations += 6;
-        let mut err = 0.0;
-        for i in 0..n {
-            let e = h * (E1 * k[0][i] + E3 * k[2][i] + E4 * k[3][i] + E5 * k[4][i] + E6 * k[5][i] + E7 * k[6][i]);
-            let sc = atol + rtol * y[i].abs().max(ynew[i].abs());
-            err += (e / sc).powi(2);
-        }
-        let err = (err / n.max(1) as f64).sqrt();
         if !err.is_finite() {
             // a stage produced inf/NaN: shrink hard and retry
             stats.rejected += 1;
@@ -169,29 +239,16 @@ pub fn integrate<S: OdeSystem>(
             continue;
         }
         if err <= 1.0 {
-            // dense output coefficients for the accepted step [t, t + h]
-            for i in 0..n {
-                let ydiff = ynew[i] - y[i];
-                let bspl = h * k[0][i] - ydiff;
-                r[0][i] = y[i];
-                r[1][i] = ydiff;
-                r[2][i] = bspl;
-                r[3][i] = ydiff - h * k[6][i] - bspl;
-                r[4][i] = h * (D1 * k[0][i] + D3 * k[2][i] + D4 * k[3][i] + D5 * k[4][i] + D6 * k[5][i] + D7 * k[6][i]);
-            }
+            st.prepare_dense(&y, h);
             let t_new = t + h;
-            sys.project(t_new, &mut ynew)?;
-            check_finite(t_new, &ynew)?;
+            sys.project(t_new, &mut st.ynew)?;
+            check_finite(t_new, &st.ynew)?;
             while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
                 let to = t_out[next];
                 if to >= t_new {
-                    obs(sys, to, &ynew, false)?;
+                    obs(sys, to, &st.ynew, false)?;
                 } else {
-                    let th = (to - t) / h;
-                    let th1 = 1.0 - th;
-                    for i in 0..n {
-                        yout[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
-                    }
+                    st.dense((to - t) / h, &mut yout);
                     sys.project(to, &mut yout)?;
                     obs(sys, to, &yout, false)?;
                 }
@@ -199,18 +256,12 @@ pub fn integrate<S: OdeSystem>(
             }
             stats.steps += 1;
             t = t_new;
-            std::mem::swap(&mut y, &mut ynew);
-            k.swap(0, 6); // first same as last
+            std::mem::swap(&mut y, &mut st.ynew);
+            st.fsal();
             if next >= t_out.len() || t >= t_end {
                 break;
             }
-            // PI step-size controller (β = 0.04)
-            let mut fac = 0.9 * err.max(1e-10).powf(-0.17) * err_old.powf(0.04);
-            fac = fac.clamp(0.2, 10.0);
-            if reject {
-                fac = fac.min(1.0);
-            }
-            h = (h * fac).min(hmax);
+            h = (h * next_factor(err, err_old, reject)).min(hmax);
             err_old = err.max(1e-4);
             reject = false;
         } else {

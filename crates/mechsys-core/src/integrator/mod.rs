@@ -6,9 +6,12 @@
 //! - [`dopri5`]: Dormand–Prince 5(4) with step-size control and dense output;
 //! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable), fixed step, for stiff systems;
 //! - [`moreau_jean`]: time-stepping at velocity/impulse level for models with unilateral contacts
-//!   (not an [`OdeSystem`] scheme: [`crate::simulate`] runs it directly).
+//!   (not an [`OdeSystem`] scheme: [`crate::simulate`] runs it directly);
+//! - [`event_driven`]: smooth phases between located contact events, impacts and transition
+//!   problems at each event (its own driver around a Dormand–Prince step).
 
 pub mod dopri5;
+pub mod event_driven;
 pub mod moreau_jean;
 pub mod radau5;
 pub mod rk4;
@@ -73,6 +76,8 @@ pub enum IntegratorKind {
         #[serde(default = "crate::solver::Method::nsgs")]
         solver: crate::solver::Method,
     },
+    /// Event-driven integration of contact models ([`event_driven`]).
+    EventDriven(event_driven::Options),
 }
 
 fn default_rtol() -> f64 {
@@ -96,6 +101,9 @@ pub struct Stats {
     pub evaluations: usize,
     /// Jacobian evaluations (implicit schemes).
     pub jacobians: usize,
+    /// Contact events (event-driven scheme).
+    #[serde(default)]
+    pub events: usize,
 }
 
 /// Runs the chosen scheme from (t0, y0) through all `t_out` (increasing, ≥ t0).
@@ -113,8 +121,8 @@ pub fn integrate<S: OdeSystem>(
             dopri5::integrate(sys, t0, y0, t_out, *rtol, *atol, *max_step, *first_step, obs)
         }
         IntegratorKind::Radau5 { dt, newton_tol } => radau5::integrate(sys, t0, y0, *dt, *newton_tol, t_out, obs),
-        IntegratorKind::MoreauJean { .. } => Err(crate::error::Error::Settings(
-            "integrator: Moreau–Jean is a time-stepping scheme for contact models; simulate() runs it".into(),
+        IntegratorKind::MoreauJean { .. } | IntegratorKind::EventDriven(_) => Err(crate::error::Error::Settings(
+            "integrator: Moreau–Jean and the event-driven scheme are for contact models; simulate() runs them".into(),
         )),
     }
 }

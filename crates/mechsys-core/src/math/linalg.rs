@@ -143,6 +143,28 @@ pub fn cholesky_semidefinite_solve(a: &[f64], n: usize, perm: &[usize], rank: us
     }
 }
 
+/// The minimum-norm solution of the consistent row-major `n × n` system `A x = b`, possibly
+/// singular: `x = Aᵀ y` with `(A Aᵀ) y = b` solved by [`cholesky_semidefinite`] (pivots below `tol`
+/// of the largest count as zero). Redundant contact constraints (a block resting on four corners)
+/// then share their load evenly instead of one taking all. `b` receives x; `aat` (`n²`), `perm`
+/// and `work` (`n`) are scratch. Returns the rank.
+pub fn solve_min_norm(a: &[f64], n: usize, b: &mut [f64], aat: &mut [f64], perm: &mut [usize], work: &mut [f64], tol: f64) -> usize {
+    for r in 0..n {
+        for c in 0..=r {
+            let v: f64 = (0..n).map(|k| a[r * n + k] * a[c * n + k]).sum();
+            aat[r * n + c] = v;
+            aat[c * n + r] = v;
+        }
+    }
+    let rank = cholesky_semidefinite(&mut aat[..n * n], n, perm, tol);
+    cholesky_semidefinite_solve(&aat[..n * n], n, perm, rank, b, work);
+    for c in 0..n {
+        work[c] = (0..n).map(|r| a[r * n + c] * b[r]).sum();
+    }
+    b[..n].copy_from_slice(&work[..n]);
+    rank
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,5 +215,24 @@ mod tests {
             let ax: f64 = (0..3).map(|c| a0[r * 3 + c] * x[c]).sum();
             assert!((ax - b[r]).abs() < 1e-12, "row {r}");
         }
+    }
+
+    #[test]
+    fn min_norm_solves_regular_and_redundant_systems() {
+        // regular (non-symmetric, needs pivoting): x = (1, 2, 3)
+        let a = [0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 4.0, 0.0, 1.0];
+        let x = [1.0, 2.0, 3.0];
+        let mut b: Vec<f64> = (0..3).map(|r| (0..3).map(|c| a[r * 3 + c] * x[c]).sum()).collect();
+        let (mut aat, mut perm, mut work) = ([0.0; 9], [0; 3], [0.0; 3]);
+        assert_eq!(solve_min_norm(&a, 3, &mut b, &mut aat, &mut perm, &mut work, 1e-12), 3);
+        for k in 0..3 {
+            assert!((b[k] - x[k]).abs() < 1e-12, "{b:?}");
+        }
+        // two equal constraints on one unknown share it: [1 1; 1 1] x = (2, 2) gives x = (1, 1),
+        // the minimum-norm point of the line x1 + x2 = 2
+        let a = [1.0, 1.0, 1.0, 1.0];
+        let mut b = [2.0, 2.0];
+        assert_eq!(solve_min_norm(&a, 2, &mut b, &mut aat, &mut perm, &mut work, 1e-12), 1);
+        assert!((b[0] - 1.0).abs() < 1e-14 && (b[1] - 1.0).abs() < 1e-14, "{b:?}");
     }
 }
