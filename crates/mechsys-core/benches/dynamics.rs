@@ -114,7 +114,7 @@ fn rk4_step<S: OdeSystem>(sys: &mut S, t: f64, h: f64, y: &mut [f64], k: &mut [V
     for i in 0..n {
         y[i] += h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
     }
-    sys.project(y);
+    sys.project(t + h, y).expect("project");
 }
 
 fn bench_stepping(c: &mut Criterion) {

@@ -152,6 +152,24 @@ pub struct Phase<'a> {
     fc: FrictionContact,
     ws: Workspace,
     z: Vec<f64>,
+    ev: EventWork,
+}
+
+/// Scratch of the event handling (impacts, transitions), sized once.
+#[derive(Default)]
+struct EventWork {
+    before: Vec<f64>,
+    lam: Vec<f64>,
+    total: Vec<f64>,
+    after_c: Vec<f64>,
+    stored: Vec<f64>,
+    extra: Vec<f64>,
+    unresolved: Vec<bool>,
+    stick: Vec<usize>,
+    touching: Vec<usize>,
+    closing: Vec<usize>,
+    old: Vec<f64>,
+    old_dir: Vec<[f64; 2]>,
 }
 
 /// What one event did, for the records.
@@ -206,6 +224,20 @@ impl<'a> Phase<'a> {
             },
             ws: Workspace::new(),
             z: Vec::with_capacity(np * (k + 2)),
+            ev: EventWork {
+                before: Vec::with_capacity(d * np),
+                lam: Vec::with_capacity(d * np),
+                total: Vec::with_capacity(d * np),
+                after_c: Vec::with_capacity(d * np),
+                stored: Vec::with_capacity(d * np),
+                extra: Vec::with_capacity(d * np),
+                unresolved: Vec::with_capacity(np),
+                stick: Vec::with_capacity(np),
+                touching: Vec::with_capacity(np),
+                closing: Vec::with_capacity(np),
+                old: Vec::with_capacity(np),
+                old_dir: Vec::with_capacity(np),
+            },
         })
     }
 
@@ -563,7 +595,10 @@ impl<'a> Phase<'a> {
         self.fc.w = Delassus::Dense(w);
         self.fc.dim = d;
         // local velocities before
-        let mut before = vec![0.0; dm];
+        let mut ev = std::mem::take(&mut self.ev);
+        let before = &mut ev.before;
+        before.clear();
+        before.resize(dm, 0.0);
         for (a, b) in before.iter_mut().enumerate() {
             *b = (0..nu).map(|i| self.rows[(a, i)] * u[i]).sum();
         }
@@ -581,8 +616,10 @@ impl<'a> Phase<'a> {
         let poisson = pts.iter().any(|&pt| matches!(model.contact_of_point(pt).impact, ImpactLaw::Poisson { .. }));
         // a rebound too low to be resolved in floating point (its apex within a few ulps of the
         // contact point's coordinates) would only chatter: such a point's impact is plastic
-        let mut unresolved = [false; 64];
-        for (a, &pt) in pts.iter().enumerate().take(64) {
+        let unresolved = &mut ev.unresolved;
+        unresolved.clear();
+        unresolved.resize(m, false);
+        for (a, &pt) in pts.iter().enumerate() {
             let eps = model.contact_of_point(pt).impact.eps();
             let v = eps * before[a * d].min(0.0);
             let acc: f64 = (0..nu).map(|i| self.rows[(a * d, i)] * self.a_free[i]).sum::<f64>() + self.kin[pt].wbar_n;
@@ -593,7 +630,7 @@ impl<'a> Phase<'a> {
                 .fold(1e-300f64, |a, b| a.max(*b));
             unresolved[a] = acc < 0.0 && v * v / (-2.0 * acc) < 64.0 * f64::EPSILON * scale;
         }
-        let eps_of = |a: usize, e: f64| if a < 64 && unresolved[a] { 0.0 } else { e };
+        let eps_of = |a: usize, e: f64| if unresolved[a] { 0.0 } else { e };
         // phase 1: Newton's law in one problem, or Poisson's compression (ġ_N ≥ 0, plastic)
         self.fc.q.clear();
         for (a, &pt) in pts.iter().enumerate() {
@@ -606,14 +643,23 @@ impl<'a> Phase<'a> {
                 self.fc.q.push(before[a * d + r]);
             }
         }
-        let mut lam = vec![0.0; dm];
-        self.solve_fc(t, pts, &method, &mut lam)?;
-        let mut total = lam.clone();
+        let (lam, total) = (&mut ev.lam, &mut ev.total);
+        lam.clear();
+        lam.resize(dm, 0.0);
+        if let Err(e) = self.solve_fc(t, pts, &method, lam) {
+            self.ev = ev;
+            return Err(e);
+        }
+        total.clear();
+        total.extend_from_slice(lam);
         if poisson && !plastic {
             // expansion: the stored impulses ε Λ_C (normal), ε_t Λ_TC (tangential) come back; the
             // extra impulse x keeps ġ_N ≥ 0 (a contact may not close further), bounded by the cone
-            let mut gc = vec![0.0; dm];
-            let mut stored = vec![0.0; dm];
+            let (gc, stored) = (&mut ev.after_c, &mut ev.stored);
+            gc.clear();
+            gc.resize(dm, 0.0);
+            stored.clear();
+            stored.resize(dm, 0.0);
             for (a, &pt) in pts.iter().enumerate() {
                 let (en, et) = match model.contact_of_point(pt).impact {
                     ImpactLaw::Poisson { eps, eps_t } => (eps_of(a, eps), eps_t),
@@ -630,9 +676,14 @@ impl<'a> Phase<'a> {
                 gc[i] = before[i] + wl;
             }
             self.fc.q.clear();
-            self.fc.q.extend_from_slice(&gc);
-            let mut x = vec![0.0; dm];
-            self.solve_fc(t, pts, &method, &mut x)?;
+            self.fc.q.extend_from_slice(gc);
+            let x = &mut ev.extra;
+            x.clear();
+            x.resize(dm, 0.0);
+            if let Err(e) = self.solve_fc(t, pts, &method, x) {
+                self.ev = ev;
+                return Err(e);
+            }
             for i in 0..dm {
                 total[i] += stored[i] + x[i];
             }
@@ -664,6 +715,7 @@ impl<'a> Phase<'a> {
                 imp[3 * pt + r] += total[a * d + r];
             }
         }
+        self.ev = ev;
         Ok(diss)
     }
 
@@ -684,8 +736,7 @@ impl<'a> Phase<'a> {
     /// The transition problem at acceleration level over the touching points `pts` with zero
     /// normal velocity: sets every point's status. Returns false when it has no solution.
     fn transition_lcp(&mut self, pts: &[usize]) -> Result<bool> {
-        let (model, nu, np, d) = (self.model, self.model.nu, self.model.n_contact_points, self.d);
-        let kdirs = if d == 2 { 2 } else { PYRAMID };
+        let (model, np) = (self.model, self.model.n_contact_points);
         let vtol = self.opts.velocity_tol;
         for pt in 0..np {
             self.status[pt] = OPEN;
@@ -694,11 +745,21 @@ impl<'a> Phase<'a> {
             return Ok(true);
         }
         // stick candidates: friction and no sliding
-        let stick: Vec<usize> = pts
-            .iter()
-            .copied()
-            .filter(|&pt| !matches!(model.contact_of_point(pt).friction, FrictionLaw::None) && self.sliding(pt).1 <= vtol)
-            .collect();
+        let mut stick = std::mem::take(&mut self.ev.stick);
+        stick.clear();
+        stick.extend(
+            pts.iter()
+                .copied()
+                .filter(|&pt| !matches!(model.contact_of_point(pt).friction, FrictionLaw::None) && self.sliding(pt).1 <= vtol),
+        );
+        let ok = self.transition_lcp_with(pts, &stick);
+        self.ev.stick = stick;
+        ok
+    }
+
+    fn transition_lcp_with(&mut self, pts: &[usize], stick: &[usize]) -> Result<bool> {
+        let (model, nu, d) = (self.model, self.model.nu, self.d);
+        let kdirs = if d == 2 { 2 } else { PYRAMID };
         let (nc, ns) = (pts.len(), stick.len());
         let nb = nc + ns * kdirs; // rows/columns with a force direction
         let n = nb + ns;
@@ -859,7 +920,9 @@ impl<'a> Phase<'a> {
             }
             self.rhs[i] = -(0..nu).map(|c| self.rows[(i, c)] * u[c]).sum::<f64>();
         }
-        let before: Vec<f64> = self.rhs[..n].iter().map(|v| -v).collect();
+        let mut before = std::mem::take(&mut self.ev.before);
+        before.clear();
+        before.extend(self.rhs[..n].iter().map(|v| -v));
         solve_min_norm(&self.mat[..n * n], n, &mut self.rhs[..n], &mut self.aat, &mut self.piv_r, &mut self.piv_c_work, 1e-13);
         for j in 0..n {
             let l = self.rhs[j];
@@ -877,35 +940,61 @@ impl<'a> Phase<'a> {
                 diss.friction += e;
             }
         }
+        self.ev.before = before;
         diss
     }
 
     /// Everything that happens at an event at (t, y): impacts, then the new contact structure.
     /// Impulses are added to `imp`; warnings (a Painlevé situation passed) to `warnings`.
     pub fn transition(&mut self, t: f64, y: &mut [f64], imp: &mut [f64], warnings: &mut Vec<String>) -> Result<Dissipation> {
+        let mut ev = std::mem::take(&mut self.ev);
+        let (mut touching, mut closing) = (std::mem::take(&mut ev.touching), std::mem::take(&mut ev.closing));
+        let (mut old, mut old_dir) = (std::mem::take(&mut ev.old), std::mem::take(&mut ev.old_dir));
+        self.ev = ev;
+        let r = self.transition_with(t, y, imp, warnings, (&mut touching, &mut closing, &mut old, &mut old_dir));
+        self.ev.touching = touching;
+        self.ev.closing = closing;
+        self.ev.old = old;
+        self.ev.old_dir = old_dir;
+        r
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn transition_with(
+        &mut self,
+        t: f64,
+        y: &mut [f64],
+        imp: &mut [f64],
+        warnings: &mut Vec<String>,
+        (touching, closing, old, old_dir): (&mut Vec<usize>, &mut Vec<usize>, &mut Vec<f64>, &mut Vec<[f64; 2]>),
+    ) -> Result<Dissipation> {
         let (nq, nu, np) = (self.model.nq, self.model.nu, self.model.n_contact_points);
         let vtol = self.opts.velocity_tol;
         let (q, rest) = y.split_at_mut(nq);
         let u = &mut rest[..nu];
         self.free_motion(t, q, u)?;
-        let touching: Vec<usize> = (0..np).filter(|&pt| self.kin[pt].point.g_n <= self.opts.gap_tol).collect();
-        let old: Vec<f64> = self.status.clone();
-        let old_dir: Vec<[f64; 2]> = self.dir.clone();
+        touching.clear();
+        touching.extend((0..np).filter(|&pt| self.kin[pt].point.g_n <= self.opts.gap_tol));
+        old.clear();
+        old.extend_from_slice(&self.status);
+        old_dir.clear();
+        old_dir.extend_from_slice(&self.dir);
         let mut diss = Dissipation::default();
         if touching.iter().any(|&pt| self.kin[pt].gd_n < -vtol) {
-            for &pt in &touching {
+            for &pt in touching.iter() {
                 if self.kin[pt].gd_n < -vtol {
                     self.log.push((t, pt, "impact"));
                 }
             }
-            let d = self.impact(t, u, &touching, false, imp)?;
+            let d = self.impact(t, u, touching, false, imp)?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             self.free_motion(t, q, u)?;
         }
-        let mut closing: Vec<usize> = touching.iter().copied().filter(|&pt| self.kin[pt].gd_n.abs() <= vtol).collect();
-        if !self.transition_lcp(&closing)? {
-            let names = self.names(&closing);
+        closing.clear();
+        closing.extend(touching.iter().copied().filter(|&pt| self.kin[pt].gd_n.abs() <= vtol));
+        if !self.transition_lcp(closing)? {
+            let names = self.names(closing);
             if !self.opts.continue_on_painleve {
                 return Err(Error::Solver(format!(
                     "Painlevé situation at t = {t:.9} s: the contact problem of {names:?} has no solution at acceleration level (sliding friction too large for the geometry); set continue_on_painleve to stop the sliding by an impulse and go on"
@@ -914,12 +1003,12 @@ impl<'a> Phase<'a> {
             warnings.push(format!(
                 "Painlevé situation at t = {t:.9} s in contacts {names:?}: the sliding was stopped by an impulse (an impact without collision)"
             ));
-            let d = self.impact(t, u, &closing, true, imp)?;
+            let d = self.impact(t, u, closing, true, imp)?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             self.free_motion(t, q, u)?;
             closing.retain(|&pt| self.kin[pt].gd_n.abs() <= vtol);
-            if !self.transition_lcp(&closing)? {
+            if !self.transition_lcp(closing)? {
                 return Err(Error::Solver(format!(
                     "Painlevé situation at t = {t:.9} s: the contact problem of {names:?} has no solution even after an impulsive stop"
                 )));
@@ -1066,7 +1155,7 @@ pub fn integrate<'a>(
         let mut theta = f64::INFINITY;
         for i in 0..2 * np {
             if e_start[i] > 0.0 && e_end[i] <= 0.0 {
-                let th = locate(phase, &st, t, h, i, e_start[i], e_end[i], &mut yout, &mut e_try)?;
+                let th = locate(phase, &st, (t, h), (i, e_start[i], e_end[i]), &mut yout, &mut e_try, &mut scratch)?;
                 stats.evaluations += 1;
                 theta = theta.min(th);
             }
@@ -1110,9 +1199,6 @@ pub fn integrate<'a>(
                 )));
             }
             let d = phase.transition(t, &mut y, &mut imp, warnings)?;
-            if std::env::var("ED_DEBUG").is_ok() {
-                eprintln!("event t={t:.15} theta={theta:.3e} h={h:.3e} g={:?} gd={:?} status={:?}", phase.kin.iter().map(|k| k.point.g_n).collect::<Vec<_>>(), phase.kin.iter().map(|k| k.gd_n).collect::<Vec<_>>(), phase.status);
-            }
             diss.impact += d.impact;
             diss.friction += d.friction;
             phase.rhs(t, &y, &mut st.k[0])?;
@@ -1147,12 +1233,18 @@ pub fn integrate<'a>(
 
 /// The root of event function `i` in the step `[t, t + h]` by Illinois' regula falsi on the
 /// continuous extension; returns θ at or just after the root (where the event has happened).
-#[allow(clippy::too_many_arguments)]
-fn locate(phase: &mut Phase, st: &Step, t: f64, h: f64, i: usize, fa: f64, fb: f64, y: &mut [f64], e: &mut [f64]) -> Result<f64> {
+fn locate(
+    phase: &mut Phase,
+    st: &Step,
+    (t, h): (f64, f64),
+    (i, fa, fb): (usize, f64, f64),
+    y: &mut [f64],
+    e: &mut [f64],
+    scratch: &mut [f64],
+) -> Result<f64> {
     let (mut a, mut b, mut fa, mut fb) = (0.0f64, 1.0f64, fa, fb);
     let mut side = 0i8;
     let tol = 1e-15 * t.abs().max(1.0) / h;
-    let mut scratch = vec![0.0; y.len()];
     for _ in 0..200 {
         if b - a <= tol {
             break;
@@ -1162,7 +1254,7 @@ fn locate(phase: &mut Phase, st: &Step, t: f64, h: f64, i: usize, fa: f64, fb: f
             c = 0.5 * (a + b);
         }
         st.dense(c, y);
-        phase.rhs(t + c * h, y, &mut scratch)?;
+        phase.rhs(t + c * h, y, scratch)?;
         phase.event_values(e);
         let fc = e[i];
         if fc <= 0.0 {
@@ -1185,4 +1277,81 @@ fn locate(phase: &mut Phase, st: &Step, t: f64, h: f64, i: usize, fa: f64, fb: f
         }
     }
     Ok(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Options;
+    use crate::forces::NoCallbacks;
+    use crate::integrator::IntegratorKind;
+    use crate::model::{Model, ModelDescription};
+    use crate::simulate::{simulate, Settings};
+
+    /// A point mass over the floor z = 0 dropped from `h0` with restitution `eps`, sliding along x
+    /// at `vx` on a floor with friction `mu`.
+    fn drop(h0: f64, eps: f64, vx: f64, mu: f64) -> Model {
+        let json = format!(
+            r#"{{"name": "drop", "gravity": [0, 0, -9.81],
+            "bodies": [{{"name": "b", "mass": 2.0, "inertia": [0.01, 0.01, 0.01]}}],
+            "joints": [{{"name": "f", "type": "free", "parent": "ground", "child": "b",
+                         "q0": [0, 0, {h0}, 1, 0, 0, 0], "u0": [{vx}, 0, 0, 0, 0, 0]}}],
+            "contacts": [{{"name": "floor", "body1": "b", "contour1": {{"type": "point"}}, "body2": "ground",
+                           "contour2": {{"type": "plane", "normal": [0, 0, 1]}},
+                           "friction": {{"type": "coulomb", "mu": {mu}}}, "impact": {{"type": "newton", "eps": {eps}}}}}]}}"#
+        );
+        Model::from_description(ModelDescription::from_json(&json).unwrap()).unwrap()
+    }
+
+    fn settings(t_end: f64, opts: Options) -> Settings {
+        let json = format!(r#"{{"t_end": {t_end}, "output_dt": 0.01, "integrator": {{"type": "event_driven"}}}}"#);
+        let mut s: Settings = serde_json::from_str(&json).unwrap();
+        assert_eq!(s.integrator, IntegratorKind::EventDriven(Options::default()));
+        s.integrator = IntegratorKind::EventDriven(opts);
+        s
+    }
+
+    #[test]
+    fn accumulation_time_and_rest() {
+        // impacts accumulate at t0 (1 + eps) / (1 - eps), t0 = sqrt(2 h0 / g); then the mass rests
+        let (h0, eps) = (0.5, 0.6);
+        let m = drop(h0, eps, 0.0, 0.0);
+        let opts = Options { velocity_tol: 1e-10, ..Options::default() };
+        let rec = simulate(&m, &settings(2.0, opts), &NoCallbacks, None).unwrap();
+        let t_inf = (2.0 * h0 / 9.81f64).sqrt() * (1.0 + eps) / (1.0 - eps);
+        let closes: Vec<f64> = rec.events.iter().filter(|e| e.3 == "close").map(|e| e.0).collect();
+        assert_eq!(closes.len(), 1);
+        assert!((closes[0] - t_inf).abs() < 1e-9 * t_inf, "{} vs {t_inf}", closes[0]);
+        // resting: λ_N = m g at the last sample, state stick (frictionless, not sliding)
+        let last = rec.contact_lambda_n.last().unwrap();
+        assert!((last - 2.0 * 9.81).abs() < 1e-10, "{last}");
+        assert_eq!(*rec.contact_state.last().unwrap(), super::STICK);
+    }
+
+    #[test]
+    fn sliding_stops_at_the_closed_form_time() {
+        // landing flat (h0 = 0) at vx = 1 m/s with mu = 0.5: it stops at v / (mu g), after
+        // sliding v² / (2 mu g), and the friction took m v² / 2
+        let m = drop(0.0, 0.0, 1.0, 0.5);
+        let rec = simulate(&m, &settings(0.5, Options::default()), &NoCallbacks, None).unwrap();
+        let stick: Vec<f64> = rec.events.iter().filter(|e| e.3 == "stick").map(|e| e.0).collect();
+        assert_eq!(stick.len(), 1);
+        assert!((stick[0] - 1.0 / (0.5 * 9.81)).abs() < 1e-9, "{stick:?}");
+        let nb = rec.n_bodies;
+        let x_end = rec.body_position[(rec.n_out - 1) * nb * 3];
+        assert!((x_end - 1.0 / (2.0 * 0.5 * 9.81)).abs() < 1e-9, "{x_end}");
+        assert!((rec.dissipated_friction.last().unwrap() - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_options_name_the_key() {
+        for (o, key) in [
+            (Options { velocity_tol: -1.0, ..Options::default() }, "velocity_tol"),
+            (Options { gap_tol: f64::NAN, ..Options::default() }, "gap_tol"),
+            (Options { atol: 0.0, ..Options::default() }, "atol"),
+            (Options { max_step: -1.0, ..Options::default() }, "max_step"),
+        ] {
+            let e = o.validate().unwrap_err().to_string();
+            assert!(e.contains(key), "{e}");
+        }
+    }
 }

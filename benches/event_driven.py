@@ -1,0 +1,165 @@
+"""Event-driven integration (issue 4): accuracy and cost against Moreau-Jean time-stepping and
+MuJoCo, in one run, on problems with closed-form answers.
+
+1. Accumulation of impacts: a point mass (the contact point is its centre) dropped from 1 m on a
+   plane with Newton's eps = 0.5; the impacts accumulate at t_inf = sqrt(2 h0 / g) (1 + eps) /
+   (1 - eps), after which it rests. Error of the time from which it rests, wall time for 2 s.
+   mechsys event-driven reads it from its event log; Moreau-Jean from the contact state at every
+   step (sampled at dt). MuJoCo has no restitution law and is not run here.
+2. Stick-slip oscillator: a 1 kg block on a rough floor (mu = 0.3 for sliding and sticking, so
+   that MuJoCo's single coefficient is the same law), tied to a wall by a 100 N/m spring,
+   released at x0 = 0.2 m: it slides through three half-cycles and sticks at
+   x = -(x0 - 6 mu g / w^2) = -0.02342 m at t = 3 pi / w (w = 10 rad/s). Error of the final
+   position, wall time for 1.5 s. MuJoCo: slide joints x and z with the spring as joint
+   stiffness, a sphere of radius 1 mm on a plane, default solver and cone, at its dt.
+3. The woodpecker toy (examples/woodpecker.py), 1 s: wall time and number of events.
+
+Times: the whole simulation from Python with the model built beforehand, min (median) over
+repeats. Usage: ``.venv/bin/python benches/event_driven.py [--out docs/benchmarks.md] [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from benchdoc import fmt_time, machine, write_doc  # noqa: E402
+
+import mechsys as ms  # noqa: E402
+
+G = 9.81
+EPS, H0 = 0.5, 1.0
+T_INF = np.sqrt(2 * H0 / G) * (1 + EPS) / (1 - EPS)
+MU, K, X0 = 0.3, 100.0, 0.2
+X_STOP = -(X0 - 6 * MU * G / K)
+
+
+def timed(fn, repeat):
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), statistics.median(times), out
+
+
+def drop_model():
+    m = ms.Model("drop", gravity=(0.0, 0.0, -G))
+    b = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, 0.1))
+    m.add_joint(ms.joints.Free("free", m.ground, b, q0=[0, 0, H0, 1, 0, 0, 0]))
+    m.add_contact(ms.Contact("floor", b.contour(ms.contours.Point()), m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
+                             impact=ms.laws.Newton(EPS)))
+    return m
+
+
+def rest_time_ed(model):
+    res = ms.simulate(model, 2.0, ms.EventDriven(velocity_tol=1e-10), output_dt=1e-2)
+    return [e["t"] for e in res.events if e["event"] == "close"][-1]
+
+
+def rest_time_mj(model, dt):
+    res = ms.simulate(model, 2.0, ms.MoreauJean(dt), output_dt=dt)
+    moving = res["contact/floor/state"] != 1
+    return res.t[np.nonzero(moving)[0][-1] + 1]
+
+
+def oscillator():
+    m = ms.Model("stick_slip", gravity=(0.0, -G, 0.0))
+    b = m.add_body("block", 1.0, ms.inertia.sphere(1.0, 0.05))
+    m.add_joint(ms.joints.Planar("plane", m.ground, b, q0=[X0, 0.0, 0.0]))
+    m.add_force(ms.forces.SpringDamper("spring", m.ground, b, point1=(-1.0, 0, 0), k=K, l0=1.0))
+    m.add_contact(ms.Contact("floor", b.contour(ms.contours.Point()), m.ground.contour(ms.contours.Line(normal=(0, 1, 0))),
+                             friction=ms.laws.Coulomb(MU)))
+    return m
+
+
+def run_ms_oscillator(model, integrator):
+    res = ms.simulate(model, 1.5, integrator, output_dt=1e-2 if isinstance(integrator, ms.EventDriven) else integrator.dt * round(1e-2 / integrator.dt))
+    return res["joint/plane/q"][-1, 0]
+
+
+def run_mujoco_oscillator(dt):
+    import mujoco
+
+    xml = f"""<mujoco><option timestep="{dt}" gravity="0 0 -{G}"/>
+<worldbody><geom type="plane" size="5 5 0.1" friction="{MU} 0.005 0.0001"/>
+<body pos="0 0 0.001"><joint name="x" type="slide" axis="1 0 0" stiffness="{K}" springref="0"/>
+<joint name="z" type="slide" axis="0 0 1"/>
+<geom type="sphere" size="0.001" mass="1" friction="{MU} 0.005 0.0001"/></body></worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    d.qpos[0] = X0
+    mujoco.mj_forward(m, d)
+    for _ in range(int(round(1.5 / dt))):
+        mujoco.mj_step(m, d)
+    return float(d.qpos[0])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, help="write the results section into this markdown file")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--quick", action="store_true")
+    a = ap.parse_args(argv)
+    repeat = 1 if a.quick else a.repeat
+    warnings.simplefilter("ignore")
+    mach = machine()
+    drop, osc = drop_model(), oscillator()
+    rows_drop, rows_osc = [], []
+    for name, fn in (("mechsys EventDriven", lambda: rest_time_ed(drop)),
+                     ("mechsys MoreauJean, dt = 1e-4", lambda: rest_time_mj(drop, 1e-4)),
+                     ("mechsys MoreauJean, dt = 1e-5", lambda: rest_time_mj(drop, 1e-5))):
+        tmin, tmed, t_rest = timed(fn, repeat)
+        rows_drop.append((name, tmin, tmed, abs(t_rest - T_INF) / T_INF))
+        print(f"drop {name:32s} {fmt_time(tmin)}  rest time relative error {rows_drop[-1][3]:.1e}")
+    for name, fn in (("mechsys EventDriven", lambda: run_ms_oscillator(osc, ms.EventDriven())),
+                     ("mechsys MoreauJean, dt = 1e-3", lambda: run_ms_oscillator(osc, ms.MoreauJean(1e-3))),
+                     ("mechsys MoreauJean, dt = 1e-4", lambda: run_ms_oscillator(osc, ms.MoreauJean(1e-4))),
+                     ("MuJoCo, dt = 1e-3", lambda: run_mujoco_oscillator(1e-3)),
+                     ("MuJoCo, dt = 1e-4", lambda: run_mujoco_oscillator(1e-4))):
+        try:
+            tmin, tmed, x = timed(fn, repeat)
+        except Exception as e:  # noqa: BLE001 - a missing peer is reported, not fatal
+            print(f"{name}: {e}")
+            continue
+        rows_osc.append((name, tmin, tmed, abs(x - X_STOP)))
+        print(f"osc  {name:32s} {fmt_time(tmin)}  final position error {rows_osc[-1][3]:.1e} m")
+    spec = importlib.util.spec_from_file_location("woodpecker", Path(__file__).resolve().parent.parent / "examples" / "woodpecker.py")
+    wp = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(wp)
+    rows_wp = []
+    for name, sim in (("mechsys EventDriven (rtol 1e-8)", wp.event_driven), ("mechsys MoreauJean, dt = 1e-5", wp.simulation)):
+        tmin, tmed, res = timed(lambda: ms.simulate(wp.model, **sim), 1 if a.quick else 2)
+        e = res["energy/total"] + res["energy/dissipated"] - res["energy/external_work"]
+        rows_wp.append((name, tmin, tmed, res.stats.get("events", 0), res.stats["steps"], float(np.ptp(e))))
+        print(f"woodpecker {name:32s} {fmt_time(tmin)}  events {rows_wp[-1][3]}  steps {rows_wp[-1][4]}  energy drift {rows_wp[-1][5]:.1e} J")
+    if a.out:
+        L = ["## Event-driven integration (issue 4)", ""]
+        L.append(f"Generated by `benches/event_driven.py` (this section only). {time.strftime('%Y-%m-%d %H:%M')} on "
+                 f"{mach['nproc']} × {mach['cpu']}, load average at start {mach['load'][0]:.2f}. Problems and settings are in "
+                 f"the script's docstring; times from Python with the model built beforehand, min (median) over {repeat} run(s).")
+        L += ["", f"### Accumulation of impacts, eps = {EPS}, t_inf = {T_INF:.10f} s", "",
+              "| scheme | wall time (2 s) | relative error of the time from which it rests |", "|---|---:|---:|"]
+        for name, tmin, tmed, err in rows_drop:
+            L.append(f"| {name} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {err:.1e} |")
+        L += ["", f"### Stick-slip oscillator, mu = {MU}, sticks at x = {X_STOP:.5f} m", "",
+              "| engine | wall time (1.5 s) | final position error |", "|---|---:|---:|"]
+        for name, tmin, tmed, err in rows_osc:
+            L.append(f"| {name} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {err:.1e} m |")
+        L += ["", "### Woodpecker toy, 1 s", "", "| scheme | wall time | events | steps | energy balance drift |", "|---|---:|---:|---:|---:|"]
+        for name, tmin, tmed, ev, steps, drift in rows_wp:
+            L.append(f"| {name} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {ev} | {steps} | {drift:.1e} J |")
+        write_doc(a.out, "\n".join(L), "<!-- event_driven.py:begin -->", "<!-- event_driven.py:end -->")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
