@@ -284,3 +284,66 @@ def test_woodpecker_event_driven_keeps_the_energy_balance_and_pecks():
     period = np.diff(wp.pecks(res))
     assert len(period) >= 4 and 0.14 < period.mean() < 0.18
     assert res.stats["events"] > 100 and res["joint/sleeve/q"][-1, 1] < -0.15
+
+
+def test_poisson_returns_the_stored_tangential_impulse():
+    """A ball (no spin) hits a very rough floor obliquely. Compression stops the contact point
+    (the tangential impulse (2/7) m g_T- stays inside the cone), expansion returns eps Lambda_NC
+    and eps_t Lambda_TC: it leaves with g_N+ = -eps g_N- and g_T+ = -eps_t g_T-, the superball's
+    reversal; Newton's law cannot give it (its tangential outcome is a stop or a slide)."""
+    r, vx, eps, eps_t = 0.1, 1.0, 0.5, 0.4
+    m = ms.Model("superball", gravity=(0.0, 0.0, -G))
+    b = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, r))
+    m.add_joint(ms.joints.Free("free", m.ground, b, q0=[0, 0, 0.5 + r, 1, 0, 0, 0], u0=[vx, 0, 0, 0, 0, 0]))
+    m.add_contact(ms.Contact("floor", b.contour(ms.contours.Sphere(radius=r)),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
+                             friction=ms.laws.Coulomb(2.0), impact=ms.laws.Poisson(eps, eps_t)))
+    res = ms.simulate(m, 0.6, ED, output_dt=1e-3)
+    t_hit = np.sqrt(2 * 0.5 / G)
+    impacts = [e["t"] for e in res.events if e["event"] == "impact"]
+    assert abs(impacts[0] - t_hit) < 1e-12
+    before, after = res.t < t_hit, (res.t > t_hit) & (res.t < 0.55)
+    gd_t = res["contact/floor/gd_t"][:, 0]
+    gt_before = gd_t[before][-1]
+    np.testing.assert_allclose(gd_t[after], -eps_t * gt_before, rtol=1e-9)
+    vz = res["body/ball/velocity"][:, 2]
+    v_in = G * t_hit
+    np.testing.assert_allclose(vz[after][0], eps * v_in - G * (res.t[after][0] - t_hit), rtol=1e-9)
+    e = res["energy/total"] + res["energy/dissipated"]
+    assert np.ptp(e) < 1e-9  # the spinning ball's body-frame velocities: integration error
+    # the impulses: normal (1 + eps) m v_in, tangential (1 + eps_t) (2/7) m |g_T-|
+    np.testing.assert_allclose(res["contact/floor/impulse_n"].sum(), (1 + eps) * v_in, rtol=1e-9)
+    np.testing.assert_allclose(np.abs(res["contact/floor/impulse_t"][:, 0].sum()), (1 + eps_t) * 2 / 7 * abs(gt_before), rtol=1e-9)
+
+
+def test_bilateral_constraints_with_contacts_agree_with_the_joint_model():
+    """A pendulum bob striking a wall (Newton, eps = 0.7, friction 0.3), once hung on a revolute
+    joint, once a planar body held by a distance constraint (the constrained inverse mass in the
+    impact and transition problems): the same impact times and motion."""
+
+    def pendulum(constrained):
+        m = ms.Model("pendulum", gravity=(0.0, -G, 0.0))
+        b = m.add_body("bob", 1.0, [1e-12, 1e-12, 1e-12])
+        if constrained:
+            m.add_joint(ms.joints.Planar("plane", m.ground, b, q0=[np.sin(1.0), -np.cos(1.0), 0.0]))
+            m.add_constraint(ms.constraints.Distance("rod", m.ground, b, length=1.0))
+        else:
+            m.add_joint(ms.joints.Revolute("pin", m.ground, b, axis=(0, 0, 1), child_frame=(0, 1.0, 0), q0=1.0))
+        m.add_contact(ms.Contact("wall", b.contour(ms.contours.Point()),
+                                 m.ground.contour(ms.contours.Line(point=(-0.35, 0, 0), normal=(1, 0, 0))),
+                                 friction=ms.laws.Coulomb(0.3), impact=ms.laws.Newton(0.7)))
+        return m
+
+    a = ms.simulate(pendulum(False), 3.0, ED, output_dt=1e-2)
+    b = ms.simulate(pendulum(True), 3.0, ED, output_dt=1e-2)
+    ta = [e["t"] for e in a.events if e["event"] == "impact"]
+    tb = [e["t"] for e in b.events if e["event"] == "impact"]
+    assert len(ta) == len(tb) >= 2
+    np.testing.assert_allclose(ta, tb, atol=1e-9)
+    np.testing.assert_allclose(a["body/bob/position"], b["body/bob/position"], atol=1e-8)
+    # the swing before the first impact keeps its energy; the impacts take (1 - eps^2) of the
+    # normal kinetic energy, which the balance accounts for
+    for r in (a, b):
+        e = r["energy/total"] + r["energy/dissipated"]
+        assert np.ptp(e) < 1e-9 and r["energy/dissipated_impact"][-1] > 0.1
+    assert np.abs(b["constraint/rod/violation"]).max() < 1e-10

@@ -585,10 +585,16 @@ impl<'a> Phase<'a> {
                 w.push(self.coupling(i, j));
             }
         }
-        // a tangent that can take no velocity (planar motion, spatial contour) takes no impulse
+        // a tangent that can take no velocity (planar motion, spatial contour) or no force (no
+        // friction) takes no impulse: decoupled, with a positive diagonal
         for a in 0..dm {
-            if a % d != 0 && (0..nu).all(|i| self.rows[(a, i)] == 0.0) {
+            let frictionless = matches!(model.contact_of_point(pts[a / d]).friction, FrictionLaw::None);
+            if a % d != 0 && (frictionless || (0..nu).all(|i| self.rows[(a, i)] == 0.0)) {
                 let nrow = a - a % d;
+                for b in 0..dm {
+                    w[a * dm + b] = 0.0;
+                    w[b * dm + a] = 0.0;
+                }
                 w[a * dm + a] = w[nrow * dm + nrow].max(f64::MIN_POSITIVE);
             }
         }
