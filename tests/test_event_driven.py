@@ -345,5 +345,5 @@ def test_bilateral_constraints_with_contacts_agree_with_the_joint_model():
     # normal kinetic energy, which the balance accounts for
     for r in (a, b):
         e = r["energy/total"] + r["energy/dissipated"]
-        assert np.ptp(e) < 1e-9 and r["energy/dissipated_impact"][-1] > 0.1
+        assert np.ptp(e) < 1e-9 * abs(e[0]) and r["energy/dissipated_impact"][-1] > 0.1
     assert np.abs(b["constraint/rod/violation"]).max() < 1e-10
