@@ -347,3 +347,30 @@ def test_bilateral_constraints_with_contacts_agree_with_the_joint_model():
         e = r["energy/total"] + r["energy/dissipated"]
         assert np.ptp(e) < 1e-9 * abs(e[0]) and r["energy/dissipated_impact"][-1] > 0.1
     assert np.abs(b["constraint/rod/violation"]).max() < 1e-10
+
+
+def test_block_slows_along_the_stribeck_curve_and_stops_at_the_closed_form_time():
+    """v' = -mu(v) g with mu(v) = mu + (mu0 - mu) exp(-(v / v_s)^2), against SciPy's solution of
+    the same ODE to 1e-8 (time-stepping reaches 2e-3), the stop located to 1e-8 s."""
+    from scipy.integrate import solve_ivp
+
+    mu0, mu, v_s, v0 = 0.5, 0.2, 0.3, 2.0
+    m = ms.Model("stribeck", gravity=(0.0, 0.0, -G))
+    half = (0.1, 0.05, 0.05)
+    b = m.add_body("block", 1.0, ms.inertia.box(1.0, (0.2, 0.1, 0.1)))
+    m.add_joint(ms.joints.Free("free", m.ground, b, q0=[0, 0, half[2], 1, 0, 0, 0], u0=[v0, 0, 0, 0, 0, 0]))
+    m.add_contact(ms.Contact("base", b.contour(ms.contours.Box(half_extents=half)),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
+                             friction=ms.laws.Stribeck(mu0=mu0, mu=mu, v_s=v_s)))
+    res = ms.simulate(m, 1.5, ED, output_dt=1e-2)
+    law = lambda v: mu + (mu0 - mu) * np.exp(-((v / v_s) ** 2))  # noqa: E731
+    stop = lambda t, y: y[0]  # noqa: E731
+    stop.terminal = True
+    ref = solve_ivp(lambda t, y: [-law(y[0]) * G], (0, 1.5), [v0], rtol=1e-12, atol=1e-14, dense_output=True, events=stop)
+    t_stop = ref.t_events[0][0]
+    sticks = [e["t"] for e in res.events if e["event"] == "stick"]
+    assert abs(sticks[0] - t_stop) < 1e-8
+    v = res["body/block/velocity"][:, 0]
+    moving = res.t < t_stop
+    np.testing.assert_allclose(v[moving], ref.sol(res.t[moving])[0], atol=1e-8)
+    assert np.abs(v[res.t > t_stop]).max() < 1e-12
