@@ -62,7 +62,15 @@ def drop_model():
 
 def rest_time_ed(model):
     res = ms.simulate(model, 2.0, ms.EventDriven(velocity_tol=1e-10), output_dt=1e-2)
-    return [e["t"] for e in res.events if e["event"] == "close"][-1]
+    return [e["t"] for e in res.events if e["event"] == "close"][-1], res
+
+
+def restitution_error_ed(res):
+    """Largest relative error of eps from successive flight times (t_k+1 - t_k = eps (t_k - t_k-1))
+    over the first ten bounces."""
+    t = np.array([e["t"] for e in res.events if e["event"] == "impact"][:12])
+    flights = np.diff(t)
+    return float(np.abs(flights[1:] / flights[:-1] / EPS - 1.0).max())
 
 
 def rest_time_mj(model, dt):
@@ -114,12 +122,14 @@ def main(argv=None) -> int:
     mach = machine()
     drop, osc = drop_model(), oscillator()
     rows_drop, rows_osc = [], []
-    for name, fn in (("mechsys EventDriven", lambda: rest_time_ed(drop)),
+    for name, fn in (("mechsys EventDriven", lambda: rest_time_ed(drop)[0]),
                      ("mechsys MoreauJean, dt = 1e-4", lambda: rest_time_mj(drop, 1e-4)),
                      ("mechsys MoreauJean, dt = 1e-5", lambda: rest_time_mj(drop, 1e-5))):
         tmin, tmed, t_rest = timed(fn, repeat)
         rows_drop.append((name, tmin, tmed, abs(t_rest - T_INF) / T_INF))
         print(f"drop {name:32s} {fmt_time(tmin)}  rest time relative error {rows_drop[-1][3]:.1e}")
+    eps_err = restitution_error_ed(rest_time_ed(drop)[1])
+    print(f"drop event-driven restitution relative error over ten bounces {eps_err:.1e}")
     for name, fn in (("mechsys EventDriven", lambda: run_ms_oscillator(osc, ms.EventDriven())),
                      ("mechsys MoreauJean, dt = 1e-3", lambda: run_ms_oscillator(osc, ms.MoreauJean(1e-3))),
                      ("mechsys MoreauJean, dt = 1e-4", lambda: run_ms_oscillator(osc, ms.MoreauJean(1e-4))),
@@ -150,6 +160,8 @@ def main(argv=None) -> int:
               "| scheme | wall time (2 s) | relative error of the time from which it rests |", "|---|---:|---:|"]
         for name, tmin, tmed, err in rows_drop:
             L.append(f"| {name} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {err:.1e} |")
+        L += ["", f"Event-driven restitution from the flight times of the first ten bounces: largest relative error {eps_err:.1e} "
+              "(issue 4's target: 1e-6; soft-contact peers miss it by percents, see the contacts section)."]
         L += ["", f"### Stick-slip oscillator, mu = {MU}, sticks at x = {X_STOP:.5f} m", "",
               "| engine | wall time (1.5 s) | final position error |", "|---|---:|---:|"]
         for name, tmin, tmed, err in rows_osc:
