@@ -38,6 +38,7 @@ bench: $(BUILD)
 	$(PY) benches/peers.py --out docs/benchmarks.md
 	$(PY) benches/constraints.py --out docs/benchmarks.md
 	$(PY) benches/contacts.py --out docs/benchmarks.md
+	$(PY) benches/stack.py --out docs/benchmarks.md
 	$(PY) benches/event_driven.py --out docs/benchmarks.md
 
 clean:

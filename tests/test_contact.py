@@ -305,10 +305,9 @@ def test_woodpecker_toy_pecks_its_way_down_in_a_repeating_cycle():
 
 
 def test_a_stack_of_boxes_rests_and_carries_the_weight():
-    """Three boxes, each smaller than the one below, stacked on the floor (box-box contacts by
-    corners against faces) stay where they are: after 1 s each has moved less than 1e-9 m, and the
-    contacts carry the weight above them. (Equal boxes stacked edge on edge put corners on
-    corners, where vertex-face contacts cannot tell the normal: not supported yet.)"""
+    """Three boxes, each smaller than the one below, stacked on the floor (box-box face contacts)
+    stay where they are: after 1 s each has moved less than 1e-9 m, and the contacts carry the
+    weight above them (equal boxes: tests/test_box_stack.py)."""
     mass, n = 1.0, 3
     halves = [(0.1 * 0.8**k, 0.1 * 0.8**k, 0.05) for k in range(n)]
     m = ms.Model("stack", gravity=(0.0, 0.0, -G))

@@ -41,7 +41,7 @@ def test_hdf5_round_trip(results, tmp_path):
     assert loaded.model == results.model
     assert loaded.model["name"] == "slider-pendulum"
     assert loaded.settings == results.settings
-    assert loaded.stats == results.stats == {"steps": 300, "rejected": 0, "evaluations": 1201, "jacobians": 0}
+    assert loaded.stats == results.stats == {"steps": 300, "rejected": 0, "evaluations": 1201, "jacobians": 0, "events": 0}
     assert len(loaded.t) == 31
 
 

@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, mechanisms
+from . import analysis, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -16,8 +16,8 @@ from .errors import (
     SingularityError,
     SolverError,
 )
-from .contacts import Contact
-from .integrators import DOPRI5, RK4, Lemke, MoreauJean, Newton, NSGS, Radau5
+from .contacts import Contact, ContactGroup
+from .integrators import DOPRI5, RK4, EventDriven, Lemke, MoreauJean, Newton, NSGS, Radau5
 from .joints import Frame
 from .model import Body, Model
 from .results import Results, load
@@ -44,12 +44,14 @@ __all__ = [
     "DOPRI5",
     "Radau5",
     "MoreauJean",
+    "EventDriven",
     "NSGS",
     "Newton",
     "Lemke",
     "joints",
     "constraints",
     "Contact",
+    "ContactGroup",
     "contours",
     "laws",
     "mechanisms",

@@ -124,11 +124,11 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.option("--t-end", type=float, help="End time (s); overrides simulation.t_end.")
 @click.option("--t0", type=float, help="Start time (s); overrides simulation.t0.")
 @click.option("--dt", type=float, help="Step of rk4/radau5/moreau_jean (s); alone it selects rk4.")
-@click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5", "moreau_jean"], case_sensitive=False),
-              help="Integration scheme (moreau_jean: time-stepping for models with contacts).")
+@click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5", "moreau_jean", "event_driven"], case_sensitive=False),
+              help="Integration scheme (moreau_jean: time-stepping for models with contacts; event_driven: located contact events).")
 @click.option("--solver", type=click.Choice(["nsgs", "newton", "lemke"], case_sensitive=False), help="Contact solver of moreau_jean.")
-@click.option("--rtol", type=float, help="Relative tolerance of dopri5.")
-@click.option("--atol", type=float, help="Absolute tolerance of dopri5.")
+@click.option("--rtol", type=float, help="Relative tolerance of dopri5 and event_driven.")
+@click.option("--atol", type=float, help="Absolute tolerance of dopri5 and event_driven.")
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
 @click.option("--out", "out", type=click.Path(path_type=Path, dir_okay=False), help="HDF5 results file [default: results/<model name>.h5].")
 @click.option("--plot", "plot_out", type=click.Path(path_type=Path, dir_okay=False), help="Write a plot (.png, .svg or .pdf).")
@@ -289,10 +289,17 @@ def info(model_file: Path) -> None:
     contacts = core.contacts()
     if contacts:
         click.echo("")
-        click.echo(f"contacts ({len(contacts)}; simulate with --integrator moreau_jean):")
+        click.echo(f"contacts ({len(contacts)}; simulate with --integrator moreau_jean or event_driven):")
         rows = [(c["name"], f"{c['body1']} / {c['body2']}", str(c["points"]), "planar" if c["tangents"] == 1 else "spatial")
                 for c in contacts]
         click.echo(_table(["name", "bodies", "points", "kind"], rows))
+    groups = core.contact_groups() if hasattr(core, "contact_groups") else []
+    if groups:
+        click.echo("")
+        click.echo(f"contact groups ({len(groups)}; pairs found by a broad phase at every step; simulate with --integrator moreau_jean):")
+        rows = [(g["name"], str(g["members"]), ", ".join(g["member_kinds"]), str(g["against"]),
+                 ", ".join(g["against_kinds"]) or "-", "planar" if g["planar"] else "spatial") for g in groups]
+        click.echo(_table(["name", "members", "member contours", "against", "against contours", "kind"], rows))
     if sim:
         click.echo("")
         click.echo("simulation defaults:")

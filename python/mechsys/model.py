@@ -58,6 +58,7 @@ class Model:
         self._forces: list[Any] = []
         self._constraints: list[Any] = []
         self._contacts: list[Any] = []
+        self._contact_groups: list[Any] = []
         self._ground_markers: list[dict] = []
         self._built: tuple[str, Any, list] | None = None
         self._engine: tuple | None = None
@@ -148,12 +149,27 @@ class Model:
         return constraint
 
     def add_contact(self, contact) -> Any:
-        """Adds a unilateral contact (see :class:`mechsys.Contact`)."""
+        """Adds a unilateral contact (see :class:`mechsys.Contact`) or a contact group
+        (:class:`mechsys.ContactGroup`)."""
+        from .contacts import ContactGroup
+
+        if isinstance(contact, ContactGroup):
+            return self.add_contact_group(contact)
         if not (hasattr(contact, "describe") or isinstance(contact, dict)):
             raise ModelError(f"add_contact: expected a mechsys.Contact, got {type(contact).__name__}")
         self._contacts.append(contact)
         self._invalidate()
         return contact
+
+    def add_contact_group(self, group) -> Any:
+        """Adds a contact group (see :class:`mechsys.ContactGroup`)."""
+        from .contacts import ContactGroup
+
+        if not isinstance(group, (ContactGroup, dict)):
+            raise ModelError(f"add_contact_group: expected a mechsys.ContactGroup, got {type(group).__name__}")
+        self._contact_groups.append(group)
+        self._invalidate()
+        return group
 
     # ---- description and engine model -----------------------------------------------------------
     def describe(self) -> tuple[dict, list]:
@@ -174,6 +190,9 @@ class Model:
         contacts = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._contacts]
         if contacts:
             desc["contacts"] = contacts
+        groups = [g if isinstance(g, dict) else g.describe(callbacks) for g in self._contact_groups]
+        if groups:
+            desc["contact_groups"] = groups
         return desc, callbacks
 
     def to_dict(self) -> dict:
@@ -223,7 +242,8 @@ class Model:
         m._ground_markers = seq("ground_markers")
         m._constraints = seq("constraints")
         m._contacts = seq("contacts")
-        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts"}
+        m._contact_groups = seq("contact_groups")
+        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts", "contact_groups"}
         extra = set(desc) - known
         if extra:
             # let the engine produce the canonical message for a misspelt top-level key

@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import MechsysError, ModelError, SettingsError
-from .integrators import DOPRI5, NSGS, RK4, Lemke, MoreauJean, Newton, Radau5
+from .integrators import DOPRI5, NSGS, RK4, EventDriven, Lemke, MoreauJean, Newton, Radau5
 from .model import Model
 
 #: Keys of the ``[simulation]`` table.
@@ -59,9 +59,10 @@ INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
     "dopri5": ("rtol", "atol", "max_step", "first_step"),
     "radau5": ("dt", "newton_tol"),
     "moreau_jean": ("dt", "solver"),
+    "event_driven": ("rtol", "atol", "max_step", "gap_tol", "velocity_tol", "max_events", "continue_on_painleve"),
 }
 
-_INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5, "moreau_jean": MoreauJean}
+_INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5, "moreau_jean": MoreauJean, "event_driven": EventDriven}
 _SOLVER_CLASSES = {"nsgs": NSGS, "newton": Newton, "lemke": Lemke}
 
 
@@ -352,7 +353,7 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
     allowed = INTEGRATOR_KEYS[kind]
     for key, value in params.items():
         if key not in allowed:
-            hint = " (it is adaptive: use --rtol/--atol)" if kind == "dopri5" else " (it has a fixed step: use --dt)"
+            hint = " (it is adaptive: use --rtol/--atol)" if kind in ("dopri5", "event_driven") else " (it has a fixed step: use --dt)"
             raise SettingsError(f"--{key} does not apply to integrator {kind}{hint}")
         spec[key] = value
     if "dt" in allowed and spec.get("dt") is None:

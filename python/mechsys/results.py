@@ -146,6 +146,19 @@ class Results:
                 put(f"{pre}/impulse_t", raw["contact_impulse_t"][:, sl, :nt] if nt > 1 else raw["contact_impulse_t"][:, sl, 0], "N s")
                 put(f"{pre}/state", raw["contact_state"][:, sl], "0 open, 1 stick, 2 slip")
                 put(f"{pre}/friction_reserve", raw["contact_reserve"][:, sl], "N")
+        if engine is not None and "group_closed" in raw:
+            # contact groups (mechsys.ContactGroup): one column per group
+            span = np.diff(raw["t"], prepend=np.nan)
+            span[0] = span[1] if len(span) > 1 else 1.0
+            for k, g in enumerate(engine.contact_groups()):
+                pre = f"contact/{g['name']}"
+                put(f"{pre}/closed", raw["group_closed"][:, k], "1")
+                put(f"{pre}/max_penetration", raw["group_max_penetration"][:, k], "m")
+                put(f"{pre}/impulse_n", raw["group_impulse_n"][:, k], "N s")
+                put(f"{pre}/lambda_n", raw["group_impulse_n"][:, k] / span, "N")
+                put(f"{pre}/pairs", raw["group_pairs"][:, k], "1")
+                put(f"{pre}/impulse_against", raw["group_impulse_against"][:, k, :], "N s")
+                put(f"{pre}/force_against", raw["group_impulse_against"][:, k, :] / span[:, None], "N")
         lazy = {}
         if engine is not None and joints:
             group = _reaction_group(engine, callbacks, joints, raw)
@@ -217,6 +230,13 @@ class Results:
     def stats(self) -> dict:
         """Integrator statistics (steps, rejected, evaluations, jacobians)."""
         return json.loads(self.attrs.get("stats", "{}"))
+
+    @property
+    def events(self) -> list[dict]:
+        """Contact events of an event-driven run, in time order: dicts with ``t`` (s), ``contact``,
+        ``point`` (candidate index within the contact) and ``event`` (``impact``, ``close``,
+        ``open``, ``stick``, ``slip``). Empty for other integrators."""
+        return json.loads(self.attrs.get("events", "[]"))
 
     def __repr__(self) -> str:
         n = len(self.t)

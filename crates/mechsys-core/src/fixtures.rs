@@ -56,6 +56,7 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
         forces: vec![],
         ground_markers: vec![],
         contacts: vec![],
+        contact_groups: vec![],
         constraints: vec![],
     }
 }

@@ -22,6 +22,7 @@ pub mod fixtures;
 pub mod forces;
 pub mod integrator;
 pub mod kinematics;
+pub mod linear;
 pub mod math;
 pub mod model;
 pub mod simulate;

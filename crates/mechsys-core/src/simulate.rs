@@ -133,6 +133,23 @@ pub struct Recording {
     pub dissipated_impact: Vec<f64>,
     /// Energy dissipated by friction since t0 (n_out), J.
     pub dissipated_friction: Vec<f64>,
+    /// Contact groups: candidate points closed (positive normal impulse) in the last step before
+    /// each sample (n_out × n_groups).
+    pub group_closed: Vec<f64>,
+    /// Contact groups: largest penetration at the step midpoints since the previous sample
+    /// (n_out × n_groups), m.
+    pub group_max_penetration: Vec<f64>,
+    /// Contact groups: normal impulses summed over the group and since the previous sample
+    /// (n_out × n_groups), N s.
+    pub group_impulse_n: Vec<f64>,
+    /// Contact groups: pairs kept by the broad phase in the last step (n_out × n_groups).
+    pub group_pairs: Vec<f64>,
+    /// Contact groups: impulse of the `against` contours on the members summed since the
+    /// previous sample, world components (n_out × n_groups × 3), N s.
+    pub group_impulse_against: Vec<f64>,
+    /// Contact events of the event-driven scheme: (time, contact, point of the contact, what:
+    /// impact, close, open, stick, slip).
+    pub events: Vec<(f64, String, usize, String)>,
     /// Integrator counters.
     pub stats: Stats,
 }
@@ -406,9 +423,18 @@ pub fn simulate(
         return time_stepping(model, settings, cb, progress, &t_out, y0, dt, solver, rec);
     }
     crate::ensure!(
+        model.contact_groups.is_empty() || matches!(settings.integrator, IntegratorKind::MoreauJean { .. }),
+        Settings,
+        "integrator: the model has contact groups ('{}'); use MoreauJean (time-stepping)",
+        model.contact_groups.first().map_or("", |g| g.name.as_str())
+    );
+    if let IntegratorKind::EventDriven(opts) = settings.integrator {
+        return event_driven(model, settings, cb, progress, &t_out, y0, opts, rec);
+    }
+    crate::ensure!(
         !contacts,
         Settings,
-        "integrator: the model has unilateral contacts ('{}'); use the time-stepping scheme MoreauJean",
+        "integrator: the model has unilateral contacts ('{}'); use MoreauJean (time-stepping) or EventDriven",
         model.contacts[0].name
     );
     let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization);
@@ -458,6 +484,7 @@ fn time_stepping(
     // (prepare() checked that output_dt is a whole multiple of dt)
     let every = (settings.output_dt / dt).round() as u64;
     let mut stepper = MoreauJean::new(model, dt, solver)?;
+    let mut group_stats = vec![crate::integrator::moreau_jean::GroupStats::default(); model.contact_groups.len()];
     let mut data = Data::new(model);
     let mut y = y0;
     model.normalize(&mut y[..nq]);
@@ -545,6 +572,15 @@ fn time_stepping(
         acc_t.fill([0.0; 2]);
         rec.dissipated_impact.push(stepper.dissipated_impact);
         rec.dissipated_friction.push(stepper.dissipated_friction);
+        // contact groups: what happened since the previous sample
+        stepper.take_group_stats(&mut group_stats);
+        for g in &group_stats {
+            rec.group_closed.push(g.closed as f64);
+            rec.group_max_penetration.push(g.max_penetration.max(0.0));
+            rec.group_impulse_n.push(g.impulse_n);
+            rec.group_pairs.push(g.pairs as f64);
+            rec.group_impulse_against.extend_from_slice(&g.impulse_against);
+        }
         if let Some(p) = progress {
             p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
             if p.cancel.load(Ordering::Relaxed) {
@@ -560,6 +596,86 @@ fn time_stepping(
     }
     stats.evaluations = stats.steps;
     rec.stats = stats;
+    Ok(rec)
+}
+
+/// The event-driven run ([`crate::integrator::event_driven`]): samples on the continuous
+/// extension of the smooth phases; contact forces are the exact ones at the sample, impulses the
+/// integrals of the forces plus the impacts since the previous sample.
+#[allow(clippy::too_many_arguments)]
+fn event_driven(
+    model: &Model,
+    settings: &Settings,
+    cb: &dyn Callbacks,
+    progress: Option<&Progress>,
+    t_out: &[f64],
+    y0: Vec<f64>,
+    opts: crate::integrator::event_driven::Options,
+    mut rec: Recording,
+) -> Result<Recording> {
+    use crate::integrator::event_driven::{self, Phase};
+    let (nq, nu, np) = (model.nq, model.nu, model.n_contact_points);
+    let mut phase = Phase::new(model, cb, opts)?;
+    let mut y = vec![0.0; phase.state_len()];
+    y[..nq + nu + 2].copy_from_slice(&y0);
+    let e = nq + nu;
+    // integrals of the forces at the previous sample, and the energy taken by impacts so far
+    let mut prev = vec![0.0; 3 * np];
+    let (mut e_impact, mut e_impulsive_friction) = (0.0, 0.0);
+    let mut first = true;
+    let mut warnings = Vec::new();
+    let mut sample = |ph: &mut Phase, t: f64, y: &[f64], imp: &[f64], d: event_driven::Dissipation| -> Result<()> {
+        record(model, &ph.data, t, y, &mut rec);
+        e_impact += d.impact;
+        e_impulsive_friction += d.friction;
+        let span = if first { 0.0 } else { 1.0 };
+        first = false;
+        for pt in 0..np {
+            let kk = &ph.kin[pt];
+            let now_n = y[e + 3 + pt];
+            let now_t = [y[e + 3 + np + 2 * pt], y[e + 3 + np + 2 * pt + 1]];
+            let i_n = span * (now_n - prev[3 * pt]) + imp[3 * pt];
+            let i_t = [
+                span * (now_t[0] - prev[3 * pt + 1]) + imp[3 * pt + 1],
+                span * (now_t[1] - prev[3 * pt + 2]) + imp[3 * pt + 2],
+            ];
+            prev[3 * pt] = now_n;
+            prev[3 * pt + 1] = now_t[0];
+            prev[3 * pt + 2] = now_t[1];
+            rec.contact_gap.push(kk.point.g_n);
+            rec.contact_gd_n.push(kk.gd_n);
+            rec.contact_gd_t.extend_from_slice(&kk.gd_t);
+            rec.contact_impulse_n.push(i_n);
+            rec.contact_impulse_t.extend_from_slice(&i_t);
+            rec.contact_lambda_n.push(ph.lam_n[pt]);
+            rec.contact_lambda_t.extend_from_slice(&ph.lam_t[pt]);
+            rec.contact_state.push(ph.state_code(pt));
+            let con = model.contact_of_point(pt);
+            let lt = (ph.lam_t[pt][0].powi(2) + ph.lam_t[pt][1].powi(2)).sqrt();
+            rec.contact_reserve.push(con.friction.mu0() * ph.lam_n[pt] - lt);
+        }
+        rec.dissipated_impact.push(e_impact);
+        rec.dissipated_friction.push(y[e + 2] + e_impulsive_friction);
+        if let Some(p) = progress {
+            p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
+            if p.cancel.load(Ordering::Relaxed) {
+                return Err(Error::Solver(format!("simulation cancelled at t = {t:.6} s")));
+            }
+        }
+        Ok(())
+    };
+    let stats = event_driven::integrate(&mut phase, settings.t0, &y, t_out, &mut warnings, &mut sample)?;
+    y.clear();
+    rec.stats = stats;
+    rec.warnings.extend(warnings);
+    rec.events = phase
+        .log
+        .iter()
+        .map(|&(t, pt, what)| {
+            let c = model.contact_of_point(pt);
+            (t, c.name.clone(), pt - c.first, what.to_string())
+        })
+        .collect();
     Ok(rec)
 }
 

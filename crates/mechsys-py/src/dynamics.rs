@@ -118,6 +118,33 @@ fn nonlinear_effects<'py>(
     Ok(PyArray1::from_slice(py, data.h.as_slice()))
 }
 
+/// Linearization at (q, u, t) into M, D, G, K, N (eq. 2.204) in minimal coordinates: a dict of
+/// row-major numpy matrices, the basis `v` (nu × n) and the `residual` Vᵀ M u̇.
+#[pyfunction]
+#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None))]
+fn linearize<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &model.model;
+    let q = q_checked(model, &q)?;
+    let u = check_len(&u, m.nu, "u")?;
+    let cb = self::callbacks(model, callbacks)?;
+    let lin = mechsys_core::linear::linearize(m, t, q, u, &cb).map_err(PyMechsysError::from)?;
+    let d = PyDict::new(py);
+    let n = lin.n;
+    for (key, v) in [("M", &lin.m), ("D", &lin.d), ("G", &lin.g), ("K", &lin.k), ("N", &lin.n_mat)] {
+        d.set_item(key, PyArray1::from_slice(py, v).reshape([n, n])?)?;
+    }
+    d.set_item("V", PyArray1::from_slice(py, &lin.v).reshape([m.nu, n])?)?;
+    d.set_item("residual", PyArray1::from_slice(py, &lin.residual))?;
+    Ok(d)
+}
+
 /// Energies and momenta at (q, u, t): kinetic and potential energy (total and per body), linear
 /// momentum and moment of momentum about `point` (total and per body).
 #[pyfunction]
@@ -171,6 +198,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea, m)?)?;
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
+    m.add_function(wrap_pyfunction!(linearize, m)?)?;
     register_reactions(m)?;
     register_constraints(m)?;
     register_constraint_gamma(m)

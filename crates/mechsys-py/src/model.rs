@@ -112,6 +112,33 @@ impl PyModel {
         Ok(out)
     }
 
+    /// One dict per contact group: name, members, against (counts), kinds (contour kinds of the
+    /// members, then of `against`), planar.
+    fn contact_groups<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut out = vec![];
+        for g in &self.model.contact_groups {
+            let d = PyDict::new(py);
+            d.set_item("name", &g.name)?;
+            d.set_item("members", g.members.len())?;
+            d.set_item("against", g.against.len())?;
+            let kinds = |l: &[mechsys_core::model::contact::GroupContour]| {
+                let mut k: Vec<&'static str> = Vec::new();
+                for c in l {
+                    let n = c.contour.kind().name();
+                    if !k.contains(&n) {
+                        k.push(n);
+                    }
+                }
+                k
+            };
+            d.set_item("member_kinds", kinds(&g.members))?;
+            d.set_item("against_kinds", kinds(&g.against))?;
+            d.set_item("planar", g.planar)?;
+            out.push(d);
+        }
+        Ok(out)
+    }
+
     fn constraints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         use mechsys_core::constraints::ConstraintKind as K;
         use mechsys_core::constraints::LoopJoint;

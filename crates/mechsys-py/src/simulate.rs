@@ -234,8 +234,9 @@ fn simulate<'py>(
     put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
     put("constraint_velocity_violation", rec.constraint_velocity_violation, &[n, m.nc])?;
     d.set_item("warnings", rec.warnings)?;
+    d.set_item("events", rec.events)?;
     let np = m.n_contact_points;
-    if !m.contacts.is_empty() {
+    if !m.contacts.is_empty() || !m.contact_groups.is_empty() {
         put("contact_gap", rec.contact_gap, &[n, np])?;
         put("contact_gd_n", rec.contact_gd_n, &[n, np])?;
         put("contact_gd_t", rec.contact_gd_t, &[n, np, 2])?;
@@ -248,11 +249,20 @@ fn simulate<'py>(
         put("dissipated_impact", rec.dissipated_impact, &[n])?;
         put("dissipated_friction", rec.dissipated_friction, &[n])?;
     }
+    let ng = m.contact_groups.len();
+    if ng > 0 {
+        put("group_closed", rec.group_closed, &[n, ng])?;
+        put("group_max_penetration", rec.group_max_penetration, &[n, ng])?;
+        put("group_impulse_n", rec.group_impulse_n, &[n, ng])?;
+        put("group_pairs", rec.group_pairs, &[n, ng])?;
+        put("group_impulse_against", rec.group_impulse_against, &[n, ng, 3])?;
+    }
     let st = PyDict::new(py);
     st.set_item("steps", rec.stats.steps)?;
     st.set_item("rejected", rec.stats.rejected)?;
     st.set_item("evaluations", rec.stats.evaluations)?;
     st.set_item("jacobians", rec.stats.jacobians)?;
+    st.set_item("events", rec.stats.events)?;
     d.set_item("stats", st)?;
     Ok(d)
 }

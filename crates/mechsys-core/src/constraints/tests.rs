@@ -67,6 +67,7 @@ pub(super) fn model_with_all_kinds() -> Model {
         forces: vec![],
         ground_markers: vec![],
         contacts: vec![],
+        contact_groups: vec![],
         constraints: vec![
             ConstraintDescription::Point {
                 name: "pin".into(),
@@ -217,6 +218,7 @@ fn drift_control_choices() {
         forces: vec![],
         ground_markers: vec![],
         contacts: vec![],
+        contact_groups: vec![],
         constraints: vec![ConstraintDescription::Distance {
             name: "rod".into(),
             body1: "b".into(),

@@ -58,6 +58,7 @@ fn model_with_new_kinds() -> Model {
         forces: vec![],
         ground_markers: vec![],
         contacts: vec![],
+        contact_groups: vec![],
         constraints: vec![
             ConstraintDescription::PointOnLine {
                 name: s("line"),
@@ -607,6 +608,7 @@ fn model_with_user_rows(rate: bool, offset: bool) -> Model {
         forces: vec![],
         ground_markers: vec![],
         contacts: vec![],
+        contact_groups: vec![],
         constraints: vec![
             ConstraintDescription::Velocity {
                 name: s("skate"),

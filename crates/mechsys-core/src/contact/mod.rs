@@ -5,6 +5,8 @@
 //! - [`broad`]: sweep and prune over bounding boxes ([`SweepAndPrune`]).
 //! - [`narrow`]: a [`ContactPair`] of two contours, prepared once, and [`evaluate`], which gives
 //!   a fixed number of candidate [`ContactPoint`]s per pair (gap, normal, points, tangents).
+//! - [`group`]: contact groups at run time: broad phase, a cache of prepared pairs, narrow phase
+//!   on the pairs that may touch ([`GroupPhase`]).
 //! - [`kinematics`]: [`contact_kinematics`], the relative velocities `ġ_N`, `ġ_T` and the
 //!   velocity-product terms `w̄_N`, `w̄_T` of the relative accelerations.
 //!
@@ -28,6 +30,7 @@
 
 pub mod broad;
 pub mod contour;
+pub mod group;
 pub mod kinematics;
 pub mod narrow;
 
@@ -36,5 +39,6 @@ pub(crate) mod test_util;
 
 pub use broad::{Aabb, SweepAndPrune};
 pub use contour::{Contour, ContourKind, Vec2};
+pub use group::GroupPhase;
 pub use kinematics::{contact_kinematics, BodyMotion, ContactKinematics};
 pub use narrow::{candidates, evaluate, ContactPair, ContactPoint};

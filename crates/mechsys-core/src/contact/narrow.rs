@@ -15,6 +15,7 @@
 //! | point, sphere – sphere | 1 | along the centre line |
 //! | point, sphere, capsule – capsule | 1 | closest points of the axis segments |
 //! | point, sphere – box | 1 | closest point of the box (deepest face when the centre is inside) |
+//! | box – box | 8 | separating axes; the clipped incident face, or one edge–edge point ([`box_box`]) |
 //! | point2, circle, polygon – line | 1, 1, vertices | as the spatial point/sphere – plane |
 //! | point2, circle – circle | 1 | along the centre line in the x-y plane |
 //!
@@ -46,6 +47,9 @@ use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};
 
 use super::contour::{lift, Contour, ContourKind};
+use box_box::BoxShape;
+
+pub mod box_box;
 
 /// One candidate contact: gap, frame and the two surface points, world components.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -85,9 +89,9 @@ enum Geometry {
     Swept { a1: Vec3, d1: Vec3, r1: f64, a2: Vec3, d2: Vec3, r2: f64, across: Vec3 },
     /// A sphere (or point, radius 0) on body 1 against a box on body 2.
     SphereBox { center: Vec3, radius: f64, box_center: Vec3, box_rotation: Mat3, half: Vec3 },
-    /// Two boxes: candidates 0–7 are body 1's corners against body 2's box, 8–15 body 2's corners
-    /// against body 1's box (vertex–face contacts only).
-    BoxBox { corners: [Vec<Vec3>; 2], boxes: [(Vec3, Mat3, Vec3); 2] },
+    /// Two boxes (body 1's, body 2's), a manifold of up to [`box_box::POINTS`] points with one
+    /// normal; `scale` is the largest half extent (tolerances of ties).
+    BoxBox { a: BoxShape, b: BoxShape, scale: f64 },
     /// Planar: circles (or points, radius 0) extruded along body 2's z axis.
     CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
 }
@@ -185,8 +189,10 @@ pub fn candidates(c1: &Contour, c2: &Contour) -> Result<usize> {
     let first = if swapped { c2 } else { c1 };
     let against_plane = matches!(c1.kind(), ContourKind::Plane) || matches!(c2.kind(), ContourKind::Plane);
     Ok(match first {
-        // each box's corners against the other box (vertex–face contacts; edge–edge ones are not seen)
-        Contour::Box { .. } if matches!((c1.kind(), c2.kind()), (ContourKind::Box, ContourKind::Box)) => 16,
+        // the clipped incident face has at most 8 vertices (one point for an edge–edge contact)
+        Contour::Box { .. } if matches!((c1.kind(), c2.kind()), (ContourKind::Box, ContourKind::Box)) => {
+            box_box::POINTS
+        }
         Contour::Box { .. } => 8,
         // end spheres and rim circles; a capsule against a capsule has one closest pair
         Contour::Capsule { .. } | Contour::Cylinder { .. } if against_plane => 2,
@@ -207,6 +213,9 @@ fn perpendicular(v: &Vec3) -> Vec3 {
 fn vel(t: &Motion, p: &Vec3) -> Vec3 {
     t.v + t.w.cross(p)
 }
+
+/// Room for the candidates [`evaluate`] computes in one pass (box–box manifolds).
+const MAX_SHARED: usize = 8;
 
 /// Lengths below this are treated as zero (coincident centres, crossing axes).
 const TINY: f64 = 1e-12;
@@ -237,6 +246,15 @@ impl ContactPair {
             _ => [Vec3::x(), Vec3::y()],
         };
         Ok(ContactPair { kinds: (k1, k2), geometry, swapped, count, planar, tangent_ref })
+    }
+
+    /// The box–box feature pair chosen at these placements (tests).
+    #[cfg(test)]
+    pub(crate) fn box_feature(&self, x1: &Pose, x2: &Pose) -> Option<box_box::Feature> {
+        match &self.geometry {
+            Geometry::BoxBox { a, b, scale } => Some(box_box::feature(x1, x2, a, b, *scale).0),
+            _ => None,
+        }
     }
 
     /// Number of candidate points (the length `evaluate` fills).
@@ -284,6 +302,23 @@ impl ContactPair {
         // canonical body 1 is the caller's body 2: flip the normal, exchange the points
         let r = self.raw(k, x2, x1, twists.map(|(a, b)| (b, a)));
         Raw { g: r.g, n: -r.n, p1: r.p2, p2: r.p1, nd: -r.nd, p1d: r.p2d, p2d: r.p1d }
+    }
+
+    /// All candidates in the caller's order into `out[..self.candidates()]`, computing work the
+    /// candidates share (the box–box manifold) once; the same values as [`Self::candidate`] for
+    /// each `k`.
+    pub(crate) fn candidates_into(&self, x1: &Pose, x2: &Pose, twists: Option<(&Motion, &Motion)>, out: &mut [Raw]) {
+        debug_assert!(out.len() >= self.count, "candidates_into: room for {} of {}", out.len(), self.count);
+        let out = &mut out[..self.count];
+        if let Geometry::BoxBox { a, b, scale } = &self.geometry {
+            if !self.swapped {
+                box_box::box_box_all(x1, x2, twists, a, b, *scale, out);
+                return;
+            }
+        }
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self.candidate(k, x1, x2, twists);
+        }
     }
 
     /// Tangents at normal `n` for body 2 at `x2`; rates from body 2's `ω` and `ṅ` when given.
@@ -363,17 +398,7 @@ impl ContactPair {
                 sphere_box(x1, x2, tw, center, *radius, box_center, box_rotation, half)
             }
             Geometry::CircleCircle { c1, r1, c2, r2 } => circle_circle(x1, x2, tw, c1, *r1, c2, *r2),
-            Geometry::BoxBox { corners, boxes } => {
-                if k < 8 {
-                    let (bc, rot, half) = &boxes[1];
-                    sphere_box(x1, x2, tw, &corners[0][k], 0.0, bc, rot, half)
-                } else {
-                    // body 2's corner against body 1's box, then back to the pair's order
-                    let (bc, rot, half) = &boxes[0];
-                    let r = sphere_box(x2, x1, tw.map(|(a, b)| (b, a)), &corners[1][k - 8], 0.0, bc, rot, half);
-                    Raw { g: r.g, n: -r.n, p1: r.p2, p2: r.p1, nd: -r.nd, p1d: r.p2d, p2d: r.p1d }
-                }
-            }
+            Geometry::BoxBox { a, b, scale } => box_box::box_box(x1, x2, tw, a, b, *scale, k),
         }
     }
 }
@@ -434,8 +459,9 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
         Contour::Box { center: bc, rotation, half_extents } if matches!(f, Contour::Box { .. }) => {
             let Contour::Box { center: c1, rotation: r1, half_extents: h1 } = f else { unreachable!() };
             Geometry::BoxBox {
-                corners: [box_corners(c1, r1, h1), box_corners(bc, rotation, half_extents)],
-                boxes: [(*c1, *r1, *h1), (*bc, *rotation, *half_extents)],
+                a: BoxShape { center: *c1, rotation: *r1, half: *h1 },
+                b: BoxShape { center: *bc, rotation: *rotation, half: *half_extents },
+                scale: h1.max().max(half_extents.max()),
             }
         }
         Contour::Box { center: bc, rotation, half_extents } => {
@@ -681,8 +707,13 @@ fn circle_circle(
 /// at `x2` (world placements). No allocation; an error only when `out` is too short.
 pub fn evaluate(pair: &ContactPair, x1: &Pose, x2: &Pose, out: &mut [ContactPoint]) -> Result<()> {
     pair.check_len(out.len())?;
+    let mut raw = [Raw::default(); MAX_SHARED];
+    let shared = matches!(pair.geometry, Geometry::BoxBox { .. }) && pair.count <= MAX_SHARED;
+    if shared {
+        pair.candidates_into(x1, x2, None, &mut raw);
+    }
     for (k, o) in out[..pair.count].iter_mut().enumerate() {
-        let r = pair.candidate(k, x1, x2, None);
+        let r = if shared { raw[k] } else { pair.candidate(k, x1, x2, None) };
         let t = pair.tangents(x2, &r.n, None);
         *o = ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 };
     }

@@ -79,6 +79,7 @@ fn mixed_tree() -> Model {
         forces,
         ground_markers: vec![],
         contacts: vec![],
+        contact_groups: vec![],
         constraints: vec![],
     })
     .unwrap()

@@ -23,10 +23,19 @@
 //! friction share is `-Λ_Tᵀ ġ_T⁺` (never negative under Coulomb's law), the impacts' the rest. Poisson's law is applied with its
 //! normal coefficient as Newton's (they agree for a single frictionless impact); its tangential
 //! coefficient needs the event-driven scheme.
+//!
+//! Assembly ([`Assembly`]): without bilateral constraints the rows of `W` are kept on their
+//! bodies' root paths and the Delassus matrix is built as per-contact blocks from the tree
+//! factor of M ([`sparse`]); with bilateral constraints `M̃⁻¹` couples every velocity and the
+//! dense path (`M̃⁻¹ W` column by column) is taken. Both give the same impulses to round-off.
+//!
+//! Contact groups ([`crate::model::contact::ContactGroup`]): at the midpoint each group's broad
+//! phase ([`GroupPhase`]) lists the pairs that may touch; their candidates join the explicit
+//! contacts' in the same problem, warm-started from the pair's impulses of the previous step.
 
 use nalgebra::DMatrix;
 
-use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
+use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics, ContactPoint, GroupPhase};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -34,8 +43,14 @@ use crate::model::contact::FrictionLaw;
 use crate::model::joint::quat_matrix;
 use crate::model::JointKind;
 use crate::model::Model;
-use crate::solver::{self, ContactState, Delassus, FrictionContact, Method, Workspace};
+use crate::solver::{self, BlockDelassus, ContactState, Delassus, FrictionContact, Method, Workspace};
 use crate::spatial::Motion;
+
+mod sparse;
+#[cfg(test)]
+mod tests;
+
+use sparse::SparseRows;
 
 /// Candidate points with a midpoint gap up to this (m) join the step's contact problem, so that
 /// resting contacts whose gap is a rounding error above zero (a box on four corners) are not
@@ -60,6 +75,56 @@ pub struct PointResult {
     pub state: f64,
 }
 
+/// How the local contact problem is assembled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Assembly {
+    /// Sparse for models without bilateral constraints, dense otherwise.
+    #[default]
+    Auto,
+    /// Dense rows `W` (dim·m × nu), `M̃⁻¹ W` column by column, dense Delassus matrix; the only
+    /// choice with bilateral constraints (`M̃⁻¹` couples everything).
+    Dense,
+    /// Rows on their bodies' root paths, per-contact Delassus blocks from the tree factor
+    /// (see [`sparse`]); for models without bilateral constraints.
+    Sparse,
+}
+
+/// Where an active contact point comes from.
+#[derive(Debug, Clone, Copy)]
+enum Source {
+    /// Candidate point `pt` of the explicit contacts.
+    Point(usize),
+    /// Candidate `k` of slot `slot` of contact group `group`.
+    Group { group: usize, slot: usize, k: usize },
+}
+
+/// A candidate point taking part in this step's contact problem.
+#[derive(Debug, Clone, Copy)]
+struct Active {
+    b1: usize,
+    b2: usize,
+    point: ContactPoint,
+    source: Source,
+}
+
+/// What a contact group did since the last [`MoreauJean::take_group_stats`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GroupStats {
+    /// Candidate points with a positive normal impulse in the last step.
+    pub closed: usize,
+    /// Largest penetration `max(0, -g_N)` over the candidates of the pairs the broad phase kept,
+    /// at the midpoints of the steps (m).
+    pub max_penetration: f64,
+    /// Sum of the normal impulses over the steps (N s).
+    pub impulse_n: f64,
+    /// Pairs the broad phase kept in the last step.
+    pub pairs: usize,
+    /// Sum over the steps of the impulses the `against` contours exert on the members,
+    /// `Λ_N n + Λ_T1 t1 + Λ_T2 t2`, world components (N s): with a container at rest this is
+    /// the weight its contents put on it (times the interval).
+    pub impulse_against: [f64; 3],
+}
+
 /// The workspace of the scheme, sized for the model.
 pub struct MoreauJean {
     /// Step size (s).
@@ -70,7 +135,6 @@ pub struct MoreauJean {
     kin: Vec<ContactKinematics>,
     /// Local rows of every candidate (dim × nu per point), world-Jacobian projections.
     w_rows: DMatrix<f64>,
-    active: Vec<usize>,
     x_cols: Vec<f64>,
     problem: FrictionContact,
     ws: Workspace,
@@ -94,17 +158,43 @@ pub struct MoreauJean {
     pub bilateral_impulse: Vec<f64>,
     /// Steps whose contact problem did not reach the solver tolerance, and the worst residual.
     pub unconverged: (usize, f64),
+    /// Broad and narrow phase of each contact group.
+    pub groups: Vec<GroupPhase>,
+    group_stats: Vec<GroupStats>,
+    act: Vec<Active>,
+    sparse: Option<SparseRows>,
+    /// Steps taken (for the validity of the groups' warm starts).
+    steps: u64,
 }
 
 impl MoreauJean {
     /// A stepper for `model` with step `h` and contact solver `method`.
     pub fn new(model: &Model, h: f64, method: Method) -> Result<Self> {
+        Self::with_assembly(model, h, method, Assembly::Auto)
+    }
+
+    /// A stepper with a chosen assembly of the contact problem (an error for [`Assembly::Sparse`]
+    /// on a model with bilateral constraints).
+    pub fn with_assembly(model: &Model, h: f64, method: Method, assembly: Assembly) -> Result<Self> {
         crate::ensure!(h.is_finite() && h > 0.0, Settings, "integrator.dt: must be > 0, got {h}");
         let (nu, np) = (model.nu, model.n_contact_points);
-        let dim = if model.contacts.iter().all(|c| c.pair.is_planar()) { 2 } else { 3 };
+        let planar =
+            model.contacts.iter().all(|c| c.pair.is_planar()) && model.contact_groups.iter().all(|g| g.planar);
+        let dim = if planar { 2 } else { 3 };
+        crate::ensure!(
+            !(assembly == Assembly::Sparse && model.nc > 0),
+            Settings,
+            "integrator: the sparse contact assembly needs a model without bilateral constraints (this one has {})",
+            model.nc
+        );
+        let use_sparse = model.nc == 0 && assembly != Assembly::Dense;
         let problem = FrictionContact {
             dim,
-            w: Delassus::Dense(Vec::with_capacity(dim * dim * np * np)),
+            w: if use_sparse {
+                Delassus::Blocks(BlockDelassus::default())
+            } else {
+                Delassus::Dense(Vec::with_capacity(dim * dim * np * np))
+            },
             q: Vec::with_capacity(dim * np),
             mu: Vec::with_capacity(np),
         };
@@ -113,9 +203,8 @@ impl MoreauJean {
             method,
             dim,
             kin: vec![ContactKinematics::default(); np],
-            w_rows: DMatrix::zeros(dim * np.max(1), nu),
-            active: Vec::with_capacity(np),
-            x_cols: vec![0.0; dim * np * nu],
+            w_rows: DMatrix::zeros(if use_sparse { 0 } else { dim * np.max(1) }, nu),
+            x_cols: if use_sparse { Vec::new() } else { vec![0.0; dim * np * nu] },
             problem,
             ws: Workspace::new(),
             r: Vec::with_capacity(dim * np),
@@ -139,7 +228,28 @@ impl MoreauJean {
             dissipated_friction: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
             unconverged: (0, 0.0),
+            groups: model.contact_groups.iter().map(GroupPhase::new).collect(),
+            group_stats: vec![GroupStats::default(); model.contact_groups.len()],
+            act: Vec::with_capacity(np),
+            sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
+            steps: 0,
         })
+    }
+
+    /// Whether the contact problem is assembled sparsely.
+    pub fn is_sparse(&self) -> bool {
+        self.sparse.is_some()
+    }
+
+    /// The statistics of each contact group since the last call, then reset (the count of closed
+    /// points is that of the last step and is kept).
+    pub fn take_group_stats(&mut self, out: &mut [GroupStats]) {
+        for (o, s) in out.iter_mut().zip(self.group_stats.iter_mut()) {
+            *o = *s;
+            s.max_penetration = 0.0;
+            s.impulse_n = 0.0;
+            s.impulse_against = [0.0; 3];
+        }
     }
 
     /// Advances (q, u) from t by one step; returns the work of the smooth external loads and the
@@ -178,10 +288,15 @@ impl MoreauJean {
             crate::dynamics::rnea::rnea_inward(model, data, &mut c);
             if pass == 0 {
                 let Data { inertia, s, ic, saddle, .. } = &mut *data;
+                let mut tree = self.sparse.as_mut().map(|sp| &mut sp.factor);
                 crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| {
-                    saddle.put_mass(r, col, v)
+                    saddle.put_mass(r, col, v);
+                    if let Some(f) = tree.as_mut() {
+                        f.put(r, col, v);
+                    }
                 });
-                if !data.saddle.factor_mass() {
+                let ok = data.saddle.factor_mass() && self.sparse.as_mut().is_none_or(|sp| sp.factor.factor());
+                if !ok {
                     return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s")));
                 }
             }
@@ -222,9 +337,9 @@ impl MoreauJean {
             data.saddle.add_constraint_accelerations(&mu, &mut self.u_free);
             self.bilateral_impulse = mu;
         }
-        // ---- contacts at the midpoint
+        // ---- contacts at the midpoint: the explicit pairs, then the groups' pairs
         let (d, np) = (self.dim, model.n_contact_points);
-        self.active.clear();
+        self.act.clear();
         for con in &model.contacts {
             let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
             let k = &mut self.kin[con.first..con.first + con.points()];
@@ -232,148 +347,237 @@ impl MoreauJean {
                 .map_err(|e| Error::Solver(format!("contact '{}' at t = {tm:.6} s: {e}", con.name)))?;
             for (j, kk) in k.iter().enumerate() {
                 if kk.point.g_n <= CONTACT_MARGIN {
-                    self.active.push(con.first + j);
+                    let pt = con.first + j;
+                    self.act.push(Active { b1: con.body1, b2: con.body2, point: kk.point, source: Source::Point(pt) });
                 }
             }
         }
-        let m = self.active.len();
+        for (gi, group) in model.contact_groups.iter().enumerate() {
+            let ph = &mut self.groups[gi];
+            ph.update(group, data, h, CONTACT_MARGIN)
+                .map_err(|e| Error::Solver(format!("at t = {tm:.6} s: {e}")))?;
+            let mut pen = self.group_stats[gi].max_penetration;
+            for &slot in &ph.live {
+                let sl = &ph.slots[slot];
+                for (k, kk) in sl.kin.iter().enumerate() {
+                    pen = pen.max(-kk.point.g_n);
+                    if kk.point.g_n <= CONTACT_MARGIN {
+                        let source = Source::Group { group: gi, slot, k };
+                        self.act.push(Active { b1: sl.body1, b2: sl.body2, point: kk.point, source });
+                    }
+                }
+            }
+            self.group_stats[gi].max_penetration = pen;
+            self.group_stats[gi].pairs = ph.live.len();
+        }
+        let m = self.act.len();
         let (mut dw_n, mut dw_t) = (0.0, 0.0);
         if m > 0 {
-            self.assemble_rows(model, data);
-            // X = M̃⁻¹ W, column by column (restricted to the bilateral constraints' tangent space)
             let dm = d * m;
-            for col in 0..dm {
-                let x = &mut self.x_cols[col * nu..(col + 1) * nu];
-                for i in 0..nu {
-                    x[i] = self.w_rows[(col, i)];
-                }
-                data.saddle.solve_mass(x);
-                if nc > 0 {
-                    let mut y = std::mem::take(&mut data.lambda);
-                    data.saddle.g_times(x, &mut y);
-                    for v in y.iter_mut() {
-                        *v = -*v;
-                    }
-                    data.saddle.solve_schur(&mut y);
-                    data.saddle.add_constraint_accelerations(&y, x);
-                    data.lambda = y;
-                }
-            }
-            // the local problem
-            let Delassus::Dense(w) = &mut self.problem.w else { unreachable!("dense Delassus") };
-            w.clear();
-            w.resize(dm * dm, 0.0);
-            for a in 0..dm {
-                for b in 0..dm {
-                    let mut s = 0.0;
-                    for i in 0..nu {
-                        s += self.w_rows[(a, i)] * self.x_cols[b * nu + i];
-                    }
-                    w[a * dm + b] = s;
-                }
-            }
-            // a tangent along which nothing can move (the out-of-plane tangent of a planar
-            // mechanism) has a zero row: give it a positive diagonal so that its impulse is zero
-            // instead of taking up the friction cone
-            for a in 0..dm {
-                if a % d != 0 && (0..nu).all(|i| self.w_rows[(a, i)] == 0.0) {
-                    let n = a - a % d;
-                    w[a * dm + a] = w[n * dm + n].max(f64::MIN_POSITIVE);
-                }
-            }
-            self.problem.dim = d;
+            // local velocities before (u_k) and without (u_free) the impulses: ġ⁻, ġ_free
+            self.gd_before.clear();
+            self.gd_before.resize(dm, 0.0);
             self.problem.q.clear();
-            self.problem.mu.clear();
-            self.r.clear();
-            for (ai, &pt) in self.active.iter().enumerate() {
-                let con = model.contact_of_point(pt);
-                let kk = &self.kin[pt];
-                let mut gd = [0.0; 3];
-                for (row, g) in gd.iter_mut().enumerate().take(d) {
-                    let a = ai * d + row;
-                    let mut s = 0.0;
-                    let mut s0 = 0.0;
+            self.problem.q.resize(dm, 0.0);
+            if let Some(sp) = self.sparse.as_mut() {
+                sp.clear();
+                for a in &self.act {
+                    let k = &a.point;
+                    sp.add_contact(model, &data.s, a.b1, &k.p1, a.b2, &k.p2, &[k.n, k.t1, k.t2]);
+                }
+                sp.delassus();
+                let Delassus::Blocks(bw) = &mut self.problem.w else { unreachable!("block Delassus") };
+                bw.refill(d, m, &sp.diag, &sp.upper, &sp.upper_val);
+                let (mut g, mut g0) = ([0.0; 3], [0.0; 3]);
+                for ai in 0..m {
+                    sp.local_velocity(ai, &self.u_free, &mut g);
+                    sp.local_velocity(ai, &self.u_prev, &mut g0);
+                    self.problem.q[ai * d..(ai + 1) * d].copy_from_slice(&g[..d]);
+                    self.gd_before[ai * d..(ai + 1) * d].copy_from_slice(&g0[..d]);
+                }
+            } else {
+                self.assemble_rows(model, data);
+                // X = M̃⁻¹ W, column by column (restricted to the bilateral constraints' tangent space)
+                if self.x_cols.len() < dm * nu {
+                    self.x_cols.resize(dm * nu, 0.0);
+                }
+                for col in 0..dm {
+                    let x = &mut self.x_cols[col * nu..(col + 1) * nu];
+                    for i in 0..nu {
+                        x[i] = self.w_rows[(col, i)];
+                    }
+                    data.saddle.solve_mass(x);
+                    if nc > 0 {
+                        let mut y = std::mem::take(&mut data.lambda);
+                        data.saddle.g_times(x, &mut y);
+                        for v in y.iter_mut() {
+                            *v = -*v;
+                        }
+                        data.saddle.solve_schur(&mut y);
+                        data.saddle.add_constraint_accelerations(&y, x);
+                        data.lambda = y;
+                    }
+                }
+                let Delassus::Dense(w) = &mut self.problem.w else { unreachable!("dense Delassus") };
+                w.clear();
+                w.resize(dm * dm, 0.0);
+                for a in 0..dm {
+                    for b in 0..dm {
+                        let mut s = 0.0;
+                        for i in 0..nu {
+                            s += self.w_rows[(a, i)] * self.x_cols[b * nu + i];
+                        }
+                        w[a * dm + b] = s;
+                    }
+                }
+                // a tangent along which nothing can move (the out-of-plane tangent of a planar
+                // mechanism) has a zero row: give it a positive diagonal so that its impulse is zero
+                // instead of taking up the friction cone
+                for a in 0..dm {
+                    if a % d != 0 && (0..nu).all(|i| self.w_rows[(a, i)] == 0.0) {
+                        let n = a - a % d;
+                        w[a * dm + a] = w[n * dm + n].max(f64::MIN_POSITIVE);
+                    }
+                }
+                for a in 0..dm {
+                    let (mut s, mut s0) = (0.0, 0.0);
                     for i in 0..nu {
                         s += self.w_rows[(a, i)] * self.u_free[i];
                         s0 += self.w_rows[(a, i)] * self.u_prev[i];
                     }
-                    *g = s;
+                    self.problem.q[a] = s;
                     self.gd_before[a] = s0;
                 }
-                let eps = con.impact.eps();
+            }
+            // the local problem: restitution, gap allowance, friction coefficients, warm start
+            self.problem.dim = d;
+            self.problem.mu.clear();
+            self.r.clear();
+            for (ai, a) in self.act.iter().enumerate() {
+                let (friction, impact, gd_t, prev, prev_state) = match a.source {
+                    Source::Point(pt) => {
+                        let con = model.contact_of_point(pt);
+                        let r = &self.results[pt];
+                        let prev = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
+                        (&con.friction, &con.impact, self.kin[pt].gd_t, prev, r.state)
+                    }
+                    Source::Group { group, slot, k } => {
+                        let g = &model.contact_groups[group];
+                        let sl = &self.groups[group].slots[slot];
+                        let fresh = sl.stamp == self.steps.wrapping_sub(1);
+                        let (prev, st) = if fresh { sl.last[k] } else { ([0.0; 3], OPEN) };
+                        (&g.friction, &g.impact, sl.kin[k].gd_t, prev, st)
+                    }
+                };
                 // a point still open by less than the margin may close within the step, not beyond
-                let gap_allowance = kk.point.g_n.max(0.0) / h;
-                self.problem.q.push(gd[0] + eps * self.gd_before[ai * d].min(0.0) + gap_allowance);
-                for g in gd.iter().take(d).skip(1) {
-                    self.problem.q.push(*g);
-                }
-                let slip_speed = (kk.gd_t[0].powi(2) + if d == 3 { kk.gd_t[1].powi(2) } else { 0.0 }).sqrt();
-                let mu = match (&con.friction, self.results[pt].state) {
+                let gap_allowance = a.point.g_n.max(0.0) / h;
+                self.problem.q[ai * d] += impact.eps() * self.gd_before[ai * d].min(0.0) + gap_allowance;
+                let slip_speed = (gd_t[0].powi(2) + if d == 3 { gd_t[1].powi(2) } else { 0.0 }).sqrt();
+                let mu = match (friction, prev_state) {
                     (FrictionLaw::None, _) => 0.0,
                     (law, s) if s == SLIP => law.mu(slip_speed.max(f64::MIN_POSITIVE)),
                     (law, _) => law.mu0(),
                 };
                 self.problem.mu.push(mu);
-                let prev = &self.results[pt];
-                self.r.push(prev.impulse_n);
-                self.r.extend_from_slice(&prev.impulse_t[..d - 1]);
+                self.r.extend_from_slice(&prev[..d]);
             }
             self.ws.reserve(&self.problem, &self.method)?;
             let warm = self.r.iter().any(|v| *v != 0.0);
             let report = solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws).map_err(|e| {
-                let names: Vec<&str> = self.active.iter().map(|&pt| model.contact_of_point(pt).name.as_str()).collect();
+                let names = self.active_names(model);
                 Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
             })?;
             if !report.converged {
                 self.unconverged.0 += 1;
                 self.unconverged.1 = self.unconverged.1.max(report.residual);
             }
-            // u⁺ = u_free + X Λ, states, dissipation
+            // u⁺ = u_free + M̃⁻¹ W Λ
             u.copy_from_slice(&self.u_free);
-            for (col, lam) in self.r.iter().enumerate() {
-                if *lam != 0.0 {
-                    for i in 0..nu {
-                        u[i] += self.x_cols[col * nu + i] * lam;
+            if let Some(sp) = self.sparse.as_mut() {
+                sp.apply(&self.r, u);
+            } else {
+                for (col, lam) in self.r.iter().enumerate() {
+                    if *lam != 0.0 {
+                        for i in 0..nu {
+                            u[i] += self.x_cols[col * nu + i] * lam;
+                        }
                     }
                 }
             }
-            for (ai, &pt) in self.active.iter().enumerate() {
-                let state = self.problem.contact_state(ai, &self.r, 1e-9 * (1.0 + self.r[ai * d].abs()))?;
-                let res = &mut self.results[pt];
-                res.impulse_n = self.r[ai * d];
-                res.impulse_t = [0.0; 2];
-                res.impulse_t[..d - 1].copy_from_slice(&self.r[ai * d + 1..ai * d + d]);
-                res.state = match state {
+            for s in self.group_stats.iter_mut() {
+                s.closed = 0;
+            }
+            let mut after = [0.0; 3];
+            let r_scale = 1.0 + self.r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let q_scale = 1.0 + self.problem.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for ai in 0..m {
+                let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
+                let state = self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)?;
+                let code = match state {
                     ContactState::Open => OPEN,
                     ContactState::Stick => STICK,
                     ContactState::Slip => SLIP,
                 };
+                let mut imp = [0.0; 3];
+                imp[..d].copy_from_slice(&self.r[ai * d..(ai + 1) * d]);
+                match self.act[ai].source {
+                    Source::Point(pt) => {
+                        self.results[pt] = PointResult { impulse_n: imp[0], impulse_t: [imp[1], imp[2]], state: code };
+                    }
+                    Source::Group { group, slot, k } => {
+                        let sl = &mut self.groups[group].slots[slot];
+                        sl.last[k] = (imp, code);
+                        sl.stamp = self.steps;
+                        let against = sl.key.1 as usize >= model.contact_groups[group].members.len();
+                        let st = &mut self.group_stats[group];
+                        st.impulse_n += imp[0];
+                        if against {
+                            let p = &self.act[ai].point;
+                            let f = p.n * imp[0] + p.t1 * imp[1] + p.t2 * imp[2];
+                            for c in 0..3 {
+                                st.impulse_against[c] += f[c];
+                            }
+                        }
+                        if imp[0] > 0.0 {
+                            st.closed += 1;
+                        }
+                    }
+                }
                 // the kinetic energy the impulses take is -Λᵀ(ġ⁻ + ġ⁺)/2 in total; friction's share
                 // is -Λ_Tᵀ ġ_T⁺ (≥ 0 by Coulomb's law, zero while sticking), the rest is the impact's
+                if let Some(sp) = self.sparse.as_ref() {
+                    sp.local_velocity(ai, u, &mut after);
+                } else {
+                    for (row, af) in after.iter_mut().enumerate().take(d) {
+                        let a = ai * d + row;
+                        *af = (0..nu).map(|i| self.w_rows[(a, i)] * u[i]).sum();
+                    }
+                }
                 for row in 0..d {
                     let a = ai * d + row;
-                    let mut after = 0.0;
-                    for i in 0..nu {
-                        after += self.w_rows[(a, i)] * u[i];
-                    }
-                    dw_n += -self.r[a] * 0.5 * (after + self.gd_before[a]);
+                    dw_n += -self.r[a] * 0.5 * (after[row] + self.gd_before[a]);
                     if row > 0 {
-                        dw_t += -self.r[a] * after;
+                        dw_t += -self.r[a] * after[row];
                     }
                 }
             }
         } else {
             u.copy_from_slice(&self.u_free);
+            for s in self.group_stats.iter_mut() {
+                s.closed = 0;
+            }
         }
-        // points that are not active carry no impulse and are open
-        let mut next_active = 0;
+        // explicit points that are not active carry no impulse and are open
+        let mut next = 0;
         for pt in 0..np {
-            if next_active < m && self.active[next_active] == pt {
-                next_active += 1;
+            let hit = self.act[next..].first().is_some_and(|a| matches!(a.source, Source::Point(p) if p == pt));
+            if hit {
+                next += 1;
             } else {
                 self.results[pt] = PointResult::default();
             }
         }
+        self.steps += 1;
         self.dissipated_impact += dw_n - dw_t;
         self.dissipated_friction += dw_t;
         // ---- positions at the end of the step, and u in the end's joint frames
@@ -406,40 +610,39 @@ impl MoreauJean {
     /// the contact forces: `w_N = J_P1ᵀ n - J_P2ᵀ n`, eq. 2.110 ff.).
     fn assemble_rows(&mut self, model: &Model, data: &Data) {
         let d = self.dim;
-        let rows = d * self.active.len();
+        let rows = d * self.act.len();
+        if self.w_rows.nrows() < rows {
+            self.w_rows = DMatrix::zeros(rows, model.nu);
+        }
         for r in 0..rows {
             for i in 0..model.nu {
                 self.w_rows[(r, i)] = 0.0;
             }
         }
-        for (ai, &pt) in self.active.iter().enumerate() {
-            let con = model.contact_of_point(pt);
-            let k = &self.kin[pt].point;
+        for (ai, a) in self.act.iter().enumerate() {
+            let k = &a.point;
             let dirs = [k.n, k.t1, k.t2];
             for (row, dir) in dirs.iter().enumerate().take(d) {
                 let r = ai * d + row;
-                crate::constraints::add_point_rows(
-                    model,
-                    &data.s,
-                    con.body1,
-                    &k.p1,
-                    1.0,
-                    Some(dir),
-                    &mut self.w_rows,
-                    r,
-                );
-                crate::constraints::add_point_rows(
-                    model,
-                    &data.s,
-                    con.body2,
-                    &k.p2,
-                    -1.0,
-                    Some(dir),
-                    &mut self.w_rows,
-                    r,
-                );
+                crate::constraints::add_point_rows(model, &data.s, a.b1, &k.p1, 1.0, Some(dir), &mut self.w_rows, r);
+                crate::constraints::add_point_rows(model, &data.s, a.b2, &k.p2, -1.0, Some(dir), &mut self.w_rows, r);
             }
         }
+    }
+
+    /// Names of the contacts (and groups) in this step's problem, for messages.
+    fn active_names(&self, model: &Model) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for a in &self.act {
+            let n = match a.source {
+                Source::Point(pt) => model.contact_of_point(pt).name.clone(),
+                Source::Group { group, .. } => format!("group {}", model.contact_groups[group].name),
+            };
+            if out.last() != Some(&n) {
+                out.push(n);
+            }
+        }
+        out
     }
 
     /// Contact geometry and relative velocities of every candidate at the state in `data`

@@ -5,7 +5,9 @@ use crate::contact::{ContactPair, Contour, Vec2};
 use crate::error::{Error, Result};
 use crate::math::Vec3;
 
-use super::contact_description::{ContactDescription, ContourDescription, FrictionDescription, ImpactDescription};
+use super::contact_description::{
+    ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, ImpactDescription,
+};
 
 /// Tangential law with its coefficients.
 #[derive(Debug, Clone, PartialEq)]
@@ -118,6 +120,35 @@ pub struct Contact {
     pub first: usize,
 }
 
+/// A contour on a body, a member (or an `against` contour) of a [`ContactGroup`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroupContour {
+    /// Body carrying it.
+    pub body: usize,
+    /// The contour, body-frame data (validated, normalized directions).
+    pub contour: Contour,
+}
+
+/// A validated contact group: every pair of `members` on different bodies, and every member
+/// against every `against` contour on another body, is a potential contact with the group's
+/// laws; the pairs that may touch are found at every step by a broad phase
+/// ([`crate::contact::group`]).
+#[derive(Debug, Clone)]
+pub struct ContactGroup {
+    /// Unique name (shared namespace with the contacts).
+    pub name: String,
+    /// Contours checked against each other and against `against`.
+    pub members: Vec<GroupContour>,
+    /// Contours checked against the members only.
+    pub against: Vec<GroupContour>,
+    /// Friction law of every pair.
+    pub friction: FrictionLaw,
+    /// Impact law of every pair.
+    pub impact: ImpactLaw,
+    /// Whether the group is planar (every contour in the x-y planes of its bodies).
+    pub planar: bool,
+}
+
 impl Contact {
     /// Number of candidate points.
     pub fn points(&self) -> usize {
@@ -179,23 +210,9 @@ fn contour(
     })
 }
 
-/// Validates one contact description (body indices resolved by `body`).
-pub(super) fn validate(
-    d: &ContactDescription,
-    index: usize,
-    first: usize,
-    body: impl Fn(&str, &str) -> Result<usize>,
-    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
-) -> Result<Contact> {
-    let what = format!("contacts[{index}] '{}'", d.name);
-    crate::ensure!(!d.name.trim().is_empty(), Model, "contacts[{index}]: name must not be empty");
-    let b1 = body(&d.body1, &format!("{what}.body1"))?;
-    let b2 = body(&d.body2, &format!("{what}.body2"))?;
-    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{}'", d.body1);
-    let c1 = contour(&d.contour1, planar(&d.contour2), &format!("{what}.contour1"), rotation)?;
-    let c2 = contour(&d.contour2, planar(&d.contour1), &format!("{what}.contour2"), rotation)?;
-    let pair = ContactPair::new(&d.name, c1, c2)?;
-    let friction = match &d.friction {
+/// The validated friction law of a description; `what` names the owner in messages.
+fn friction_law(friction: &FrictionDescription, what: &str) -> Result<FrictionLaw> {
+    Ok(match friction {
         FrictionDescription::None => FrictionLaw::None,
         FrictionDescription::Coulomb { mu, mu0 } => {
             let mu = finite(*mu, &format!("{what}.friction.mu"))?;
@@ -240,8 +257,12 @@ pub(super) fn validate(
             }
             FrictionLaw::Table { speed: speed.clone(), mu: mu.clone() }
         }
-    };
-    let impact = match d.impact {
+    })
+}
+
+/// The validated impact law of a description.
+fn impact_law(impact: &ImpactDescription, what: &str) -> Result<ImpactLaw> {
+    let impact = match *impact {
         ImpactDescription::Newton { eps } => ImpactLaw::Newton { eps },
         ImpactDescription::Poisson { eps, eps_t } => ImpactLaw::Poisson { eps, eps_t },
     };
@@ -256,5 +277,98 @@ pub(super) fn validate(
             "{what}.impact.{k}: must be in [0, 1], got {e}"
         );
     }
+    Ok(impact)
+}
+
+/// Validates one contact description (body indices resolved by `body`).
+pub(super) fn validate(
+    d: &ContactDescription,
+    index: usize,
+    first: usize,
+    body: impl Fn(&str, &str) -> Result<usize>,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
+) -> Result<Contact> {
+    let what = format!("contacts[{index}] '{}'", d.name);
+    crate::ensure!(!d.name.trim().is_empty(), Model, "contacts[{index}]: name must not be empty");
+    let b1 = body(&d.body1, &format!("{what}.body1"))?;
+    let b2 = body(&d.body2, &format!("{what}.body2"))?;
+    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{}'", d.body1);
+    let c1 = contour(&d.contour1, planar(&d.contour2), &format!("{what}.contour1"), rotation)?;
+    let c2 = contour(&d.contour2, planar(&d.contour1), &format!("{what}.contour2"), rotation)?;
+    let pair = ContactPair::new(&d.name, c1, c2)?;
+    let friction = friction_law(&d.friction, &what)?;
+    let impact = impact_law(&d.impact, &what)?;
     Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, friction, impact, first })
+}
+
+/// Validates one contact group (body indices resolved by `body`): names, contours, that every
+/// kind of pair the group can form has a contact geometry, and the laws.
+pub(super) fn validate_group(
+    d: &ContactGroupDescription,
+    index: usize,
+    body: impl Fn(&str, &str) -> Result<usize>,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
+) -> Result<ContactGroup> {
+    let what = format!("contact_groups[{index}] '{}'", d.name);
+    crate::ensure!(!d.name.trim().is_empty(), Model, "contact_groups[{index}]: name must not be empty");
+    crate::ensure!(!d.members.is_empty(), Model, "{what}.members: a group needs at least one member");
+    let any_planar = d.members.iter().chain(&d.against).any(|m| planar(&m.contour));
+    let any_spatial = d.members.iter().chain(&d.against).any(|m| {
+        !planar(&m.contour) && !matches!(m.contour, ContourDescription::Point { .. })
+    });
+    crate::ensure!(
+        !(any_planar && any_spatial),
+        Model,
+        "{what}: mixes planar contours (circle, line, polygon) with spatial ones; a group is either planar or spatial"
+    );
+    let side = |list: &[super::contact_description::GroupContourDescription], key: &str| -> Result<Vec<GroupContour>> {
+        list.iter()
+            .enumerate()
+            .map(|(k, m)| {
+                let w = format!("{what}.{key}[{k}]");
+                let b = body(&m.body, &format!("{w}.body"))?;
+                let c = contour(&m.contour, any_planar, &format!("{w}.contour"), rotation)?;
+                c.validate(&format!("{w}.contour ({})", c.kind()))?;
+                Ok(GroupContour { body: b, contour: c.normalized() })
+            })
+            .collect()
+    };
+    let members = side(&d.members, "members")?;
+    let against = side(&d.against, "against")?;
+    // one check per kind of pair: (first, second) member of each contour kind
+    let kinds_of = |list: &[GroupContour]| {
+        let mut seen: Vec<(crate::contact::ContourKind, usize, Option<usize>)> = Vec::new();
+        for (k, m) in list.iter().enumerate() {
+            match seen.iter_mut().find(|(kind, _, _)| *kind == m.contour.kind()) {
+                Some(e) if e.2.is_none() => e.2 = Some(k),
+                Some(_) => {}
+                None => seen.push((m.contour.kind(), k, None)),
+            }
+        }
+        seen
+    };
+    let (mk, ak) = (kinds_of(&members), kinds_of(&against));
+    let check = |c1: &GroupContour, c2: &GroupContour, l1: String, l2: String| -> Result<()> {
+        crate::contact::candidates(&c1.contour, &c2.contour).map(|_| ()).map_err(|e| {
+            Error::Model(format!(
+                "{what}: {l1} ({}) and {l2} ({}) cannot touch: {e}",
+                c1.contour.kind(),
+                c2.contour.kind()
+            ))
+        })
+    };
+    for (x, &(_, i, second)) in mk.iter().enumerate() {
+        if let Some(j) = second {
+            check(&members[i], &members[j], format!("members[{i}]"), format!("members[{j}]"))?;
+        }
+        for &(_, j, _) in &mk[x + 1..] {
+            check(&members[i], &members[j], format!("members[{i}]"), format!("members[{j}]"))?;
+        }
+        for &(_, k, _) in &ak {
+            check(&members[i], &against[k], format!("members[{i}]"), format!("against[{k}]"))?;
+        }
+    }
+    let friction = friction_law(&d.friction, &what)?;
+    let impact = impact_law(&d.impact, &what)?;
+    Ok(ContactGroup { name: d.name.clone(), members, against, friction, impact, planar: any_planar })
 }

@@ -179,3 +179,36 @@ impl Default for ImpactDescription {
         ImpactDescription::Newton { eps: 0.0 }
     }
 }
+
+/// A contact group: every pair among `members` may touch (pairs on one body excepted), and each
+/// member may touch each contour of `against` (typically the walls and floor of a container),
+/// all with one friction law and one impact law. Which pairs are close enough to be checked is
+/// decided at every step by a broad phase over bounding boxes, so a group of N members costs
+/// about O(N) per step rather than the N(N-1)/2 explicit contacts it stands for.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactGroupDescription {
+    /// Unique name (shared namespace with the contacts).
+    pub name: String,
+    /// Contours that may touch each other and the `against` contours.
+    pub members: Vec<GroupContourDescription>,
+    /// Contours that the members may touch but that are not checked against each other.
+    #[serde(default)]
+    pub against: Vec<GroupContourDescription>,
+    /// Tangential law (frictionless if absent).
+    #[serde(default)]
+    pub friction: FrictionDescription,
+    /// Impact law (a fully plastic Newton impact, ε = 0, if absent).
+    #[serde(default)]
+    pub impact: ImpactDescription,
+}
+
+/// A contour on a body, as a member of a contact group.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupContourDescription {
+    /// The body carrying the contour (`ground` allowed).
+    pub body: String,
+    /// The contour, body-frame data.
+    pub contour: ContourDescription,
+}

@@ -35,6 +35,10 @@ pub struct ModelDescription {
     /// Unilateral contacts between contours on bodies.
     #[serde(default)]
     pub contacts: Vec<super::contact_description::ContactDescription>,
+    /// Contact groups: every pair among a set of contours, and each of them against a set of
+    /// other contours, with one friction and one impact law (pairs found by a broad phase).
+    #[serde(default)]
+    pub contact_groups: Vec<super::contact_description::ContactGroupDescription>,
 }
 
 /// A bilateral constraint. Read through a JSON value so that a malformed entry's error names the

@@ -275,6 +275,8 @@ pub struct Model {
     pub constraints: Vec<crate::constraints::Constraint>,
     /// Unilateral contacts.
     pub contacts: Vec<contact::Contact>,
+    /// Contact groups (pairs found by a broad phase at every step).
+    pub contact_groups: Vec<contact::ContactGroup>,
     /// Number of candidate contact points over all contacts.
     pub n_contact_points: usize,
     /// Total number of constraint equations.

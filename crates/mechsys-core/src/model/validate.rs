@@ -772,6 +772,17 @@ impl Model {
             contacts.push(c);
         }
 
+        let mut contact_groups = Vec::with_capacity(desc.contact_groups.len());
+        for (i, d) in desc.contact_groups.iter().enumerate() {
+            crate::ensure!(
+                contact_names.insert(d.name.clone()),
+                Model,
+                "contact_groups[{i}] '{}': duplicate name (contacts and contact groups share one namespace)",
+                d.name
+            );
+            contact_groups.push(super::contact::validate_group(d, i, body, rotation)?);
+        }
+
         let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
         Ok(Model {
@@ -782,6 +793,7 @@ impl Model {
             forces,
             constraints,
             contacts,
+            contact_groups,
             n_contact_points,
             nc: row,
             nq: iq,

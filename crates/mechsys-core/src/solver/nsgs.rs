@@ -208,7 +208,7 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
     let stick = solve3(a, &[-b[0], -b[1], -b[2]]);
     let guess_dir = match stick {
         Some(x) => {
-            if x[0] > 0.0 && x[1].hypot(x[2]) <= mu * x[0] * (1.0 + SLACK) {
+            if x[0] > 0.0 && (x[1] * x[1] + x[2] * x[2]).sqrt() <= mu * x[0] * (1.0 + SLACK) {
                 return x;
             }
             [-x[1], -x[2]]
@@ -222,6 +222,26 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
             ut
         }
     };
+    // an isotropic block (W_NT = W_TN = 0, W_TT = c I, e.g. any contact of spheres with uniform
+    // inertia): the sliding velocity stays parallel to b_T, so the slip solution is explicit
+    let tiny = 1e-13 * (a[0] + a[4] + a[8]);
+    let btn = (b[1] * b[1] + b[2] * b[2]).sqrt();
+    if btn > 0.0
+        && a[1].abs() <= tiny
+        && a[2].abs() <= tiny
+        && a[3].abs() <= tiny
+        && a[6].abs() <= tiny
+        && a[5].abs() <= tiny
+        && a[7].abs() <= tiny
+        && (a[4] - a[8]).abs() <= tiny
+        && a[4] > 0.0
+    {
+        let rn = -bn / ann;
+        // stick failed: |b_T| / c > μ r_N, so u_T = b_T (1 − c μ r_N / |b_T|) points along b_T
+        if btn > a[4] * mu * rn {
+            return [rn, -mu * rn * b[1] / btn, -mu * rn * b[2] / btn];
+        }
+    }
     // the previous sliding direction is the better guess inside a Gauss–Seidel loop
     let theta0 = if prev[0] > 0.0 && prev[1].hypot(prev[2]) > 0.0 {
         (-prev[2]).atan2(-prev[1])

@@ -217,7 +217,60 @@ impl BlockDelassusBuilder {
     }
 }
 
+impl Default for BlockDelassus {
+    fn default() -> Self {
+        BlockDelassus { dim: 3, n: 0, diag: Vec::new(), row_start: vec![0], col: Vec::new(), val: Vec::new() }
+    }
+}
+
 impl BlockDelassus {
+    /// Refills the matrix in place for `n` contacts of dimension `dim` from the row-major
+    /// diagonal blocks `diag` (`n d²` entries) and the blocks `W_ij`, `i < j`, listed in `upper`
+    /// with their row-major values in `upper_val` (`d²` each, at most one entry per pair); `W_ji`
+    /// is stored as the transpose. Reuses the storage: no allocation once the capacities have
+    /// grown to the largest problem seen (a time-stepping scheme refills it every step).
+    pub fn refill(&mut self, dim: usize, n: usize, diag: &[f64], upper: &[(usize, usize)], upper_val: &[f64]) {
+        let dd = dim * dim;
+        debug_assert!(diag.len() >= n * dd && upper_val.len() >= upper.len() * dd);
+        self.dim = dim;
+        self.n = n;
+        self.diag.clear();
+        self.diag.extend_from_slice(&diag[..n * dd]);
+        // counting sort of both triangles by block row
+        self.row_start.clear();
+        self.row_start.resize(n + 2, 0);
+        for &(i, j) in upper {
+            debug_assert!(i < j && j < n);
+            self.row_start[i + 2] += 1;
+            self.row_start[j + 2] += 1;
+        }
+        for i in 0..n {
+            self.row_start[i + 2] += self.row_start[i + 1];
+        }
+        let m = 2 * upper.len();
+        self.col.clear();
+        self.col.resize(m, 0);
+        self.val.clear();
+        self.val.resize(m * dd, 0.0);
+        // row_start[i + 1] is the next free slot of row i while filling; afterwards the start of row i + 1
+        for (k, &(i, j)) in upper.iter().enumerate() {
+            let b = &upper_val[k * dd..(k + 1) * dd];
+            let s = self.row_start[i + 1];
+            self.row_start[i + 1] += 1;
+            self.col[s] = j;
+            self.val[s * dd..(s + 1) * dd].copy_from_slice(b);
+            let s = self.row_start[j + 1];
+            self.row_start[j + 1] += 1;
+            self.col[s] = i;
+            for a in 0..dim {
+                for c in 0..dim {
+                    self.val[s * dd + a * dim + c] = b[c * dim + a];
+                }
+            }
+        }
+        self.row_start.truncate(n + 1);
+    }
+
     /// Contact dimension `d`.
     pub fn dim(&self) -> usize {
         self.dim
@@ -289,6 +342,26 @@ impl Delassus {
                     }
                     u[a] += s;
                 }
+            }
+            Delassus::Blocks(bw) if d == 3 => {
+                // the common spatial case with fixed-size blocks (the inner loops unrolled)
+                let (mut u0, mut u1, mut u2) = (0.0, 0.0, 0.0);
+                let mut add = |blk: &[f64], x: &[f64]| {
+                    let (blk, x): (&[f64; 9], &[f64; 3]) = (blk.try_into().unwrap(), x.try_into().unwrap());
+                    u0 += blk[0] * x[0] + blk[1] * x[1] + blk[2] * x[2];
+                    u1 += blk[3] * x[0] + blk[4] * x[1] + blk[5] * x[2];
+                    u2 += blk[6] * x[0] + blk[7] * x[1] + blk[8] * x[2];
+                };
+                if !skip_diagonal {
+                    add(bw.diag_block(i), &r[3 * i..3 * i + 3]);
+                }
+                for k in bw.row_start[i]..bw.row_start[i + 1] {
+                    let j = bw.col[k];
+                    add(&bw.val[9 * k..9 * k + 9], &r[3 * j..3 * j + 3]);
+                }
+                u[0] += u0;
+                u[1] += u1;
+                u[2] += u2;
             }
             Delassus::Blocks(bw) => {
                 if !skip_diagonal {
@@ -497,6 +570,19 @@ impl FrictionContact {
     pub fn friction_reserve(&self, i: usize, r: &[f64]) -> Result<f64> {
         let (ri, _) = self.local(i, r)?;
         Ok(self.mu[i] * ri[0] - (ri[1] * ri[1] + ri[2] * ri[2]).sqrt())
+    }
+
+    /// [`FrictionContact::contact_state`] with the scales `1 + ‖r‖∞` and `1 + ‖q‖∞` computed
+    /// by the caller once for all contacts (the plain call costs O(n) per contact).
+    pub fn contact_state_scaled(&self, i: usize, r: &[f64], tol: f64, r_scale: f64, q_scale: f64) -> Result<ContactState> {
+        let (ri, u) = self.local(i, r)?;
+        Ok(if ri[0] <= tol * r_scale {
+            ContactState::Open
+        } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {
+            ContactState::Slip
+        } else {
+            ContactState::Stick
+        })
     }
 
     /// Open, stick or slip for contact `i` of the solution `r`.

@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::*;
 use crate::contact::narrow::{evaluate, ContactPair};
-use crate::contact::test_util::{close, random_poses, sample, Rng, Trajectory, PAIRS};
+use crate::contact::test_util::{close, random_poses, rot, sample, Rng, Trajectory, PAIRS};
 use crate::contact::Contour;
 use crate::math::Mat3;
 
@@ -85,36 +85,150 @@ fn rates_match_finite_differences_for_every_pair() {
     }
 }
 
-/// Box on box (vertex–face candidates): a tilted box resting over the top face of another, both
-/// moving; the 16 candidates' rates against finite differences, and the reversed pair gives the
-/// same contacts with candidates 0–7 and 8–15 exchanged.
+/// Box–box candidates (the clipped face manifold and the edge–edge point) along prescribed motions
+/// of both boxes: `ṅ`, `Ṗ1`, `Ṗ2` against central differences of the candidate's `n`, `P1`, `P2`;
+/// `ġ_N`, `ġ_T` against the frozen material points; `g̈_N` and `d ġ_T/dt` against differences of
+/// `ġ_N`, `ġ_T`; and the rate of the gap `d g_N/dt = ġ_N + n·(σ1 - σ2)` with `σ_i = Ṗ_i - v_i(P_i)`
+/// the motion of the point over its box. Returns how many used candidates have `n·(σ1 - σ2) = 0`
+/// identically (corners, edge–edge points: there also `g̈_N` against the second difference of
+/// `g_N`) and how many slide over the incident face.
+fn check_box(pair: &ContactPair, tr1: &Trajectory, tr2: &Trajectory, edge: bool, tag: &str) -> (usize, usize) {
+    use crate::contact::narrow::box_box::Feature;
+    let (h1, h2) = (1e-5, 1e-4);
+    let at = |t: f64| kin(pair, &tr1.at(t), &tr2.at(t));
+    let raw = |t: f64, k: usize| {
+        let (m1, m2) = (tr1.at(t), tr2.at(t));
+        pair.candidate(k, &m1.pose, &m2.pose, Some((&m1.twist, &m2.twist)))
+    };
+    let (k0, kp, km) = (at(0.0), at(h1), at(-h1));
+    let (k2p, k2m) = (at(h2), at(-h2));
+    let (m1, m2) = (tr1.at(0.0), tr2.at(0.0));
+    let far = 0.5 * ((m1.pose.r - m2.pose.r).norm() + 0.3);
+    let (mut exact, mut sliding) = (0, 0);
+    for (k, c) in k0.iter().enumerate() {
+        if c.point.g_n > far {
+            continue; // unused
+        }
+        let tag = format!("{tag} candidate {k}");
+        let r = raw(0.0, k);
+        let (rp, rm) = (raw(h1, k), raw(-h1, k));
+        let fd = |a: Vec3, b: Vec3| (a - b) / (2.0 * h1);
+        let tol = |v: &Vec3| 1e-6 * v.norm().max(1.0);
+        for (name, rate, d) in
+            [("n", r.nd, fd(rp.n, rm.n)), ("P1", r.p1d, fd(rp.p1, rm.p1)), ("P2", r.p2d, fd(rp.p2, rm.p2))]
+        {
+            assert!((rate - d).norm() < tol(&d), "{tag}: rate of {name} {rate:?} vs difference {d:?}");
+        }
+        // ġ_N and ġ_T from the material points at P1, P2, frozen in their bodies
+        let (p1b, p2b) =
+            (m1.pose.inverse().point_to_parent(&c.point.p1), m2.pose.inverse().point_to_parent(&c.point.p2));
+        let pos = |tr: &Trajectory, pb: &Vec3, t: f64| tr.at(t).pose.point_to_parent(pb);
+        let dv = (pos(tr1, &p1b, h1) - pos(tr1, &p1b, -h1) - pos(tr2, &p2b, h1) + pos(tr2, &p2b, -h1)) / (2.0 * h1);
+        assert!(close(c.gd_n, c.point.n.dot(&dv), 1e-6), "{tag}: ġ_N vs material points");
+        for (j, t) in [c.point.t1, c.point.t2].iter().enumerate() {
+            assert!(close(c.gd_t[j], t.dot(&dv), 1e-6), "{tag}: ġ_T[{j}]");
+            let d = (kp[k].gd_t[j] - km[k].gd_t[j]) / (2.0 * h1);
+            assert!(close(c.wbar_t[j], d, 1e-6), "{tag}: d ġ_T[{j}]/dt {} vs difference {d}", c.wbar_t[j]);
+        }
+        let d = (kp[k].gd_n - km[k].gd_n) / (2.0 * h1);
+        assert!(close(c.wbar_n, d, 1e-6), "{tag}: g̈_N {} vs difference of ġ_N {d}", c.wbar_n);
+        // the rate of the gap
+        let (s1, s2) = (r.p1d - m1.point_velocity(&r.p1), r.p2d - m2.point_velocity(&r.p2));
+        let defect = r.n.dot(&(s1 - s2));
+        let gd_fd = (kp[k].point.g_n - km[k].point.g_n) / (2.0 * h1);
+        assert!(close(c.gd_n + defect, gd_fd, 1e-6), "{tag}: d g/dt {gd_fd} vs ġ_N {} + n·σ {defect}", c.gd_n);
+        // identically ⟂ n: an edge–edge point, or a corner of the incident face (the point on the
+        // reference face moves in that face, ⟂ n)
+        let corner = match pair.box_feature(&m1.pose, &m2.pose) {
+            Some(Feature::Face { ref_a: true, .. }) => s2.norm() < 1e-12,
+            Some(Feature::Face { ref_a: false, .. }) => s1.norm() < 1e-12,
+            _ => false,
+        };
+        assert_eq!(edge, matches!(pair.box_feature(&m1.pose, &m2.pose), Some(Feature::Edge { .. })), "{tag}");
+        if corner || edge {
+            assert!(defect.abs() < 1e-12, "{tag}: n·σ = {defect}, σ1 {s1:?} σ2 {s2:?} {r:?}");
+            exact += 1;
+            let gdd = (k2p[k].point.g_n - 2.0 * c.point.g_n + k2m[k].point.g_n) / (h2 * h2);
+            assert!(close(c.wbar_n, gdd, 1e-6), "{tag}: g̈_N {} vs second difference {gdd}", c.wbar_n);
+        } else {
+            sliding += 1;
+        }
+    }
+    (exact, sliding)
+}
+
+/// Box on box, both moving: a tilted box over another's top face, turned so that its bottom face
+/// crosses the other's edges (corners, clipped edge points and reference corners in one
+/// manifold), the upper face as the reference when the upper box tips over the lower one's edge,
+/// and crossing edges; the reversed pair gives the same contacts with the normal reversed.
 #[test]
 fn box_on_box_rates_and_reversal() {
     let mut rng = Rng::new(31);
-    let upper = sample("box_b");
-    let lower =
-        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.6, 0.5, 0.2) };
-    let pair = ContactPair::new("bb", upper.clone(), lower.clone()).unwrap();
-    assert_eq!(pair.candidates(), 16);
-    let rev = ContactPair::new("bb", lower, upper).unwrap();
-    for it in 0..6 {
-        let tilt = nalgebra::Rotation3::from_euler_angles(0.1 * it as f64, -0.05, 0.3).into_inner();
-        let x1 = Pose::new(tilt, Vec3::new(0.05, -0.03, 0.32 + 0.01 * it as f64));
-        let x2 = Pose::new(nalgebra::Rotation3::from_euler_angles(0.0, 0.0, 0.2).into_inner(), Vec3::zeros());
-        let tr1 = Trajectory::random(&mut rng, &x1, 0.3, 0.2);
-        let tr2 = Trajectory::random(&mut rng, &x2, 0.3, 0.2);
-        check(&pair, &tr1, &tr2, &format!("box–box #{it}"));
-        let (mut f, mut r) =
-            ([crate::contact::ContactPoint::default(); 16], [crate::contact::ContactPoint::default(); 16]);
-        evaluate(&pair, &x1, &x2, &mut f).unwrap();
-        evaluate(&rev, &x2, &x1, &mut r).unwrap();
-        for k in 0..16 {
-            let (a, b) = (&f[k], &r[(k + 8) % 16]);
-            assert!(
-                (a.g_n - b.g_n).abs() < 1e-14 && (a.n + b.n).norm() < 1e-14 && (a.p1 - b.p2).norm() < 1e-14,
-                "candidate {k}"
-            );
+    let cuboid = |h: Vec3, r: Mat3| Contour::Box { center: Vec3::new(0.01, -0.02, 0.0), rotation: r, half_extents: h };
+    let (wide, square) = (Vec3::new(0.3, 0.1, 0.1), Vec3::new(0.2, 0.2, 0.1));
+    let q = std::f64::consts::FRAC_PI_4;
+    let cases = [
+        // (upper, lower, upper pose, lower pose, used candidates at least, corners expected)
+        (
+            cuboid(wide, Mat3::identity()),
+            cuboid(square, Mat3::identity()),
+            Pose::new(rot(&Vec3::z(), 0.5) * rot(&Vec3::new(1.0, 0.3, 0.0), 0.006), Vec3::new(0.02, -0.01, 0.2012)),
+            Pose::new(rot(&Vec3::z(), 0.1) * rot(&Vec3::new(1.0, -1.0, 0.0), 0.003), Vec3::zeros()),
+            5,
+            true,
+        ),
+        // tipped over the lower box's edge x = 0.2 (the upper face is the reference)
+        (
+            cuboid(Vec3::new(0.2, 0.15, 0.1), Mat3::identity()),
+            cuboid(square, Mat3::identity()),
+            Pose::new(rot(&Vec3::y(), 0.2), Vec3::new(0.35, 0.0, 0.24)),
+            Pose::IDENTITY,
+            3,
+            false,
+        ),
+        // crossing edges
+        (
+            cuboid(Vec3::repeat(0.1), rot(&Vec3::x(), q)),
+            cuboid(Vec3::repeat(0.15), rot(&Vec3::y(), q)),
+            Pose::new(rot(&Vec3::z(), 0.2), Vec3::new(0.0, 0.0, 0.35)),
+            Pose::IDENTITY,
+            1,
+            true,
+        ),
+    ];
+    for (ci, (upper, lower, x1, x2, n_used, corners)) in cases.into_iter().enumerate() {
+        let pair = ContactPair::new("bb", upper.clone(), lower.clone()).unwrap();
+        let rev = ContactPair::new("bb", lower, upper).unwrap();
+        assert_eq!(pair.candidates(), 8);
+        let (mut ex, mut sl) = (0, 0);
+        for it in 0..4 {
+            let tr1 = Trajectory::random(&mut rng, &x1, 0.3, 0.2);
+            let tr2 = if it == 3 { Trajectory::fixed(&x2) } else { Trajectory::random(&mut rng, &x2, 0.3, 0.2) };
+            let (e, s) = check_box(&pair, &tr1, &tr2, ci == 2, &format!("case {ci} #{it}"));
+            assert!(e + s >= n_used, "case {ci}: {e} + {s} candidates in use");
+            ex += e;
+            sl += s;
+            // reversed: the same candidates, normal reversed, points exchanged, same rates
+            let (a, b) = (kin(&pair, &tr1.at(0.0), &tr2.at(0.0)), kin(&rev, &tr2.at(0.0), &tr1.at(0.0)));
+            let far = 0.5 * ((x1.r - x2.r).norm() + 0.3);
+            for (k, (f, r)) in a.iter().zip(&b).enumerate().filter(|(_, (f, _))| f.point.g_n < far) {
+                assert!(
+                    (f.point.g_n - r.point.g_n).abs() < 1e-13 && (f.point.n + r.point.n).norm() < 1e-13,
+                    "case {ci} candidate {k}"
+                );
+                assert!(
+                    (f.point.p1 - r.point.p2).norm() < 1e-13 && (f.point.p2 - r.point.p1).norm() < 1e-13,
+                    "case {ci} candidate {k}"
+                );
+                assert!(
+                    (f.gd_n - r.gd_n).abs() < 1e-12 && (f.wbar_n - r.wbar_n).abs() < 1e-10,
+                    "case {ci} candidate {k}: rates"
+                );
+            }
         }
+        assert_eq!(ex > 0, corners, "case {ci}: corner or edge–edge candidates {ex}");
+        // every face manifold here has sliding points; the edge–edge point does not slide off n
+        assert_eq!(sl > 0, ci != 2, "case {ci}: sliding candidates {sl}");
     }
 }
 

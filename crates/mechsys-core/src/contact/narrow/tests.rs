@@ -39,9 +39,14 @@ fn smooth(c: &Contour) -> bool {
 
 /// Minimum of a function convex on [0, 1] (golden-section search).
 fn argmin01(f: impl Fn(f64) -> f64) -> f64 {
+    argmin01_n(f, 200)
+}
+
+/// The same with `iters` golden-section steps (0.618^iters of the interval).
+fn argmin01_n(f: impl Fn(f64) -> f64, iters: usize) -> f64 {
     let (mut a, mut b) = (0.0, 1.0);
     let g = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..200 {
+    for _ in 0..iters {
         let (c, d) = (b - g * (b - a), a + g * (b - a));
         if f(c) < f(d) {
             b = d;
@@ -60,8 +65,8 @@ fn candidate_counts_and_unsupported_pairs() {
         assert_eq!(candidates(&c1, &c2).unwrap(), n, "{a}–{b}");
         assert_eq!(candidates(&c2, &c1).unwrap(), n, "{b}–{a}");
     }
-    // box–box: each box's eight corners against the other box
-    assert_eq!(candidates(&sample("box"), &sample("box_b")).unwrap(), 16);
+    // box–box: the clipped incident face has at most eight vertices
+    assert_eq!(candidates(&sample("box"), &sample("box_b")).unwrap(), 8);
     for (a, b) in [
         ("cylinder", "box"),
         ("plane", "plane"),
@@ -320,5 +325,312 @@ fn degenerate_configurations_are_defined() {
         let pair = ContactPair::new("n", sample(a), sample(b)).unwrap();
         let _ = eval(&pair, &nan, &Pose::IDENTITY);
         let _ = eval(&pair, &Pose::IDENTITY, &nan);
+    }
+}
+
+// ---- box–box ---------------------------------------------------------------------------------------
+
+fn cuboid(h: Vec3) -> Contour {
+    Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: h }
+}
+
+/// The candidates in use (unused ones carry a gap larger than the pair's whole extent).
+fn used(pair: &ContactPair, x1: &Pose, x2: &Pose) -> Vec<ContactPoint> {
+    let cs = eval(pair, x1, x2);
+    let far = (x1.r - x2.r).norm() + 0.5;
+    let (u, rest): (Vec<_>, Vec<_>) = cs.into_iter().partition(|c| c.g_n < far * 0.5);
+    for c in &rest {
+        assert!(c.g_n > 0.1 && c.g_n.is_finite(), "an unused candidate must stay inactive: {c:?}");
+    }
+    u
+}
+
+/// Equal boxes stacked face on face: four candidates at the corners of the contact square with
+/// the exact gap, the lower box's face as the reference (n = +z), and the same under rounding-
+/// sized perturbations (no flip of the normal, no near-duplicate points).
+#[test]
+fn box_box_aligned_equal_boxes_give_four_corners() {
+    let h = Vec3::new(0.2, 0.15, 0.1);
+    let pair = ContactPair::new("bb", cuboid(h), cuboid(h)).unwrap();
+    assert_eq!(pair.candidates(), 8);
+    for (dz, dx, eps) in
+        [(0.0, 0.0, 0.0), (-1e-6, 0.0, 0.0), (3e-4, 0.0, 0.0), (0.0, 1e-13, 1e-15), (-2e-7, -3e-14, -2e-16)]
+    {
+        let x1 = Pose::new(rot(&Vec3::new(0.3, -0.2, 1.0), eps), Vec3::new(dx, 0.0, 0.2 + dz));
+        let cs = used(&pair, &x1, &Pose::IDENTITY);
+        assert_eq!(cs.len(), 4, "dz {dz} dx {dx}: {cs:?}");
+        for c in &cs {
+            assert!((c.n - Vec3::z()).norm() < 1e-14, "{c:?}");
+            assert!((c.g_n - dz).abs() < 1e-14 + 1e-15 * 0.2, "gap {} vs {dz}", c.g_n);
+            assert!((c.p2.z - 0.1).abs() < 1e-15, "P2 on the lower box's top face");
+            assert!((c.p1.x.abs() - 0.2).abs() < 1e-12 && (c.p1.y.abs() - 0.15).abs() < 1e-12, "a corner: {:?}", c.p1);
+        }
+        // the four distinct corners
+        let mut q: Vec<(i32, i32)> = cs.iter().map(|c| (c.p1.x.signum() as i32, c.p1.y.signum() as i32)).collect();
+        q.sort();
+        assert_eq!(q, vec![(-1, -1), (-1, 1), (1, -1), (1, 1)]);
+    }
+}
+
+/// A cube turned by 45° about the vertical on an equal cube: the contact region is the regular
+/// octagon, vertices at (±h, ±(√2 - 1) h) and (±(√2 - 1) h, ±h), all at the same gap.
+#[test]
+fn box_box_cube_turned_45_degrees_gives_the_octagon() {
+    let h = 0.1;
+    let pair = ContactPair::new("bb", cuboid(Vec3::repeat(h)), cuboid(Vec3::repeat(h))).unwrap();
+    let gap = -2e-5;
+    let x1 = Pose::new(rot(&Vec3::z(), std::f64::consts::FRAC_PI_4), Vec3::new(0.0, 0.0, 2.0 * h + gap));
+    let x2 = Pose::new(Mat3::identity(), Vec3::zeros());
+    let cs = used(&pair, &x1, &x2);
+    assert_eq!(cs.len(), 8, "{cs:?}");
+    let w = (2f64.sqrt() - 1.0) * h;
+    let mut expect: Vec<Vec3> = [(h, w), (h, -w), (-h, w), (-h, -w), (w, h), (-w, h), (w, -h), (-w, -h)]
+        .iter()
+        .map(|&(x, y)| Vec3::new(x, y, h))
+        .collect();
+    for c in &cs {
+        assert!((c.g_n - gap).abs() < 1e-15 && (c.n - Vec3::z()).norm() < 1e-15, "{c:?}");
+        let k =
+            expect.iter().position(|e| (e - c.p2).norm() < 1e-14).unwrap_or_else(|| panic!("{:?} not a vertex", c.p2));
+        expect.remove(k);
+        // P1 on the upper cube's bottom face
+        assert!(sdf(&cuboid(Vec3::repeat(h)), &x1, &c.p1).abs() < 1e-15);
+    }
+    // the same octagon when both are turned together about the vertical and moved
+    let turn = rot(&Vec3::z(), 0.7);
+    let shift = Vec3::new(0.3, -0.2, 0.5);
+    let cs2 = used(&pair, &Pose::new(turn * x1.a, turn * x1.r + shift), &Pose::new(turn, shift));
+    assert_eq!(cs2.len(), 8);
+    for (a, b) in cs.iter().zip(&cs2) {
+        assert!((turn * a.p2 + shift - b.p2).norm() < 1e-14 && (b.g_n - gap).abs() < 1e-15);
+    }
+}
+
+/// Two cubes with crossing edges (upper turned 45° about x, lower 45° about y): one candidate at
+/// the crossing, gap z_1 - z_2 - √2 (h_1 + h_2), normal +z; then the reversed pair.
+#[test]
+fn box_box_crossing_edges_give_the_closed_form_gap() {
+    let (h1, h2) = (0.1, 0.15);
+    let pair = ContactPair::new("ee", cuboid(Vec3::repeat(h1)), cuboid(Vec3::repeat(h2))).unwrap();
+    let rev = ContactPair::new("ee", cuboid(Vec3::repeat(h2)), cuboid(Vec3::repeat(h1))).unwrap();
+    let q = std::f64::consts::FRAC_PI_4;
+    for (gap, off) in [(0.01, Vec3::zeros()), (0.0, Vec3::new(0.02, -0.03, 0.0)), (-1e-3, Vec3::new(-0.01, 0.05, 0.0))]
+    {
+        let z1 = 2f64.sqrt() * (h1 + h2) + gap;
+        let x1 = Pose::new(rot(&Vec3::x(), q), Vec3::new(off.x, off.y, z1));
+        let x2 = Pose::new(rot(&Vec3::y(), q), Vec3::new(-off.y, off.x, 0.0));
+        let cs = used(&pair, &x1, &x2);
+        assert_eq!(cs.len(), 1, "{cs:?}");
+        let c = cs[0];
+        assert!((c.g_n - gap).abs() < 1e-15, "gap {} vs {gap}", c.g_n);
+        assert!((c.n - Vec3::z()).norm() < 1e-15);
+        // on the upper cube's lowest edge (along x) above the lower cube's top edge (along y)
+        let p2 = Vec3::new(-off.y, off.y, 2f64.sqrt() * h2);
+        assert!((c.p2 - p2).norm() < 1e-14 && (c.p1 - p2 - Vec3::z() * gap).norm() < 1e-14, "{c:?}");
+        let r = used(&rev, &x2, &x1);
+        assert!(r.len() == 1 && (r[0].g_n - gap).abs() < 1e-15 && (r[0].n + Vec3::z()).norm() < 1e-15);
+        assert!((r[0].p1 - c.p2).norm() < 1e-14 && (r[0].p2 - c.p1).norm() < 1e-14);
+    }
+}
+
+/// A box tilted over an edge of the lower one's top face: the upper box's face is the reference
+/// once the tilt is larger than the tie tolerance; its normal then turns with the tilt (no flip).
+/// Over a sweep of small rotations of the upper box the normal stays within the tilt of +z.
+#[test]
+fn box_box_normal_is_continuous_under_small_rotations() {
+    let h = Vec3::new(0.2, 0.15, 0.1);
+    let pair = ContactPair::new("bb", cuboid(h), cuboid(h)).unwrap();
+    let mut rng = Rng::new(17);
+    for _ in 0..200 {
+        let axis = rng.unit();
+        let angle = rng.uniform(-1e-3, 1e-3) * 10f64.powi(-(rng.uniform(0.0, 9.0) as i32));
+        let x1 = Pose::new(rot(&axis, angle), Vec3::new(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), 0.2));
+        let cs = used(&pair, &x1, &Pose::IDENTITY);
+        assert!(cs.len() >= 4, "{cs:?}");
+        for c in &cs {
+            assert!(c.n.z > 0.0 && (c.n - Vec3::z()).norm() <= angle.abs() * 1.000001 + 1e-15, "angle {angle}: {c:?}");
+            assert!(c.g_n.abs() < 0.3 * angle.abs() + 1e-15, "{c:?}");
+        }
+    }
+    // overhanging by 0.25 and tipped about the lower box's edge x = 0.2: the upper face is the
+    // reference, n = its bottom normal reversed, and the edge's two ends touch at g = 0
+    for tilt in [1e-6, 0.05, 0.3] {
+        let a = rot(&Vec3::y(), tilt);
+        // the upper bottom face passes through the lower's top edge (0.2, y, 0.1)
+        let c_local = Vec3::new(0.05, 0.0, 0.1); // lower edge point in the upper frame: (x, ·, -0.1) → centre offset
+        let r = Vec3::new(0.2, 0.0, 0.1) + a * Vec3::new(c_local.x, 0.0, c_local.z);
+        let x1 = Pose::new(a, r);
+        let cs = used(&pair, &x1, &Pose::IDENTITY);
+        let n = a * Vec3::z();
+        let touching: Vec<_> = cs.iter().filter(|c| c.g_n.abs() < 1e-13).collect();
+        assert_eq!(touching.len(), 2, "tilt {tilt}: {cs:?}");
+        for c in &cs {
+            assert!((c.n - n).norm() < 1e-13, "tilt {tilt}: n {:?} vs {n:?}", c.n);
+            assert!(c.g_n > -1e-13);
+        }
+        for c in touching {
+            assert!(
+                (c.p2.x - 0.2).abs() < 1e-13 && (c.p2.z - 0.1).abs() < 1e-13 && (c.p2.y.abs() - 0.15).abs() < 1e-13
+            );
+        }
+    }
+}
+
+/// At random placements of two boxes near each other: unit normals, P1 - P2 = g n, orthonormal
+/// frames, both points on their boxes' surfaces for face manifolds, the same manifold in the
+/// reversed order (away from ties), and the least gap equal to the distance of the boxes from
+/// brute force where a face or edge pair is closest (separated boxes).
+#[test]
+fn box_box_random_configurations() {
+    let (ca, cb) = (sample("box"), sample("box_b"));
+    let pair = ContactPair::new("bb", ca.clone(), cb.clone()).unwrap();
+    let rev = ContactPair::new("bb", cb.clone(), ca.clone()).unwrap();
+    let mut rng = Rng::new(123);
+    let (mut faces, mut edges, mut exact, mut fallback) = (0, 0, 0, 0);
+    let corners = |c: &Contour, x: &Pose| -> Vec<Vec3> {
+        let Contour::Box { center, rotation, half_extents: h } = c else { unreachable!() };
+        (0..8)
+            .map(|i| {
+                let s = |b: usize| if i & (1 << b) != 0 { 1.0 } else { -1.0 };
+                x.point_to_parent(&(center + rotation * Vec3::new(s(0) * h.x, s(1) * h.y, s(2) * h.z)))
+            })
+            .collect()
+    };
+    for it in 0..400 {
+        let (x1, mut x2) = random_poses(&mut rng, false);
+        x2.r = x1.r + (x2.r - x1.r).normalize() * rng.uniform(0.15, 0.6);
+        let cs = eval(&pair, &x1, &x2);
+        let rs = eval(&rev, &x2, &x1);
+        let Geometry::BoxBox { a, b, scale } = &pair.geometry else { unreachable!() };
+        let (feature, s) = box_box::feature(&x1, &x2, a, b, *scale);
+        let is_face = matches!(feature, box_box::Feature::Face { .. });
+        if is_face {
+            faces += 1
+        } else {
+            edges += 1
+        }
+        let far = 0.5 * ((x1.r - x2.r).norm() + 0.5);
+        let mut gmin = f64::INFINITY;
+        for (k, c) in cs.iter().enumerate() {
+            let tag = format!("#{it} candidate {k} ({feature:?})");
+            assert!((c.n.norm() - 1.0).abs() < 1e-12, "{tag}");
+            assert!((c.p1 - c.p2 - c.n * c.g_n).norm() < 1e-12, "{tag}: P1 - P2 = g n");
+            let frame = Mat3::from_columns(&[c.t1, c.t2, c.n]);
+            assert!(
+                (frame.transpose() * frame - Mat3::identity()).norm() < 1e-12 && frame.determinant() > 0.0,
+                "{tag}"
+            );
+            if c.g_n > far {
+                continue;
+            }
+            gmin = gmin.min(c.g_n);
+            assert!(c.g_n >= s - 1e-12, "{tag}: a candidate's gap {} below the separation {s}", c.g_n);
+            if let box_box::Feature::Face { ref_a, .. } = feature {
+                // the incident point on its box; the reference point on the reference face, or
+                // (the fallback when the clipped face is empty: one candidate) on its plane
+                let (d1, d2) = (sdf(&ca, &x1, &c.p1), sdf(&cb, &x2, &c.p2));
+                let (d_inc, d_ref) = if ref_a { (d2, d1) } else { (d1, d2) };
+                assert!(d_inc.abs() < 5e-10, "{tag}: incident point off its box by {d_inc}");
+                let in_use = cs.iter().filter(|c| c.g_n < far).count();
+                if d_ref.abs() > 5e-10 {
+                    assert!(in_use == 1 && d_ref > 0.0, "{tag}: reference point off its face by {d_ref}");
+                    fallback += 1;
+                }
+            }
+            // the reversed pair: the same points with the normal reversed (away from ties)
+            let r = &rs[k];
+            assert!((c.g_n - r.g_n).abs() < 1e-13 && (c.n + r.n).norm() < 1e-13, "{tag}: reversed");
+            assert!((c.p1 - r.p2).norm() < 1e-13 && (c.p2 - r.p1).norm() < 1e-13, "{tag}: reversed");
+        }
+        // separated: the distance by brute force (corners against the other box, edges against edges)
+        if gmin.is_finite() && s > 1e-6 {
+            let (k1, k2) = (corners(&ca, &x1), corners(&cb, &x2));
+            let mut dist = k1
+                .iter()
+                .map(|p| sdf(&cb, &x2, p))
+                .chain(k2.iter().map(|p| sdf(&ca, &x1, p)))
+                .fold(f64::INFINITY, f64::min);
+            let edges_of = |k: &[Vec3]| -> Vec<(Vec3, Vec3)> {
+                let mut e = vec![];
+                for i in 0..8 {
+                    for b in 0..3 {
+                        if i & (1 << b) == 0 {
+                            e.push((k[i], k[i | (1 << b)]));
+                        }
+                    }
+                }
+                e
+            };
+            for (p, q) in edges_of(&k1) {
+                for (u, v) in edges_of(&k2) {
+                    let f = |t: f64| argmin01_n(|w| (p + (q - p) * t - u - (v - u) * w).norm(), 70);
+                    dist = dist.min(argmin01_n(f, 70));
+                }
+            }
+            // the separation of the chosen axis is a lower bound; the least candidate gap is the
+            // distance when the closest points are a vertex over a face or two crossing edges
+            assert!(s <= dist + 1e-9, "#{it}: separation {s} above the distance {dist}");
+            if (gmin - dist).abs() < 1e-8 {
+                exact += 1;
+            }
+        }
+    }
+    assert!(faces > 50 && edges > 10, "faces {faces}, edges {edges}");
+    assert!(exact > 30, "exact distances {exact}");
+    assert!((1..10).contains(&fallback), "empty clipped faces {fallback}");
+}
+
+/// The one-pass evaluation of all candidates equals the candidate-by-candidate one (values and
+/// rates), in both orders.
+#[test]
+fn box_box_one_pass_equals_each_candidate() {
+    let mut rng = Rng::new(8);
+    for (c1, c2) in [(sample("box"), sample("box_b")), (sample("box_b"), sample("box"))] {
+        let pair = ContactPair::new("bb", c1, c2).unwrap();
+        for _ in 0..50 {
+            let (x1, mut x2) = random_poses(&mut rng, false);
+            x2.r = x1.r + (x2.r - x1.r).normalize() * rng.uniform(0.15, 0.5);
+            let (w1, w2) = (Motion::new(rng.vec3(1.0), rng.vec3(1.0)), Motion::new(rng.vec3(1.0), rng.vec3(1.0)));
+            let mut all = [Raw::default(); 8];
+            pair.candidates_into(&x1, &x2, Some((&w1, &w2)), &mut all);
+            for (k, a) in all.iter().enumerate() {
+                let b = pair.candidate(k, &x1, &x2, Some((&w1, &w2)));
+                assert!(
+                    a.g == b.g
+                        && a.n == b.n
+                        && a.p1 == b.p1
+                        && a.p2 == b.p2
+                        && a.nd == b.nd
+                        && a.p1d == b.p1d
+                        && a.p2d == b.p2d
+                );
+            }
+        }
+    }
+}
+
+/// Degenerate box–box input: NaN placements do not panic; an incident face that misses the
+/// reference face's slab still gives one candidate (its deepest corner), with the exact gap.
+#[test]
+fn box_box_degenerate_inputs() {
+    let h = Vec3::new(0.2, 0.15, 0.1);
+    let pair = ContactPair::new("bb", cuboid(h), cuboid(Vec3::new(0.05, 0.05, 0.3))).unwrap();
+    let nan = Pose::new(Mat3::repeat(f64::NAN), Vec3::repeat(f64::NAN));
+    let _ = eval(&pair, &nan, &Pose::IDENTITY);
+    let _ = eval(&pair, &Pose::IDENTITY, &nan);
+    let mut out = [Raw::default(); 8];
+    let tw = Motion::new(Vec3::repeat(f64::NAN), Vec3::zeros());
+    pair.candidates_into(&Pose::IDENTITY, &nan, Some((&tw, &tw)), &mut out);
+    // a thin post (body 2, half 0.05 x 0.05 x 0.3) pushed into the middle of a plate's long side
+    // (body 1), overlapping by 0.01 along x: the least overlap is along x, the post's face x is the
+    // reference (it is smaller, but the plate's faces overlap more), and the plate's side face
+    // clipped against the post's side planes gives the post's cross-section, 4 points
+    let x1 = Pose::new(Mat3::identity(), Vec3::new(0.24, 0.0, 0.0));
+    let cs = used(&pair, &x1, &Pose::IDENTITY);
+    assert_eq!(cs.len(), 4, "{cs:?}");
+    let gmin = cs.iter().map(|c| c.g_n).fold(f64::INFINITY, f64::min);
+    assert!((gmin + 0.01).abs() < 1e-14, "{cs:?}");
+    for c in &cs {
+        assert!((c.n - Vec3::x()).norm() < 1e-14);
     }
 }

@@ -1,0 +1,482 @@
+//! Box against box: the separating-axis test and a contact manifold with one normal per pair.
+//!
+//! Box A is the canonical body 1's, box B body 2's; `d = c_A - c_B` joins their centres. Along a
+//! unit axis `u` the two boxes' projections are separated by
+//! `s(u) = |d·u| - Σ_k hA_k |a_k·u| - Σ_l hB_l |b_l·u|` (negative: they overlap by `-s`). The 15
+//! axes are the six face normals `a_i`, `b_j` and the nine edge directions `a_i × b_j`. For
+//! separated boxes the largest `s` is the distance whenever a face or a pair of edges is closest;
+//! for overlapping boxes it is the least overlap, the classic choice of the contact normal.
+//!
+//! **Choice of the axis.** A near tie between two axes must not flip the manifold with rounding
+//! errors (two equal boxes stacked face on face tie exactly between `a_z`, `b_z` and the edge axes
+//! `a_x × b_y`, `a_y × b_x`). Faces of B win over faces of A unless A's separation exceeds B's by
+//! [`TIE`]` · scale` (within it the box with the larger face area is the reference, B when the
+//! areas are equal), and an edge axis wins only if it beats the chosen face axis by that
+//! tolerance plus 10 % of the face's overlap. Edge axes are skipped when the edges are nearly
+//! parallel (`|a_i × b_j| < 1e-6`, no reliable direction) or when the axis lies within ≈ 0.01 rad
+//! of a face normal of either box: both edges then lie nearly in that face's plane, which the face
+//! manifold covers (two equal boxes turned slightly against each other and pressed together would
+//! otherwise pick such an axis by a rounding-sized margin and lose three of their four points).
+//!
+//! **Face manifold.** On the reference face (outward unit normal `m`, pointing towards the other
+//! box, fixed in the reference body) the other box's incident face is the one whose outward
+//! normal is most opposed to `m`. Its four corners are clipped against the reference face's four
+//! side planes (Sutherland–Hodgman): at most 8 vertices `v`, each on the incident face. Each
+//! becomes one candidate with gap `g = m·(v - p_ref)` (`p_ref` on the reference face), the point
+//! `v` on the incident box and `v - g m` on the reference face's plane. Should the incident face
+//! miss the reference face's side planes altogether, its corner deepest along `-m` is the one
+//! candidate (so overlapping boxes are never left without one). The normal of every candidate is
+//! the pair's normal: `m` when B is the reference, `-m` when A is. A vertex within
+//! [`TIE`]` · scale` of a side plane counts as lying on it (no near-duplicate vertex is made), so
+//! equal boxes stacked exactly keep four corner candidates.
+//!
+//! **Edge–edge.** For the axis `u ∝ a_i × b_j` oriented from B to A, the edge of A parallel to
+//! `a_i` farthest along `-u` and the edge of B parallel to `b_j` farthest along `+u`; one
+//! candidate between the closest points of their lines (`P1 - P2 = g u`, `g = s(u)`).
+//!
+//! **Unused candidates.** A pair has [`POINTS`] candidates; those the manifold does not use get the
+//! gap `|d| + |hA| + |hB|` (more than the distance between any two points of the boxes, never
+//! active) with `P2` at B's centre, `P1 = P2 + g n`; their rates are not meaningful.
+//!
+//! **Rates.** A clipped vertex is the intersection of the incident face's plane with two more
+//! planes, each a side plane of the incident face (fixed in the incident body) or of the
+//! reference face (fixed in the reference body). A point kept on a plane fixed in body X moves, normal to
+//! that plane, with body X's material velocity there: `m_k·v̇ = m_k·v_X(v)` for the three planes,
+//! solved for `v̇`. A corner of the incident face is then a material point; a reference corner or
+//! an incident edge crossing a reference side plane slides over the incident face. The gap of
+//! such a sliding vertex changes also by `n·σ` (σ its velocity over the incident face) when that
+//! face is tilted against the reference face, so there `d g_N/dt = n·(v_1(P1) - v_2(P2)) + n·σ`
+//! and the relative normal velocity of the material points (what the time-stepping constrains)
+//! differs from the rate of the gap by a term of the order of the tilt times the sliding speed.
+//! Corners and edge–edge points have `d g_N/dt = ġ_N` exactly.
+
+use crate::math::{Mat3, Vec3};
+use crate::spatial::{Motion, Pose};
+
+use super::{vel, Raw};
+
+/// Candidate points of a box–box pair (the clipped face polygon has at most 8 vertices).
+pub const POINTS: usize = 8;
+
+/// Relative tolerance (times the largest half extent of the pair) of ties between axes and of a
+/// vertex lying on a side plane.
+pub const TIE: f64 = 1e-9;
+
+/// Edge axes with `|a_i × b_j|` below this are skipped.
+const PARALLEL: f64 = 1e-6;
+
+/// Edge axes closer than ≈ 0.01 rad to a face normal are skipped (`cos` of that angle).
+const NEAR_FACE: f64 = 1.0 - 5e-5;
+
+/// An edge axis must beat the face axis by this share of the face's overlap, besides the tie.
+const EDGE_BIAS: f64 = 0.1;
+
+/// A box in its body's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct BoxShape {
+    pub center: Vec3,
+    pub rotation: Mat3,
+    pub half: Vec3,
+}
+
+/// A box placed in the world: centre, axes (columns), half extents.
+#[derive(Clone, Copy)]
+struct Placed {
+    c: Vec3,
+    r: Mat3,
+    h: Vec3,
+}
+
+impl Placed {
+    fn new(b: &BoxShape, x: &Pose) -> Self {
+        Placed { c: x.point_to_parent(&b.center), r: x.a * b.rotation, h: b.half }
+    }
+    #[inline]
+    fn axis(&self, k: usize) -> Vec3 {
+        self.r.column(k).into_owned()
+    }
+    /// Half the length of the box's projection on the unit axis `u`.
+    #[inline]
+    fn radius(&self, u: &Vec3) -> f64 {
+        (0..3).map(|k| self.h[k] * self.axis(k).dot(u).abs()).sum()
+    }
+}
+
+/// The feature pair the separating-axis test chose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Feature {
+    /// A face of B (`ref_a == false`) or of A is the reference; `axis` its normal's index.
+    Face { ref_a: bool, axis: usize },
+    /// Edges parallel to `a_i` and `b_j`.
+    Edge { i: usize, j: usize },
+}
+
+/// The separating-axis test: the chosen feature and its separation `s`.
+fn choose(a: &Placed, b: &Placed, scale: f64) -> (Feature, f64) {
+    let d = a.c - b.c;
+    let tol = TIE * scale;
+    let face = |p: &Placed, q: &Placed| {
+        let mut best = (f64::NEG_INFINITY, 0);
+        for k in 0..3 {
+            let u = p.axis(k);
+            let s = d.dot(&u).abs() - p.h[k] - q.radius(&u);
+            if s > best.0 {
+                best = (s, k);
+            }
+        }
+        best
+    };
+    let (sa, ia) = face(a, b);
+    let (sb, jb) = face(b, a);
+    let ref_a = if (sa - sb).abs() <= tol {
+        // a tie: the larger reference face, B's when equal
+        let area = |p: &Placed, k: usize| p.h[(k + 1) % 3] * p.h[(k + 2) % 3];
+        area(a, ia) > area(b, jb) * (1.0 + 1e-12)
+    } else {
+        sa > sb
+    };
+    let (mut feature, s_face) =
+        if ref_a { (Feature::Face { ref_a, axis: ia }, sa) } else { (Feature::Face { ref_a, axis: jb }, sb) };
+    let mut best_edge = (f64::NEG_INFINITY, 0, 0);
+    for i in 0..3 {
+        for j in 0..3 {
+            let c = a.axis(i).cross(&b.axis(j));
+            let cn = c.norm();
+            if cn < PARALLEL {
+                continue;
+            }
+            let u = c / cn;
+            // an edge axis next to a face normal is that face's contact (the edges lie nearly in it)
+            if (0..3).any(|k| a.axis(k).dot(&u).abs() > NEAR_FACE || b.axis(k).dot(&u).abs() > NEAR_FACE) {
+                continue;
+            }
+            let s = d.dot(&u).abs() - a.radius(&u) - b.radius(&u);
+            if s > best_edge.0 {
+                best_edge = (s, i, j);
+            }
+        }
+    }
+    let mut s = s_face;
+    if best_edge.0 > s_face + tol + EDGE_BIAS * (-s_face).max(0.0) {
+        feature = Feature::Edge { i: best_edge.1, j: best_edge.2 };
+        s = best_edge.0;
+    }
+    (feature, s)
+}
+
+/// A plane through a polygon vertex: which body carries it (`true`: the reference box) and its
+/// outward normal's axis and sign in that box.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Label {
+    on_ref: bool,
+    axis: u8,
+    positive: bool,
+}
+
+/// A vertex of the clipped incident face with the planes it lies on (besides the incident face
+/// itself; the first two define it).
+#[derive(Debug, Clone, Copy, Default)]
+struct Vertex {
+    p: Vec3,
+    labels: [Label; 4],
+    count: u8,
+}
+
+impl Vertex {
+    fn has(&self, l: &Label) -> bool {
+        self.labels[..self.count as usize].contains(l)
+    }
+    fn add(&mut self, l: Label) {
+        if !self.has(&l) && (self.count as usize) < self.labels.len() {
+            self.labels[self.count as usize] = l;
+            self.count += 1;
+        }
+    }
+}
+
+/// The clipped incident face of a face contact: vertices, the reference normal `m` (outward of
+/// the reference face, fixed in the reference body) and a point `p_ref` of the reference face;
+/// `f` the incident face's outward normal.
+struct Manifold {
+    v: [Vertex; POINTS],
+    count: usize,
+    m: Vec3,
+    p_ref: Vec3,
+    f: Vec3,
+}
+
+/// Clips the incident box's face most opposed to the reference face `axis` of `rf`.
+fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
+    let tol = TIE * scale;
+    let ra = rf.axis(axis);
+    let sgn = if (inc.c - rf.c).dot(&ra) >= 0.0 { 1.0 } else { -1.0 };
+    let m = ra * sgn;
+    let p_ref = rf.c + m * rf.h[axis];
+    // the incident face: outward normal most opposed to m
+    let dots = Vec3::from_fn(|k, _| inc.axis(k).dot(&m));
+    let j = dots.iamax();
+    let fs = if dots[j] > 0.0 { -1.0 } else { 1.0 };
+    let f = inc.axis(j) * fs;
+    let fc = inc.c + f * inc.h[j];
+    let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+    let (u1, u2) = (inc.axis(j1), inc.axis(j2));
+    let mut buf = [[Vertex::default(); POINTS]; 2];
+    for (n, v) in buf[0].iter_mut().take(4).enumerate() {
+        *v = corner(&fc, &u1, &u2, inc.h[j1], inc.h[j2], n, j1, j2);
+    }
+    let mut count = 4;
+    let mut cur = 0;
+    for k in [(axis + 1) % 3, (axis + 2) % 3] {
+        let e = rf.axis(k);
+        for positive in [true, false] {
+            // the side plane ±e·(x - c) = h
+            let normal = if positive { e } else { -e };
+            let label = Label { on_ref: true, axis: k as u8, positive };
+            let dist = |p: &Vec3| normal.dot(&(p - rf.c)) - rf.h[k];
+            let (src, dst) = if cur == 0 {
+                let (a, b) = buf.split_at_mut(1);
+                (&a[0], &mut b[0])
+            } else {
+                let (a, b) = buf.split_at_mut(1);
+                (&b[0], &mut a[0])
+            };
+            let mut out = 0;
+            for q in 0..count {
+                let (p, qv) = (&src[(q + count - 1) % count], &src[q]);
+                let (dp, dq) = (dist(&p.p), dist(&qv.p));
+                let crossing = |out: &mut usize, dst: &mut [Vertex; POINTS]| {
+                    // the edge p → q lies on their common plane; the new vertex on it and on this one
+                    let t = dp / (dp - dq);
+                    let mut x = Vertex { p: p.p + (qv.p - p.p) * t, ..Default::default() };
+                    let common = p.labels[..p.count as usize].iter().find(|l| qv.has(l)).copied();
+                    x.add(common.unwrap_or(p.labels[0]));
+                    x.add(label);
+                    if *out < POINTS {
+                        dst[*out] = x;
+                        *out += 1;
+                    }
+                };
+                if dq <= tol {
+                    if dp > tol && dq < -tol {
+                        crossing(&mut out, dst);
+                    }
+                    let mut kept = *qv;
+                    if dq.abs() <= tol {
+                        kept.add(label);
+                    }
+                    if out < POINTS {
+                        dst[out] = kept;
+                        out += 1;
+                    }
+                } else if dp < -tol {
+                    crossing(&mut out, dst);
+                }
+            }
+            count = out;
+            cur = 1 - cur;
+            if count == 0 {
+                break;
+            }
+        }
+        if count == 0 {
+            break;
+        }
+    }
+    if count == 0 {
+        // the incident face misses the reference face's slab (overlapping boxes at odd angles,
+        // or separated ones): keep its corner deepest along -m, a material point
+        let at = |n: usize| corner(&fc, &u1, &u2, inc.h[j1], inc.h[j2], n, j1, j2);
+        let deepest = (0..4).min_by(|&p, &q| at(p).p.dot(&m).total_cmp(&at(q).p.dot(&m))).unwrap_or(0);
+        return Manifold { v: [at(deepest); POINTS], count: 1, m, p_ref, f };
+    }
+    Manifold { v: buf[cur], count, m, p_ref, f }
+}
+
+/// Corner `n` of the incident face (cyclic order (-,-), (+,-), (+,+), (-,+) along `u1`, `u2`),
+/// labelled with the incident box's two side planes through it.
+#[allow(clippy::too_many_arguments)]
+fn corner(fc: &Vec3, u1: &Vec3, u2: &Vec3, e1: f64, e2: f64, n: usize, j1: usize, j2: usize) -> Vertex {
+    let (s1, s2) = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)][n];
+    let mut v = Vertex { p: fc + u1 * (s1 * e1) + u2 * (s2 * e2), ..Default::default() };
+    v.add(Label { on_ref: false, axis: j1 as u8, positive: s1 > 0.0 });
+    v.add(Label { on_ref: false, axis: j2 as u8, positive: s2 > 0.0 });
+    v
+}
+
+/// Candidate `k` of two boxes, canonical order (A on body 1, B on body 2).
+pub(super) fn box_box(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    sa: &BoxShape,
+    sb: &BoxShape,
+    scale: f64,
+    k: usize,
+) -> Raw {
+    let mut out = [Raw::default(); POINTS];
+    box_box_all(x1, x2, tw, sa, sb, scale, &mut out);
+    out[k]
+}
+
+/// All [`POINTS`] candidates of two boxes into `out`, canonical order.
+pub(super) fn box_box_all(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    sa: &BoxShape,
+    sb: &BoxShape,
+    scale: f64,
+    out: &mut [Raw],
+) {
+    let (a, b) = (Placed::new(sa, x1), Placed::new(sb, x2));
+    let (feature, _) = choose(&a, &b, scale);
+    match feature {
+        Feature::Face { ref_a, axis } => {
+            let (rf, inc) = if ref_a { (&a, &b) } else { (&b, &a) };
+            let mf = clip(rf, inc, axis, scale);
+            // the pair's normal, from B towards A
+            let n = if ref_a { -mf.m } else { mf.m };
+            for (k, o) in out.iter_mut().enumerate().take(POINTS) {
+                *o = if k < mf.count {
+                    face_point(&mf, &mf.v[k], ref_a, &a, &b, n, tw)
+                } else {
+                    unused(&a, &b, n, tw, ref_a)
+                };
+            }
+        }
+        Feature::Edge { i, j } => {
+            let e = edge_point(&a, &b, i, j, tw);
+            out[0] = e;
+            for o in out.iter_mut().take(POINTS).skip(1) {
+                *o = unused(&a, &b, e.n, tw, false);
+            }
+        }
+    }
+}
+
+/// One vertex of a face manifold as a candidate, with rates.
+fn face_point(
+    mf: &Manifold,
+    vx: &Vertex,
+    ref_a: bool,
+    a: &Placed,
+    b: &Placed,
+    n: Vec3,
+    tw: Option<(&Motion, &Motion)>,
+) -> Raw {
+    let g = mf.m.dot(&(vx.p - mf.p_ref));
+    let q = vx.p - mf.m * g;
+    let mut out = if ref_a {
+        Raw { g, n, p1: q, p2: vx.p, ..Default::default() }
+    } else {
+        Raw { g, n, p1: vx.p, p2: q, ..Default::default() }
+    };
+    if let Some((t1, t2)) = tw {
+        let (t_ref, t_inc) = if ref_a { (t1, t2) } else { (t2, t1) };
+        let (r_ref, r_inc) = if ref_a { (&a.r, &b.r) } else { (&b.r, &a.r) };
+        // m_k·v̇ = m_k·v_X(v) for the incident face and the vertex's two defining planes
+        let planes = [(mf.f, false), plane(&vx.labels[0], r_ref, r_inc), plane(&vx.labels[1], r_ref, r_inc)];
+        let rhs = planes.map(|(nk, on_ref)| nk.dot(&vel(if on_ref { t_ref } else { t_inc }, &vx.p)));
+        let (c0, c1, c2) =
+            (planes[1].0.cross(&planes[2].0), planes[2].0.cross(&planes[0].0), planes[0].0.cross(&planes[1].0));
+        let det = planes[0].0.dot(&c0);
+        let vd = if vx.count >= 2 && det.abs() > 1e-12 {
+            (c0 * rhs[0] + c1 * rhs[1] + c2 * rhs[2]) / det
+        } else {
+            vel(t_inc, &vx.p)
+        };
+        let md = t_ref.w.cross(&mf.m);
+        let gd = md.dot(&(vx.p - mf.p_ref)) + mf.m.dot(&(vd - vel(t_ref, &mf.p_ref)));
+        let qd = vd - mf.m * gd - md * g;
+        if ref_a {
+            out.nd = -md;
+            out.p1d = qd;
+            out.p2d = vd;
+        } else {
+            out.nd = md;
+            out.p1d = vd;
+            out.p2d = qd;
+        }
+    }
+    out
+}
+
+/// The edge–edge candidate of the edges parallel to `a_i` and `b_j`, with rates.
+fn edge_point(a: &Placed, b: &Placed, i: usize, j: usize, tw: Option<(&Motion, &Motion)>) -> Raw {
+    let (ai, bj) = (a.axis(i), b.axis(j));
+    let c = ai.cross(&bj);
+    let cn = c.norm();
+    let d = a.c - b.c;
+    let sigma = if d.dot(&c) >= 0.0 { 1.0 } else { -1.0 };
+    let n = c * (sigma / cn);
+    // the extreme edges: A's towards B (along -n), B's towards A (along +n)
+    let side = |x: f64| if x >= 0.0 { 1.0 } else { -1.0 };
+    let mut ea = a.c;
+    let mut eb = b.c;
+    for l in 0..3 {
+        if l != i {
+            ea -= a.axis(l) * (side(a.axis(l).dot(&n)) * a.h[l]);
+        }
+        if l != j {
+            eb += b.axis(l) * (side(b.axis(l).dot(&n)) * b.h[l]);
+        }
+    }
+    // closest points of the lines ea + s a_i, eb + t b_j (unit directions, cos = a_i·b_j)
+    let r = ea - eb;
+    let cab = ai.dot(&bj);
+    let den = 1.0 - cab * cab;
+    let s = (cab * bj.dot(&r) - ai.dot(&r)) / den;
+    let t = cab * s + bj.dot(&r);
+    let x1p = ea + ai * s;
+    let x2p = eb + bj * t;
+    let g = n.dot(&(x1p - x2p));
+    let mut out = Raw { g, n, p1: x1p, p2: x1p - n * g, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        let (ad, bd) = (t1.w.cross(&ai), t2.w.cross(&bj));
+        let cd = ad.cross(&bj) + ai.cross(&bd);
+        let u = c / cn;
+        let nd = (cd - u * u.dot(&cd)) * (sigma / cn);
+        // d/dt a_i·(X1 - X2) = 0 and d/dt b_j·(X1 - X2) = 0 with X1 = material point + ṡ a_i
+        let dd = x1p - x2p;
+        let dv = vel(t1, &x1p) - vel(t2, &x2p);
+        let (b1, b2) = (-ad.dot(&dd) - ai.dot(&dv), -bd.dot(&dd) - bj.dot(&dv));
+        let sd = (b1 - cab * b2) / den;
+        let td = cab * sd - b2;
+        let x1d = vel(t1, &x1p) + ai * sd;
+        let x2d = vel(t2, &x2p) + bj * td;
+        let gd = nd.dot(&dd) + n.dot(&(x1d - x2d));
+        out.nd = nd;
+        out.p1d = x1d;
+        out.p2d = x1d - n * gd - nd * g;
+    }
+    out
+}
+
+/// World normal of a labelled plane and whether the reference body carries it.
+#[inline]
+fn plane(l: &Label, r_ref: &Mat3, r_inc: &Mat3) -> (Vec3, bool) {
+    let axis = if l.on_ref { r_ref.column(l.axis as usize) } else { r_inc.column(l.axis as usize) };
+    let s = if l.positive { 1.0 } else { -1.0 };
+    (axis * s, l.on_ref)
+}
+
+/// An unused candidate: never active, finite (see the module docs).
+fn unused(a: &Placed, b: &Placed, n: Vec3, tw: Option<(&Motion, &Motion)>, ref_a: bool) -> Raw {
+    let g = (a.c - b.c).norm() + a.h.norm() + b.h.norm();
+    let p2 = b.c;
+    let p1 = p2 + n * g;
+    let mut out = Raw { g, n, p1, p2, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        // the normal turns with the reference body; the points move with their bodies
+        out.nd = if ref_a { t1.w.cross(&n) } else { t2.w.cross(&n) };
+        out.p1d = vel(t1, &p1);
+        out.p2d = vel(t2, &p2);
+    }
+    out
+}
+
+/// The chosen feature at body placements `x1`, `x2` (for tests and diagnostics).
+#[cfg(test)]
+pub(super) fn feature(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> (Feature, f64) {
+    choose(&Placed::new(sa, x1), &Placed::new(sb, x2), scale)
+}

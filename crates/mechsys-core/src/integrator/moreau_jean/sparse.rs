@@ -1,0 +1,466 @@
+//! Sparse assembly of the local contact problem on a kinematic tree (models without bilateral
+//! constraints).
+//!
+//! The row `w_a` of a contact (its normal or a tangent, `w_a = J_P1ᵀ e - J_P2ᵀ e`) is nonzero
+//! only on the velocities of the root paths of its two bodies, a set closed under ancestors in
+//! the velocity tree. With the tree factor `M = Lᵀ D L` (no fill, see
+//! [`crate::dynamics::sparse`]), `M⁻¹ = L⁻¹ D⁻¹ L⁻ᵀ` and `y_a = D^{-1/2} L⁻ᵀ w_a` keeps the
+//! pattern of `w_a` (the back substitution runs from the leaves to the root), so the Delassus
+//! matrix `Wᵀ M⁻¹ W` has the blocks `W_ij = Σ_k y_i,k y_j,kᵀ` over the velocities `k` the two
+//! contacts share. Two patterns meet exactly when the contacts have a tree in common, i.e. share
+//! the root velocity of one of their bodies' paths: contacts are bucketed by those roots and only
+//! pairs within a bucket are formed. The impulses act through `u⁺ = u_free + M⁻¹ Σ_a w_a Λ_a`,
+//! one scatter and one O(nu) solve.
+//!
+//! Cost per step: O(Σ pattern lengths × d) for the rows, O(Σ_pairs shared velocities × d²) for
+//! the blocks, O(nu) for the update — for N free bodies with a bounded number of contacts each,
+//! O(N). All storage grows to the largest problem seen and is reused: no allocation afterwards.
+
+use crate::math::Vec3;
+use crate::model::Model;
+use crate::spatial::Motion;
+
+/// `M = Lᵀ D L` on the velocity tree (the same recursion as the constrained solve's factor,
+/// kept here so that the contact rows can be reduced on their own patterns).
+#[derive(Debug, Clone)]
+pub(super) struct TreeFactor {
+    nu: usize,
+    depth: Vec<usize>,
+    /// Ancestors of velocity k, nearest first: `anc_idx[anc_ptr[k]..anc_ptr[k + 1]]`.
+    anc_ptr: Vec<usize>,
+    anc_idx: Vec<usize>,
+    /// `M(k, ancestor)`, then `L` after [`TreeFactor::factor`].
+    off: Vec<f64>,
+    /// Diagonal of M, then D.
+    diag: Vec<f64>,
+    /// `D^{-1/2}` after factoring.
+    inv_sqrt_d: Vec<f64>,
+}
+
+impl TreeFactor {
+    fn new(model: &Model) -> Self {
+        let nu = model.nu;
+        // within a joint each velocity hangs on the previous one; a joint's first velocity on the
+        // last velocity of the nearest ancestor joint that has any
+        let mut parent = vec![usize::MAX; nu];
+        let mut last = vec![usize::MAX; model.nbodies()];
+        for (ji, j) in model.joints.iter().enumerate() {
+            let mut p = last[j.parent];
+            for k in 0..j.nu() {
+                parent[j.iu + k] = p;
+                p = j.iu + k;
+            }
+            last[ji + 1] = p;
+        }
+        let mut depth = vec![0; nu];
+        let (mut anc_ptr, mut anc_idx) = (vec![0; nu + 1], Vec::new());
+        for k in 0..nu {
+            let mut a = parent[k];
+            while a != usize::MAX {
+                anc_idx.push(a);
+                a = parent[a];
+            }
+            anc_ptr[k + 1] = anc_idx.len();
+            depth[k] = anc_ptr[k + 1] - anc_ptr[k];
+        }
+        TreeFactor {
+            nu,
+            depth,
+            off: vec![0.0; anc_idx.len()],
+            anc_ptr,
+            anc_idx,
+            diag: vec![0.0; nu],
+            inv_sqrt_d: vec![0.0; nu],
+        }
+    }
+
+    /// Sets `M(r, c)` (either triangle; r and c on one root path).
+    #[inline]
+    pub(super) fn put(&mut self, r: usize, c: usize, v: f64) {
+        if r == c {
+            self.diag[r] = v;
+        } else {
+            let (hi, lo) = if r > c { (r, c) } else { (c, r) };
+            self.off[self.anc_ptr[hi] + self.depth[hi] - 1 - self.depth[lo]] = v;
+        }
+    }
+
+    /// Factors in place, leaves first: `M = Lᵀ D L`; false if a pivot is not positive.
+    pub(super) fn factor(&mut self) -> bool {
+        let scale = self.diag.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
+        for k in (0..self.nu).rev() {
+            let d = self.diag[k];
+            if !(d > 1e-14 * scale) {
+                return false;
+            }
+            let (s, e) = (self.anc_ptr[k], self.anc_ptr[k + 1]);
+            for p in 0..e - s {
+                let i = self.anc_idx[s + p];
+                let mk = self.off[s + p];
+                let a = mk / d;
+                self.diag[i] -= a * mk;
+                // M(i, j) -= a M(k, j) for the ancestors j of i (they follow i on k's path)
+                let si = self.anc_ptr[i];
+                for q in p + 1..e - s {
+                    self.off[si + q - p - 1] -= a * self.off[s + q];
+                }
+                self.off[s + p] = a;
+            }
+            self.inv_sqrt_d[k] = 1.0 / d.sqrt();
+        }
+        true
+    }
+
+    /// `x ← M⁻¹ x`.
+    pub(super) fn solve(&self, x: &mut [f64]) {
+        for k in (0..self.nu).rev() {
+            let xk = x[k];
+            if xk != 0.0 {
+                for p in self.anc_ptr[k]..self.anc_ptr[k + 1] {
+                    x[self.anc_idx[p]] -= self.off[p] * xk;
+                }
+            }
+        }
+        for k in 0..self.nu {
+            let mut s = x[k] / self.diag[k];
+            for p in self.anc_ptr[k]..self.anc_ptr[k + 1] {
+                s -= self.off[p] * x[self.anc_idx[p]];
+            }
+            x[k] = s;
+        }
+    }
+}
+
+/// Contact rows on their patterns, their reduced form `y`, and the Delassus blocks.
+#[derive(Debug, Clone)]
+pub(super) struct SparseRows {
+    pub(super) factor: TreeFactor,
+    dim: usize,
+    /// Root velocity of body b's path (usize::MAX for the ground and bodies without velocities).
+    root: Vec<usize>,
+    /// Pattern of contact a: `pat_idx[pat_ptr[a]..pat_ptr[a + 1]]`, ascending.
+    pat_ptr: Vec<usize>,
+    pat_idx: Vec<usize>,
+    /// The pattern of contact a as runs of consecutive velocities (one per joint on the two root
+    /// paths): `(first velocity, length, first pattern entry)` in `runs[run_ptr[a]..run_ptr[a + 1]]`.
+    run_ptr: Vec<usize>,
+    runs: Vec<(usize, usize, usize)>,
+    /// Runs of the root path of body b (joint velocity ranges), ascending.
+    body_runs_ptr: Vec<usize>,
+    body_runs: Vec<(usize, usize)>,
+    /// Rows on the pattern, `dim` values per pattern entry (entry e, row r at `e dim + r`).
+    w: Vec<f64>,
+    /// `D^{-1/2} L⁻ᵀ w` on the pattern, same layout.
+    y: Vec<f64>,
+    /// The two roots of each contact (usize::MAX if none).
+    roots: Vec<[usize; 2]>,
+    /// Scratch: position of a velocity in the current pattern (nu).
+    pos: Vec<usize>,
+    /// Contacts bucketed by root velocity.
+    bucket_ptr: Vec<usize>,
+    bucket: Vec<usize>,
+    /// Row-major diagonal blocks (n d²).
+    pub(super) diag: Vec<f64>,
+    /// Off-diagonal pairs (i < j) and their row-major blocks.
+    pub(super) upper: Vec<(usize, usize)>,
+    pub(super) upper_val: Vec<f64>,
+    /// Scratch (nu).
+    f: Vec<f64>,
+}
+
+impl SparseRows {
+    /// Planned for `model`, contact dimension `dim`.
+    pub(super) fn new(model: &Model, dim: usize) -> Self {
+        let factor = TreeFactor::new(model);
+        let nb = model.nbodies();
+        let mut root = vec![usize::MAX; nb];
+        let (mut body_runs_ptr, mut body_runs) = (vec![0; nb + 1], Vec::new());
+        let mut buf = Vec::new();
+        for b in 0..nb {
+            let s0 = body_runs.len();
+            let mut x = b;
+            while x != 0 {
+                let j = &model.joints[x - 1];
+                if j.nu() > 0 {
+                    body_runs.push((j.iu, j.nu()));
+                }
+                x = j.parent;
+            }
+            body_runs[s0..].reverse();
+            body_runs_ptr[b + 1] = body_runs.len();
+            buf.clear();
+            let mut x = b;
+            while x != 0 {
+                let j = &model.joints[x - 1];
+                buf.extend(j.iu..j.iu + j.nu());
+                x = j.parent;
+            }
+            buf.sort_unstable();
+            root[b] = buf.first().copied().unwrap_or(usize::MAX);
+        }
+        SparseRows {
+            factor,
+            dim,
+            root,
+            pat_ptr: vec![0],
+            pat_idx: Vec::new(),
+            run_ptr: vec![0],
+            runs: Vec::new(),
+            body_runs_ptr,
+            body_runs,
+            w: Vec::new(),
+            y: Vec::new(),
+            roots: Vec::new(),
+            pos: vec![0; model.nu],
+            bucket_ptr: vec![0; model.nu + 2],
+            bucket: Vec::new(),
+            diag: Vec::new(),
+            upper: Vec::new(),
+            upper_val: Vec::new(),
+            f: vec![0.0; model.nu],
+        }
+    }
+
+    /// Forgets the contacts of the previous step.
+    pub(super) fn clear(&mut self) {
+        self.pat_ptr.truncate(1);
+        self.pat_idx.clear();
+        self.run_ptr.truncate(1);
+        self.runs.clear();
+        self.w.clear();
+        self.y.clear();
+        self.roots.clear();
+    }
+
+    /// Number of contacts added since [`SparseRows::clear`].
+    pub(super) fn len(&self) -> usize {
+        self.roots.len()
+    }
+
+    /// Adds the rows `dirs[r]ᵀ (J_P1 - J_P2)`, r < dim, of a contact between `p1` on `b1` and `p2`
+    /// on `b2` (world points), and reduces them (the factor must be current).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn add_contact(
+        &mut self,
+        model: &Model,
+        s_all: &[[Motion; 6]],
+        b1: usize,
+        p1: &Vec3,
+        b2: usize,
+        p2: &Vec3,
+        dirs: &[Vec3; 3],
+    ) {
+        let d = self.dim;
+        let start = self.pat_idx.len();
+        // pattern: the union of the two ascending paths, joint by joint (two runs are the same
+        // joint or disjoint)
+        let (mut x, xe) = (self.body_runs_ptr[b1], self.body_runs_ptr[b1 + 1]);
+        let (mut z, ze) = (self.body_runs_ptr[b2], self.body_runs_ptr[b2 + 1]);
+        while x < xe || z < ze {
+            let a = if x < xe { self.body_runs[x] } else { (usize::MAX, 0) };
+            let c = if z < ze { self.body_runs[z] } else { (usize::MAX, 0) };
+            let run = if a.0 <= c.0 { a } else { c };
+            if a.0 == run.0 {
+                x += 1;
+            }
+            if c.0 == run.0 {
+                z += 1;
+            }
+            let e0 = self.pat_idx.len() - start;
+            self.runs.push((run.0, run.1, self.pat_idx.len()));
+            for k in run.0..run.0 + run.1 {
+                self.pos[k] = e0 + k - run.0;
+                self.pat_idx.push(k);
+            }
+        }
+        self.run_ptr.push(self.runs.len());
+        let len = self.pat_idx.len() - start;
+        self.pat_ptr.push(self.pat_idx.len());
+        self.roots.push([self.root[b1], self.root[b2]]);
+        let w0 = self.w.len();
+        self.w.resize(w0 + len * d, 0.0);
+        // eq. 2.112 ff.: w = J_P1ᵀ e - J_P2ᵀ e, J_P of a body point from the joint subspaces
+        for (body, p, sign) in [(b1, p1, 1.0), (b2, p2, -1.0)] {
+            let mut b = body;
+            while b != 0 {
+                let j = &model.joints[b - 1];
+                for k in 0..j.nu() {
+                    let s = &s_all[b][k];
+                    let v = (s.v + s.w.cross(p)) * sign;
+                    let e = w0 + self.pos[j.iu + k] * d;
+                    for r in 0..d {
+                        self.w[e + r] += dirs[r].dot(&v);
+                    }
+                }
+                b = j.parent;
+            }
+        }
+        // y = D^{-1/2} L⁻ᵀ w on the pattern, leaves first
+        self.y.extend_from_slice(&self.w[w0..w0 + len * d]);
+        let f = &self.factor;
+        for e in (0..len).rev() {
+            let k = self.pat_idx[start + e];
+            let ye = w0 + e * d;
+            for p in f.anc_ptr[k]..f.anc_ptr[k + 1] {
+                let l = f.off[p];
+                let ya = w0 + self.pos[f.anc_idx[p]] * d;
+                for r in 0..d {
+                    self.y[ya + r] -= l * self.y[ye + r];
+                }
+            }
+        }
+        for e in 0..len {
+            let s = f.inv_sqrt_d[self.pat_idx[start + e]];
+            for r in 0..d {
+                self.y[w0 + e * d + r] *= s;
+            }
+        }
+    }
+
+    /// The Delassus blocks of the contacts added: `diag` (n d², row-major) and the coupled pairs
+    /// in `upper`, `upper_val`. A tangent row that is zero (a direction along which nothing can
+    /// move, e.g. out of the plane of a planar mechanism) gets the normal's diagonal value so that
+    /// its impulse comes out zero.
+    pub(super) fn delassus(&mut self) {
+        let (d, n) = (self.dim, self.len());
+        let dd = d * d;
+        self.diag.clear();
+        self.diag.resize(n * dd, 0.0);
+        for a in 0..n {
+            let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+            let blk = &mut self.diag[a * dd..(a + 1) * dd];
+            for x in s..e {
+                let y = &self.y[x * d..(x + 1) * d];
+                for r in 0..d {
+                    for c in 0..d {
+                        blk[r * d + c] += y[r] * y[c];
+                    }
+                }
+            }
+            for r in 1..d {
+                if (s..e).all(|x| self.w[x * d + r] == 0.0) {
+                    blk[r * d + r] = blk[0].max(f64::MIN_POSITIVE);
+                }
+            }
+        }
+        // buckets of contacts by root velocity
+        let nu = self.pos.len();
+        self.bucket_ptr.clear();
+        self.bucket_ptr.resize(nu + 2, 0);
+        for rt in &self.roots {
+            for (q, &r) in rt.iter().enumerate() {
+                if r != usize::MAX && !(q == 1 && rt[0] == r) {
+                    self.bucket_ptr[r + 2] += 1;
+                }
+            }
+        }
+        for k in 0..nu {
+            self.bucket_ptr[k + 2] += self.bucket_ptr[k + 1];
+        }
+        let total = self.bucket_ptr[nu + 1];
+        self.bucket.clear();
+        self.bucket.resize(total, 0);
+        for (a, rt) in self.roots.iter().enumerate() {
+            for (q, &r) in rt.iter().enumerate() {
+                if r != usize::MAX && !(q == 1 && rt[0] == r) {
+                    let slot = self.bucket_ptr[r + 1];
+                    self.bucket[slot] = a;
+                    self.bucket_ptr[r + 1] += 1;
+                }
+            }
+        }
+        // bucket_ptr[r]..bucket_ptr[r + 1] now lists root r's contacts, ascending
+        self.upper.clear();
+        self.upper_val.clear();
+        for r in 0..nu {
+            let (s, e) = (self.bucket_ptr[r], self.bucket_ptr[r + 1]);
+            for x in s..e {
+                let i = self.bucket[x];
+                for z in x + 1..e {
+                    let j = self.bucket[z];
+                    // the pair is formed at the smallest root the two contacts share
+                    let shared = self.roots[i]
+                        .iter()
+                        .filter(|&&ri| ri != usize::MAX && self.roots[j].contains(&ri))
+                        .min()
+                        .copied();
+                    if shared != Some(r) {
+                        continue;
+                    }
+                    let off = self.upper_val.len();
+                    self.upper_val.resize(off + dd, 0.0);
+                    // Σ over the shared velocities: the runs both patterns have (ascending)
+                    let (mut p, pe) = (self.run_ptr[i], self.run_ptr[i + 1]);
+                    let (mut q, qe) = (self.run_ptr[j], self.run_ptr[j + 1]);
+                    while p < pe && q < qe {
+                        let ((kp, len, ep), (kq, _, eq)) = (self.runs[p], self.runs[q]);
+                        if kp < kq {
+                            p += 1;
+                        } else if kq < kp {
+                            q += 1;
+                        } else {
+                            let blk = &mut self.upper_val[off..off + dd];
+                            let (ya, yb) = (&self.y[ep * d..(ep + len) * d], &self.y[eq * d..(eq + len) * d]);
+                            if d == 3 {
+                                let blk: &mut [f64; 9] = blk.try_into().unwrap();
+                                for (a, b) in ya.chunks_exact(3).zip(yb.chunks_exact(3)) {
+                                    for r in 0..3 {
+                                        blk[3 * r] += a[r] * b[0];
+                                        blk[3 * r + 1] += a[r] * b[1];
+                                        blk[3 * r + 2] += a[r] * b[2];
+                                    }
+                                }
+                            } else {
+                                for (a, b) in ya.chunks_exact(d).zip(yb.chunks_exact(d)) {
+                                    for r in 0..d {
+                                        for c in 0..d {
+                                            blk[r * d + c] += a[r] * b[c];
+                                        }
+                                    }
+                                }
+                            }
+                            p += 1;
+                            q += 1;
+                        }
+                    }
+                    self.upper.push((i, j));
+                }
+            }
+        }
+    }
+
+    /// `out[r] = w_{a,r}ᵀ u`, r < dim, for contact `a`.
+    pub(super) fn local_velocity(&self, a: usize, u: &[f64], out: &mut [f64; 3]) {
+        let d = self.dim;
+        *out = [0.0; 3];
+        for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
+            let uk = u[self.pat_idx[x]];
+            for r in 0..d {
+                out[r] += self.w[x * d + r] * uk;
+            }
+        }
+    }
+
+    /// `u += M⁻¹ Σ_a w_a Λ_a` for the impulses `lambda` (d per contact).
+    pub(super) fn apply(&mut self, lambda: &[f64], u: &mut [f64]) {
+        let d = self.dim;
+        self.f.fill(0.0);
+        for a in 0..self.len() {
+            let l = &lambda[a * d..(a + 1) * d];
+            if l.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
+                let mut s = 0.0;
+                for r in 0..d {
+                    s += self.w[x * d + r] * l[r];
+                }
+                self.f[self.pat_idx[x]] += s;
+            }
+        }
+        self.factor.solve(&mut self.f);
+        for (ui, fi) in u.iter_mut().zip(&self.f) {
+            *ui += fi;
+        }
+    }
+}
