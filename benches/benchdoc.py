@@ -8,7 +8,19 @@ import math
 import os
 import platform
 import re
+import statistics
+import time
 from pathlib import Path
+
+
+def timed(fn, repeat: int):
+    """Runs ``fn`` ``repeat`` times: (min, median) wall time and the last result."""
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), statistics.median(times), out
 
 
 def fmt_time(s: float | None) -> str:

@@ -52,20 +52,13 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, ratio, write_doc  # noqa: E402
+from benchdoc import fmt_time, machine, ratio, timed, write_doc  # noqa: E402
 
 G, R, H0, EPS = 9.81, 0.1, 1.0, 0.8
 ALPHA, MU0, MU = 0.3, 0.4, 0.3
 HALF = (0.1, 0.05, 0.05)
 
 
-def timed(fn, repeat: int):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), statistics.median(times), out
 
 
 def apexes(t, z, n=3):

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import statistics
 import sys
 import time
 import warnings
@@ -31,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, write_doc  # noqa: E402
+from benchdoc import fmt_time, machine, timed, write_doc  # noqa: E402
 
 import mechsys as ms  # noqa: E402
 
@@ -42,13 +41,6 @@ MU, K, X0 = 0.3, 100.0, 0.2
 X_STOP = -(X0 - 6 * MU * G / K)
 
 
-def timed(fn, repeat):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), statistics.median(times), out
 
 
 def drop_model():

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import statistics
 import sys
 import time
 import warnings
@@ -39,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, ratio, write_doc  # noqa: E402
+from benchdoc import fmt_time, machine, ratio, timed, write_doc  # noqa: E402
 
 G, N, MASS, MU = 9.81, 10, 1.0, 0.5
 HALF = (0.1, 0.1, 0.05)
@@ -49,13 +48,6 @@ def z0(k: int) -> float:
     return HALF[2] * (2 * k + 1)
 
 
-def timed(fn, repeat: int):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), statistics.median(times), out
 
 
 def drifts(top: np.ndarray, t: np.ndarray, t_end: float) -> tuple[float, float]:
