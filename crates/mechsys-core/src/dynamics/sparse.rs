@@ -72,34 +72,42 @@ fn path_velocities(model: &Model, body: usize, out: &mut Vec<usize>) {
     }
 }
 
+/// The velocity tree's ancestor lists: within a joint each velocity hangs on the previous one, a
+/// joint's first velocity on the last velocity of the nearest ancestor joint that has any.
+/// Returns (parent velocity or `usize::MAX`, depth per velocity, CSR pointers, ancestors nearest
+/// first).
+pub(crate) fn velocity_ancestors(model: &Model) -> (Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>) {
+    let nu = model.nu;
+    let mut parent = vec![usize::MAX; nu];
+    let mut last = vec![usize::MAX; model.nbodies()];
+    for (ji, j) in model.joints.iter().enumerate() {
+        let mut p = last[j.parent];
+        for k in 0..j.nu() {
+            parent[j.iu + k] = p;
+            p = j.iu + k;
+        }
+        last[ji + 1] = p;
+    }
+    let mut depth = vec![0; nu];
+    let (mut anc_ptr, mut anc_idx) = (vec![0; nu + 1], Vec::new());
+    for k in 0..nu {
+        let mut a = parent[k];
+        while a != usize::MAX {
+            anc_idx.push(a);
+            a = parent[a];
+        }
+        anc_ptr[k + 1] = anc_idx.len();
+        depth[k] = anc_ptr[k + 1] - anc_ptr[k];
+    }
+    (parent, depth, anc_ptr, anc_idx)
+}
+
 impl Saddle {
     /// Plans the solve for `model` (structure only; without constraints only the tree factor of M,
     /// which the time-stepping schemes use).
     pub fn new(model: &Model) -> Self {
         let (nu, nc) = (model.nu, model.nc);
-        // velocity tree: within a joint each velocity hangs on the previous one; a joint's first
-        // velocity hangs on the last velocity of the nearest ancestor joint that has any
-        let mut parent = vec![usize::MAX; nu];
-        let mut last = vec![usize::MAX; model.nbodies()];
-        for (ji, j) in model.joints.iter().enumerate() {
-            let mut p = last[j.parent];
-            for k in 0..j.nu() {
-                parent[j.iu + k] = p;
-                p = j.iu + k;
-            }
-            last[ji + 1] = p;
-        }
-        let mut depth = vec![0; nu];
-        let (mut anc_ptr, mut anc_idx) = (vec![0; nu + 1], Vec::new());
-        for k in 0..nu {
-            let mut a = parent[k];
-            while a != usize::MAX {
-                anc_idx.push(a);
-                a = parent[a];
-            }
-            anc_ptr[k + 1] = anc_idx.len();
-            depth[k] = anc_ptr[k + 1] - anc_ptr[k];
-        }
+        let (parent, depth, anc_ptr, anc_idx) = velocity_ancestors(model);
         // row patterns
         let (mut row_ptr, mut row_idx) = (vec![0; nc + 1], Vec::new());
         let mut buf = Vec::new();

@@ -40,29 +40,7 @@ pub(super) struct TreeFactor {
 impl TreeFactor {
     fn new(model: &Model) -> Self {
         let nu = model.nu;
-        // within a joint each velocity hangs on the previous one; a joint's first velocity on the
-        // last velocity of the nearest ancestor joint that has any
-        let mut parent = vec![usize::MAX; nu];
-        let mut last = vec![usize::MAX; model.nbodies()];
-        for (ji, j) in model.joints.iter().enumerate() {
-            let mut p = last[j.parent];
-            for k in 0..j.nu() {
-                parent[j.iu + k] = p;
-                p = j.iu + k;
-            }
-            last[ji + 1] = p;
-        }
-        let mut depth = vec![0; nu];
-        let (mut anc_ptr, mut anc_idx) = (vec![0; nu + 1], Vec::new());
-        for k in 0..nu {
-            let mut a = parent[k];
-            while a != usize::MAX {
-                anc_idx.push(a);
-                a = parent[a];
-            }
-            anc_ptr[k + 1] = anc_idx.len();
-            depth[k] = anc_ptr[k + 1] - anc_ptr[k];
-        }
+        let (_, depth, anc_ptr, anc_idx) = crate::dynamics::sparse::velocity_ancestors(model);
         TreeFactor {
             nu,
             depth,
