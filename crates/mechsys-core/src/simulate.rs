@@ -452,13 +452,7 @@ pub fn simulate(
             sys.rhs(t, y, &mut scratch)?;
         }
         record(model, &sys.data, t, y, &mut rec);
-        if let Some(p) = progress {
-            p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
-            if p.cancel.load(Ordering::Relaxed) {
-                return Err(Error::Solver(format!("simulation cancelled at t = {t:.6} s")));
-            }
-        }
-        Ok(())
+        report_progress(progress, rec.t.len(), t)
     };
     let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
     rec.stats = stats;
@@ -581,12 +575,7 @@ fn time_stepping(
             rec.group_pairs.push(g.pairs as f64);
             rec.group_impulse_against.extend_from_slice(&g.impulse_against);
         }
-        if let Some(p) = progress {
-            p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
-            if p.cancel.load(Ordering::Relaxed) {
-                return Err(Error::Solver(format!("simulation cancelled at t = {t_rec:.6} s")));
-            }
-        }
+        report_progress(progress, rec.t.len(), t_rec)?;
     }
     if stepper.unconverged.0 > 0 {
         rec.warnings.push(format!(
@@ -622,23 +611,17 @@ fn event_driven(
     // integrals of the forces at the previous sample, and the energy taken by impacts so far
     let mut prev = vec![0.0; 3 * np];
     let (mut e_impact, mut e_impulsive_friction) = (0.0, 0.0);
-    let mut first = true;
     let mut warnings = Vec::new();
     let mut sample = |ph: &mut Phase, t: f64, y: &[f64], imp: &[f64], d: event_driven::Dissipation| -> Result<()> {
         record(model, &ph.data, t, y, &mut rec);
         e_impact += d.impact;
         e_impulsive_friction += d.friction;
-        let span = if first { 0.0 } else { 1.0 };
-        first = false;
         for pt in 0..np {
             let kk = &ph.kin[pt];
             let now_n = y[e + 3 + pt];
             let now_t = [y[e + 3 + np + 2 * pt], y[e + 3 + np + 2 * pt + 1]];
-            let i_n = span * (now_n - prev[3 * pt]) + imp[3 * pt];
-            let i_t = [
-                span * (now_t[0] - prev[3 * pt + 1]) + imp[3 * pt + 1],
-                span * (now_t[1] - prev[3 * pt + 2]) + imp[3 * pt + 2],
-            ];
+            let i_n = now_n - prev[3 * pt] + imp[3 * pt];
+            let i_t = [now_t[0] - prev[3 * pt + 1] + imp[3 * pt + 1], now_t[1] - prev[3 * pt + 2] + imp[3 * pt + 2]];
             prev[3 * pt] = now_n;
             prev[3 * pt + 1] = now_t[0];
             prev[3 * pt + 2] = now_t[1];
@@ -656,16 +639,9 @@ fn event_driven(
         }
         rec.dissipated_impact.push(e_impact);
         rec.dissipated_friction.push(y[e + 2] + e_impulsive_friction);
-        if let Some(p) = progress {
-            p.samples.store(rec.t.len() as u64, Ordering::Relaxed);
-            if p.cancel.load(Ordering::Relaxed) {
-                return Err(Error::Solver(format!("simulation cancelled at t = {t:.6} s")));
-            }
-        }
-        Ok(())
+        report_progress(progress, rec.t.len(), t)
     };
     let stats = event_driven::integrate(&mut phase, settings.t0, &y, t_out, &mut warnings, &mut sample)?;
-    y.clear();
     rec.stats = stats;
     rec.warnings.extend(warnings);
     rec.events = phase
@@ -677,6 +653,17 @@ fn event_driven(
         })
         .collect();
     Ok(rec)
+}
+
+/// Tells the progress watcher how many samples are recorded; an error if it asked to cancel.
+fn report_progress(progress: Option<&Progress>, samples: usize, t: f64) -> Result<()> {
+    if let Some(p) = progress {
+        p.samples.store(samples as u64, Ordering::Relaxed);
+        if p.cancel.load(Ordering::Relaxed) {
+            return Err(Error::Solver(format!("simulation cancelled at t = {t:.6} s")));
+        }
+    }
+    Ok(())
 }
 
 /// The record stage: appends one sample of every signal from an evaluated workspace.

@@ -170,6 +170,8 @@ struct EventWork {
     closing: Vec<usize>,
     old: Vec<f64>,
     old_dir: Vec<[f64; 2]>,
+    /// Full-acceleration kinematics of one contact's points (the apex cap).
+    apex: Vec<ContactKinematics>,
 }
 
 /// What one event did, for the records.
@@ -237,6 +239,7 @@ impl<'a> Phase<'a> {
                 closing: Vec::with_capacity(np),
                 old: Vec::with_capacity(np),
                 old_dir: Vec::with_capacity(np),
+                apex: vec![ContactKinematics::default(); model.contacts.iter().map(|c| c.points()).max().unwrap_or(0)],
             },
         })
     }
@@ -528,12 +531,10 @@ impl<'a> Phase<'a> {
             if !pts.clone().any(|pt| self.status[pt] == OPEN && self.kin[pt].gd_n > 0.0) {
                 continue;
             }
-            let mut k = [ContactKinematics::default(); 16];
+            // (every contact's points, not a fixed-size buffer: none may be skipped)
+            let k = &mut self.ev.apex;
             let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
             let n = con.points();
-            if n > k.len() {
-                continue;
-            }
             contact_kinematics(&con.pair, &b1, &b2, &mut k[..n])?;
             for (j, kk) in k[..n].iter().enumerate() {
                 let pt = con.first + j;
