@@ -1,6 +1,13 @@
-"""Force elements: point-to-point spring-dampers (linear, cubic, tabulated), forces and torques on
-bodies, generalized forces on joints, and Python force laws. Gravity is a property of the Model;
-joint springs and dampers are given with the joint (``spring=``, ``damper=``).
+"""Force elements: point-to-point spring-dampers (linear, cubic, tabulated, progressive), forces and
+torques on bodies, generalized forces on joints, Python force laws, and the damping elements of
+section 2.6: six-component bushings, the squeeze-film slide way (eq. 2.211), the journal bearing
+(eq. 2.212) and Jenkins dry-friction elements with press-fit chains (eq. 2.215, Fig. 2.39).
+Gravity is a property of the Model; joint springs and dampers are given with the joint
+(``spring=``, ``damper=``).
+
+Every element with a deflection records ``force/<name>/force`` (the force it carries along its
+deflection, positive when it resists a positive deflection) and ``force/<name>/deflection``, so
+``ms.linear.hysteresis`` can draw its loop.
 """
 
 from __future__ import annotations
@@ -13,6 +20,7 @@ import numpy as np
 from . import functions
 from .errors import ModelError
 from .joints import JointDamper, JointSpring, RotaryDamper, RotarySpring, LinearDamper, LinearSpring  # noqa: F401
+from .joints import Frame, _frame
 from .joints import _vec3 as _vec
 
 
@@ -38,6 +46,8 @@ class SpringDamper:
     l0: float = 0.0
     k3: float = 0.0
     table: tuple[Sequence[float], Sequence[float]] | None = None
+    #: stop travel s (m) of a progressive elastomer law: k and d are divided by 1 - (delta/s)^2
+    travel: float | None = None
 
     def describe(self, callbacks: list) -> dict:
         w = f"force '{self.name}'"
@@ -57,6 +67,184 @@ class SpringDamper:
             x, y = self.table
             d["table_deflection"] = [float(v) for v in x]
             d["table_force"] = [float(v) for v in y]
+        if self.travel is not None:
+            d["travel"] = float(self.travel)
+        return d
+
+
+def _six(v, what: str) -> list[float]:
+    """6 diagonal values or a 6x6 matrix, flattened row-major."""
+    if v is None:
+        return []
+    a = np.asarray(v, dtype=float)
+    if a.shape == (6, 6):
+        return a.ravel().tolist()
+    if a.shape == (6,):
+        return a.tolist()
+    if a.ndim == 0:
+        raise ModelError(f"{what}: expected 6 values [x, y, z, alpha, beta, gamma] or a 6x6 matrix, got a number")
+    raise ModelError(f"{what}: expected 6 values or a 6x6 matrix, got shape {a.shape}")
+
+
+@dataclass
+class Bushing:
+    """Six-component bushing between ``frame1`` on ``body1`` and ``frame2`` on ``body2``.
+
+    The deflection x = [dr; theta] (translation and rotation vector of frame 2 relative to frame 1,
+    frame-1 components) gives the wrench -K x - D x_dot on frame 2 and its opposite on body1.
+    ``k``, ``d``: 6 diagonal values (N/m, N/m, N/m, N m/rad, ...) or symmetric 6x6 matrices.
+    ``travel``: 6 stop travels (m, rad) making each component progressive, as an elastomer mount:
+    k_i and d_i are divided by 1 - (x_i/s_i)^2 (diagonal k and d only).
+    """
+
+    name: str
+    body1: Any
+    body2: Any
+    frame1: Any = None
+    frame2: Any = None
+    k: Any = None
+    d: Any = None
+    travel: Sequence[float] | None = None
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"force '{self.name}'"
+        d = {
+            "type": "bushing",
+            "name": self.name,
+            "body1": _name(self.body1),
+            "frame1": _frame(self.frame1 if self.frame1 is not None else Frame(), f"{w}.frame1"),
+            "body2": _name(self.body2),
+            "frame2": _frame(self.frame2 if self.frame2 is not None else Frame(), f"{w}.frame2"),
+            "k": _six(self.k, f"{w}.k"),
+            "d": _six(self.d, f"{w}.d"),
+        }
+        if self.travel is not None:
+            t = np.asarray(self.travel, dtype=float)
+            if t.shape != (6,):
+                raise ModelError(f"{w}.travel: expected 6 stop travels, got shape {t.shape}")
+            d["travel"] = t.tolist()
+        return d
+
+
+@dataclass
+class SqueezeFilm:
+    """Squeeze-film slide way (eq. 2.211): an oil film of gap h = gap + n . (p2 - p1) between the
+    surface of ``body1`` through ``point1`` with normal ``normal`` (body1 frame) and ``point2`` on
+    ``body2``; the film resists the gap rate with F = 12 eta A l^2 / h^3 * h_dot.
+
+    ``eta`` dynamic viscosity (Pa s), ``length`` the half-length l of the way (m), ``area`` the gap
+    cross-section A (m^2), ``gap`` h0 (m). Valid for a thin film: 0 < h <= length/10 (refused
+    outside, at input and during a run).
+    """
+
+    name: str
+    body1: Any
+    body2: Any
+    normal: Sequence[float]
+    eta: float
+    length: float
+    area: float
+    gap: float
+    point1: Sequence[float] = (0.0, 0.0, 0.0)
+    point2: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"force '{self.name}'"
+        return {
+            "type": "squeeze_film",
+            "name": self.name,
+            "body1": _name(self.body1),
+            "point1": _vec(self.point1, f"{w}.point1"),
+            "normal": _vec(self.normal, f"{w}.normal"),
+            "body2": _name(self.body2),
+            "point2": _vec(self.point2, f"{w}.point2"),
+            "eta": float(self.eta),
+            "length": float(self.length),
+            "area": float(self.area),
+            "gap": float(self.gap),
+        }
+
+
+@dataclass
+class JournalBearing:
+    """Journal-bearing friction torque (eq. 2.212, Reynolds-Sommerfeld) on a revolute ``joint``:
+    M = 2(1 + 2 eps^2) / (sqrt(1 - eps^2)(1 + eps^2/2)) * pi r0^2 b eta / a * r0 Omega, opposing
+    the shaft speed Omega. Petroff's law at eps = 0.
+
+    ``radius`` r0, ``length`` b, ``clearance`` a (m; a <= r0/50), ``eta`` (Pa s),
+    ``eccentricity`` eps in [0, 0.95].
+    """
+
+    name: str
+    joint: Any
+    radius: float
+    length: float
+    clearance: float
+    eta: float
+    eccentricity: float = 0.0
+
+    def describe(self, callbacks: list) -> dict:
+        return {
+            "type": "journal_bearing",
+            "name": self.name,
+            "joint": _name(self.joint),
+            "radius": float(self.radius),
+            "length": float(self.length),
+            "clearance": float(self.clearance),
+            "eta": float(self.eta),
+            "eccentricity": float(self.eccentricity),
+        }
+
+    def coefficient(self) -> float:
+        """Torque per shaft speed c (N m s/rad) of eq. 2.212."""
+        return journal_bearing_coefficient(self.radius, self.length, self.clearance, self.eta, self.eccentricity)
+
+
+def journal_bearing_coefficient(radius: float, length: float, clearance: float, eta: float, eccentricity: float = 0.0) -> float:
+    """c of eq. 2.212 with the wall speed u_w = r0 Omega, so that M = c Omega (N m s/rad)."""
+    e2 = eccentricity**2
+    shape = 2 * (1 + 2 * e2) / (np.sqrt(1 - e2) * (1 + e2 / 2))
+    return float(shape * np.pi * radius**2 * length * eta / clearance * radius)
+
+
+def squeeze_film_coefficient(eta: float, length: float, area: float, gap: float) -> float:
+    """12 eta A l^2 / h^3 of eq. 2.211: the film force per gap rate at gap h (N s/m)."""
+    return float(12 * eta * area * length**2 / gap**3)
+
+
+@dataclass
+class Jenkins:
+    """Jenkins dry-friction elements (a spring ``k`` in series with a Coulomb slider, eq. 2.215) on
+    velocity ``index`` of ``joint`` (the relative displacement of shaft and hub).
+
+    ``slip``: one slip force (or torque) per element. Without ``shaft_stiffness`` the elements act
+    in parallel (one element: the classic Jenkins element; several: a Masing/Iwan model). With
+    it they form a press fit (Fig. 2.39): massless shaft segments of that stiffness, each held to
+    the hub by one element, loaded at the first. The sliders are solved exactly as a linear
+    complementarity problem (Lemke), not with a smoothed sign function. ``offset``: the joint
+    coordinate where all springs are relaxed.
+    """
+
+    name: str
+    joint: Any
+    k: float
+    slip: float | Sequence[float]
+    shaft_stiffness: float | None = None
+    index: int = 0
+    offset: float = 0.0
+
+    def describe(self, callbacks: list) -> dict:
+        d = {
+            "type": "jenkins",
+            "name": self.name,
+            "joint": _name(self.joint),
+            "index": int(self.index),
+            "k": float(self.k),
+            "slip": [float(x) for x in np.atleast_1d(self.slip)],
+            "offset": float(self.offset),
+        }
+        if self.shaft_stiffness is not None:
+            d["shaft_stiffness"] = float(self.shaft_stiffness)
         return d
 
 
@@ -133,6 +321,12 @@ class PythonForce:
 
 __all__ = [
     "SpringDamper",
+    "Bushing",
+    "SqueezeFilm",
+    "JournalBearing",
+    "Jenkins",
+    "journal_bearing_coefficient",
+    "squeeze_film_coefficient",
     "BodyForce",
     "JointForce",
     "PythonForce",

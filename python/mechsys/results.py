@@ -130,6 +130,13 @@ class Results:
                     vv = raw["constraint_velocity_violation"]
                     put(f"constraint/{c['name']}/velocity_violation", vv[:, sl] if c["rows"] > 1 else vv[:, c["row"]],
                         _rate_unit(c["violation_unit"]))
+        if engine is not None and "force_value" in raw:
+            # each force element's force along its deflection (resisting it) and the deflection
+            for f in engine.force_outputs():
+                k, w = f["first"], f["width"]
+                sl = slice(k, k + w) if w > 1 else k
+                put(f"force/{f['name']}/force", raw["force_value"][:, sl], f["force_unit"])
+                put(f"force/{f['name']}/deflection", raw["force_deflection"][:, sl], f["deflection_unit"])
         if engine is not None and "contact_gap" in raw:
             put("energy/dissipated_impact", raw["dissipated_impact"], "J")
             put("energy/dissipated_friction", raw["dissipated_friction"], "J")

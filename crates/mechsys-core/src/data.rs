@@ -106,6 +106,18 @@ pub struct Data {
     pub saddle: crate::dynamics::sparse::Saddle,
     /// constraints: rows found dependent at the last solve (nc).
     pub dependent: Vec<bool>,
+    /// forces: committed positions of the Jenkins sliders, the history of the dry friction (n_sliders).
+    pub slider: Vec<f64>,
+    /// forces: slider positions solved at the last force evaluation (n_sliders).
+    pub slider_trial: Vec<f64>,
+    /// forces: slider forces λ at the last force evaluation (n_sliders).
+    pub slider_force: Vec<f64>,
+    /// forces: solver scratch of each Jenkins chain (press fits).
+    pub jenkins_work: Vec<crate::forces::jenkins::ChainWork>,
+    /// forces: each element's force at the last evaluation, resisting its deflection (n_force_outputs).
+    pub element_force: Vec<f64>,
+    /// forces: each element's deflection at the last evaluation (n_force_outputs).
+    pub element_deflection: Vec<f64>,
 }
 
 impl Data {
@@ -156,6 +168,21 @@ impl Data {
             null_scratch: vec![0.0; model.nc],
             saddle: crate::dynamics::sparse::Saddle::new(model),
             dependent: vec![false; model.nc],
+            slider: vec![0.0; model.n_sliders],
+            slider_trial: vec![0.0; model.n_sliders],
+            slider_force: vec![0.0; model.n_sliders],
+            jenkins_work: model
+                .forces
+                .iter()
+                .filter_map(|f| match f {
+                    crate::model::ForceElement::Jenkins(j) if j.shaft.is_some() => {
+                        Some(crate::forces::jenkins::ChainWork::new(j))
+                    }
+                    _ => None,
+                })
+                .collect(),
+            element_force: vec![0.0; model.n_force_outputs],
+            element_deflection: vec![0.0; model.n_force_outputs],
         }
     }
 }

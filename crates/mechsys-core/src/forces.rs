@@ -2,6 +2,9 @@
 //! dynamics as a base acceleration; this stage turns every other element into body wrenches
 //! (`Data::f_ext`, world components about the inertial origin) and generalized forces (`Data::tau_applied`).
 
+pub mod damping;
+pub mod jenkins;
+
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::kinematics::{point_position, point_velocity};
@@ -156,6 +159,14 @@ fn add_point_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) {
     data.f_ext[b] += Force::new(p.cross(f_i), *f_i);
 }
 
+/// Adds the wrench of force `f` through the world point `p` plus torque `n` (I components) to body b.
+#[inline]
+fn add_wrench_at(data: &mut Data, b: usize, p: &Vec3, f: &Vec3, n: &Vec3) {
+    if b != 0 {
+        data.f_ext[b] += Force::new(p.cross(f) + n, *f);
+    }
+}
+
 /// Power balance of the force elements at one instant.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Powers {
@@ -205,9 +216,11 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
         }
     }
 
+    // o: the element's first recorded value; chain: its index among the Jenkins chains
+    let (mut o, mut chain) = (0usize, 0usize);
     for fe in &model.forces {
         match fe {
-            ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table } => {
+            ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table, travel } => {
                 let p1 = point_position(data, *body1, point1);
                 let p2 = point_position(data, *body2, point2);
                 let dr = p2 - p1;
@@ -222,11 +235,109 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                 }
                 let e = dr / l;
                 let ldot = e.dot(&(point_velocity(data, *body2, point2) - point_velocity(data, *body1, point1)));
-                let f = spring_force(*k, *k3, table, l - l0) + d * ldot;
-                p_diss += d * ldot * ldot;
+                let delta = l - l0;
+                // a progressive (elastomer) law stiffens and damps the linear terms towards the stop
+                let g = if *travel > 0.0 {
+                    damping::progressive_factor(delta, *travel).ok_or_else(|| {
+                        Error::Solver(format!(
+                            "spring-damper '{name}': deflection {delta:.6} m reached its stop travel {travel} m at t = {t} s"
+                        ))
+                    })?
+                } else {
+                    1.0
+                };
+                let f = spring_force(k * g, *k3, table, delta) + d * g * ldot;
+                p_diss += d * g * ldot * ldot;
                 let fv = e * f;
                 add_point_force(data, *body1, point1, &fv);
                 add_point_force(data, *body2, point2, &(-fv));
+                data.element_force[o] = f;
+                data.element_deflection[o] = delta;
+            }
+            ForceElement::Bushing { name, body1, frame1, body2, frame2, k, d, travel } => {
+                let (b1, b2) = (*body1, *body2);
+                let a1 = data.x_abs[b1].a * frame1.a;
+                let a2 = data.x_abs[b2].a * frame2.a;
+                let p1 = point_position(data, b1, &frame1.r);
+                let p2 = point_position(data, b2, &frame2.r);
+                let w1 = data.v[b1].w;
+                // deflection [Δr; θ] of frame 2 against frame 1 and its rate, frame-1 components
+                let dr = a1.transpose() * (p2 - p1);
+                let theta = crate::math::rotation::matrix_to_rotvec(&(a1.transpose() * a2))
+                    .map_err(|e| Error::Solver(format!("bushing '{name}' at t = {t} s: {e}")))?;
+                let dr_dot = a1.transpose() * (point_velocity(data, b2, &frame2.r) - point_velocity(data, b1, &frame1.r))
+                    - (a1.transpose() * w1).cross(&dr);
+                let w_rel = a1.transpose() * (data.v[b2].w - w1);
+                let x = nalgebra::Vector6::new(dr.x, dr.y, dr.z, theta.x, theta.y, theta.z);
+                let v = nalgebra::Vector6::new(dr_dot.x, dr_dot.y, dr_dot.z, w_rel.x, w_rel.y, w_rel.z);
+                let (fk, fd) = match travel {
+                    None => (k * x, d * v),
+                    Some(s) => {
+                        let mut g = nalgebra::Vector6::zeros();
+                        for i in 0..6 {
+                            g[i] = damping::progressive_factor(x[i], s[i]).ok_or_else(|| {
+                                Error::Solver(format!(
+                                    "bushing '{name}': component {i} deflected {:.6} to its stop travel {} at t = {t} s",
+                                    x[i], s[i]
+                                ))
+                            })?;
+                        }
+                        (k * x.component_mul(&g), d * v.component_mul(&g))
+                    }
+                };
+                p_diss += v.dot(&fd);
+                // the torque conjugate to θ: n = −J⁻ᵀ ∂V/∂θ keeps the rotational spring conservative
+                let jt = damping::rotvec_jacobian_inv_t(&theta);
+                let f1 = -(Vec3::new(fk[0], fk[1], fk[2]) + Vec3::new(fd[0], fd[1], fd[2]));
+                let n1 = -(jt * Vec3::new(fk[3], fk[4], fk[5]) + Vec3::new(fd[3], fd[4], fd[5]));
+                let (f, n) = (a1 * f1, a1 * n1);
+                add_wrench_at(data, b2, &p2, &f, &n);
+                add_wrench_at(data, b1, &p2, &(-f), &(-n));
+                for i in 0..6 {
+                    data.element_force[o + i] = fk[i] + fd[i];
+                    data.element_deflection[o + i] = x[i];
+                }
+            }
+            ForceElement::SqueezeFilm { name, body1, point1, normal, body2, point2, coeff, gap, gap_max } => {
+                let (b1, b2) = (*body1, *body2);
+                let n = data.x_abs[b1].a * normal;
+                let p1 = point_position(data, b1, point1);
+                let p2 = point_position(data, b2, point2);
+                let h = gap + n.dot(&(p2 - p1));
+                if !(h > 0.0 && h <= *gap_max) {
+                    return Err(Error::Solver(format!(
+                        "squeeze film '{name}': gap h = {h:.3e} m at t = {t} s is outside the thin-film range 0 < h ≤ {gap_max} m of eq. 2.211"
+                    )));
+                }
+                // ḣ: the slider point against body1's material point under it
+                let v1 = data.v[b1].v + data.v[b1].w.cross(&p2);
+                let hdot = n.dot(&(point_velocity(data, b2, point2) - v1));
+                let f = damping::squeeze_film_force(*coeff, h, hdot);
+                p_diss += f * hdot;
+                let fv = n * f;
+                let zero = Vec3::zeros();
+                add_wrench_at(data, b2, &p2, &(-fv), &zero);
+                add_wrench_at(data, b1, &p2, &fv, &zero);
+                data.element_force[o] = f;
+                data.element_deflection[o] = h - gap;
+            }
+            ForceElement::JournalBearing { joint, c, .. } => {
+                let j = &model.joints[*joint];
+                let om = u[j.iu];
+                data.tau_applied[j.iu] -= c * om;
+                p_diss += c * om * om;
+                data.element_force[o] = c * om;
+                data.element_deflection[o] = q[j.iq];
+            }
+            ForceElement::Jenkins(jk) => {
+                let f = jenkins::evaluate(jk, chain, data, q, t)?;
+                if jk.shaft.is_some() {
+                    chain += 1;
+                }
+                // the sliders' dissipation is booked when a step is committed (jenkins::commit)
+                data.tau_applied[jk.iu] -= f;
+                data.element_force[o] = f;
+                data.element_deflection[o] = q[jk.iq] - jk.offset;
             }
             ForceElement::BodyForce { body, point, force, torque, frame, function, .. } => {
                 let s = function.eval(t, cb)?;
@@ -255,6 +366,7 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                 p_ext += after - before;
             }
         }
+        o += fe.outputs();
     }
     Ok(Powers { dissipated: p_diss, external: p_ext })
 }

@@ -108,6 +108,10 @@ pub struct Recording {
     pub constraint_violation: Vec<f64>,
     /// Velocity-level constraint residuals `G u - b` (n_out × nc).
     pub constraint_velocity_violation: Vec<f64>,
+    /// Force of each force element along its deflection, resisting it (n_out × n_force_outputs).
+    pub force_value: Vec<f64>,
+    /// Deflection of each force element (n_out × n_force_outputs).
+    pub force_deflection: Vec<f64>,
     /// Notes on the run that did not stop it (near-singular configurations), in time order.
     pub warnings: Vec<String>,
     /// Contact gaps g_N per candidate point (n_out × n_points), m.
@@ -268,6 +272,13 @@ impl OdeSystem for MultibodySystem<'_> {
         dy[nq + nu + 1] = p.external;
         Ok(())
     }
+    fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        if self.model.n_sliders > 0 {
+            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, &y[..nq], t)?;
+        }
+        Ok(())
+    }
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         self.model.normalize(&mut y[..nq]);
@@ -406,6 +417,8 @@ pub fn simulate(
         constraint_lambda: Vec::with_capacity(n_out * model.nc),
         constraint_violation: Vec::with_capacity(n_out * model.nc),
         constraint_velocity_violation: Vec::with_capacity(n_out * model.nc),
+        force_value: Vec::with_capacity(n_out * model.n_force_outputs),
+        force_deflection: Vec::with_capacity(n_out * model.n_force_outputs),
         warnings: Vec::new(),
         stats: Stats::default(),
         ..Default::default()
@@ -518,6 +531,9 @@ fn time_stepping(
                 }
                 energy[0] += diss;
                 energy[1] += work;
+                if model.n_sliders > 0 {
+                    energy[0] += crate::forces::jenkins::commit(model, &mut data, q, t + dt)?;
+                }
                 for i in 0..nu {
                     udot[i] = (u[i] - u_start[i]) / dt;
                 }
@@ -712,6 +728,8 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
     rec.momentum_angular.extend_from_slice(l.as_slice());
     rec.constraint_lambda.extend_from_slice(&data.lambda);
     rec.constraint_violation.extend_from_slice(&data.phi);
+    rec.force_value.extend_from_slice(&data.element_force);
+    rec.force_deflection.extend_from_slice(&data.element_deflection);
     let k = rec.constraint_velocity_violation.len();
     rec.constraint_velocity_violation.resize(k + model.nc, 0.0);
     if model.nc > 0 {

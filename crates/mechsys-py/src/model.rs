@@ -207,10 +207,52 @@ impl PyModel {
                     F::BodyForce { .. } => "body_force",
                     F::JointForce { .. } => "joint_force",
                     F::Callback { .. } => "callback",
+                    F::Bushing { .. } => "bushing",
+                    F::SqueezeFilm { .. } => "squeeze_film",
+                    F::JournalBearing { .. } => "journal_bearing",
+                    F::Jenkins(_) => "jenkins",
                 };
                 (f.name().to_string(), t.to_string())
             })
             .collect()
+    }
+    /// The recorded force and deflection values of each force element: dicts with name, type,
+    /// first (column), width, force_unit and deflection_unit.
+    fn force_outputs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        use mechsys_core::model::{ForceElement as F, JointKind};
+        let mut out = Vec::new();
+        let mut first = 0usize;
+        for f in &self.model.forces {
+            let width = f.outputs();
+            let joint_units = |j: usize| match self.model.joints[j].kind {
+                JointKind::Revolute { .. } => ("N m", "rad"),
+                JointKind::Prismatic { .. } => ("N", "m"),
+                _ => ("mixed", "mixed"),
+            };
+            let (kind, fu, du) = match f {
+                F::SpringDamper { .. } => ("spring_damper", "N", "m"),
+                F::Bushing { .. } => ("bushing", "N, N m", "m, rad"),
+                F::SqueezeFilm { .. } => ("squeeze_film", "N", "m"),
+                F::JournalBearing { joint, .. } => ("journal_bearing", joint_units(*joint).0, "rad"),
+                F::Jenkins(j) => {
+                    let (a, b) = joint_units(j.joint);
+                    ("jenkins", a, b)
+                }
+                _ => ("", "", ""),
+            };
+            if width > 0 {
+                let d = PyDict::new(py);
+                d.set_item("name", f.name())?;
+                d.set_item("type", kind)?;
+                d.set_item("first", first)?;
+                d.set_item("width", width)?;
+                d.set_item("force_unit", fu)?;
+                d.set_item("deflection_unit", du)?;
+                out.push(d);
+            }
+            first += width;
+        }
+        Ok(out)
     }
     /// The model's initial coordinates.
     fn q0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

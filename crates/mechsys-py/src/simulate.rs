@@ -233,6 +233,10 @@ fn simulate<'py>(
     put("constraint_lambda", rec.constraint_lambda, &[n, m.nc])?;
     put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
     put("constraint_velocity_violation", rec.constraint_velocity_violation, &[n, m.nc])?;
+    if m.n_force_outputs > 0 {
+        put("force_value", rec.force_value, &[n, m.n_force_outputs])?;
+        put("force_deflection", rec.force_deflection, &[n, m.n_force_outputs])?;
+    }
     d.set_item("warnings", rec.warnings)?;
     d.set_item("events", rec.events)?;
     let np = m.n_contact_points;

@@ -3,6 +3,7 @@
 //! linear momentum `p = Σ m_i v_ci` and moment of momentum about the inertial origin.
 
 use crate::data::Data;
+use crate::forces::damping::progressive_energy;
 use crate::forces::spring_energy;
 use crate::kinematics::point_position;
 use crate::math::Vec3;
@@ -30,9 +31,28 @@ pub fn body_gravity_energy(model: &Model, data: &Data, i: usize) -> f64 {
 pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
     let mut v: f64 = (1..model.nbodies()).map(|i| body_gravity_energy(model, data, i)).sum();
     for f in &model.forces {
-        if let ForceElement::SpringDamper { body1, point1, body2, point2, k, k3, l0, table, .. } = f {
-            let l = (point_position(data, *body2, point2) - point_position(data, *body1, point1)).norm();
-            v += spring_energy(*k, *k3, table, l - l0);
+        match f {
+            ForceElement::SpringDamper { body1, point1, body2, point2, k, k3, l0, table, travel, .. } => {
+                let l = (point_position(data, *body2, point2) - point_position(data, *body1, point1)).norm();
+                v += if *travel > 0.0 {
+                    spring_energy(0.0, *k3, table, l - l0) + progressive_energy(*k, l - l0, *travel)
+                } else {
+                    spring_energy(*k, *k3, table, l - l0)
+                };
+            }
+            ForceElement::Bushing { body1, frame1, body2, frame2, k, travel, .. } => {
+                let a1 = data.x_abs[*body1].a * frame1.a;
+                let a2 = data.x_abs[*body2].a * frame2.a;
+                let dr = a1.transpose() * (point_position(data, *body2, &frame2.r) - point_position(data, *body1, &frame1.r));
+                let th = crate::math::rotation::matrix_to_rotvec(&(a1.transpose() * a2)).unwrap_or_else(|_| Vec3::zeros());
+                let x = nalgebra::Vector6::new(dr.x, dr.y, dr.z, th.x, th.y, th.z);
+                v += match travel {
+                    None => 0.5 * x.dot(&(k * x)),
+                    Some(s) => (0..6).map(|i| progressive_energy(k[(i, i)], x[i], s[i])).sum(),
+                };
+            }
+            ForceElement::Jenkins(j) => v += j.energy(data, q),
+            _ => {}
         }
     }
     for j in &model.joints {

@@ -254,6 +254,7 @@ pub fn integrate<S: OdeSystem>(
                 }
                 next += 1;
             }
+            sys.accepted(t_new, &mut st.ynew)?;
             stats.steps += 1;
             t = t_new;
             std::mem::swap(&mut y, &mut st.ynew);

@@ -1067,6 +1067,13 @@ impl OdeSystem for Phase<'_> {
         }
         Ok(())
     }
+    fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        if self.model.n_sliders > 0 {
+            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, &y[..nq], t)?;
+        }
+        Ok(())
+    }
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         self.model.normalize(&mut y[..nq]);
@@ -1190,6 +1197,7 @@ pub fn integrate<'a>(
             }
             t = t_new;
             phase.project(t, &mut y)?;
+            phase.accepted(t, &mut y)?;
             events += 1;
             if (t - last_event).abs() <= 1e-12 * t.abs().max(1.0) {
                 same_instant += 1;
@@ -1224,6 +1232,7 @@ pub fn integrate<'a>(
         }
         phase.project(t_new, &mut st.ynew)?;
         crate::integrator::check_finite(t_new, &st.ynew)?;
+        phase.accepted(t_new, &mut st.ynew)?;
         t = t_new;
         std::mem::swap(&mut y, &mut st.ynew);
         st.fsal();

@@ -30,6 +30,12 @@ pub trait OdeSystem {
     fn project(&mut self, _t: f64, _y: &mut [f64]) -> Result<()> {
         Ok(())
     }
+    /// Called once per accepted step at its end (t, y), after the outputs inside the step: the
+    /// place to commit history variables (the sliders of dry-friction elements). It may add to y's
+    /// bookkeeping entries but must not move the state.
+    fn accepted(&mut self, _t: f64, _y: &mut [f64]) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Called at each output time with the system and the state; `fresh` says the system's last `rhs`

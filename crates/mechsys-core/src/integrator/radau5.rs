@@ -114,6 +114,7 @@ fn step<S: OdeSystem>(
                 y[i] += w.z[2 * n + i]; // stiffly accurate: y_new = y + Z_3
             }
             sys.project(t + h, y)?;
+            sys.accepted(t + h, y)?;
             return Ok(true);
         }
         last = nrm;

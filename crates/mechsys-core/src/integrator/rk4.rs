@@ -56,6 +56,7 @@ pub fn integrate<S: OdeSystem>(
         }
         sys.project(t + h, &mut y)?;
         check_finite(t + h, &y)?;
+        sys.accepted(t + h, &mut y)?;
         step += 1;
         stats.steps += 1;
     }

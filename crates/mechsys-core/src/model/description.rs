@@ -547,6 +547,104 @@ pub enum ForceDescription {
         /// Forces (N) at `table_deflection`.
         #[serde(default)]
         table_force: Option<Vec<f64>>,
+        /// Stop travel s (m) of a progressive (elastomer-mount) law: the linear spring and damper
+        /// terms are divided by `1 − (δ/s)²`, so the force grows without bound as |δ| → s.
+        #[serde(default)]
+        travel: Option<f64>,
+    },
+    /// Six-component bushing between `frame1` on body1 and `frame2` on body2: the deflection
+    /// `x = [Δr; θ]` of frame 2 relative to frame 1 (translation and rotation vector, frame-1
+    /// components) and its rate give the wrench `−K x − D ẋ` on frame 2 (equal and opposite on body1).
+    Bushing {
+        /// Element name.
+        name: String,
+        /// First body.
+        body1: String,
+        /// Frame on body1.
+        #[serde(default)]
+        frame1: FrameDescription,
+        /// Second body.
+        body2: String,
+        /// Frame on body2.
+        #[serde(default)]
+        frame2: FrameDescription,
+        /// Stiffness: 6 diagonal values [kx, ky, kz, kα, kβ, kγ] (N/m, N m/rad) or a symmetric 6×6 matrix (36 values, row-major).
+        #[serde(default)]
+        k: Vec<f64>,
+        /// Damping: 6 diagonal values (N s/m, N m s/rad) or a symmetric 6×6 matrix (36 values).
+        #[serde(default)]
+        d: Vec<f64>,
+        /// Stop travel per component (m, rad) of a progressive elastomer law (diagonal k, d only).
+        #[serde(default)]
+        travel: Option<[f64; 6]>,
+    },
+    /// Squeeze-film slide way (eq. 2.211): an oil film of gap h between a surface of body1
+    /// (through `point1`, normal `normal`, body1 frame) and `point2` on body2, pushing back with
+    /// `F = 12 η A l² / h³ · ḣ` against the change of the gap.
+    SqueezeFilm {
+        /// Element name.
+        name: String,
+        /// Body carrying the guide surface.
+        body1: String,
+        /// A point of the surface, body1 frame.
+        #[serde(default)]
+        point1: [f64; 3],
+        /// Surface normal towards body2, body1 frame.
+        normal: [f64; 3],
+        /// Body carrying the slider.
+        body2: String,
+        /// The slider point, body2 frame.
+        #[serde(default)]
+        point2: [f64; 3],
+        /// Dynamic viscosity η (Pa s).
+        eta: f64,
+        /// Half-length l of the slide way (m).
+        length: f64,
+        /// Cross-section area A of the gap flow (m²).
+        area: f64,
+        /// Gap h0 (m) when `point2` lies on the surface's offset by zero: h = h0 + n·(p2 − p1).
+        gap: f64,
+    },
+    /// Journal-bearing friction torque by Reynolds–Sommerfeld (eq. 2.212) on a revolute joint:
+    /// `M = 2(1 + 2ε²) / (√(1 − ε²)(1 + ε²/2)) · π r0² b η / a · r0 Ω`, opposing the joint speed Ω.
+    JournalBearing {
+        /// Element name.
+        name: String,
+        /// The revolute joint between shaft and bearing.
+        joint: String,
+        /// Shaft radius r0 (m).
+        radius: f64,
+        /// Bearing length b (m).
+        length: f64,
+        /// Radial clearance a (m), a ≪ r0.
+        clearance: f64,
+        /// Dynamic viscosity η (Pa s).
+        eta: f64,
+        /// Relative eccentricity ε = e/a, 0 ≤ ε ≤ 0.95.
+        #[serde(default)]
+        eccentricity: f64,
+    },
+    /// Jenkins elements (a spring in series with a Coulomb slider, eq. 2.215) on one velocity of a
+    /// joint: one element, several in parallel, or a press fit (Fig. 2.39): a chain of massless
+    /// shaft segments of stiffness `shaft_stiffness`, each held to the hub by a Jenkins element.
+    Jenkins {
+        /// Element name.
+        name: String,
+        /// The joint whose coordinate is the relative displacement (shaft against hub).
+        joint: String,
+        /// Which velocity of the joint (0 for one-degree-of-freedom joints).
+        #[serde(default)]
+        index: usize,
+        /// Stiffness of each Jenkins spring (N/m or N m/rad).
+        k: f64,
+        /// Slip force (or torque) of each slider, one per element (> 0).
+        slip: Vec<f64>,
+        /// Stiffness of each shaft segment between the elements; absent: a rigid shaft (elements in parallel).
+        #[serde(default)]
+        shaft_stiffness: Option<f64>,
+        /// Joint coordinate at which the springs are relaxed with the sliders at rest.
+        #[serde(default)]
+        offset: f64,
     },
     /// A force and torque on a body, scaled by a time function.
     BodyForce {

@@ -208,7 +208,60 @@ pub enum ForceElement {
         l0: f64,
         /// Tabulated force–deflection curve (deflections, forces), possibly empty.
         table: (Vec<f64>, Vec<f64>),
+        /// Stop travel of the progressive law (0: linear).
+        travel: f64,
     },
+    /// Six-component bushing (see [`description::ForceDescription::Bushing`]).
+    Bushing {
+        /// Name.
+        name: String,
+        /// First body index.
+        body1: usize,
+        /// Frame on body1.
+        frame1: Pose,
+        /// Second body index.
+        body2: usize,
+        /// Frame on body2.
+        frame2: Pose,
+        /// Stiffness (6 × 6, symmetric), on `[Δr; θ]` in frame-1 components.
+        k: nalgebra::Matrix6<f64>,
+        /// Damping (6 × 6, symmetric), on the relative velocity `[Δṙ; ω_rel]` in frame-1 components.
+        d: nalgebra::Matrix6<f64>,
+        /// Stop travel per component of the progressive law (diagonal k, d), or none.
+        travel: Option<[f64; 6]>,
+    },
+    /// Squeeze-film slide way (eq. 2.211).
+    SqueezeFilm {
+        /// Name.
+        name: String,
+        /// Body of the guide surface.
+        body1: usize,
+        /// Point of the surface, body1 frame.
+        point1: Vec3,
+        /// Unit normal towards body2, body1 frame.
+        normal: Vec3,
+        /// Body of the slider.
+        body2: usize,
+        /// Slider point, body2 frame.
+        point2: Vec3,
+        /// `12 η A l²` (N s m²): the force is this over h³ times ḣ.
+        coeff: f64,
+        /// Gap h0 at zero offset (m).
+        gap: f64,
+        /// Largest gap of the thin-film law, l/10 (m).
+        gap_max: f64,
+    },
+    /// Journal-bearing friction torque (eq. 2.212) on a revolute joint.
+    JournalBearing {
+        /// Name.
+        name: String,
+        /// Joint index.
+        joint: usize,
+        /// Torque per shaft speed (N m s/rad).
+        c: f64,
+    },
+    /// Jenkins elements on one joint velocity (see [`crate::forces::jenkins`]).
+    Jenkins(crate::forces::jenkins::Jenkins),
     /// Force and torque on a body.
     BodyForce {
         /// Name.
@@ -253,7 +306,24 @@ impl ForceElement {
             ForceElement::SpringDamper { name, .. }
             | ForceElement::BodyForce { name, .. }
             | ForceElement::JointForce { name, .. }
+            | ForceElement::Bushing { name, .. }
+            | ForceElement::SqueezeFilm { name, .. }
+            | ForceElement::JournalBearing { name, .. }
             | ForceElement::Callback { name, .. } => name,
+            ForceElement::Jenkins(j) => &j.name,
+        }
+    }
+
+    /// How many values the element records as its force (and as its deflection): 6 for a
+    /// bushing, 1 for the elements acting along one coordinate, 0 for loads.
+    pub fn outputs(&self) -> usize {
+        match self {
+            ForceElement::Bushing { .. } => 6,
+            ForceElement::SpringDamper { .. }
+            | ForceElement::SqueezeFilm { .. }
+            | ForceElement::JournalBearing { .. }
+            | ForceElement::Jenkins(_) => 1,
+            ForceElement::BodyForce { .. } | ForceElement::JointForce { .. } | ForceElement::Callback { .. } => 0,
         }
     }
 }
@@ -291,6 +361,10 @@ pub struct Model {
     pub qdot_is_u: bool,
     /// Number of user callbacks the model refers to.
     pub n_callbacks: usize,
+    /// Number of Coulomb sliders over all Jenkins elements (history variables of the forces).
+    pub n_sliders: usize,
+    /// Number of recorded force and deflection values over all force elements.
+    pub n_force_outputs: usize,
     /// The description it was built from (stored with results).
     pub description: ModelDescription,
     body_index: HashMap<String, usize>,

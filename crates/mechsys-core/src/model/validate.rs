@@ -18,6 +18,28 @@ fn finite3(v: &[f64; 3], what: &str) -> Result<Vec3> {
     Ok(Vec3::new(v[0], v[1], v[2]))
 }
 
+/// A symmetric 6×6 matrix from 6 diagonal values or 36 row-major values (empty: zero).
+fn matrix6(v: &[f64], what: &str) -> Result<nalgebra::Matrix6<f64>> {
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(err(format!("{what}[{i}]: must be finite, got {}", v[i])));
+    }
+    let m = match v.len() {
+        0 => nalgebra::Matrix6::zeros(),
+        6 => nalgebra::Matrix6::from_diagonal(&nalgebra::Vector6::from_column_slice(v)),
+        36 => nalgebra::Matrix6::from_row_slice(v),
+        n => return Err(err(format!("{what}: expected 6 diagonal values or a 6x6 matrix (36 values), got {n}"))),
+    };
+    let asym = (m - m.transpose()).abs().max();
+    crate::ensure!(asym <= 1e-12 * m.abs().max().max(1.0), Model, "{what}: the 6x6 matrix must be symmetric");
+    let low = m.symmetric_eigen().eigenvalues.min();
+    crate::ensure!(
+        low >= -1e-12 * m.abs().max(),
+        Model,
+        "{what}: must be positive semidefinite (smallest eigenvalue {low:.3e})"
+    );
+    Ok(m)
+}
+
 fn unit_axis(v: &[f64; 3], what: &str) -> Result<Vec3> {
     let a = finite3(v, what)?;
     let n = a.norm();
@@ -446,6 +468,7 @@ impl Model {
         };
         let joint_index: HashMap<String, usize> = joints.iter().enumerate().map(|(i, j)| (j.name.clone(), i)).collect();
         let mut n_callbacks = 0usize;
+        let mut n_sliders = 0usize;
         let mut force_names = HashSet::new();
         let mut forces = Vec::with_capacity(desc.forces.len());
         for (i, f) in desc.forces.iter().enumerate() {
@@ -453,6 +476,10 @@ impl Model {
                 ForceDescription::SpringDamper { name, .. }
                 | ForceDescription::BodyForce { name, .. }
                 | ForceDescription::JointForce { name, .. }
+                | ForceDescription::Bushing { name, .. }
+                | ForceDescription::SqueezeFilm { name, .. }
+                | ForceDescription::JournalBearing { name, .. }
+                | ForceDescription::Jenkins { name, .. }
                 | ForceDescription::Callback { name, .. } => name.clone(),
             };
             let what = format!("forces[{i}] '{name}'");
@@ -469,10 +496,14 @@ impl Model {
                     l0,
                     table_deflection,
                     table_force,
+                    travel,
                     ..
                 } => {
                     for (x, key) in [(k, "k"), (k3, "k3"), (d, "d"), (l0, "l0")] {
                         crate::ensure!(x.is_finite(), Model, "{what}.{key}: must be finite, got {x}");
+                    }
+                    if let Some(s) = travel {
+                        crate::ensure!(s.is_finite() && *s > 0.0, Model, "{what}.travel: must be > 0 (m), got {s}");
                     }
                     crate::ensure!(*l0 >= 0.0, Model, "{what}.l0: must be >= 0, got {l0}");
                     let b1 = body(body1, &format!("{what}.body1"))?;
@@ -497,7 +528,136 @@ impl Model {
                         d: *d,
                         l0: *l0,
                         table: tab,
+                        travel: travel.unwrap_or(0.0),
                     }
+                }
+                ForceDescription::Bushing { body1, frame1, body2, frame2, k, d, travel, .. } => {
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    let km = matrix6(k, &format!("{what}.k"))?;
+                    let dm = matrix6(d, &format!("{what}.d"))?;
+                    if let Some(s) = travel {
+                        crate::ensure!(
+                            s.iter().all(|x| x.is_finite() && *x > 0.0),
+                            Model,
+                            "{what}.travel: every stop travel must be > 0, got {s:?}"
+                        );
+                        crate::ensure!(
+                            k.len() <= 6 && d.len() <= 6,
+                            Model,
+                            "{what}.travel: a progressive bushing takes diagonal k and d (6 values each)"
+                        );
+                    }
+                    ForceElement::Bushing {
+                        name,
+                        body1: b1,
+                        frame1: frame(frame1, &format!("{what}.frame1"))?,
+                        body2: b2,
+                        frame2: frame(frame2, &format!("{what}.frame2"))?,
+                        k: km,
+                        d: dm,
+                        travel: *travel,
+                    }
+                }
+                ForceDescription::SqueezeFilm {
+                    body1, point1, normal, body2, point2, eta, length, area, gap, ..
+                } => {
+                    let b1 = body(body1, &format!("{what}.body1"))?;
+                    let b2 = body(body2, &format!("{what}.body2"))?;
+                    crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");
+                    for (x, key, unit) in [(eta, "eta", "Pa s"), (length, "length", "m"), (area, "area", "m²"), (gap, "gap", "m")] {
+                        crate::ensure!(x.is_finite() && *x > 0.0, Model, "{what}.{key}: must be > 0 ({unit}), got {x}");
+                    }
+                    // eq. 2.211 is a thin-film (boundary-layer) law: h ≪ l
+                    crate::ensure!(
+                        *gap <= 0.1 * length,
+                        Model,
+                        "{what}.gap: {gap} m is outside the thin-film validity of eq. 2.211 (gap ≤ length/10 = {} m)",
+                        0.1 * length
+                    );
+                    ForceElement::SqueezeFilm {
+                        name,
+                        body1: b1,
+                        point1: finite3(point1, &format!("{what}.point1"))?,
+                        normal: nonzero_direction(normal, &format!("{what}.normal"))?,
+                        body2: b2,
+                        point2: finite3(point2, &format!("{what}.point2"))?,
+                        coeff: 12.0 * eta * area * length * length,
+                        gap: *gap,
+                        gap_max: 0.1 * length,
+                    }
+                }
+                ForceDescription::JournalBearing { joint, radius, length, clearance, eta, eccentricity, .. } => {
+                    let ji =
+                        *joint_index.get(joint).ok_or_else(|| err(format!("{what}.joint: unknown joint '{joint}'")))?;
+                    crate::ensure!(
+                        matches!(joints[ji].kind, JointKind::Revolute { .. }),
+                        Model,
+                        "{what}.joint: joint '{joint}' must be revolute (the shaft turning in the bearing)"
+                    );
+                    for (x, key, unit) in
+                        [(radius, "radius", "m"), (length, "length", "m"), (clearance, "clearance", "m"), (eta, "eta", "Pa s")]
+                    {
+                        crate::ensure!(x.is_finite() && *x > 0.0, Model, "{what}.{key}: must be > 0 ({unit}), got {x}");
+                    }
+                    // the boundary-layer theory behind eq. 2.212 needs a ≪ r0; relative clearances of
+                    // real bearings are 0.05–0.3 %
+                    crate::ensure!(
+                        *clearance <= 0.02 * radius,
+                        Model,
+                        "{what}.clearance: {clearance} m is outside the validity of eq. 2.212 (clearance ≤ radius/50 = {} m)",
+                        0.02 * radius
+                    );
+                    crate::ensure!(
+                        eccentricity.is_finite() && (0.0..=crate::forces::damping::MAX_ECCENTRICITY).contains(eccentricity),
+                        Model,
+                        "{what}.eccentricity: must lie in [0, {}] (eq. 2.212 diverges as the shaft touches the shell), got {eccentricity}",
+                        crate::forces::damping::MAX_ECCENTRICITY
+                    );
+                    ForceElement::JournalBearing {
+                        name,
+                        joint: ji,
+                        c: crate::forces::damping::journal_bearing_coefficient(*radius, *length, *clearance, *eta, *eccentricity),
+                    }
+                }
+                ForceDescription::Jenkins { joint, index, k, slip, shaft_stiffness, offset, .. } => {
+                    let ji =
+                        *joint_index.get(joint).ok_or_else(|| err(format!("{what}.joint: unknown joint '{joint}'")))?;
+                    let jt = &joints[ji];
+                    crate::ensure!(
+                        !matches!(jt.kind, JointKind::Spherical | JointKind::Free),
+                        Model,
+                        "{what}.joint: joint '{joint}' has quaternion coordinates; use a joint whose coordinates are its velocities"
+                    );
+                    crate::ensure!(
+                        *index < jt.nu(),
+                        Model,
+                        "{what}.index: joint '{joint}' has {} velocities, got index {index}",
+                        jt.nu()
+                    );
+                    crate::ensure!(k.is_finite() && *k > 0.0, Model, "{what}.k: must be > 0, got {k}");
+                    crate::ensure!(!slip.is_empty(), Model, "{what}.slip: give at least one slip force");
+                    if let Some(i) = slip.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+                        return Err(err(format!("{what}.slip[{i}]: slip forces must be > 0, got {}", slip[i])));
+                    }
+                    if let Some(ks) = shaft_stiffness {
+                        crate::ensure!(ks.is_finite() && *ks > 0.0, Model, "{what}.shaft_stiffness: must be > 0, got {ks}");
+                    }
+                    crate::ensure!(offset.is_finite(), Model, "{what}.offset: must be finite, got {offset}");
+                    let j = crate::forces::jenkins::Jenkins::new(
+                        name,
+                        ji,
+                        jt.iq + index,
+                        jt.iu + index,
+                        *k,
+                        slip.clone(),
+                        *shaft_stiffness,
+                        *offset,
+                        n_sliders,
+                    );
+                    n_sliders += j.len();
+                    ForceElement::Jenkins(j)
                 }
                 ForceDescription::BodyForce { body: b, point, force, torque, frame, function, .. } => {
                     let bi = body(b, &format!("{what}.body"))?;
@@ -785,6 +945,7 @@ impl Model {
 
         let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
+        let n_force_outputs = forces.iter().map(|f| f.outputs()).sum();
         Ok(Model {
             name: desc.name.clone(),
             gravity: g,
@@ -801,6 +962,8 @@ impl Model {
             variable_mass,
             qdot_is_u,
             n_callbacks,
+            n_sliders,
+            n_force_outputs,
             description: desc,
             body_index,
             joint_index,
