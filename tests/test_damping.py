@@ -312,3 +312,24 @@ def test_jenkins_with_moreau_jean_and_bad_input():
         m.add_force(ms.forces.Jenkins("press", **args))
         with pytest.raises(ms.ModelError, match=f"press.*{words}"):
             m.build()
+
+
+def test_press_fit_model_file_runs_from_the_command_line(tmp_path):
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from mechsys.cli import cli
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "press_fit.toml"
+    out = tmp_path / "pf.h5"
+    r = CliRunner().invoke(cli, ["run", str(example), "--t-end", "0.5", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    res = ms.load(out)
+    # the fit never carries more than the sum of its slip torques, and the bearing follows eq. 2.212
+    assert np.abs(res["force/press/force"]).max() <= 15.0 * (1 + 1e-12)
+    c = ms.forces.journal_bearing_coefficient(0.04, 0.06, 6e-5, 0.02, 0.4)
+    np.testing.assert_allclose(res["force/bearing/force"], c * res["joint/fit/u"], rtol=1e-12, atol=1e-15)
+    # energy balance of the whole run: T + V + losses = work of the excitation
+    e = res["energy/total"] + res["energy/dissipated"] - res["energy/external_work"]
+    assert abs(e - e[0]).max() < 1e-6 * res["energy/external_work"].max()
