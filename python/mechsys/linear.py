@@ -16,11 +16,12 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
 from . import _core
-from .errors import ModelError, SettingsError
+from .errors import MechsysError, ModelError, SettingsError
 from .model import Model
 
 
@@ -81,6 +82,8 @@ class LinearModel:
     u: np.ndarray
     t: float = 0.0
     names: list = field(default_factory=list)
+    #: the model it came from (for re-linearizing, e.g. by :meth:`campbell`); None when built by hand
+    model: Model | None = field(default=None, repr=False, compare=False)
 
     @property
     def n(self) -> int:
@@ -119,25 +122,58 @@ class LinearModel:
             zeta = np.where(wn > 0, -lam.real / np.where(wn > 0, wn, 1.0), 0.0)
         return Modes(lam, wn / (2 * np.pi), np.abs(lam.imag) / (2 * np.pi), zeta, shapes, self.V @ shapes)
 
-    def frf(self, frequencies, inputs=None, outputs=None) -> np.ndarray:
+    def frf(self, frequencies, inputs=None, outputs=None, method: str = "auto") -> np.ndarray:
         """H(j w) = [-w^2 M + j w (D + G) + (K + N)]^-1 (eq. 2.205) at ``frequencies`` (Hz, > 0),
         between generalized forces on the coordinates ``inputs`` and the coordinates ``outputs``
-        (indices into y; all by default). Returns complex (n_freq, n_out, n_in), in m/N (or rad/(N m))."""
+        (indices into y; all by default). Returns complex (n_freq, n_out, n_in), in m/N (or rad/(N m)).
+
+        ``method``: ``"direct"`` solves the n x n system at every frequency; ``"modal"``
+        diagonalizes the state-space form once, H = C Phi (j w - Lambda)^-1 Phi^-1 B (fast for a
+        few inputs and outputs; refused when the eigenvectors are nearly dependent, as with
+        rigid-body modes); ``"auto"`` (default) takes the modal form when there are no more
+        input-output pairs than coordinates and it is well conditioned, else the direct one."""
         f = np.atleast_1d(np.asarray(frequencies, dtype=float))
         if f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
             raise SettingsError("frf: frequencies must be finite and > 0 (Hz)")
+        if method not in ("auto", "direct", "modal"):
+            raise SettingsError(f"frf: method must be 'auto', 'direct' or 'modal', got {method!r}")
         ins = list(range(self.n)) if inputs is None else [self._index(i, "inputs") for i in np.atleast_1d(inputs)]
         outs = list(range(self.n)) if outputs is None else [self._index(i, "outputs") for i in np.atleast_1d(outputs)]
-        out = np.empty((f.size, len(outs), len(ins)), dtype=complex)
+        w = 2 * np.pi * f
+        if method == "modal" or (method == "auto" and len(ins) * len(outs) <= self.n):
+            h = self._frf_modal(w, ins, outs, strict=method == "modal")
+            if h is not None:
+                return h
+        return self._frf_direct(w, ins, outs)
+
+    def _frf_direct(self, w: np.ndarray, ins: list, outs: list) -> np.ndarray:
+        out = np.empty((w.size, len(outs), len(ins)), dtype=complex)
         b = np.zeros((self.n, len(ins)))
         b[ins, range(len(ins))] = 1.0
         c = self.D + self.G
         s = self.K + self.N
-        for k, fk in enumerate(f):
-            w = 2 * np.pi * fk
-            z = -w * w * self.M + 1j * w * c + s
+        z = np.empty((self.n, self.n), dtype=complex)
+        for k, wk in enumerate(w):
+            z.real = s - wk * wk * self.M
+            z.imag = wk * c
             out[k] = np.linalg.solve(z, b)[outs, :]
         return out
+
+    def _frf_modal(self, w: np.ndarray, ins: list, outs: list, strict: bool):
+        n = self.n
+        lam, phi = np.linalg.eig(self.state_matrix())
+        if np.linalg.cond(phi) > 1e6:
+            if strict:
+                raise SettingsError("frf: method='modal': the eigenvectors are nearly dependent (rigid-body or defective "
+                                    "modes); use method='direct'")
+            return None
+        b = np.zeros((2 * n, len(ins)))
+        unit = np.zeros((n, len(ins)))
+        unit[ins, range(len(ins))] = 1.0
+        b[n:, :] = np.linalg.solve(self.M, unit)
+        r = np.linalg.solve(phi, b)
+        d = 1.0 / (1j * w[:, None] - lam[None, :])
+        return np.einsum("ok,fk,ki->foi", phi[outs, :], d, r, optimize=True)
 
     def _index(self, i, what: str) -> int:
         if isinstance(i, (str, np.str_)):
@@ -166,6 +202,104 @@ class LinearModel:
         """Rayleigh's dissipation function R = y'^T D y' / 2 (eq. 2.206: the power lost is 2R)."""
         v = np.asarray(ydot, dtype=float)
         return 0.5 * float(v @ self.D @ v)
+
+    def energy(self, y, ydot) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic and potential energy of the linear model, E_k = y'^T M y' / 2 and
+        E_p = y^T K y / 2, for one state or for samples (rows of ``y`` and ``ydot``)."""
+        y, v = self._samples(y, "y"), self._samples(ydot, "ydot")
+        ek = 0.5 * np.einsum("ki,ij,kj->k", v, self.M, v)
+        ep = 0.5 * np.einsum("ki,ij,kj->k", y, self.K, y)
+        return ek, ep
+
+    def power_balance(self, t, y, ydot, yddot=None) -> dict:
+        """The power equation (eq. 2.206) along sampled motion (rows of ``y``, ``ydot`` at times
+        ``t``): ``energy`` E_k + E_p, ``dE_dt`` its time derivative (y'^T M y'' + y'^T K y with
+        the accelerations ``yddot`` if given, e.g. ``res["udot"]`` when V = I, else second-order
+        differences),
+        ``dissipation`` -y'^T D y' = -2R, ``circulatory`` -y'^T N y (the non-conservative
+        forces' power) and ``external`` dE_dt minus both (the power of the loads g(t) and the
+        linearization error; zero for free motion of a linear model)."""
+        tt = np.asarray(t, dtype=float).reshape(-1)
+        y, v = self._samples(y, "y"), self._samples(ydot, "ydot")
+        if not (tt.size == y.shape[0] == v.shape[0]) or tt.size < 3:
+            raise SettingsError(f"power_balance: t, y, ydot need the same number (>= 3) of samples, got {tt.size}, {y.shape[0]}, {v.shape[0]}")
+        ek, ep = self.energy(y, v)
+        e = ek + ep
+        if yddot is None:
+            de = np.gradient(e, tt, edge_order=2)
+        else:
+            a = self._samples(yddot, "yddot")
+            de = np.einsum("ki,ij,kj->k", v, self.M, a) + np.einsum("ki,ij,kj->k", v, self.K, y)
+        diss = -np.einsum("ki,ij,kj->k", v, self.D, v)
+        circ = -np.einsum("ki,ij,kj->k", v, self.N, y)
+        return {"energy": e, "dE_dt": de, "dissipation": diss, "circulatory": circ, "external": de - diss - circ}
+
+    def _samples(self, a, what: str) -> np.ndarray:
+        arr = np.atleast_2d(np.asarray(a, dtype=float))
+        if arr.shape[-1] != self.n:
+            raise SettingsError(f"{what}: expected rows of {self.n} coordinates, got shape {np.shape(a)}")
+        return arr
+
+    def deviation(self, q, u) -> tuple[np.ndarray, np.ndarray]:
+        """y and y' of sampled states (rows of ``q``, ``u``, e.g. ``res["q"]``, ``res["u"]``)
+        relative to the linearization point: y = V^+ (q - q_lin), y' = V^+ u. Only for models
+        whose coordinates are their velocities' integrals (no quaternion joints)."""
+        qa, ua = np.atleast_2d(np.asarray(q, dtype=float)), np.atleast_2d(np.asarray(u, dtype=float))
+        if qa.shape[-1] != self.q.size or ua.shape[-1] != self.u.size or self.q.size != self.u.size:
+            raise SettingsError("deviation: needs a model with as many coordinates as velocities (no quaternion "
+                                f"joints) and rows of q ({self.q.size}) and u ({self.u.size})")
+        vp = np.linalg.pinv(self.V)
+        return (qa - self.q) @ vp.T, (ua - self.u) @ vp.T
+
+    def campbell(self, values, joint: str, whirl=None, component: int | None = None, track: str = "mac",
+                 rigid_tol: float = 1e-6) -> "Campbell":
+        """Campbell diagram: the stored model re-linearized (as an operating point) with the
+        velocity of the spin joint ``joint`` set to each of ``values`` (rad/s), the other
+        coordinates and velocities as at this point. Modes with |lambda| below ``rigid_tol`` times
+        the largest (rigid-body ones, e.g. the spin itself) are left out; the others are followed
+        from speed to speed by the modal assurance criterion of their complex shapes
+        (``track="mac"``) or by frequency order (``"order"``).
+
+        ``whirl``: the two lateral coordinates of the whirl plane (names or indices into y),
+        x then y with x, y and the spin axis right-handed (displacements along x and y, or tilts
+        about x and y). A mode whirls ``forward`` when its orbit y(t) = Re(s e^(lambda t)) in
+        that plane turns with the spin (sign of Im(s_x conj(s_y)) equal to the speed's sign),
+        ``backward`` against it; ``""`` at zero speed, without ``whirl`` or for a straight-line
+        orbit."""
+        if self.model is None:
+            raise SettingsError("campbell: this LinearModel has no model to re-linearize (use ms.linear.linearize)")
+        speeds = np.atleast_1d(np.asarray(values, dtype=float)).reshape(-1)
+        if speeds.size == 0 or not np.all(np.isfinite(speeds)):
+            raise SettingsError("campbell: values must be finite spin speeds (rad/s)")
+        if track not in ("mac", "order"):
+            raise SettingsError(f"campbell: track must be 'mac' or 'order', got {track!r}")
+        iu = _spin_index(self.model, joint, component)
+        pair = None if whirl is None else self._whirl_pair(whirl)
+        per_speed, worst = [], 0.0
+        for w in speeds:
+            u = self.u.copy()
+            u[iu] = w
+            lin = _relinearize(self, u)
+            worst = max(worst, float(np.abs(lin.residual).max(initial=0.0)))
+            per_speed.append(_elastic_modes(lin.modes(), rigid_tol))
+        return _campbell(speeds, per_speed, pair, track, f"{joint}" if component is None else f"{joint}[{component}]", worst)
+
+    def _whirl_pair(self, whirl) -> tuple[int, int]:
+        """Indices of the whirl plane's coordinates from ``(x, y)`` or ``"x,y"`` (names or indices)."""
+        parts = [p.strip() for p in whirl.split(",")] if isinstance(whirl, str) else \
+            list(whirl) if isinstance(whirl, (tuple, list, np.ndarray)) else []
+        if len(parts) != 2:
+            raise SettingsError(f"campbell: whirl must be two coordinates (x, y) as names or indices, got {whirl!r}")
+        idx = []
+        for p in parts:
+            p = int(p) if isinstance(p, str) and p.isdigit() else p
+            try:
+                idx.append(self._index(p, "whirl"))
+            except (SettingsError, TypeError, ValueError) as e:
+                raise SettingsError(f"campbell: whirl: {e}".replace("frf: whirl: ", "")) from None
+        if idx[0] == idx[1]:
+            raise SettingsError(f"campbell: whirl needs two different coordinates, got {whirl!r}")
+        return idx[0], idx[1]
 
 
 def rayleigh_coefficients(zeta1: float, f1: float, zeta2: float, f2: float) -> tuple[float, float]:
@@ -212,23 +346,31 @@ def _names(model: Model, n_u: int) -> list[str]:
     return names if len(names) == n_u else [f"u{k}" for k in range(n_u)]
 
 
-def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: bool = False) -> LinearModel:
+def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: bool = False, at=None) -> LinearModel:
     """Linearizes ``model`` at (``q``, ``u``, ``t``) (the model's q0, u0 by default).
 
     At a point that is not an equilibrium (``residual`` beyond round-off) a ``UserWarning``
     reports the residual, unless ``operating_point=True`` says the point is meant as it is (a
-    steady motion, or a quasi-static state whose imbalance the user accepts)."""
+    steady motion, or a quasi-static state whose imbalance the user accepts).
+
+    ``at`` chooses the point instead of ``q``/``u``: ``None`` or ``"q0"`` (the model's q0, u0),
+    ``"equilibrium"`` (:func:`mechsys.analysis.static_equilibrium` from ``q``, at rest unless
+    ``u`` is given), or a dict ``{"q": ..., "u": ...}`` whose entries are full vectors or
+    ``{joint: value}`` dicts, or directly a ``{joint: q value}`` dict as ``simulate``'s q0.
+    ``q``, ``u`` also accept ``{joint: value}`` dicts. A mass matrix that is singular (a
+    coordinate without inertia) raises a ModelError naming the coordinate."""
     if not isinstance(model, Model):
         raise SettingsError(f"linearize: expected a mechsys.Model, got {type(model).__name__}")
     core, cbs = model.engine()
-    q = model.q0() if q is None else np.ascontiguousarray(q, dtype=float)
-    u = model.u0() if u is None else np.ascontiguousarray(u, dtype=float)
+    q, u = _point(model, q, u, float(t), at)
     raw = _core.linearize(core, q, u, float(t), cbs)
     n_u = raw["V"].shape[0]
     names = _names(model, n_u)
     if raw["V"].shape[1] != n_u or not np.allclose(raw["V"], np.eye(n_u)):
         names = [f"y{k}" for k in range(raw["V"].shape[1])]
     lin = LinearModel(raw["M"], raw["D"], raw["G"], raw["K"], raw["N"], raw["V"], raw["residual"], q, u, float(t), names)
+    lin = replace(lin, model=model)
+    _check_mass(lin, model.name)
     scale = 1.0 + np.abs(lin.K).max(initial=0.0) + np.abs(lin.M).max(initial=0.0)
     res = float(np.abs(lin.residual).max(initial=0.0))
     if res > 1e-8 * scale and not operating_point:
@@ -241,4 +383,424 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
     return lin
 
 
-__all__ = ["linearize", "LinearModel", "Modes", "rayleigh_coefficients", "sdof_frequencies", "sdof_response"]
+# ---- the linearization point ---------------------------------------------------------------------
+
+
+def _vector(model: Model, values, which: str, what: str) -> np.ndarray:
+    """A full q (``which="q"``) or u vector from None (the model's own), an array or a
+    ``{joint: value}`` dict; errors name ``what``."""
+    try:
+        v = np.array(model.state_vector(values, which), dtype=float)
+    except MechsysError as e:
+        raise type(e)(f"linearize: {what}: " + str(e).split(": ", 1)[-1]) from None
+    except (TypeError, ValueError):
+        raise SettingsError(f"linearize: {what}: expected a vector or a {{joint: value}} dict, got {values!r}") from None
+    if not np.all(np.isfinite(v)):
+        raise SettingsError(f"linearize: {what}: values must be finite, got {values!r}")
+    return v
+
+
+def _point(model: Model, q, u, t: float, at) -> tuple[np.ndarray, np.ndarray]:
+    """(q, u) of the linearization point from linearize's ``q``, ``u`` and ``at``."""
+    if at is None or (isinstance(at, str) and at == "q0"):
+        return _vector(model, q, "q", "q"), _vector(model, u, "u", "u")
+    if isinstance(at, str):
+        if at != "equilibrium":
+            raise SettingsError(f"linearize: at={at!r}: expected None, 'q0', 'equilibrium' or a dict {{'q': ..., 'u': ...}}")
+        from .analysis import static_equilibrium
+
+        eq = static_equilibrium(model, _vector(model, q, "q", "q"), t)
+        return np.array(eq["q"], dtype=float), np.zeros(model.nu) if u is None else _vector(model, u, "u", "u")
+    if isinstance(at, dict):
+        if q is not None or u is not None:
+            raise SettingsError("linearize: give the point by at= or by q=/u=, not both")
+        if at and set(at) <= {"q", "u"}:
+            return _vector(model, at.get("q"), "q", "at['q']"), _vector(model, at.get("u"), "u", "at['u']")
+        return _vector(model, at, "q", "at"), _vector(model, None, "u", "u")
+    raise SettingsError(f"linearize: at: expected None, 'q0', 'equilibrium' or a dict {{'q': ..., 'u': ...}}, "
+                        f"got {type(at).__name__} {at!r}")
+
+
+def _check_mass(lin: LinearModel, model_name: str) -> None:
+    """ModelError naming the coordinate(s) without inertia when M is singular (to round-off)."""
+    m = lin.M
+    if not np.all(np.isfinite(m)):
+        raise ModelError(f"model '{model_name}': the linearized mass matrix is not finite")
+    if lin.n == 0:
+        return
+    d = np.diag(m)
+    big = float(np.abs(d).max())
+    light = np.nonzero(d <= 1e-13 * big)[0] if big > 0 else np.arange(lin.n)
+    if light.size == 0:
+        s = m / np.sqrt(np.outer(d, d))
+        w, v = np.linalg.eigh(0.5 * (s + s.T))
+        if w[0] > 1e-12 * w[-1]:
+            return
+        light = np.nonzero(np.abs(v[:, 0]) > 0.1 * np.abs(v[:, 0]).max())[0]
+    names = ", ".join(f"'{lin.names[k]}'" for k in light)
+    raise ModelError(f"model '{model_name}': the mass matrix is singular: coordinate{'s' if light.size > 1 else ''} "
+                     f"{names} {'have' if light.size > 1 else 'has'} no inertia (give the body on that joint mass "
+                     "or inertia, or remove the coordinate)")
+
+
+# ---- Campbell diagrams ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Campbell:
+    """Modes of a spinning model against the spin speed, each column one mode followed across
+    the speeds (NaN where it is missing)."""
+
+    #: spin speeds (rad/s)
+    speeds: np.ndarray
+    #: damped (whirl) frequencies Im(lambda) / 2 pi (Hz), n_speeds x n_modes
+    frequencies: np.ndarray
+    #: undamped natural frequencies |lambda| / 2 pi (Hz)
+    natural_frequency: np.ndarray
+    #: damping ratios -Re(lambda) / |lambda| (negative: unstable)
+    damping_ratio: np.ndarray
+    #: 'forward', 'backward' or '' per speed and mode
+    whirl: np.ndarray
+    #: the spin joint (and component)
+    joint: str = ""
+    #: the largest equilibrium residual over the speeds (nonzero: not a steady motion)
+    residual: float = 0.0
+
+    def critical_speeds(self, order: float = 1.0) -> list[dict]:
+        """Speeds (rad/s) where a mode's frequency crosses the excitation line f = order * speed / 2 pi
+        (linear interpolation): dicts with mode (column), speed, frequency (Hz), whirl."""
+        out = []
+        for c in range(self.frequencies.shape[1]):
+            g = self.frequencies[:, c] - order * self.speeds / (2 * np.pi)
+            for k in range(len(g) - 1):
+                if np.isfinite(g[k]) and np.isfinite(g[k + 1]) and g[k] * g[k + 1] <= 0 and g[k] != g[k + 1]:
+                    a = g[k] / (g[k] - g[k + 1])
+                    w = self.speeds[k] + a * (self.speeds[k + 1] - self.speeds[k])
+                    out.append({"mode": c, "speed": float(w), "frequency": float(order * w / (2 * np.pi)),
+                                "whirl": self.whirl[k + (a > 0.5), c]})
+        return sorted(out, key=lambda d: abs(d["speed"]))
+
+    def table(self) -> str:
+        """A text table: one row per speed, the frequency (Hz) of each mode with f/b for the whirl."""
+        n = self.frequencies.shape[1]
+        rows = [f"{'speed (rad/s)':>13}" + "".join(f"  {'mode ' + str(c + 1) + ' (Hz)':>15}" for c in range(n))]
+        mark = {"forward": " f", "backward": " b", "": "  "}
+        for k, w in enumerate(self.speeds):
+            rows.append(f"{w:13.6g}" + "".join(f"  {self.frequencies[k, c]:13.6g}{mark[self.whirl[k, c]]}" for c in range(n)))
+        return "\n".join(rows)
+
+    def plot(self, out=None, orders=(1.0,), title: str | None = None, rpm: bool = False):
+        """Frequency (Hz) against speed (rad/s, or rpm with ``rpm=True``): forward whirl solid,
+        backward dashed, undetermined dotted; the excitation lines f = order * speed (``orders``,
+        e.g. (1, 2)) and their crossings (critical speeds). Saved to ``out`` if given."""
+        fig = _figure(out, (7.5, 5.0))
+        ax = fig.subplots()
+        scale = 60 / (2 * np.pi) if rpm else 1.0
+        x = self.speeds * scale
+        styles = {"forward": "-", "backward": "--", "": ":"}
+        colors = [f"C{c % 10}" for c in range(self.frequencies.shape[1])]
+        for c in range(self.frequencies.shape[1]):
+            f, lab = self.frequencies[:, c], self.whirl[:, c]
+            start = 0
+            for k in range(1, len(f) + 1):
+                if k == len(f) or lab[k] != lab[start]:
+                    seg = slice(max(start - 1, 0), k)
+                    ax.plot(x[seg], f[seg], styles[lab[start]], color=colors[c], lw=1.6)
+                    start = k
+        top = np.nanmax(self.frequencies) * 1.1 if np.isfinite(self.frequencies).any() else 1.0
+        for o in orders:
+            ax.plot(x, o * np.abs(self.speeds) / (2 * np.pi), color="0.4", lw=1.0)
+            ax.annotate(f"{o:g}×", (x[-1], min(o * abs(self.speeds[-1]) / (2 * np.pi), top)), fontsize="small",
+                        color="0.3", ha="right", va="bottom")
+            for cs in self.critical_speeds(o):
+                ax.plot(cs["speed"] * scale, abs(cs["frequency"]), "o", mfc="none", color="k", ms=7)
+        from matplotlib.lines import Line2D
+
+        handles = [Line2D([], [], color=colors[c], lw=1.6, label=f"mode {c + 1}") for c in range(len(colors))]
+        handles += [Line2D([], [], color="k", ls="-", label="forward whirl"), Line2D([], [], color="k", ls="--", label="backward whirl"),
+                    Line2D([], [], color="0.4", lw=1.0, label="excitation (order × speed)"),
+                    Line2D([], [], marker="o", mfc="none", color="k", ls="", label="critical speed")]
+        ax.legend(handles=handles, fontsize="small", loc="upper left", framealpha=0.8)
+        ax.set_xlim(x.min(), x.max() if x.max() > x.min() else x.min() + 1)
+        ax.set_ylim(0, top)
+        ax.set_xlabel(f"spin speed of '{self.joint}' [{'rpm' if rpm else 'rad/s'}]")
+        ax.set_ylabel("whirl frequency [Hz]")
+        ax.grid(True, alpha=0.3)
+        ax.set_title(title or "Campbell diagram")
+        return _save(fig, out)
+
+
+def _spin_index(model: Model, joint: str, component: int | None) -> int:
+    """Index into u of the spin joint's velocity (component ``component`` of a multi-velocity joint)."""
+    info = {j["name"]: j for j in model.joint_info()}
+    if joint not in info:
+        raise SettingsError(f"campbell: unknown joint '{joint}' (joints: {', '.join(info)})")
+    j = info[joint]
+    if component is None:
+        if j["nu"] != 1:
+            raise SettingsError(f"campbell: joint '{joint}' ({j['type']}) has {j['nu']} velocities; a spin joint has one "
+                                f"(or pass component=0..{j['nu'] - 1})")
+        return j["iu"]
+    if not (isinstance(component, (int, np.integer)) and 0 <= component < j["nu"]):
+        raise SettingsError(f"campbell: component {component!r} of joint '{joint}' out of range 0..{j['nu'] - 1}")
+    return j["iu"] + int(component)
+
+
+def _relinearize(lin: LinearModel, u: np.ndarray) -> LinearModel:
+    """``lin``'s model linearized again at its q, t with the velocities ``u`` (same method)."""
+    extra = {"method": lin.method} if getattr(lin, "method", None) is not None else {}
+    return linearize(lin.model, q=lin.q, u=u, t=lin.t, operating_point=True, **extra)
+
+
+def _elastic_modes(modes: Modes, rigid_tol: float) -> dict:
+    """Eigenvalues and shapes of the modes with |lambda| above ``rigid_tol`` times the largest."""
+    mag = np.abs(modes.eigenvalues)
+    keep = mag > rigid_tol * mag.max(initial=0.0)
+    return {"lam": modes.eigenvalues[keep], "shapes": modes.shapes[:, keep]}
+
+
+def _mac(a: np.ndarray, b: np.ndarray) -> float:
+    """Modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of two complex shapes."""
+    den = float(np.vdot(a, a).real * np.vdot(b, b).real)
+    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+def _whirl(shape: np.ndarray, pair, speed: float, lam: complex) -> str:
+    """'forward' / 'backward' from the orbit's sense in the whirl plane against the spin's sign."""
+    if pair is None or speed == 0 or lam.imag <= 0:
+        return ""
+    sx, sy = shape[pair[0]], shape[pair[1]]
+    size = abs(sx) ** 2 + abs(sy) ** 2
+    sense = (sx * np.conj(sy)).imag
+    if size <= 1e-12 * float(np.vdot(shape, shape).real) or abs(sense) <= 1e-6 * size:
+        return ""
+    return "forward" if np.sign(sense) == np.sign(speed) else "backward"
+
+
+def _campbell(speeds, per_speed: list[dict], pair, track: str, joint: str, residual: float) -> Campbell:
+    """Assembles a :class:`Campbell`, assigning each speed's modes to columns (by MAC and
+    frequency from the previous speed, or by frequency order)."""
+    from scipy.optimize import linear_sum_assignment
+
+    ns, nc = len(speeds), max((len(m["lam"]) for m in per_speed), default=0)
+    lam = np.full((ns, nc), np.nan + 0j)
+    whirl = np.full((ns, nc), "", dtype=object)
+    last: list = [None] * nc
+    for k, m in enumerate(per_speed):
+        cur = m["lam"]
+        if track == "order" or k == 0:
+            cols = np.arange(len(cur))
+        else:
+            fscale = max(float(np.nanmax(np.abs(lam[:k]))), 1e-300) if k else 1.0
+            cost = np.full((len(cur), nc), 3.0)
+            for i in range(len(cur)):
+                for c in range(nc):
+                    if last[c] is not None:
+                        cost[i, c] = 1.0 - _mac(m["shapes"][:, i], last[c][0]) + 0.1 * abs(abs(cur[i]) - abs(last[c][1])) / fscale
+            rows, cols_ = linear_sum_assignment(cost)
+            cols = np.empty(len(cur), dtype=int)
+            cols[rows] = cols_
+        for i, c in enumerate(cols):
+            lam[k, c] = cur[i]
+            last[c] = (m["shapes"][:, i], cur[i])
+            whirl[k, c] = _whirl(m["shapes"][:, i], pair, float(speeds[k]), complex(cur[i]))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wn = np.abs(lam)
+        zeta = np.where(wn > 0, -lam.real / wn, np.nan)
+    return Campbell(np.asarray(speeds, dtype=float), np.abs(lam.imag) / (2 * np.pi), wn / (2 * np.pi), zeta,
+                    whirl.astype(str), joint, residual)
+
+
+# ---- hysteresis (section 2.6.3) ------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Hysteresis:
+    """The force-displacement loop of the last whole cycle(s) of a periodic steady state, its
+    dissipated work per cycle W_D (eq. 2.213) and the equivalent linear element of equal loop
+    area (Fig. 2.37): F ~ F_m + k_eq (x - x_m) + d_eq x'."""
+
+    #: time, displacement and force samples of the analysed cycles (the loop)
+    t: np.ndarray
+    x: np.ndarray
+    force: np.ndarray
+    #: work dissipated per cycle W_D = sign * closed integral F dx / cycles (J, or N m per rad ...)
+    work: float
+    #: amplitude of the displacement's fundamental harmonic x_a
+    amplitude: float
+    #: half the displacement's peak-to-peak range
+    peak: float
+    #: angular frequency 2 pi / period (rad/s) and the period (s)
+    omega: float
+    period: float
+    #: equivalent viscous damping by equal loop area d_eq = W_D / (pi omega x_a^2)
+    d_eq: float
+    #: equivalent stiffness: in-phase part of the force's fundamental over x_a
+    k_eq: float
+    #: mean displacement and force over the cycles
+    x_mean: float
+    force_mean: float
+    cycles: int = 1
+
+    @property
+    def loss_factor(self) -> float:
+        """W_D / (pi k_eq x_a^2) = d_eq omega / k_eq (NaN without stiffness)."""
+        return float(self.d_eq * self.omega / self.k_eq) if self.k_eq != 0 else float("nan")
+
+    def ellipse(self, n: int = 361) -> tuple[np.ndarray, np.ndarray]:
+        """The loop of the equivalent linear element under x = x_m + x_a sin(theta): the ellipse
+        enclosing the same area W_D (Fig. 2.37, left)."""
+        th = np.linspace(0.0, 2 * np.pi, n)
+        x = self.x_mean + self.amplitude * np.sin(th)
+        f = self.force_mean + self.k_eq * self.amplitude * np.sin(th) + self.d_eq * self.omega * self.amplitude * np.cos(th)
+        return x, f
+
+    def plot(self, out=None, title: str | None = None, xlabel: str = "displacement", ylabel: str = "force"):
+        """The loop and its equivalent ellipse (equal area); saved to ``out`` if given."""
+        fig = _figure(out, (6.0, 5.0))
+        ax = fig.subplots()
+        ax.plot(self.x, self.force, lw=1.6, label=f"loop, W_D = {self.work:.4g} per cycle")
+        ex, ef = self.ellipse()
+        ax.plot(ex, ef, "--", lw=1.2, color="C3", label=f"equal area: k_eq = {self.k_eq:.4g}, d_eq = {self.d_eq:.4g}")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small", loc="upper left", framealpha=0.8)
+        ax.set_title(title or f"hysteresis, omega = {self.omega:.4g} rad/s, x_a = {self.amplitude:.4g}")
+        return _save(fig, out)
+
+
+def hysteresis(t, displacement, force, period: float | None = None, cycles: int = 1, sign: float = 1.0) -> Hysteresis:
+    """Hysteresis analysis of a periodic steady state: the last ``cycles`` whole periods of the
+    signals ``displacement`` x(t) and ``force`` F(t) (e.g. ``res["force/<e>/deflection"]`` and
+    ``res["force/<e>/force"]``).
+
+    Sign convention: ``force`` is the force the element exerts *against* its displacement (the
+    force it carries along its deflection, as the ``force/<e>/force`` signals), so that
+    W_D = closed integral F dx > 0 for a dissipating element; pass ``sign=-1`` for the force the
+    element exerts on the moving side. ``period``: known period (s); by default it is found from
+    the spacing of the last upward mean crossings of x (give it for noisy or multi-harmonic x).
+
+    W_D uses the trapezoidal rule on F dx (error about (2 pi / samples per cycle)^2 / 6 relative);
+    the amplitude x_a and k_eq are the fundamental harmonics' least-squares fit; d_eq = W_D /
+    (pi omega x_a^2) is the viscous damper with the same loop area (Fig. 2.37)."""
+    tt, x, f = _signals(t, displacement, force)
+    if sign not in (1, -1, 1.0, -1.0):
+        raise SettingsError(f"hysteresis: sign must be +1 or -1, got {sign!r}")
+    if not (isinstance(cycles, (int, np.integer)) and cycles >= 1):
+        raise SettingsError(f"hysteresis: cycles must be an integer >= 1, got {cycles!r}")
+    T = _period(tt, x) if period is None else float(period)
+    if not (np.isfinite(T) and T > 0):
+        raise SettingsError(f"hysteresis: period must be > 0 (s), got {period!r}")
+    ta = tt[-1] - cycles * T
+    if ta < tt[0] - 1e-12 * T:
+        raise SettingsError(f"hysteresis: the signals span {tt[-1] - tt[0]:.6g} s, less than {cycles} period(s) of {T:.6g} s")
+    inside = tt > ta
+    wt = np.concatenate([[ta], tt[inside]])
+    wx = np.concatenate([[np.interp(ta, tt, x)], x[inside]])
+    wf = np.concatenate([[np.interp(ta, tt, f)], f[inside]])
+    work = float(sign * np.sum(0.5 * (wf[1:] + wf[:-1]) * np.diff(wx)) / cycles)
+    omega = 2 * np.pi / T
+    xm, xc, xs = _fundamental(wt, wx, omega)
+    fm, fc, fs = _fundamental(wt, wf, omega)
+    # phasors X = xc - j xs, F = fc - j fs of x = Re(X e^(j omega t)); k* = F / X
+    amp = float(np.hypot(xc, xs))
+    kstar = sign * complex(fc, -fs) / complex(xc, -xs) if amp > 0 else complex("nan")
+    d_eq = work / (np.pi * omega * amp * amp) if amp > 0 else float("nan")
+    return Hysteresis(wt, wx, wf, work, amp, float(0.5 * np.ptp(wx)), float(omega), float(T), float(d_eq),
+                      float(kstar.real), float(xm), float(fm), int(cycles))
+
+
+def _signals(t, x, f) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    arrs = []
+    for name, a in (("t", t), ("displacement", x), ("force", f)):
+        try:
+            v = np.asarray(a, dtype=float)
+        except (TypeError, ValueError):
+            raise SettingsError(f"hysteresis: {name}: expected an array of numbers") from None
+        if v.ndim != 1:
+            raise SettingsError(f"hysteresis: {name}: expected a 1-D signal, got shape {v.shape} (pick one component)")
+        if not np.all(np.isfinite(v)):
+            raise SettingsError(f"hysteresis: {name}: contains NaN or infinite values")
+        arrs.append(v)
+    tt, xx, ff = arrs
+    if not (tt.size == xx.size == ff.size) or tt.size < 8:
+        raise SettingsError(f"hysteresis: t, displacement, force need the same length (>= 8), got {tt.size}, {xx.size}, {ff.size}")
+    if np.any(np.diff(tt) <= 0):
+        raise SettingsError("hysteresis: t must be increasing")
+    return tt, xx, ff
+
+
+def _period(t: np.ndarray, x: np.ndarray) -> float:
+    """Period from the last upward crossings of x through its mean over the second half."""
+    xm = x - x[t >= 0.5 * (t[0] + t[-1])].mean()
+    k = np.nonzero((xm[:-1] < 0) & (xm[1:] >= 0))[0]
+    if k.size < 3:
+        raise SettingsError("hysteresis: cannot find the period (fewer than 3 crossings of the mean); pass period=")
+    tc = t[k] - xm[k] * (t[k + 1] - t[k]) / (xm[k + 1] - xm[k])
+    tc = tc[-6:]
+    return float((tc[-1] - tc[0]) / (tc.size - 1))
+
+
+def _fundamental(t: np.ndarray, y: np.ndarray, omega: float) -> tuple[float, float, float]:
+    """Least-squares mean, cosine and sine amplitudes of y ~ m + c cos(omega t) + s sin(omega t)."""
+    a = np.column_stack([np.ones_like(t), np.cos(omega * t), np.sin(omega * t)])
+    m, c, s = np.linalg.lstsq(a, y, rcond=None)[0]
+    return float(m), float(c), float(s)
+
+
+# ---- plots ---------------------------------------------------------------------------------------
+
+
+def _figure(out, size):
+    """A matplotlib Figure: Agg canvas when saving or headless (as mechsys.plotting)."""
+    from .plotting import FORMATS, _headless
+
+    if out is not None and Path(out).suffix.lower() not in FORMATS:
+        raise SettingsError(f"plot: cannot write {out} ('{Path(out).suffix}'); use one of {', '.join(FORMATS)}")
+    if out is not None or _headless():
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=size, layout="constrained")
+        FigureCanvasAgg(fig)
+        return fig
+    import matplotlib.pyplot as plt
+
+    return plt.figure(figsize=size, layout="constrained")
+
+
+def _save(fig, out):
+    if out is not None:
+        path = Path(out)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=150, format=path.suffix.lower()[1:])
+    return fig
+
+
+def bode(lin: LinearModel, frequencies, input=0, output=0, out=None, title: str | None = None):
+    """Bode plot of H(j w) (eq. 2.205) from generalized force ``input`` to coordinate ``output``
+    (names or indices): magnitude (log-log) and phase (degrees) against frequency (Hz), the
+    natural frequencies marked. Saved to ``out`` if given; returns the Figure."""
+    f = np.atleast_1d(np.asarray(frequencies, dtype=float))
+    h = lin.frf(f, inputs=[input], outputs=[output])[:, 0, 0]
+    i, o = lin.names[lin._index(input, "inputs")], lin.names[lin._index(output, "outputs")]
+    fig = _figure(out, (7.5, 5.5))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    ax1.loglog(f, np.abs(h), lw=1.5)
+    ax2.semilogx(f, np.degrees(np.unwrap(np.angle(h))), lw=1.5)
+    for fn in lin.modes().natural_frequency:
+        if f.min() <= fn <= f.max():
+            for ax in (ax1, ax2):
+                ax.axvline(fn, color="0.6", ls=":", lw=1.0)
+    ax1.set_ylabel(f"|H| [{o} per unit force on {i}]")
+    ax2.set_ylabel("phase [deg]")
+    ax2.set_xlabel("frequency [Hz]")
+    for ax in (ax1, ax2):
+        ax.grid(True, which="both", alpha=0.3)
+    ax1.set_title(title or f"frequency response {i} -> {o}")
+    return _save(fig, out)
+
+
+__all__ = ["linearize", "LinearModel", "Modes", "Campbell", "Hysteresis", "hysteresis", "bode",
+           "rayleigh_coefficients", "sdof_frequencies", "sdof_response"]
