@@ -1,4 +1,5 @@
-"""The ``mechsys`` command line: run model files, inspect models and results, plot signals.
+"""The ``mechsys`` command line: run model files, inspect models and results, plot signals, analyse
+linear vibrations.
 
 ::
 
@@ -6,6 +7,7 @@
     mechsys info model.toml
     mechsys signals results.h5
     mechsys plot results.h5 joint/hinge/q energy/total --out q.svg
+    mechsys linear model.toml --at equilibrium --frf 0:1 --campbell spin:0:500:51 --whirl x,y
 
 Errors in the input (model files, settings, results files) are printed as one line
 ``error: <message>`` on stderr with exit status 2.
@@ -321,6 +323,123 @@ def signals(results_file: Path) -> None:
         shape = "(" + ", ".join(str(s) for s in res[n].shape) + ("," if res[n].ndim == 1 else "") + ")"
         rows.append((n, res.unit(n) or "-", shape))
     click.echo(_table(["signal", "unit", "shape"], rows, indent=""))
+
+
+def _pair(text: str, option: str, parts: int, form: str) -> list[str]:
+    """``text`` split at colons into ``parts`` non-empty fields, or a CliError naming ``option``."""
+    fields = [p.strip() for p in text.split(":")]
+    if len(fields) != parts or not all(fields):
+        raise CliError(f"{option}: expected {form}, got '{text}'")
+    return fields
+
+
+def _coordinate(lin: Any, name: str, option: str) -> int:
+    """Index of a coordinate of the linear model from a name or an index, or a CliError."""
+    from .errors import SettingsError
+
+    try:
+        return lin._index(int(name) if name.lstrip("-").isdigit() else name, option)
+    except SettingsError as e:
+        raise CliError(f"{option}: {str(e).split(': ', 2)[-1]}") from None
+
+
+def _campbell_option(text: str) -> tuple[str, Any]:
+    """JOINT:START:STOP:N into the joint name and the speeds (rad/s)."""
+    import numpy as np
+
+    joint, *nums = _pair(text, "--campbell", 4, "JOINT:START:STOP:N (speeds in rad/s)")
+    try:
+        start, stop, n = float(nums[0]), float(nums[1]), int(nums[2])
+    except ValueError:
+        raise CliError(f"--campbell: START and STOP must be numbers and N an integer, got '{text}'") from None
+    if n < 2 or not (np.isfinite(start) and np.isfinite(stop)) or stop == start:
+        raise CliError(f"--campbell: need N >= 2 and finite START != STOP, got '{text}'")
+    return joint, np.linspace(start, stop, n)
+
+
+def _frequency_grid(modes: Any, fmin: float | None, fmax: float | None, n: int) -> Any:
+    """Log-spaced frequencies (Hz) around the natural frequencies unless given."""
+    import numpy as np
+
+    f = modes.natural_frequency[modes.natural_frequency > 1e-9 * max(modes.natural_frequency.max(initial=0.0), 1e-300)]
+    lo = fmin if fmin is not None else (0.1 * f.min() if f.size else 0.01)
+    hi = fmax if fmax is not None else (3.0 * f.max() if f.size else 100.0)
+    for name, v in (("--fmin", lo), ("--fmax", hi)):
+        if not (np.isfinite(v) and v > 0):
+            raise CliError(f"{name}: must be a frequency > 0 (Hz), got {v:g}")
+    if hi <= lo:
+        raise CliError(f"--fmax ({hi:g} Hz) must be above --fmin ({lo:g} Hz)")
+    if n < 2:
+        raise CliError(f"--n: need at least 2 frequencies, got {n}")
+    return np.geomspace(lo, hi, n)
+
+
+@cli.command()
+@click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
+@click.option("--at", "at", type=click.Choice(["q0", "equilibrium"]), default="q0", show_default=True,
+              help="Linearize at the model's q0/u0 or at the static equilibrium (found from q0, at rest).")
+@click.option("--out-dir", type=click.Path(path_type=Path, file_okay=False), default=Path("results"), show_default=True,
+              help="Folder for the plots.")
+@click.option("--frf", "frf", metavar="IN:OUT", help="Bode plot from a generalized force on coordinate IN to coordinate OUT "
+              "(names or indices) [default: the first coordinate to itself].")
+@click.option("--fmin", type=float, help="Lowest FRF frequency (Hz) [default: 0.1 x the lowest natural frequency].")
+@click.option("--fmax", type=float, help="Highest FRF frequency (Hz) [default: 3 x the highest natural frequency].")
+@click.option("--n", "n_freq", type=int, default=500, show_default=True, help="Number of FRF frequencies (log-spaced).")
+@click.option("--campbell", "campbell", metavar="JOINT:START:STOP:N",
+              help="Campbell diagram: re-linearize with the spin joint's velocity at N speeds START..STOP (rad/s).")
+@click.option("--whirl", metavar="X,Y", help="Coordinates of the whirl plane (x then y, right-handed with the spin axis) "
+              "to tell forward from backward whirl.")
+def linear(model_file: Path, at: str, out_dir: Path, frf: str | None, fmin: float | None, fmax: float | None,
+           n_freq: int, campbell: str | None, whirl: str | None) -> None:
+    """Linear vibration analysis of a model file: modes, a Bode plot, a Campbell diagram."""
+    import warnings
+
+    from . import linear as lin_mod
+    from .modelfile import load_model
+
+    model, _ = load_model(model_file)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lin = lin_mod.linearize(model, at=at)
+    if lin.n == 0:
+        raise CliError(f"{model_file}: the model has no degree of freedom to analyse")
+    modes = lin.modes()
+    point = ", ".join(f"{j['name']} = " + (f"{lin.q[j['iq']]:.6g}" if j["nq"] == 1 else _fmt_vec(lin.q[j["iq"]:j["iq"] + j["nq"]]))
+                      for j in model.joint_info() if j["nq"])
+    click.echo(f"model     {model.name} ({model_file}), {lin.n} coordinates: {', '.join(lin.names)}")
+    click.echo(f"point     {'static equilibrium' if at == 'equilibrium' else 'q0, u0'}: {point or '-'}")
+    click.echo(f"residual  {float(abs(lin.residual).max(initial=0.0)):.4g} (largest |V^T M u'| at the point)")
+    for w in caught:
+        click.echo(f"warning: {w.message}" + ("; try --at equilibrium" if at == "q0" else ""))
+    click.echo("")
+    click.echo(modes.table())
+    click.echo("stable" if modes.stable else f"unstable: modes {', '.join(str(k + 1) for k in modes.unstable)}")
+    click.echo("")
+    i, o = (0, 0) if frf is None else (_coordinate(lin, s, "--frf") for s in _pair(frf, "--frf", 2, "IN:OUT"))
+    freqs = _frequency_grid(modes, fmin, fmax, n_freq)
+    stem = _safe_name(model.name)
+    bode_path = out_dir / f"{stem}_bode.png"
+    lin_mod.bode(lin, freqs, input=i, output=o, out=bode_path, title=f"{model.name}: {lin.names[i]} -> {lin.names[o]}")
+    click.echo(f"bode      {lin.names[i]} -> {lin.names[o]}, {freqs.size} frequencies {freqs[0]:.4g} .. {freqs[-1]:.4g} Hz: {bode_path}")
+    if campbell is None:
+        if whirl is not None:
+            raise CliError("--whirl: needs --campbell")
+        return
+    joint, speeds = _campbell_option(campbell)
+    from .errors import SettingsError
+
+    try:
+        diagram = lin.campbell(speeds, joint=joint, whirl=whirl)
+    except SettingsError as e:
+        msg = str(e).split(": ", 1)[-1]
+        option = "--whirl" if msg.startswith("whirl") else "--campbell"
+        raise CliError(f"{option}: {msg.removeprefix('whirl: ')}") from None
+    camp_path = out_dir / f"{stem}_campbell.png"
+    diagram.plot(out=camp_path, orders=(1.0, 2.0), title=f"{model.name}: Campbell diagram")
+    click.echo(f"campbell  '{joint}' at {speeds.size} speeds {speeds[0]:g} .. {speeds[-1]:g} rad/s: {camp_path}")
+    for cs in diagram.critical_speeds():
+        kind = f", {cs['whirl']} whirl" if cs["whirl"] else ""
+        click.echo(f"critical  {cs['speed']:.6g} rad/s ({cs['speed'] * 30 / 3.141592653589793:.6g} rpm): mode {cs['mode'] + 1}{kind}")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

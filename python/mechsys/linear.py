@@ -510,8 +510,10 @@ class Campbell:
         top = np.nanmax(self.frequencies) * 1.1 if np.isfinite(self.frequencies).any() else 1.0
         for o in orders:
             ax.plot(x, o * np.abs(self.speeds) / (2 * np.pi), color="0.4", lw=1.0)
-            ax.annotate(f"{o:g}×", (x[-1], min(o * abs(self.speeds[-1]) / (2 * np.pi), top)), fontsize="small",
-                        color="0.3", ha="right", va="bottom")
+            # the label near where the line leaves the axes
+            end = min(float(np.abs(self.speeds).max()), top * 2 * np.pi / o) * 0.93
+            ax.annotate(f"{o:g}×", (end * scale * (1 if x.max() > 0 else -1), o * end / (2 * np.pi)), xytext=(5, -2),
+                        textcoords="offset points", fontsize="medium", color="0.3", ha="left", va="top")
             for cs in self.critical_speeds(o):
                 ax.plot(cs["speed"] * scale, abs(cs["frequency"]), "o", mfc="none", color="k", ms=7)
         from matplotlib.lines import Line2D
