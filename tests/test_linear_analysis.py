@@ -215,6 +215,10 @@ def test_frf_modal_equals_direct_and_falls_back_with_rigid_modes():
                                rtol=1e-12)
     with pytest.raises(ms.SettingsError, match="method='modal'"):
         spun.frf(f, method="modal")
+    # proportional damping (D = K / 100) and a free spin at standstill: the real modes of K, M
+    for other in (ms.linear.linearize(chain2(d=(1.0, 1.5))), ms.linear.linearize(rotor())):
+        assert other._frf_real_modes(2 * np.pi * f, [0], [0]) is not None
+        np.testing.assert_allclose(other.frf(f, method="modal"), other.frf(f, method="direct"), rtol=1e-10, atol=1e-14)
     with pytest.raises(ms.SettingsError, match="frequencies"):
         lin.frf([-1.0], method="modal")
     with pytest.raises(ms.SettingsError, match="method must be"):

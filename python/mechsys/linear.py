@@ -128,10 +128,12 @@ class LinearModel:
         (indices into y; all by default). Returns complex (n_freq, n_out, n_in), in m/N (or rad/(N m)).
 
         ``method``: ``"direct"`` solves the n x n system at every frequency; ``"modal"``
-        diagonalizes the state-space form once, H = C Phi (j w - Lambda)^-1 Phi^-1 B (fast for a
-        few inputs and outputs; refused when the eigenvectors are nearly dependent, as with
-        rigid-body modes); ``"auto"`` (default) takes the modal form when there are no more
-        input-output pairs than coordinates and it is well conditioned, else the direct one."""
+        diagonalizes once: with G = N = 0 and proportional damping by the real modes of K, M
+        (H = Phi diag(1 / (w_i^2 - w^2 + j w d_i)) Phi^T), else by the state-space form,
+        H = C Phi (j w - Lambda)^-1 Phi^-1 B (refused when its eigenvectors are nearly dependent,
+        as with rigid-body modes); both are fast for a few inputs and outputs. ``"auto"``
+        (default) takes the modal form when there are no more input-output pairs than
+        coordinates and it is well conditioned, else the direct one."""
         f = np.atleast_1d(np.asarray(frequencies, dtype=float))
         if f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
             raise SettingsError("frf: frequencies must be finite and > 0 (Hz)")
@@ -160,6 +162,9 @@ class LinearModel:
         return out
 
     def _frf_modal(self, w: np.ndarray, ins: list, outs: list, strict: bool):
+        real = self._frf_real_modes(w, ins, outs)
+        if real is not None:
+            return real
         n = self.n
         lam, phi = np.linalg.eig(self.state_matrix())
         if np.linalg.cond(phi) > 1e6:
@@ -174,6 +179,23 @@ class LinearModel:
         r = np.linalg.solve(phi, b)
         d = 1.0 / (1j * w[:, None] - lam[None, :])
         return np.einsum("ok,fk,ki->foi", phi[outs, :], d, r, optimize=True)
+
+    def _frf_real_modes(self, w: np.ndarray, ins: list, outs: list):
+        """H = Phi diag(1 / (w_i^2 - w^2 + j w d_i)) Phi^T from K Phi = M Phi W^2 (Phi^T M Phi = I)
+        when G = N = 0 and the damping is proportional (Phi^T D Phi diagonal); else None."""
+        # G, N and the modal damping's off-diagonal part below the linearization's round-off (~1e-10)
+        tiny = 1e-9 * (np.abs(self.K).max(initial=0.0) + np.abs(self.D).max(initial=0.0) + 1e-300)
+        if np.abs(self.G).max(initial=0.0) > tiny or np.abs(self.N).max(initial=0.0) > tiny:
+            return None
+        from scipy.linalg import eigh
+
+        w2, phi = eigh(0.5 * (self.K + self.K.T), 0.5 * (self.M + self.M.T))
+        dm = phi.T @ self.D @ phi
+        diag = np.diag(dm).copy()
+        if np.abs(dm - np.diag(diag)).max(initial=0.0) > 1e-8 * max(np.abs(diag).max(initial=0.0), 1e-300):
+            return None
+        d = 1.0 / (w2[None, :] - (w * w)[:, None] + 1j * w[:, None] * diag[None, :])
+        return np.einsum("ok,fk,ik->foi", phi[outs, :], d, phi[ins, :], optimize=True)
 
     def _index(self, i, what: str) -> int:
         if isinstance(i, (str, np.str_)):
