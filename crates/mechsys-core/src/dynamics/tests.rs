@@ -70,6 +70,7 @@ fn mixed_tree() -> Model {
         l0: 0.1,
         table_deflection: None,
         table_force: None,
+        travel: None,
     }];
     Model::from_description(ModelDescription {
         name: "mixed".into(),

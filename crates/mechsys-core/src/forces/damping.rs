@@ -59,7 +59,7 @@ mod tests {
 
     #[test]
     fn journal_bearing_reduces_to_petroff_and_grows_with_eccentricity() {
-        let (r, b, a, eta) = (0.05, 0.08, 5e-5, 0.02);
+        let (r, b, a, eta): (f64, f64, f64, f64) = (0.05, 0.08, 5e-5, 0.02);
         let petroff = 2.0 * std::f64::consts::PI * r.powi(3) * b * eta / a;
         assert!((journal_bearing_coefficient(r, b, a, eta, 0.0) / petroff - 1.0).abs() < 1e-14);
         // ε = 0.6: 2(1.72)/(0.8 · 1.18) times π r² b η / a · r
