@@ -14,23 +14,27 @@
 //! Directions. The minimal coordinates y live in the tangent chart `q = q* ⊕ V y` of
 //! `Model::integrate` (quaternions turned by rotation vectors in the child frame,
 //! `q ⊗ exp(½ ω)`; the free joint's position moved by `A(q) v`). The derivative of that chart
-//! along column `V_j` at y = 0 is `Ḣ*`-free and exactly `H*(q) V_j` (eq. 2.34, `Model::qdot`):
+//! along column `V_j` at y = 0 is exactly `H*(q) V_j` (eq. 2.34, `Model::qdot`):
 //! `d/ds [q ⊗ (cos ½s|ω|, sin ½s|ω| ω/|ω|)]₀ = ½ q ⊗ (0, ω)`. So seeding `q + ε H*(q) V_j` gives
 //! `∂ID/∂q V_j` in the same chart as the central differences use, and seeding `u + ε V_j` gives
-//! `∂ID/∂u V_j`, both with `u̇ = u̇*` held fixed. That is 2n passes of O(bodies) each: O(n²).
+//! `∂ID/∂u V_j`, both with `u̇ = u̇*` held fixed. The 2n seeds go eight at a time through one
+//! pass of vector duals (`x + Σ ε_l ẋ_l`): 2n/8 passes of O(bodies) each, O(n²) in all, the real
+//! part computed once per pass, and values none of a pass's seeds reach (the bodies before the
+//! seeded joints, constants) carrying no derivative part at all.
 //!
-//! Why `num-dual`: its `Dual64` is a `nalgebra::Scalar` (`Copy`, all arithmetic and assign
-//! operators, `From<f64>`), so `Vector3<Dual64>` and `Matrix3<Dual64>` work with nalgebra's own
-//! products and cross products, and its `DualNum<f64>` trait is also implemented for `f64`, which
-//! lets one generic body serve both the derivative passes and the value check. A hand-written
-//! dual type would have needed the same dozen operator impls and the nalgebra trait plumbing.
+//! Why `num-dual`: its `DualSVec64<N>` is a `nalgebra::Scalar` (`Copy`, all arithmetic and
+//! assign operators, `From<f64>`), so `Vector3` and `Matrix3` of it work with nalgebra's own
+//! products and cross products, it stores an all-zero derivative as `None` (the sparsity above for
+//! free), and its `DualNum<f64>` trait is also implemented for `f64`, which lets one generic body
+//! serve both the derivative passes and the value check against the engine's RNEA. A hand-written
+//! dual type would have needed the same operator impls and the nalgebra trait plumbing.
 //!
 //! Elements not covered: `ForceElement::Callback` (a Python function of (t, q, u) whose
 //! derivative nothing here can see) and any element kind added after this module; [`unsupported`]
 //! names the first such element so the caller can fall back to central differences.
 
-use nalgebra::{DMatrix, Matrix3, Vector3};
-use num_dual::{Dual64, DualNum};
+use nalgebra::{Const, DMatrix, Matrix3, SVector, Vector3, U1};
+use num_dual::{Derivative, DualNum, DualSVec64};
 
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -515,8 +519,17 @@ impl<T: Real> Tree<T> {
     }
 }
 
-/// `∂ID/∂q V` and `∂ID/∂u V` (each nu × n) at (t, q, u) with `u̇ = udot` held, exact: column j
-/// from one dual pass seeded with `q + ε H*(q) V_j`, and one seeded with `u + ε V_j`.
+/// Directions carried by one dual pass.
+const LANES: usize = 8;
+
+/// A dual number with [`LANES`] derivative directions; a value whose directions are all zero
+/// carries none (`None`), so the parts of the tree a pass's seeds do not reach cost no more than
+/// plain f64 arithmetic.
+type Lanes = DualSVec64<LANES>;
+
+/// `∂ID/∂q V` and `∂ID/∂u V` (each nu × n) at (t, q, u) with `u̇ = udot` held, exact. The 2n
+/// seeds `q + ε H*(q) V_j` and `u + ε V_j` go [`LANES`] at a time through one vector-dual pass,
+/// the q and u seeds of a column side by side (they reach the same part of the tree).
 pub(super) fn inverse_dynamics_derivatives(
     model: &Model,
     t: f64,
@@ -527,33 +540,55 @@ pub(super) fn inverse_dynamics_derivatives(
     cb: &dyn Callbacks,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
     let (nq, nu, n) = (model.nq, model.nu, v.ncols());
-    let mut tree = Tree::<Dual64>::new(model);
-    let mut qd: Vec<Dual64> = q.iter().map(|x| Dual64::from_re(*x)).collect();
-    let mut ud: Vec<Dual64> = u.iter().map(|x| Dual64::from_re(*x)).collect();
-    let mut out = vec![Dual64::from_re(0.0); nu];
+    // the chart's tangents H*(q) V_j, one column per direction
+    let mut tangents = DMatrix::zeros(nq, n);
     let (mut dir, mut tangent) = (vec![0.0; nu], vec![0.0; nq]);
-    let (mut dq, mut du) = (DMatrix::zeros(nu, n), DMatrix::zeros(nu, n));
     for j in 0..n {
         for i in 0..nu {
             dir[i] = v[(i, j)];
         }
         model.qdot(q, &dir, &mut tangent);
-        for (x, e) in qd.iter_mut().zip(&tangent) {
-            x.eps = *e;
+        for i in 0..nq {
+            tangents[(i, j)] = tangent[i];
         }
+    }
+    let seeds: Vec<(usize, bool)> = (0..n).flat_map(|j| [(j, false), (j, true)]).collect();
+    let mut tree = Tree::<Lanes>::new(model);
+    let lift_seeded = |x: f64, e: SVector<f64, LANES>| {
+        Lanes::new(x, Derivative::new(if e.iter().all(|v| *v == 0.0) { None } else { Some(e) }))
+    };
+    let (mut qd, mut ud) = (Vec::with_capacity(nq), Vec::with_capacity(nu));
+    let mut out = vec![Lanes::from_re(0.0); nu];
+    let (mut dq, mut du) = (DMatrix::zeros(nu, n), DMatrix::zeros(nu, n));
+    for chunk in seeds.chunks(LANES) {
+        let mut eq = vec![SVector::<f64, LANES>::zeros(); nq];
+        let mut eu = vec![SVector::<f64, LANES>::zeros(); nu];
+        for (l, &(j, velocity)) in chunk.iter().enumerate() {
+            if velocity {
+                for i in 0..nu {
+                    eu[i][l] = v[(i, j)];
+                }
+            } else {
+                for i in 0..nq {
+                    eq[i][l] = tangents[(i, j)];
+                }
+            }
+        }
+        qd.clear();
+        qd.extend(q.iter().zip(eq).map(|(x, e)| lift_seeded(*x, e)));
+        ud.clear();
+        ud.extend(u.iter().zip(eu).map(|(x, e)| lift_seeded(*x, e)));
         tree.inverse_dynamics(model, t, &qd, &ud, udot, cb, &mut out)?;
         for i in 0..nu {
-            dq[(i, j)] = out[i].eps;
+            let d = out[i].eps.clone().unwrap_generic(Const::<LANES>, U1);
+            for (l, &(j, velocity)) in chunk.iter().enumerate() {
+                if velocity {
+                    du[(i, j)] = d[l];
+                } else {
+                    dq[(i, j)] = d[l];
+                }
+            }
         }
-        qd.iter_mut().for_each(|x| x.eps = 0.0);
-        for (x, e) in ud.iter_mut().zip(&dir) {
-            x.eps = *e;
-        }
-        tree.inverse_dynamics(model, t, &qd, &ud, udot, cb, &mut out)?;
-        for i in 0..nu {
-            du[(i, j)] = out[i].eps;
-        }
-        ud.iter_mut().for_each(|x| x.eps = 0.0);
     }
     Ok((dq, du))
 }

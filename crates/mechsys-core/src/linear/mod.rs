@@ -173,8 +173,11 @@ pub fn linearize_with(
     // the point: accelerations u̇* and multipliers λ*
     crate::dynamics::forward_dynamics(model, &mut data, t, q, u, None, cb)?;
     let (a0, lambda) = (data.udot.clone(), data.lambda.clone());
+    // Vᵀ X; without constraints V = I and the O(nu³) products are skipped
+    let identity = nc == 0;
     let vt = v.transpose();
-    let vt_m = &vt * &mass;
+    let project = |a: DMatrix<f64>| if identity { a } else { &vt * a };
+    let vt_m = project(mass);
     let (c, s, method) = if exact {
         let (mut dq, du) = ad::inverse_dynamics_derivatives(model, t, q, u, &a0, &v, cb)?;
         let method = if nc > 0 {
@@ -183,12 +186,12 @@ pub fn linearize_with(
         } else {
             DerivativeMethod::Exact
         };
-        (&vt * du, &vt * dq, method)
+        (project(du), project(dq), method)
     } else {
         let (dq, du) = differences::acceleration_derivatives(model, &mut data, t, q, u, &v, cb)?;
         (-(&vt_m * du), -(&vt_m * dq), DerivativeMethod::CentralDifferences)
     };
-    let m_r = &vt_m * &v;
+    let m_r = if identity { vt_m.clone() } else { &vt_m * &v };
     let residual = &vt_m * DVector::from_vec(a0);
     let row_major = |a: &DMatrix<f64>| -> Vec<f64> { (0..a.nrows()).flat_map(|r| (0..a.ncols()).map(move |c| a[(r, c)])).collect() };
     let sym = |a: &DMatrix<f64>| (a + a.transpose()) * 0.5;
