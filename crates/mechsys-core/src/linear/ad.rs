@@ -580,7 +580,7 @@ pub(super) fn inverse_dynamics_derivatives(
         ud.extend(u.iter().zip(eu).map(|(x, e)| lift_seeded(*x, e)));
         tree.inverse_dynamics(model, t, &qd, &ud, udot, cb, &mut out)?;
         for i in 0..nu {
-            let d = out[i].eps.clone().unwrap_generic(Const::<LANES>, U1);
+            let d = out[i].eps.unwrap_generic(Const::<LANES>, U1);
             for (l, &(j, velocity)) in chunk.iter().enumerate() {
                 if velocity {
                     du[(i, j)] = d[l];

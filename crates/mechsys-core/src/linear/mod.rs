@@ -168,7 +168,10 @@ pub fn linearize_with(
     crate::dynamics::crba::mass_matrix(model, &mut data, t, q);
     let mass = data.mass_matrix.clone();
     if let Some(i) = (0..nu).find(|&i| !(mass[(i, i)] > 0.0)) {
-        return Err(Error::Model(format!("linearize: the mass matrix is singular (diagonal entry {i} is {})", mass[(i, i)])));
+        return Err(Error::Model(format!(
+            "linearize: the mass matrix is singular (diagonal entry {i} is {})",
+            mass[(i, i)]
+        )));
     }
     // the point: accelerations u̇* and multipliers λ*
     crate::dynamics::forward_dynamics(model, &mut data, t, q, u, None, cb)?;
@@ -193,7 +196,9 @@ pub fn linearize_with(
     };
     let m_r = if identity { vt_m.clone() } else { &vt_m * &v };
     let residual = &vt_m * DVector::from_vec(a0);
-    let row_major = |a: &DMatrix<f64>| -> Vec<f64> { (0..a.nrows()).flat_map(|r| (0..a.ncols()).map(move |c| a[(r, c)])).collect() };
+    let row_major = |a: &DMatrix<f64>| -> Vec<f64> {
+        (0..a.nrows()).flat_map(|r| (0..a.ncols()).map(move |c| a[(r, c)])).collect()
+    };
     let sym = |a: &DMatrix<f64>| (a + a.transpose()) * 0.5;
     let skew = |a: &DMatrix<f64>| (a - a.transpose()) * 0.5;
     let lin = Linearization {

@@ -40,9 +40,15 @@ fn chain(m: f64, k: f64, d: f64) -> Model {
             r#"{{"type": "spring_damper", "name": "{a}_{b}", "body1": "{a}", "point1": [{pa}, 0, 0], "body2": "{b}", "k": {k}, "d": {d}, "l0": 1.0}}"#
         )
     };
-    let forces = [spring("ground", 0.0, "m0"), spring("m0", 0.0, "m1"), spring("m1", 0.0, "m2"), spring("m2", 0.0, "ground")];
+    let forces =
+        [spring("ground", 0.0, "m0"), spring("m0", 0.0, "m1"), spring("m1", 0.0, "m2"), spring("m2", 0.0, "ground")];
     // the last spring runs from m2 to the wall at x = 4: swap its ends' roles through point1
-    let forces = [forces[0].clone(), forces[1].clone(), forces[2].clone(), forces[3].replace(r#""body2": "ground""#, r#""body2": "ground", "point2": [4, 0, 0]"#)];
+    let forces = [
+        forces[0].clone(),
+        forces[1].clone(),
+        forces[2].clone(),
+        forces[3].replace(r#""body2": "ground""#, r#""body2": "ground", "point2": [4, 0, 0]"#),
+    ];
     model(&format!(
         r#"{{"name": "chain", "gravity": [0, 0, 0], "bodies": [{}], "joints": [{}], "forces": [{}]}}"#,
         (0..3).map(body).collect::<Vec<_>>().join(","),
@@ -174,14 +180,25 @@ fn differences(a: &Linearization, b: &Linearization) -> [f64; 6] {
 
 /// Exact and central-difference linearizations at one point; asserts that they agree to `tol`
 /// (relative, see [`differences`]) and that the exact one says so.
-fn exact_vs_fd(what: &str, model: &Model, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks, tol: f64) -> (Linearization, Linearization) {
+fn exact_vs_fd(
+    what: &str,
+    model: &Model,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    tol: f64,
+) -> (Linearization, Linearization) {
     let ex = linearize_with(model, t, q, u, cb, Derivatives::Exact).unwrap();
     let fd = linearize_with(model, t, q, u, cb, Derivatives::CentralDifferences).unwrap();
     let want = if model.nc > 0 { DerivativeMethod::ExactWithDifferencedConstraints } else { DerivativeMethod::Exact };
     assert_eq!(ex.method, want);
     assert_eq!(fd.method, DerivativeMethod::CentralDifferences);
     let e = differences(&ex, &fd);
-    eprintln!("{what}: exact vs fd relative differences M {:.1e} D {:.1e} G {:.1e} K {:.1e} N {:.1e} residual {:.1e}", e[0], e[1], e[2], e[3], e[4], e[5]);
+    eprintln!(
+        "{what}: exact vs fd relative differences M {:.1e} D {:.1e} G {:.1e} K {:.1e} N {:.1e} residual {:.1e}",
+        e[0], e[1], e[2], e[3], e[4], e[5]
+    );
     for (name, x) in ["M", "D", "G", "K", "N", "residual"].iter().zip(e) {
         assert!(x < tol, "{what}: {name} differs by {x:.3e} (relative) between exact and central differences");
     }
@@ -316,7 +333,15 @@ fn exact_four_bar_with_a_loop_constraint_matches_differences() {
     let b = (a.0 + along * dx / dist - h * dy / dist, a.1 + along * dy / dist + h * dx / dist);
     let phi2 = (b.1 - a.1).atan2(b.0 - a.0);
     let phi3 = (dpt.1 - b.1).atan2(dpt.0 - b.0);
-    let body = |n: &str, l: f64| format!(r#"{{"name": "{n}", "mass": {}, "com": [{}, 0, 0], "inertia": [1e-3, {}, {}]}}"#, 2.0 * l, 0.5 * l, l * l / 6.0, l * l / 6.0);
+    let body = |n: &str, l: f64| {
+        format!(
+            r#"{{"name": "{n}", "mass": {}, "com": [{}, 0, 0], "inertia": [1e-3, {}, {}]}}"#,
+            2.0 * l,
+            0.5 * l,
+            l * l / 6.0,
+            l * l / 6.0
+        )
+    };
     let json = format!(
         r#"{{"name": "fourbar", "gravity": [0, -9.81, 0],
         "bodies": [{}, {}, {}],
@@ -445,7 +470,14 @@ impl Callbacks for Torsion {
     fn time_function(&self, id: usize, _t: f64) -> crate::error::Result<f64> {
         Err(crate::error::Error::Callback(format!("no time function {id}")))
     }
-    fn generalized_force(&self, _id: usize, _t: f64, q: &[f64], _u: &[f64], out: &mut [f64]) -> crate::error::Result<()> {
+    fn generalized_force(
+        &self,
+        _id: usize,
+        _t: f64,
+        q: &[f64],
+        _u: &[f64],
+        out: &mut [f64],
+    ) -> crate::error::Result<()> {
         out[0] -= self.0 * q[0];
         Ok(())
     }
