@@ -333,3 +333,29 @@ def test_press_fit_model_file_runs_from_the_command_line(tmp_path):
     # energy balance of the whole run: T + V + losses = work of the excitation
     e = res["energy/total"] + res["energy/dissipated"] - res["energy/external_work"]
     assert abs(e - e[0]).max() < 1e-6 * res["energy/external_work"].max()
+
+
+def test_damping_elements_in_the_linearization():
+    # the bearing's exact derivative is its coefficient; central differences agree
+    c = ms.forces.journal_bearing_coefficient(0.03, 0.05, 4e-5, 0.03, 0.3)
+    exact = ms.linear.linearize(flywheel(), method="exact", operating_point=True)
+    assert exact.method == "exact"
+    assert exact.D[0, 0] == pytest.approx(c, rel=1e-14)
+    fd = ms.linear.linearize(flywheel(), method="fd", operating_point=True)
+    assert fd.D[0, 0] == pytest.approx(c, rel=1e-8)
+    # elements the exact path does not cover fall back to differences under "auto", and "exact" names them
+    m = bushed_block([2e4, 3e4, 5e4, 40.0, 90.0, 200.0])
+    assert ms.linear.linearize(m).method == "fd"
+    with pytest.raises(ms.SettingsError, match="mount"):
+        ms.linear.linearize(m, method="exact")
+    # the slide way linearizes to its film coefficient at the gap h0 (eq. 2.211)
+    lin = ms.linear.linearize(slide_way(x0=0.0))
+    assert lin.D[0, 0] == pytest.approx(ms.forces.squeeze_film_coefficient(0.05, 0.05, 2e-4, 1e-3), rel=1e-7)
+    # Jenkins elements linearize with their sliders stuck: k, and for a press fit the network's stiffness
+    for shaft, expect in ((None, 1e4), (5e4, 1e4 * 5e4 / (1e4 + 5e4))):
+        m = ms.Model("fit")
+        b = m.add_body("shaft", mass=2.0, inertia=[1, 1, 1])
+        m.add_joint(ms.joints.Prismatic("fit", m.ground, b, axis=(1, 0, 0)))
+        m.add_force(ms.forces.Jenkins("press", "fit", k=1e4, slip=5.0, shaft_stiffness=shaft))
+        lin = ms.linear.linearize(m)
+        assert lin.method == "fd" and lin.K[0, 0] == pytest.approx(expect, rel=1e-8)

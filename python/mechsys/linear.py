@@ -82,6 +82,8 @@ class LinearModel:
     u: np.ndarray
     t: float = 0.0
     names: list = field(default_factory=list)
+    #: which derivatives built it: "exact", "exact+fd-constraints" or "fd"
+    method: str = "fd"
     #: the model it came from (for re-linearizing, e.g. by :meth:`campbell`); None when built by hand
     model: Model | None = field(default=None, repr=False, compare=False)
 
@@ -368,8 +370,14 @@ def _names(model: Model, n_u: int) -> list[str]:
     return names if len(names) == n_u else [f"u{k}" for k in range(n_u)]
 
 
-def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: bool = False, at=None) -> LinearModel:
+def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: bool = False, at=None,
+              method: str = "auto") -> LinearModel:
     """Linearizes ``model`` at (``q``, ``u``, ``t``) (the model's q0, u0 by default).
+
+    ``method`` chooses the derivatives: ``"auto"`` (exact where the model allows, else central
+    differences), ``"exact"`` (dual numbers; an error on a model with a callback force) or
+    ``"fd"`` (central differences); ``LinearModel.method`` says which were used (``"exact"``,
+    ``"exact+fd-constraints"`` with bilateral constraints, or ``"fd"``).
 
     At a point that is not an equilibrium (``residual`` beyond round-off) a ``UserWarning``
     reports the residual, unless ``operating_point=True`` says the point is meant as it is (a
@@ -385,13 +393,13 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
         raise SettingsError(f"linearize: expected a mechsys.Model, got {type(model).__name__}")
     core, cbs = model.engine()
     q, u = _point(model, q, u, float(t), at)
-    raw = _core.linearize(core, q, u, float(t), cbs)
+    raw = _core.linearize(core, q, u, float(t), cbs, method)
     n_u = raw["V"].shape[0]
     names = _names(model, n_u)
     if raw["V"].shape[1] != n_u or not np.allclose(raw["V"], np.eye(n_u)):
         names = [f"y{k}" for k in range(raw["V"].shape[1])]
-    lin = LinearModel(raw["M"], raw["D"], raw["G"], raw["K"], raw["N"], raw["V"], raw["residual"], q, u, float(t), names)
-    lin = replace(lin, model=model)
+    lin = LinearModel(raw["M"], raw["D"], raw["G"], raw["K"], raw["N"], raw["V"], raw["residual"], q, u, float(t), names,
+                      raw["method"], model)
     _check_mass(lin, model.name)
     scale = 1.0 + np.abs(lin.K).max(initial=0.0) + np.abs(lin.M).max(initial=0.0)
     res = float(np.abs(lin.residual).max(initial=0.0))

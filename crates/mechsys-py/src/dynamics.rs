@@ -119,9 +119,12 @@ fn nonlinear_effects<'py>(
 }
 
 /// Linearization at (q, u, t) into M, D, G, K, N (eq. 2.204) in minimal coordinates: a dict of
-/// row-major numpy matrices, the basis `v` (nu × n) and the `residual` Vᵀ M u̇.
+/// row-major numpy matrices, the basis `v` (nu × n), the `residual` Vᵀ M u̇ and the `method` the
+/// derivatives were taken by (`method`: "auto" exact where the model allows, "exact", or "fd"
+/// central differences; see `mechsys_core::linear`).
 #[pyfunction]
-#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None))]
+#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None, method = "auto"))]
+#[allow(clippy::too_many_arguments)]
 fn linearize<'py>(
     py: Python<'py>,
     model: &PyModel,
@@ -129,18 +132,25 @@ fn linearize<'py>(
     u: PyReadonlyArray1<'py, f64>,
     t: f64,
     callbacks: Option<Vec<PyObject>>,
+    method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    use mechsys_core::linear::Derivatives;
+    let how = Derivatives::from_name(method).ok_or_else(|| {
+        let allowed = Derivatives::NAMES.map(|n| format!("'{n}'")).join(", ");
+        settings(format!("linearize: method must be one of {allowed}, got '{method}'"))
+    })?;
     let m = &model.model;
     let q = q_checked(model, &q)?;
     let u = check_len(&u, m.nu, "u")?;
     let cb = self::callbacks(model, callbacks)?;
-    let lin = mechsys_core::linear::linearize(m, t, q, u, &cb).map_err(PyMechsysError::from)?;
+    let lin = mechsys_core::linear::linearize_with(m, t, q, u, &cb, how).map_err(PyMechsysError::from)?;
     let d = PyDict::new(py);
     let n = lin.n;
     for (key, v) in [("M", &lin.m), ("D", &lin.d), ("G", &lin.g), ("K", &lin.k), ("N", &lin.n_mat)] {
         d.set_item(key, PyArray1::from_slice(py, v).reshape([n, n])?)?;
     }
     d.set_item("V", PyArray1::from_slice(py, &lin.v).reshape([m.nu, n])?)?;
+    d.set_item("method", lin.method.as_str())?;
     d.set_item("residual", PyArray1::from_slice(py, &lin.residual))?;
     Ok(d)
 }

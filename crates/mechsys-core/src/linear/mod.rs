@@ -12,17 +12,90 @@
 //! ```
 //!
 //! because `Vᵀ M u̇ = Vᵀ (h + Gᵀλ) = Vᵀ h` on the constraint manifold: the reaction forces drop out
-//! and their geometric stiffness stays in. The derivatives are taken by central differences of
-//! the engine's own forward dynamics (step `1e-5`, error of order 1e-10 relative for smooth
-//! force laws; exact for linear ones). The residual `Vᵀ M u̇*` says how far the point is from an
-//! equilibrium (zero there; a steady operating point has `u̇* = 0` with `u* ≠ 0`).
+//! and their geometric stiffness stays in. The residual `Vᵀ M u̇*` says how far the point is from
+//! an equilibrium (zero there; a steady operating point has `u̇* = 0` with `u* ≠ 0`).
+//!
+//! Two ways to the derivatives ([`Derivatives`]):
+//!
+//! - **Exact** (`ad`): the equations `r(q, u, u̇) = M(q) u̇ − h(q, u, t) − Gᵀλ = 0` hold at
+//!   every (q, u) for the u̇, λ of the forward dynamics. Differentiating them with u̇*, λ* held and
+//!   premultiplying by Vᵀ (`Vᵀ Gᵀ = 0` drops `∂λ`) gives, with the inverse dynamics
+//!   `ID = M u̇ − h`,
+//!
+//!   ```text
+//!   C = Vᵀ ∂ID/∂u V,   S = Vᵀ (∂ID/∂q − ∂(Gᵀλ*)/∂q) V,
+//!   ```
+//!
+//!   the same matrices as above without differencing the forward dynamics. `∂ID/∂q` and
+//!   `∂ID/∂u` are exact (forward-mode dual numbers through a generic RNEA, in the same chart); the
+//!   geometric stiffness of the constraints `∂(Gᵀλ*)/∂q` is taken by five-point differences of
+//!   `Gᵀλ*` at fixed λ* (`geometric`, ~1e-12 relative), and the method is then reported as
+//!   [`DerivativeMethod::ExactWithDifferencedConstraints`].
+//! - **Central differences** (`differences`) of the engine's own forward dynamics (step `1e-5`,
+//!   error of order 1e-10 relative for smooth force laws; exact for linear ones). Needed for
+//!   force elements the exact path cannot see into (Python callbacks).
 
-use nalgebra::DMatrix;
+mod ad;
+mod differences;
+mod geometric;
+
+use nalgebra::{DMatrix, DVector};
 
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::model::Model;
+
+/// How [`linearize_with`] takes the derivatives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Derivatives {
+    /// Exact where the model allows (every force element covered), else central differences.
+    #[default]
+    Auto,
+    /// Exact; a model with an element the exact path does not cover is an `Error::Settings`
+    /// naming it.
+    Exact,
+    /// Central differences of the forward dynamics.
+    CentralDifferences,
+}
+
+impl Derivatives {
+    /// The names [`Derivatives::from_name`] accepts, in the order of the variants.
+    pub const NAMES: [&'static str; 3] = ["auto", "exact", "fd"];
+
+    /// From `"auto"`, `"exact"` or `"fd"` (None for anything else).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "auto" => Some(Derivatives::Auto),
+            "exact" => Some(Derivatives::Exact),
+            "fd" => Some(Derivatives::CentralDifferences),
+            _ => None,
+        }
+    }
+}
+
+/// Which derivatives a [`Linearization`] was built from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DerivativeMethod {
+    /// Exact (dual numbers) throughout.
+    Exact,
+    /// Exact for the tree and its force elements; the geometric stiffness of the bilateral
+    /// constraints by five-point differences (module `geometric`).
+    ExactWithDifferencedConstraints,
+    /// Central differences of the forward dynamics.
+    CentralDifferences,
+}
+
+impl DerivativeMethod {
+    /// Short name: `"exact"`, `"exact+fd-constraints"` or `"fd"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DerivativeMethod::Exact => "exact",
+            DerivativeMethod::ExactWithDifferencedConstraints => "exact+fd-constraints",
+            DerivativeMethod::CentralDifferences => "fd",
+        }
+    }
+}
 
 /// The linear model at one point (row-major `n × n` matrices, `n` = degrees of freedom).
 #[derive(Debug, Clone, PartialEq)]
@@ -43,13 +116,24 @@ pub struct Linearization {
     pub v: Vec<f64>,
     /// `Vᵀ M u̇*`: the generalized force out of balance at the point (n).
     pub residual: Vec<f64>,
+    /// How the derivatives were taken.
+    pub method: DerivativeMethod,
 }
 
-/// Relative step of the central differences.
-const STEP: f64 = 1e-5;
-
-/// Linearizes `model` at (t, q, u).
+/// Linearizes `model` at (t, q, u), exactly where the model allows ([`Derivatives::Auto`]).
 pub fn linearize(model: &Model, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<Linearization> {
+    linearize_with(model, t, q, u, cb, Derivatives::Auto)
+}
+
+/// Linearizes `model` at (t, q, u) with the derivatives taken as `how` says.
+pub fn linearize_with(
+    model: &Model,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    how: Derivatives,
+) -> Result<Linearization> {
     let (nq, nu, nc) = (model.nq, model.nu, model.nc);
     crate::ensure!(q.len() == nq, Settings, "linearize: q has {} entries, the model {nq}", q.len());
     crate::ensure!(u.len() == nu, Settings, "linearize: u has {} entries, the model {nu}", u.len());
@@ -57,6 +141,19 @@ pub fn linearize(model: &Model, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks
     if let Some(i) = u.iter().position(|v| !v.is_finite()) {
         return Err(Error::Settings(format!("linearize: u[{i}] is not finite ({})", u[i])));
     }
+    let exact = match how {
+        Derivatives::CentralDifferences => false,
+        Derivatives::Auto => ad::unsupported(model).is_none(),
+        Derivatives::Exact => {
+            if let Some(name) = ad::unsupported(model) {
+                return Err(Error::Settings(format!(
+                    "linearize: exact derivatives do not cover force element '{name}' (a callback force); \
+                     use method \"auto\" or \"fd\" (central differences)"
+                )));
+            }
+            true
+        }
+    };
     let mut data = Data::new(model);
     // the basis of the allowed directions
     let v = if nc > 0 {
@@ -71,47 +168,37 @@ pub fn linearize(model: &Model, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks
     crate::dynamics::crba::mass_matrix(model, &mut data, t, q);
     let mass = data.mass_matrix.clone();
     if let Some(i) = (0..nu).find(|&i| !(mass[(i, i)] > 0.0)) {
-        return Err(Error::Model(format!("linearize: the mass matrix is singular (diagonal entry {i} is {})", mass[(i, i)])));
+        return Err(Error::Model(format!(
+            "linearize: the mass matrix is singular (diagonal entry {i} is {})",
+            mass[(i, i)]
+        )));
     }
-    let accel = |data: &mut Data, q: &[f64], u: &[f64]| -> Result<Vec<f64>> {
-        crate::dynamics::forward_dynamics(model, data, t, q, u, None, cb)?;
-        Ok(data.udot.clone())
+    // the point: accelerations u̇* and multipliers λ*
+    crate::dynamics::forward_dynamics(model, &mut data, t, q, u, None, cb)?;
+    let (a0, lambda) = (data.udot.clone(), data.lambda.clone());
+    // Vᵀ X; without constraints V = I and the O(nu³) products are skipped
+    let identity = nc == 0;
+    let vt = v.transpose();
+    let project = |a: DMatrix<f64>| if identity { a } else { &vt * a };
+    let vt_m = project(mass);
+    let (c, s, method) = if exact {
+        let (mut dq, du) = ad::inverse_dynamics_derivatives(model, t, q, u, &a0, &v, cb)?;
+        let method = if nc > 0 {
+            dq -= geometric::constraint_load_derivative(model, t, q, &lambda, &v, cb)?;
+            DerivativeMethod::ExactWithDifferencedConstraints
+        } else {
+            DerivativeMethod::Exact
+        };
+        (project(du), project(dq), method)
+    } else {
+        let (dq, du) = differences::acceleration_derivatives(model, &mut data, t, q, u, &v, cb)?;
+        (-(&vt_m * du), -(&vt_m * dq), DerivativeMethod::CentralDifferences)
     };
-    let a0 = accel(&mut data, q, u)?;
-    let (mut qp, mut up, mut dir) = (vec![0.0; nq], u.to_vec(), vec![0.0; nu]);
-    let mut dq = DMatrix::zeros(nu, n);
-    let mut du = DMatrix::zeros(nu, n);
-    for j in 0..n {
-        for i in 0..nu {
-            dir[i] = v[(i, j)];
-        }
-        // positions: q* ⊕ ±h V_j
-        let mut col = [vec![0.0; nu], vec![0.0; nu]];
-        for (s, sign) in [1.0, -1.0].iter().enumerate() {
-            model.integrate(q, &dir, sign * STEP, &mut qp);
-            model.normalize(&mut qp);
-            col[s] = accel(&mut data, &qp, u)?;
-        }
-        for i in 0..nu {
-            dq[(i, j)] = (col[0][i] - col[1][i]) / (2.0 * STEP);
-        }
-        let hu = STEP * u.iter().fold(1.0f64, |a, x| a.max(x.abs()));
-        for (s, sign) in [1.0, -1.0].iter().enumerate() {
-            for i in 0..nu {
-                up[i] = u[i] + sign * hu * dir[i];
-            }
-            col[s] = accel(&mut data, q, &up)?;
-        }
-        for i in 0..nu {
-            du[(i, j)] = (col[0][i] - col[1][i]) / (2.0 * hu);
-        }
-    }
-    let vt_m = v.transpose() * &mass;
-    let m_r = &vt_m * &v;
-    let c = -(&vt_m * du);
-    let s = -(&vt_m * dq);
-    let residual = &vt_m * nalgebra::DVector::from_vec(a0);
-    let row_major = |a: &DMatrix<f64>| -> Vec<f64> { (0..a.nrows()).flat_map(|r| (0..a.ncols()).map(move |c| a[(r, c)])).collect() };
+    let m_r = if identity { vt_m.clone() } else { &vt_m * &v };
+    let residual = &vt_m * DVector::from_vec(a0);
+    let row_major = |a: &DMatrix<f64>| -> Vec<f64> {
+        (0..a.nrows()).flat_map(|r| (0..a.ncols()).map(move |c| a[(r, c)])).collect()
+    };
     let sym = |a: &DMatrix<f64>| (a + a.transpose()) * 0.5;
     let skew = |a: &DMatrix<f64>| (a - a.transpose()) * 0.5;
     let lin = Linearization {
@@ -123,6 +210,7 @@ pub fn linearize(model: &Model, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks
         n_mat: row_major(&skew(&s)),
         v: row_major(&v),
         residual: residual.iter().copied().collect(),
+        method,
     };
     if let Some(x) = lin.m.iter().chain(&lin.d).chain(&lin.k).chain(&lin.g).chain(&lin.n_mat).find(|x| !x.is_finite()) {
         return Err(Error::Solver(format!("linearize: a matrix entry is not finite ({x})")));

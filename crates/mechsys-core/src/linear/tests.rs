@@ -1,8 +1,9 @@
 //! Linearization against closed forms: a spring–mass chain, pendulums upright and hanging, the
-//! same pendulum held by a constraint, a damper, and finite-difference consistency.
+//! same pendulum held by a constraint, a damper, and finite-difference consistency; the exact
+//! (dual-number) derivatives against central differences and closed forms.
 
-use super::linearize;
-use crate::forces::NoCallbacks;
+use super::{linearize, linearize_with, DerivativeMethod, Derivatives, Linearization};
+use crate::forces::{Callbacks, NoCallbacks};
 use crate::model::{Model, ModelDescription};
 use nalgebra::DMatrix;
 
@@ -39,9 +40,15 @@ fn chain(m: f64, k: f64, d: f64) -> Model {
             r#"{{"type": "spring_damper", "name": "{a}_{b}", "body1": "{a}", "point1": [{pa}, 0, 0], "body2": "{b}", "k": {k}, "d": {d}, "l0": 1.0}}"#
         )
     };
-    let forces = [spring("ground", 0.0, "m0"), spring("m0", 0.0, "m1"), spring("m1", 0.0, "m2"), spring("m2", 0.0, "ground")];
+    let forces =
+        [spring("ground", 0.0, "m0"), spring("m0", 0.0, "m1"), spring("m1", 0.0, "m2"), spring("m2", 0.0, "ground")];
     // the last spring runs from m2 to the wall at x = 4: swap its ends' roles through point1
-    let forces = [forces[0].clone(), forces[1].clone(), forces[2].clone(), forces[3].replace(r#""body2": "ground""#, r#""body2": "ground", "point2": [4, 0, 0]"#)];
+    let forces = [
+        forces[0].clone(),
+        forces[1].clone(),
+        forces[2].clone(),
+        forces[3].replace(r#""body2": "ground""#, r#""body2": "ground", "point2": [4, 0, 0]"#),
+    ];
     model(&format!(
         r#"{{"name": "chain", "gravity": [0, 0, 0], "bodies": [{}], "joints": [{}], "forces": [{}]}}"#,
         (0..3).map(body).collect::<Vec<_>>().join(","),
@@ -137,4 +144,366 @@ fn bad_points_name_the_item() {
     assert!(e.contains("q has 0 entries"), "{e}");
     let e = linearize(&m, 0.0, &q, &[f64::NAN], &NoCallbacks).unwrap_err().to_string();
     assert!(e.contains("u[0]"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Exact derivatives (module `ad`) against central differences and closed forms
+// ---------------------------------------------------------------------------------------------
+
+fn max_abs(a: &[f64]) -> f64 {
+    a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// Relative differences of M, D, G, K, N and the residual between two linearizations. D and G
+/// are measured against the size of C = D + G, K and N against that of S = K + N (an entry that
+/// should be zero is judged on the scale of its matrix), the residual against |M|·1 m/s² at least.
+fn differences(a: &Linearization, b: &Linearization) -> [f64; 6] {
+    assert_eq!(a.n, b.n);
+    let floor = 1e-9 * (max_abs(&b.m) + max_abs(&b.k));
+    let sc = max_abs(&b.d).max(max_abs(&b.g)).max(floor);
+    let ss = max_abs(&b.k).max(max_abs(&b.n_mat)).max(floor);
+    let sr = max_abs(&b.residual).max(max_abs(&b.m));
+    [
+        max_diff(&a.m, &b.m) / max_abs(&b.m),
+        max_diff(&a.d, &b.d) / sc,
+        max_diff(&a.g, &b.g) / sc,
+        max_diff(&a.k, &b.k) / ss,
+        max_diff(&a.n_mat, &b.n_mat) / ss,
+        max_diff(&a.residual, &b.residual) / sr,
+    ]
+}
+
+/// Exact and central-difference linearizations at one point; asserts that they agree to `tol`
+/// (relative, see [`differences`]) and that the exact one says so.
+fn exact_vs_fd(
+    what: &str,
+    model: &Model,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    tol: f64,
+) -> (Linearization, Linearization) {
+    let ex = linearize_with(model, t, q, u, cb, Derivatives::Exact).unwrap();
+    let fd = linearize_with(model, t, q, u, cb, Derivatives::CentralDifferences).unwrap();
+    let want = if model.nc > 0 { DerivativeMethod::ExactWithDifferencedConstraints } else { DerivativeMethod::Exact };
+    assert_eq!(ex.method, want);
+    assert_eq!(fd.method, DerivativeMethod::CentralDifferences);
+    let e = differences(&ex, &fd);
+    eprintln!(
+        "{what}: exact vs fd relative differences M {:.1e} D {:.1e} G {:.1e} K {:.1e} N {:.1e} residual {:.1e}",
+        e[0], e[1], e[2], e[3], e[4], e[5]
+    );
+    for (name, x) in ["M", "D", "G", "K", "N", "residual"].iter().zip(e) {
+        assert!(x < tol, "{what}: {name} differs by {x:.3e} (relative) between exact and central differences");
+    }
+    (ex, fd)
+}
+
+#[test]
+fn exact_spring_chain_matches_differences_and_the_closed_form() {
+    // linear springs on prismatic joints: both methods are exact, off the rest position and moving
+    let (m, k, d) = (2.0, 300.0, 3.0);
+    let model = chain(m, k, d);
+    let q: Vec<f64> = model.q0().iter().enumerate().map(|(i, x)| x + 0.05 * (i as f64 - 1.0)).collect();
+    let u = [0.3, -0.2, 0.5];
+    let (ex, _) = exact_vs_fd("spring chain", &model, 0.0, &q, &u, &NoCallbacks, 1e-9);
+    // K = k tridiag(-1, 2, -1), D = (d / k) K
+    for r in 0..3 {
+        for c in 0..3 {
+            let kk = match (r as i32 - c as i32).abs() {
+                0 => 2.0 * k,
+                1 => -k,
+                _ => 0.0,
+            };
+            assert!((ex.k[r * 3 + c] - kk).abs() < 1e-12 * k, "K[{r}{c}] = {}", ex.k[r * 3 + c]);
+            assert!((ex.d[r * 3 + c] - kk * d / k).abs() < 1e-12 * k, "D[{r}{c}] = {}", ex.d[r * 3 + c]);
+        }
+    }
+    assert!(max_abs(&ex.g) == 0.0 && max_abs(&ex.n_mat) < 1e-12 * k);
+}
+
+/// A spatial double pendulum: a spherical joint at the ground, a revolute joint (with spring and
+/// damper) between the links, off-principal inertias and offsets.
+fn spatial_double_pendulum() -> Model {
+    model(
+        r#"{"name": "dp", "gravity": [0, 0, -9.81],
+        "bodies": [
+            {"name": "a", "mass": 1.2, "com": [0.25, 0.02, -0.01], "inertia": [[0.02, 0.001, -0.002], [0.001, 0.05, 0.003], [-0.002, 0.003, 0.06]]},
+            {"name": "b", "mass": 0.7, "com": [0.2, -0.03, 0.01], "inertia": [0.01, 0.03, 0.035]}],
+        "joints": [
+            {"name": "ball", "type": "spherical", "parent": "ground", "child": "a",
+             "parent_frame": {"position": [0.1, 0, 0.5], "rotation": {"cardan": [0.2, -0.1, 0.3]}},
+             "q0": [0.9, 0.2, -0.3, 0.25]},
+            {"name": "hinge", "type": "revolute", "parent": "a", "child": "b", "axis": [0, 0.6, 0.8],
+             "parent_frame": {"position": [0.5, 0, 0]}, "child_frame": {"position": [-0.05, 0.01, 0]},
+             "q0": [0.7], "spring": {"k": [4.0], "q_free": [0.2]}, "damper": {"d": [0.3]}}]}"#,
+    )
+}
+
+#[test]
+fn exact_spatial_double_pendulum_with_a_quaternion_joint_matches_differences() {
+    let model = spatial_double_pendulum();
+    let mut q = model.q0();
+    model.normalize(&mut q);
+    let u = [0.8, -1.1, 0.6, 1.7];
+    let (ex, _) = exact_vs_fd("spatial double pendulum", &model, 0.0, &q, &u, &NoCallbacks, 1e-7);
+    // off equilibrium and moving: every matrix is populated
+    for (name, m) in [("D", &ex.d), ("G", &ex.g), ("K", &ex.k), ("N", &ex.n_mat), ("residual", &ex.residual)] {
+        assert!(max_abs(m) > 1e-3, "{name} is zero");
+    }
+}
+
+#[test]
+fn exact_sleeping_top_has_the_closed_form_gyroscopic_and_stiffness_matrices() {
+    // a symmetric top on a ball joint, spinning upright at Ω: I_pivot = diag(a + m l², same, c);
+    // Euler's equations about the pivot linearize to G = Ω (c − a') [[0, 1, 0], [−1, 0, 0], 0],
+    // K = −m g l diag(1, 1, 0) (upright: unstable without the spin), D = N = 0
+    let (m, l, a, c, g, om) = (2.0, 0.3, 0.04, 0.07, 9.81, 25.0);
+    let model = model(&format!(
+        r#"{{"name": "top", "gravity": [0, 0, -{g}],
+        "bodies": [{{"name": "top", "mass": {m}, "com": [0, 0, {l}], "inertia": [{a}, {a}, {c}]}}],
+        "joints": [{{"name": "ball", "type": "spherical", "parent": "ground", "child": "top"}}]}}"#
+    ));
+    let q = model.q0();
+    let u = [0.0, 0.0, om];
+    let (ex, _) = exact_vs_fd("sleeping top", &model, 0.0, &q, &u, &NoCallbacks, 1e-8);
+    let a1 = a + m * l * l;
+    let g01 = om * (c - a1);
+    assert!((ex.g[1] - g01).abs() < 1e-13 * g01.abs(), "G01 = {} vs {g01}", ex.g[1]);
+    assert!((ex.g[3] + g01).abs() < 1e-13 * g01.abs());
+    for (i, kk) in [(0, -m * g * l), (4, -m * g * l), (8, 0.0)] {
+        assert!((ex.k[i] - kk).abs() < 1e-13 * m * g * l, "K[{i}] = {} vs {kk}", ex.k[i]);
+    }
+    assert!(max_abs(&ex.d) < 1e-13 * g01.abs() && max_abs(&ex.n_mat) < 1e-13 * m * g * l);
+    assert!(max_abs(&ex.residual) < 1e-13);
+}
+
+/// A planar body tied to the ground by a spring–damper with linear, cubic and tabulated terms,
+/// loaded by a body-frame force and a joint force.
+fn nonlinear_spring_model() -> Model {
+    model(
+        r#"{"name": "sd", "gravity": [0, -9.81, 0],
+        "bodies": [{"name": "box", "mass": 1.3, "com": [0.02, 0.01, 0], "inertia": [0.01, 0.02, 0.025]}],
+        "joints": [{"name": "plane", "type": "planar", "parent": "ground", "child": "box",
+                    "q0": [0.35, -0.6, 0.4]}],
+        "forces": [
+            {"type": "spring_damper", "name": "mount", "body1": "ground", "point1": [0.1, 0.2, 0],
+             "body2": "box", "point2": [0.05, 0.08, 0], "k": 150.0, "k3": 900.0, "d": 2.5, "l0": 0.6,
+             "table_deflection": [-0.5, -0.1, 0.0, 0.1, 0.3, 0.8], "table_force": [-40, -9, 0, 12, 55, 70]},
+            {"type": "body_force", "name": "push", "body": "box", "point": [0.1, -0.05, 0],
+             "force": [3.0, 1.0, 0], "torque": [0, 0, 0.4], "frame": "body",
+             "function": {"type": "harmonic", "amplitude": 2.0, "omega": 3.0, "phase": 0.2, "offset": 1.0}},
+            {"type": "joint_force", "name": "drive", "joint": "plane", "value": [0.5, -0.2, 0.1]}]}"#,
+    )
+}
+
+#[test]
+fn exact_spring_damper_with_cubic_and_table_terms_matches_differences() {
+    let model = nonlinear_spring_model();
+    let q = model.q0();
+    let u = [0.4, -0.3, 1.2];
+    // the deflection lies inside a table segment, where the table force is smooth
+    let l = ((0.35f64 + 0.05 * 0.4f64.cos() - 0.08 * 0.4f64.sin() - 0.1).powi(2)
+        + (-0.6f64 + 0.05 * 0.4f64.sin() + 0.08 * 0.4f64.cos() - 0.2).powi(2))
+    .sqrt();
+    let delta = l - 0.6;
+    assert!([-0.5, -0.1, 0.0, 0.1, 0.3, 0.8].iter().all(|x: &f64| (x - delta).abs() > 1e-3), "δ = {delta}");
+    let (ex, _) = exact_vs_fd("spring-damper with cubic and table terms", &model, 0.7, &q, &u, &NoCallbacks, 1e-7);
+    assert!(max_abs(&ex.d) > 1.0 && max_abs(&ex.k) > 100.0);
+}
+
+#[test]
+fn exact_four_bar_with_a_loop_constraint_matches_differences() {
+    // crank (0.3) – coupler (0.8) – rocker (0.6) between ground pivots 1 m apart, the rocker's tip
+    // pinned to the ground by a point constraint; gravity −y, off equilibrium and moving
+    let th1 = 1.1f64;
+    let a = (0.3 * th1.cos(), 0.3 * th1.sin());
+    let dpt = (1.0, 0.0);
+    // B on the circles |B − A| = 0.8, |B − D| = 0.6 (the upper intersection)
+    let (dx, dy) = (dpt.0 - a.0, dpt.1 - a.1);
+    let dist = (dx * dx + dy * dy).sqrt();
+    let along = (0.8 * 0.8 - 0.6 * 0.6 + dist * dist) / (2.0 * dist);
+    let h = (0.8 * 0.8 - along * along).sqrt();
+    let b = (a.0 + along * dx / dist - h * dy / dist, a.1 + along * dy / dist + h * dx / dist);
+    let phi2 = (b.1 - a.1).atan2(b.0 - a.0);
+    let phi3 = (dpt.1 - b.1).atan2(dpt.0 - b.0);
+    let body = |n: &str, l: f64| {
+        format!(
+            r#"{{"name": "{n}", "mass": {}, "com": [{}, 0, 0], "inertia": [1e-3, {}, {}]}}"#,
+            2.0 * l,
+            0.5 * l,
+            l * l / 6.0,
+            l * l / 6.0
+        )
+    };
+    let json = format!(
+        r#"{{"name": "fourbar", "gravity": [0, -9.81, 0],
+        "bodies": [{}, {}, {}],
+        "joints": [
+            {{"name": "j1", "type": "revolute", "parent": "ground", "child": "crank", "q0": [{th1}]}},
+            {{"name": "j2", "type": "revolute", "parent": "crank", "child": "coupler", "parent_frame": {{"position": [0.3, 0, 0]}}, "q0": [{}]}},
+            {{"name": "j3", "type": "revolute", "parent": "coupler", "child": "rocker", "parent_frame": {{"position": [0.8, 0, 0]}}, "q0": [{}]}}],
+        "constraints": [{{"type": "point", "name": "closure", "body1": "rocker", "point1": [0.6, 0, 0], "body2": "ground", "point2": [1, 0, 0]}}]}}"#,
+        body("crank", 0.3),
+        body("coupler", 0.8),
+        body("rocker", 0.6),
+        phi2 - th1,
+        phi3 - phi2
+    );
+    let model = model(&json);
+    let q = model.q0();
+    let at_rest = linearize_with(&model, 0.0, &q, &model.u0(), &NoCallbacks, Derivatives::CentralDifferences).unwrap();
+    assert_eq!(at_rest.n, 1, "a four-bar has one degree of freedom");
+    let u: Vec<f64> = (0..3).map(|i| 1.5 * at_rest.v[i]).collect();
+    let (ex, fd) = exact_vs_fd("four-bar (point loop constraint)", &model, 0.0, &q, &u, &NoCallbacks, 1e-6);
+    assert!(max_abs(&ex.k) > 0.1 && max_abs(&ex.d) > 0.01, "K {:?} D {:?}", ex.k, ex.d);
+    // Auto takes the exact path here too
+    let auto = linearize(&model, 0.0, &q, &u, &NoCallbacks).unwrap();
+    assert_eq!(auto.method, DerivativeMethod::ExactWithDifferencedConstraints);
+    assert_eq!(auto.k, ex.k);
+    let _ = fd;
+}
+
+#[test]
+fn exact_pendulum_stiffness_is_exact_where_differences_are_not() {
+    // K = m g l cos θ off equilibrium: exact to round-off, while the central differences carry
+    // their truncation error h²/6 ≈ 1.7e-11 (sin θ differenced with h = 1e-5)
+    let th = 0.3f64;
+    let (m, q) = pendulum(th, false);
+    let exact_k = 1.5 * 9.81 * 0.8 * th.cos();
+    let ex = linearize_with(&m, 0.0, &q, &[0.7], &NoCallbacks, Derivatives::Exact).unwrap();
+    let fd = linearize_with(&m, 0.0, &q, &[0.7], &NoCallbacks, Derivatives::CentralDifferences).unwrap();
+    let (e_ex, e_fd) = ((ex.k[0] - exact_k).abs() / exact_k, (fd.k[0] - exact_k).abs() / exact_k);
+    eprintln!("pendulum K = m g l cos θ: exact {e_ex:.1e}, central differences {e_fd:.1e} (relative)");
+    assert!(e_ex < 1e-14, "exact: {e_ex:.3e}");
+    assert!(e_fd > 1e-12, "the differences were expected to show their truncation error: {e_fd:.3e}");
+    assert_eq!((ex.d[0], ex.g[0]), (0.0, 0.0));
+}
+
+/// Every joint type in one chain, with a variable-mass body and every covered force element.
+fn zoo() -> Model {
+    model(
+        r#"{"name": "zoo", "gravity": [0.3, -9.81, 0.5],
+        "bodies": [
+            {"name": "b1", "mass": 1.0, "com": [0.1, 0.0, 0.05], "inertia": [0.01, 0.02, 0.03]},
+            {"name": "b2", "mass": 0.8, "com": [0.0, 0.1, 0.0], "inertia": [0.02, 0.02, 0.01]},
+            {"name": "b3", "mass": 0.6, "com": [0.05, 0.05, 0.0], "inertia": [[0.01, 0.001, 0], [0.001, 0.02, 0], [0, 0, 0.02]]},
+            {"name": "b4", "mass": 0.9, "com": [0.1, -0.02, 0.03], "inertia": [0.015, 0.01, 0.02],
+             "mass_rate": -0.2, "ejection_velocity": [-50, 3, 0], "ejection_point": [-0.1, 0, 0], "mass_final": 0.3},
+            {"name": "b5", "mass": 0.5, "com": [0.1, 0.0, 0.0], "inertia": [0.005, 0.01, 0.012]},
+            {"name": "b6", "mass": 0.4, "com": [0.0, 0.0, 0.02], "inertia": [0.004, 0.006, 0.008]},
+            {"name": "b7", "mass": 0.7, "com": [0.02, 0.01, -0.01], "inertia": [0.01, 0.012, 0.009]},
+            {"name": "b8", "mass": 0.3, "com": [0.05, 0.0, 0.0], "inertia": [0.002, 0.003, 0.003]}],
+        "joints": [
+            {"name": "rev", "type": "revolute", "parent": "ground", "child": "b1", "axis": [0, 0.6, 0.8], "q0": [0.4],
+             "spring": {"k": [3.0]}, "damper": {"d": [0.2]}},
+            {"name": "pri", "type": "prismatic", "parent": "b1", "child": "b2", "axis": [0.8, 0, 0.6],
+             "parent_frame": {"position": [0.2, 0, 0], "rotation": {"cardan": [0.1, 0.2, -0.3]}}, "q0": [0.15],
+             "spring": {"k": [40.0], "q_free": [0.1]}},
+            {"name": "cyl", "type": "cylindrical", "parent": "b2", "child": "b3", "axis": [0, 0, 1],
+             "parent_frame": {"position": [0, 0.2, 0]}, "child_frame": {"position": [0.01, 0, 0.02], "rotation": {"rotvec": [0.2, 0, 0.1]}},
+             "q0": [0.3, -0.05], "damper": {"d": [0.1, 0.5]}},
+            {"name": "uni", "type": "universal", "parent": "b3", "child": "b4", "axis": [1, 0, 0], "axis2": [0, 0.6, 0.8],
+             "parent_frame": {"position": [0.1, 0.1, 0]}, "q0": [0.5, -0.4]},
+            {"name": "sph", "type": "spherical", "parent": "b4", "child": "b5",
+             "parent_frame": {"position": [0.2, 0, 0]}, "q0": [0.8, 0.3, -0.4, 0.3]},
+            {"name": "pla", "type": "planar", "parent": "b5", "child": "b6",
+             "parent_frame": {"position": [0.2, 0, 0], "rotation": {"cardan": [0.4, 0, 0]}}, "q0": [0.05, -0.03, 0.6],
+             "spring": {"k": [10.0, 12.0, 2.0]}},
+            {"name": "fre", "type": "free", "parent": "ground", "child": "b7", "q0": [0.3, 0.2, -0.1, 0.7, -0.2, 0.5, 0.4]},
+            {"name": "fix", "type": "fixed", "parent": "b7", "child": "b8", "parent_frame": {"position": [0.1, 0.05, 0], "rotation": {"cardan": [0.3, 0.2, 0.1]}}}],
+        "forces": [
+            {"type": "spring_damper", "name": "s1", "body1": "b2", "point1": [0.05, 0, 0], "body2": "b6", "point2": [0, 0.02, 0],
+             "k": 80.0, "k3": 500.0, "d": 1.5, "l0": 0.1, "table_deflection": [-1, 0, 0.5, 2], "table_force": [-10, 0, 20, 30]},
+            {"type": "spring_damper", "name": "s2", "body1": "ground", "point1": [0.5, 0.5, 0], "body2": "b8", "point2": [0.05, 0, 0.01],
+             "k": 20.0, "d": 0.5, "l0": 0.3},
+            {"type": "body_force", "name": "f1", "body": "b5", "point": [0.1, 0.02, 0], "force": [1, 2, 3], "torque": [0.1, 0, -0.2], "frame": "body"},
+            {"type": "body_force", "name": "f2", "body": "b7", "point": [0.0, 0.1, 0], "force": [0, 0, 4], "torque": [0.3, 0, 0],
+             "function": {"type": "ramp", "slope": 2.0}},
+            {"type": "joint_force", "name": "f3", "joint": "uni", "value": [0.3, -0.1]}]}"#,
+    )
+}
+
+fn zoo_state(model: &Model) -> (Vec<f64>, Vec<f64>) {
+    let mut q = model.q0();
+    model.normalize(&mut q);
+    let u: Vec<f64> = (0..model.nu).map(|i| 0.6 * ((i as f64) * 1.3 + 0.4).sin()).collect();
+    (q, u)
+}
+
+#[test]
+fn generic_inverse_dynamics_equals_the_engine_rnea_for_every_joint_and_element() {
+    // the element laws and joint kinematics written over a generic scalar reproduce forces.rs,
+    // kinematics and the RNEA: the value part at f64, on every joint type and covered element
+    let model = zoo();
+    let (q, u) = zoo_state(&model);
+    let udot: Vec<f64> = (0..model.nu).map(|i| 0.9 * ((i as f64) * 0.7 - 0.2).cos()).collect();
+    let t = 0.8;
+    let mut data = crate::data::Data::new(&model);
+    let mut want = vec![0.0; model.nu];
+    crate::dynamics::inverse_dynamics(&model, &mut data, t, &q, &u, &udot, &NoCallbacks, &mut want).unwrap();
+    let mut tree = super::ad::Tree::<f64>::new(&model);
+    let mut got = vec![0.0; model.nu];
+    tree.inverse_dynamics(&model, t, &q, &u, &udot, &NoCallbacks, &mut got).unwrap();
+    let err = max_diff(&got, &want) / max_abs(&want);
+    eprintln!("generic ID vs engine RNEA on all joint types: {err:.1e} relative");
+    assert!(err < 1e-13, "{err:.3e}: {got:?} vs {want:?}");
+}
+
+#[test]
+fn exact_on_every_joint_type_matches_differences() {
+    let model = zoo();
+    let (q, u) = zoo_state(&model);
+    exact_vs_fd("all joint types and elements", &model, 0.8, &q, &u, &NoCallbacks, 1e-6);
+}
+
+/// A callback force: a torsion spring −k q on the pendulum's pin.
+struct Torsion(f64);
+
+impl Callbacks for Torsion {
+    fn time_function(&self, id: usize, _t: f64) -> crate::error::Result<f64> {
+        Err(crate::error::Error::Callback(format!("no time function {id}")))
+    }
+    fn generalized_force(
+        &self,
+        _id: usize,
+        _t: f64,
+        q: &[f64],
+        _u: &[f64],
+        out: &mut [f64],
+    ) -> crate::error::Result<()> {
+        out[0] -= self.0 * q[0];
+        Ok(())
+    }
+}
+
+#[test]
+fn callback_forces_make_auto_fall_back_and_exact_name_the_element() {
+    let m = model(
+        r#"{"name": "p", "gravity": [0, -9.81, 0],
+        "bodies": [{"name": "bob", "mass": 1.5, "inertia": [1e-9, 1e-9, 1e-9]}],
+        "joints": [{"name": "pin", "type": "revolute", "parent": "ground", "child": "bob", "axis": [0, 0, 1],
+                     "child_frame": {"position": [0, 0.8, 0]}}],
+        "forces": [{"type": "callback", "name": "torsion spring", "id": 0}]}"#,
+    );
+    let cb = Torsion(5.0);
+    let e = linearize_with(&m, 0.0, &m.q0(), &m.u0(), &cb, Derivatives::Exact).unwrap_err();
+    assert!(matches!(e, crate::error::Error::Settings(_)), "{e:?}");
+    assert!(e.to_string().contains("'torsion spring'"), "{e}");
+    let auto = linearize(&m, 0.0, &m.q0(), &m.u0(), &cb).unwrap();
+    assert_eq!(auto.method, DerivativeMethod::CentralDifferences);
+    let k = 1.5 * 9.81 * 0.8 + 5.0;
+    assert!((auto.k[0] - k).abs() < 1e-8 * k, "{}", auto.k[0]);
+    // without the callback the same pendulum goes the exact way
+    let (p, q) = pendulum(0.0, false);
+    assert_eq!(linearize(&p, 0.0, &q, &p.u0(), &NoCallbacks).unwrap().method, DerivativeMethod::Exact);
+    assert_eq!(Derivatives::from_name("fd"), Some(Derivatives::CentralDifferences));
+    assert_eq!(Derivatives::from_name("exact"), Some(Derivatives::Exact));
+    assert_eq!(Derivatives::from_name("Exact"), None);
 }
