@@ -85,7 +85,6 @@ def main(argv=None) -> int:
     methods = [None]
     if "method" in inspect.signature(ms.linear.linearize).parameters:
         methods = ["exact", "fd"]
-    # TODO: without a method= keyword only the one linearization is timed (no exact/fd comparison)
     rows_lin, lins = [], {}
     for meth in methods:
         kw = {} if meth is None else {"method": meth}
