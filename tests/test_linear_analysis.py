@@ -305,3 +305,18 @@ def test_hysteresis_bad_input():
         ms.linear.hysteresis(t, np.zeros((100, 2)), t)
     with pytest.raises(ms.SettingsError, match="period"):
         ms.linear.hysteresis(t, t, t)
+
+
+def test_modal_damping_gives_each_mode_its_ratio():
+    from test_linear import chain
+
+    lin = ms.linear.linearize(chain(2.0, 300.0))
+    zeta = [0.01, 0.05, 0.2]
+    modes = lin.modal_damping(zeta).modes()
+    np.testing.assert_allclose(modes.damping_ratio, zeta, rtol=1e-10)
+    # the undamped frequencies stay
+    np.testing.assert_allclose(modes.natural_frequency, lin.modes().natural_frequency, rtol=1e-10)
+    with pytest.raises(ms.SettingsError, match="damping ratios"):
+        lin.modal_damping([0.1, -0.1, 0.1])
+    with pytest.raises(ms.SettingsError, match="one damping ratio or 3"):
+        lin.modal_damping([0.1, 0.2])

@@ -222,6 +222,23 @@ class LinearModel:
         a, b = rayleigh_coefficients(zeta1, f1, zeta2, f2)
         return self.with_damping(a * self.M + b * self.K)
 
+    def modal_damping(self, zeta) -> "LinearModel":
+        """The model with modal damping: each undamped mode i of (M, K) gets the damping ratio
+        ``zeta[i]`` (one number: all modes), D = M Phi diag(2 zeta_i w_i) Phi^T M with the modes
+        Phi mass-normalized (Phi^T M Phi = E). Modes in order of rising frequency; needs K
+        positive definite (no rigid-body or unstable modes)."""
+        lam, phi = _undamped_modes(self.M, self.K)
+        if lam.size and lam.min() <= 1e-12 * max(lam.max(), 1.0):
+            raise SettingsError("modal_damping: K must be positive definite (a rigid-body or unstable mode has no "
+                                f"damping ratio; smallest eigenvalue {lam.min():.3g})")
+        z = np.broadcast_to(np.asarray(zeta, dtype=float), lam.shape) if np.ndim(zeta) == 0 else np.asarray(zeta, float)
+        if z.shape != lam.shape:
+            raise SettingsError(f"modal_damping: give one damping ratio or {lam.size}, got {z.size}")
+        if not np.all(np.isfinite(z)) or np.any(z < 0):
+            raise SettingsError(f"modal_damping: damping ratios must be finite and >= 0, got {z.tolist()}")
+        mp = self.M @ phi
+        return self.with_damping(mp @ np.diag(2 * z * np.sqrt(lam)) @ mp.T)
+
     def dissipation(self, ydot) -> float:
         """Rayleigh's dissipation function R = y'^T D y' / 2 (eq. 2.206: the power lost is 2R)."""
         v = np.asarray(ydot, dtype=float)
@@ -324,6 +341,14 @@ class LinearModel:
         if idx[0] == idx[1]:
             raise SettingsError(f"campbell: whirl needs two different coordinates, got {whirl!r}")
         return idx[0], idx[1]
+
+
+def _undamped_modes(m: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues w^2 (rising) and mass-normalized modes of K phi = w^2 M phi."""
+    from scipy.linalg import eigh
+
+    lam, phi = eigh(0.5 * (k + k.T), 0.5 * (m + m.T))
+    return lam, phi
 
 
 def rayleigh_coefficients(zeta1: float, f1: float, zeta2: float, f2: float) -> tuple[float, float]:
