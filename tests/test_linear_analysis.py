@@ -320,3 +320,15 @@ def test_modal_damping_gives_each_mode_its_ratio():
         lin.modal_damping([0.1, -0.1, 0.1])
     with pytest.raises(ms.SettingsError, match="one damping ratio or 3"):
         lin.modal_damping([0.1, 0.2])
+
+
+def test_mode_shapes_mapped_back_to_the_bodies():
+    # pendulum: the bob's centre moves along the tangent, l times the joint's angle; it turns about z
+    mod = ms.Model("pendulum", gravity=(0.0, -9.81, 0.0))
+    b = mod.add_body("bob", 1.5, [1e-3] * 3, com=(0.0, -0.8, 0.0))
+    mod.add_joint(ms.joints.Revolute("pin", mod.ground, b, axis=(0, 0, 1)))
+    lin = ms.linear.linearize(mod)
+    modes = lin.modes()
+    shape = lin.body_shapes(modes)["bob"][0]
+    theta = modes.shapes[0, 0]
+    np.testing.assert_allclose(shape, np.array([0.8, 0, 0, 0, 0, 1.0]) * theta, atol=1e-12)

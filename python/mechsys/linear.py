@@ -222,6 +222,21 @@ class LinearModel:
         a, b = rayleigh_coefficients(zeta1, f1, zeta2, f2)
         return self.with_damping(a * self.M + b * self.K)
 
+    def body_shapes(self, modes: "Modes | None" = None) -> dict[str, np.ndarray]:
+        """Mode shapes mapped back to the bodies: for each body, a complex (modes x 6) array of
+        the displacement of its centre of mass (3) and its rotation (3), inertial components,
+        for the mode shapes of ``modes`` (``self.modes()`` by default) as scaled there."""
+        if self.model is None:
+            raise SettingsError("body_shapes: this LinearModel has no model (built by hand); use ms.linear.linearize")
+        from .kinematics import point_jacobian
+
+        modes = self.modes() if modes is None else modes
+        out = {}
+        for b in self.model.body_info():
+            jt, jr = point_jacobian(self.model, self.q, b["name"], b["com"])
+            out[b["name"]] = np.hstack([(jt @ modes.shapes_u).T, (jr @ modes.shapes_u).T])
+        return out
+
     def modal_damping(self, zeta) -> "LinearModel":
         """The model with modal damping: each undamped mode i of (M, K) gets the damping ratio
         ``zeta[i]`` (one number: all modes), D = M Phi diag(2 zeta_i w_i) Phi^T M with the modes
