@@ -348,9 +348,36 @@ def test_damping_elements_in_the_linearization():
     assert ms.linear.linearize(m).method == "fd"
     with pytest.raises(ms.SettingsError, match="mount"):
         ms.linear.linearize(m, method="exact")
-    # the slide way linearizes to its film coefficient at the gap h0 (eq. 2.211)
-    lin = ms.linear.linearize(slide_way(x0=0.0))
-    assert lin.D[0, 0] == pytest.approx(ms.forces.squeeze_film_coefficient(0.05, 0.05, 2e-4, 1e-3), rel=1e-7)
+    # the slide way linearizes to its film coefficient at the gap h0 (eq. 2.211), exactly
+    lin = ms.linear.linearize(slide_way(x0=0.0), method="exact")
+    assert lin.method == "exact"
+    assert lin.D[0, 0] == pytest.approx(ms.forces.squeeze_film_coefficient(0.05, 0.05, 2e-4, 1e-3), rel=1e-13)
+    # off its rest point and moving: K = k - 3 c hdot / h^4 and D = c / h^3 with c = 12 eta A l^2;
+    # the exact path hits them to round-off, central differences only to ~1e-5 (the h^-4 curvature)
+    c, h, hd = 12 * 0.05 * 2e-4 * 0.05**2, 1.3e-3, 0.05
+    model = slide_way(x0=3e-4)
+    ex = ms.linear.linearize(model, u=[hd], method="exact", operating_point=True)
+    fd = ms.linear.linearize(model, u=[hd], method="fd", operating_point=True)
+    assert ex.K[0, 0] == pytest.approx(4e5 - 3 * c * hd / h**4, rel=1e-12)
+    assert ex.D[0, 0] == pytest.approx(c / h**3, rel=1e-12)
+    assert fd.K[0, 0] == pytest.approx(ex.K[0, 0], rel=1e-4)
+    # a moving progressive mount with damping: K = k (1 + r)/(1 - r)^2 + d u dg/d(delta), D = d g,
+    # g = 1/(1 - r), r = (delta/s)^2
+    k, d, s_, x, v = 1e4, 15.0, 0.01, 0.006, 0.3
+    model = mount_mass(s_, x0=x, u0=v, d=d, k=k)
+    ex = ms.linear.linearize(model, method="exact", operating_point=True)
+    fd = ms.linear.linearize(model, method="fd", operating_point=True)
+    r = (x / s_) ** 2
+    g = 1 / (1 - r)
+    assert ex.method == "exact"
+    assert ex.K[0, 0] == pytest.approx(k * (1 + r) / (1 - r) ** 2 + d * v * 2 * x / s_**2 * g**2, rel=1e-12)
+    assert ex.D[0, 0] == pytest.approx(d * g, rel=1e-13)
+    assert fd.K[0, 0] == pytest.approx(ex.K[0, 0], rel=1e-4)
+    # the progressive mount's tangent stiffness: d/d(delta) of k delta / (1 - (delta/s)^2)
+    k, s_, x = 1e4, 0.01, 0.006
+    lin = ms.linear.linearize(mount_mass(s_, x0=x, k=k), method="exact", operating_point=True)
+    r = (x / s_) ** 2
+    assert lin.K[0, 0] == pytest.approx(k * (1 + r) / (1 - r) ** 2, rel=1e-13)
     # Jenkins elements linearize with their sliders stuck: k, and for a press fit the network's stiffness
     for shaft, expect in ((None, 1e4), (5e4, 1e4 * 5e4 / (1e4 + 5e4))):
         m = ms.Model("fit")

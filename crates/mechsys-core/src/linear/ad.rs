@@ -318,9 +318,11 @@ pub(super) fn unsupported(model: &Model) -> Option<&str> {
 /// not covered (and so falls back to differences) until it is written here too.
 fn covered(fe: &ForceElement) -> bool {
     match fe {
-        // the progressive (elastomer) law is not written here yet
-        ForceElement::SpringDamper { travel, .. } => *travel == 0.0,
-        ForceElement::BodyForce { .. } | ForceElement::JointForce { .. } | ForceElement::JournalBearing { .. } => true,
+        ForceElement::SpringDamper { .. }
+        | ForceElement::SqueezeFilm { .. }
+        | ForceElement::BodyForce { .. }
+        | ForceElement::JointForce { .. }
+        | ForceElement::JournalBearing { .. } => true,
         _ => false,
     }
 }
@@ -433,7 +435,7 @@ impl<T: Real> Tree<T> {
         }
         for fe in &model.forces {
             match fe {
-                ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table, .. } => {
+                ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table, travel } => {
                     let p1 = self.x_abs[*body1].point(point1);
                     let p2 = self.x_abs[*body2].point(point2);
                     let dr = p2 - p1;
@@ -448,7 +450,15 @@ impl<T: Real> Tree<T> {
                     }
                     let e = dr / l;
                     let ldot = e.dot(&(self.point_velocity(*body2, &p2) - self.point_velocity(*body1, &p1)));
-                    let f = spring_force(*k, *k3, table, l - *l0) + ldot * *d;
+                    let delta = l - *l0;
+                    // the progressive (elastomer) law divides the linear terms by 1 − (δ/s)², as in forces.rs
+                    let g = if *travel > 0.0 {
+                        let r = delta / *travel;
+                        (cst::<T>(1.0) - r * r).recip()
+                    } else {
+                        cst(1.0)
+                    };
+                    let f = spring_force(0.0, *k3, table, delta) + delta * g * *k + ldot * g * *d;
                     let fv = e * f;
                     self.add_point_force(*body1, point1, fv);
                     self.add_point_force(*body2, point2, -fv);
@@ -463,6 +473,21 @@ impl<T: Real> Tree<T> {
                     };
                     let w = Wrench { n: n + x.point(point).cross(&f), f };
                     self.f_ext[*body] = self.f_ext[*body].add(&w);
+                }
+                ForceElement::SqueezeFilm { body1, point1, normal, body2, point2, coeff, gap, .. } => {
+                    // eq. 2.211, as in forces.rs: F = coeff / h³ · ḣ along the body1 normal
+                    let n = self.x_abs[*body1].a * lift::<T>(normal);
+                    let p1 = self.x_abs[*body1].point(point1);
+                    let p2 = self.x_abs[*body2].point(point2);
+                    let h = n.dot(&(p2 - p1)) + *gap;
+                    let hdot = n.dot(&(self.point_velocity(*body2, &p2) - self.point_velocity(*body1, &p2)));
+                    let fv = n * (hdot * *coeff / (h * h * h));
+                    if *body2 != 0 {
+                        self.f_ext[*body2] = self.f_ext[*body2].add(&Wrench::at(&p2, -fv));
+                    }
+                    if *body1 != 0 {
+                        self.f_ext[*body1] = self.f_ext[*body1].add(&Wrench::at(&p2, fv));
+                    }
                 }
                 ForceElement::JournalBearing { joint, c, .. } => {
                     // eq. 2.212: a torque linear in the shaft speed
