@@ -139,10 +139,11 @@ def test_bushing_is_conservative_at_large_anisotropic_rotations():
     K = a @ a.T + np.diag([3e3, 3e3, 3e3, 20.0, 30.0, 50.0])
     m = bushed_block(K, frame1=ms.Frame(position=(0.1, 0, 0)), frame2=ms.Frame(position=(0.1, 0.02, 0), cardan=(0.1, 0, 0.2)))
     res = ms.simulate(m, t_end=0.5, output_dt=0.01, integrator=TIGHT,
-                      u0={"float": [0.0, 0.1, 0.0, 3.0, -4.0, 6.0]})
+                      u0={"float": [0.0, 0.1, 0.0, 18.0, -24.0, 36.0]})
     e = res["energy/total"]
     assert abs(e - e[0]).max() < 1e-8 * abs(e[0])
-    assert np.ptp(res["force/mount/deflection"][:, 3:], axis=0).max() > 0.4  # rotations far from small
+    # the run reaches rotations of 40 degrees and more, far from the small-angle range
+    assert np.linalg.norm(res["force/mount/deflection"][:, 3:], axis=1).max() > np.radians(40)
 
 
 def test_bushing_damping_dissipates_what_is_lost():
@@ -286,8 +287,9 @@ def test_press_fit_loops_widen_and_soften_with_the_load():
         x, f = res["force/press/deflection"][n:], res["force/press/force"][n:]
         works.append(loop_work(x, f))
         secants.append((f.max() - f.min()) / (x.max() - x.min()))
-    # microslip: the work grows much faster than the amplitude squared of a viscous damper
-    assert works[0] > 0 and works[1] > 5 * works[0] and works[2] > 3 * works[1]
+    # microslip: the work grows faster than a viscous damper's, which goes with the amplitude squared
+    assert works[0] > 0
+    assert works[1] / works[0] > (5 / 3) ** 2 and works[2] / works[1] > (8 / 5) ** 2
     assert secants[0] > secants[1] > secants[2]
     # the secant of the smallest loop is below the all-stuck stiffness of the network
     stuck = np.linalg.inv(np.diag([2 * ks + k] * 4 + [ks + k]) - ks * (np.eye(5, k=1) + np.eye(5, k=-1)))
@@ -386,3 +388,33 @@ def test_damping_elements_in_the_linearization():
         m.add_force(ms.forces.Jenkins("press", "fit", k=1e4, slip=5.0, shaft_stiffness=shaft))
         lin = ms.linear.linearize(m)
         assert lin.method == "fd" and lin.K[0, 0] == pytest.approx(expect, rel=1e-8)
+
+
+def test_recorded_forces_keep_their_columns_when_a_damper_has_no_direction():
+    # a pure damper through coincident points carries no force; the bearing after it must still
+    # record into its own column
+    m = flywheel()
+    m.add_force(ms.forces.SpringDamper("idle", m.ground, "wheel", d=3.0))
+    m.add_force(ms.forces.JournalBearing("bearing2", "shaft", radius=0.03, length=0.05, clearance=4e-5, eta=0.03))
+    res = ms.simulate(m, t_end=0.1, output_dt=0.01, integrator=TIGHT)
+    c2 = ms.forces.journal_bearing_coefficient(0.03, 0.05, 4e-5, 0.03)
+    np.testing.assert_allclose(res["force/bearing2/force"], c2 * res["joint/shaft/u"], rtol=1e-12)
+    assert np.all(res["force/idle/force"] == 0.0)
+
+
+def test_bushing_refuses_rotations_near_pi():
+    # the rotation vector flips at pi: a bushing twisted that far stops with an error naming it
+    m = bushed_block([2e4, 3e4, 5e4, 0.0, 0.0, 1e-3])
+    with pytest.raises(ms.SolverError, match="mount.*rotation"):
+        ms.simulate(m, t_end=2.0, integrator=ms.DOPRI5(), u0={"float": [0, 0, 0, 0, 0, 10.0]})
+
+
+def test_coefficient_helpers_refuse_input_outside_validity():
+    with pytest.raises(ms.SettingsError, match="eccentricity"):
+        ms.forces.journal_bearing_coefficient(0.03, 0.05, 4e-5, 0.03, 1.0)
+    with pytest.raises(ms.SettingsError, match="clearance"):
+        ms.forces.journal_bearing_coefficient(0.03, 0.05, 0.0, 0.03)
+    with pytest.raises(ms.SettingsError, match="gap"):
+        ms.forces.squeeze_film_coefficient(0.05, 0.05, 2e-4, -1e-3)
+    with pytest.raises(ms.SettingsError, match="area"):
+        ms.forces.squeeze_film_coefficient(0.05, 0.05, float("nan"), 1e-3)

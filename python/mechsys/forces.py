@@ -6,7 +6,7 @@ Gravity is a property of the Model; joint springs and dampers are given with the
 (``spring=``, ``damper=``).
 
 Every element with a deflection records ``force/<name>/force`` (the force it carries along its
-deflection, positive when it resists a positive deflection) and ``force/<name>/deflection``, so
+deflection, positive when it resists a positive deflection or deflection rate) and ``force/<name>/deflection``, so
 ``ms.linear.hysteresis`` can draw its loop.
 """
 
@@ -17,8 +17,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from . import functions
-from .errors import ModelError
+from . import _core, functions
+from .errors import ModelError, SettingsError
 from .joints import JointDamper, JointSpring, RotaryDamper, RotarySpring, LinearDamper, LinearSpring  # noqa: F401
 from .joints import Frame, _frame
 from .joints import _vec3 as _vec
@@ -201,15 +201,18 @@ class JournalBearing:
 
 
 def journal_bearing_coefficient(radius: float, length: float, clearance: float, eta: float, eccentricity: float = 0.0) -> float:
-    """c of eq. 2.212 with the wall speed u_w = r0 Omega, so that M = c Omega (N m s/rad)."""
-    e2 = eccentricity**2
-    shape = 2 * (1 + 2 * e2) / (np.sqrt(1 - e2) * (1 + e2 / 2))
-    return float(shape * np.pi * radius**2 * length * eta / clearance * radius)
+    """c of eq. 2.212 with the wall speed u_w = r0 Omega, so that M = c Omega (N m s/rad): the
+    engine's own law. Parameters outside the element's validity raise a SettingsError."""
+    return _core.journal_bearing_coefficient(float(radius), float(length), float(clearance), float(eta),
+                                             float(eccentricity))
 
 
 def squeeze_film_coefficient(eta: float, length: float, area: float, gap: float) -> float:
-    """12 eta A l^2 / h^3 of eq. 2.211: the film force per gap rate at gap h (N s/m)."""
-    return float(12 * eta * area * length**2 / gap**3)
+    """12 eta A l^2 / h^3 of eq. 2.211: the film force per gap rate at gap h (N s/m), from the
+    engine's law."""
+    if not (np.isfinite(gap) and gap > 0):
+        raise SettingsError(f"squeeze_film_coefficient: gap must be > 0, got {gap}")
+    return _core.squeeze_film_coefficient(float(eta), float(length), float(area)) / float(gap) ** 3
 
 
 @dataclass

@@ -619,9 +619,11 @@ def _spin_index(model: Model, joint: str, component: int | None) -> int:
 
 
 def _relinearize(lin: LinearModel, u: np.ndarray) -> LinearModel:
-    """``lin``'s model linearized again at its q, t with the velocities ``u`` (same method)."""
-    extra = {"method": lin.method} if getattr(lin, "method", None) is not None else {}
-    return linearize(lin.model, q=lin.q, u=u, t=lin.t, operating_point=True, **extra)
+    """``lin``'s model linearized again at its q, t with the velocities ``u``, by the same kind of
+    derivatives (``lin.method`` names what was used, e.g. "exact+fd-constraints"; the request
+    that gives it again is "fd" or "exact")."""
+    return linearize(lin.model, q=lin.q, u=u, t=lin.t, operating_point=True,
+                     method="fd" if lin.method == "fd" else "exact")
 
 
 def _elastic_modes(modes: Modes, rigid_tol: float) -> dict:

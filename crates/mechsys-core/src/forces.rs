@@ -216,9 +216,12 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
         }
     }
 
-    // o: the element's first recorded value; chain: its index among the Jenkins chains
-    let (mut o, mut chain) = (0usize, 0usize);
+    // next: the first recorded value of the next element; chain: index among the Jenkins chains
+    let (mut next, mut chain) = (0usize, 0usize);
     for fe in &model.forces {
+        // this element's recorded values (taken first: an arm may `continue`)
+        let o = next;
+        next += fe.outputs();
         match fe {
             ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table, travel } => {
                 let p1 = point_position(data, *body1, point1);
@@ -231,6 +234,9 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                             "spring-damper '{name}': its two points coincide at t = {t} s, the force direction is undefined"
                         )));
                     }
+                    // a pure damper through coincident points: no direction, no force
+                    data.element_force[o] = 0.0;
+                    data.element_deflection[o] = -l0;
                     continue;
                 }
                 let e = dr / l;
@@ -265,6 +271,14 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                 let dr = a1.transpose() * (p2 - p1);
                 let theta = crate::math::rotation::matrix_to_rotvec(&(a1.transpose() * a2))
                     .map_err(|e| Error::Solver(format!("bushing '{name}' at t = {t} s: {e}")))?;
+                // the rotation vector flips sign at π (and J⁻ᵀ is 0/0 there): the law ends before it
+                if theta.norm() > damping::MAX_BUSHING_ROTATION {
+                    return Err(Error::Solver(format!(
+                        "bushing '{name}': relative rotation {:.4} rad at t = {t} s is beyond the bushing law's range (below {:.4} rad)",
+                        theta.norm(),
+                        damping::MAX_BUSHING_ROTATION
+                    )));
+                }
                 let dr_dot = a1.transpose() * (point_velocity(data, b2, &frame2.r) - point_velocity(data, b1, &frame1.r))
                     - (a1.transpose() * w1).cross(&dr);
                 let w_rel = a1.transpose() * (data.v[b2].w - w1);
@@ -366,7 +380,6 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                 p_ext += after - before;
             }
         }
-        o += fe.outputs();
     }
     Ok(Powers { dissipated: p_diss, external: p_ext })
 }

@@ -202,7 +202,37 @@ fn energies<'py>(
     Ok(d)
 }
 
+/// Checks that each named value is finite and > 0, naming the first that is not.
+fn positive(values: &[(&str, f64)], what: &str) -> PyResult<()> {
+    match values.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+        Some((k, v)) => Err(settings(format!("{what}: {k} must be > 0, got {v}"))),
+        None => Ok(()),
+    }
+}
+
+/// Torque per shaft speed of eq. 2.212 (the engine's law), checked like the element's input.
+#[pyfunction]
+#[pyo3(signature = (radius, length, clearance, eta, eccentricity=0.0))]
+fn journal_bearing_coefficient(radius: f64, length: f64, clearance: f64, eta: f64, eccentricity: f64) -> PyResult<f64> {
+    use mechsys_core::forces::damping::{journal_bearing_coefficient as c, MAX_ECCENTRICITY};
+    let what = "journal_bearing_coefficient";
+    positive(&[("radius", radius), ("length", length), ("clearance", clearance), ("eta", eta)], what)?;
+    if !(eccentricity.is_finite() && (0.0..=MAX_ECCENTRICITY).contains(&eccentricity)) {
+        return Err(settings(format!("{what}: eccentricity must lie in [0, {MAX_ECCENTRICITY}], got {eccentricity}")));
+    }
+    Ok(c(radius, length, clearance, eta, eccentricity))
+}
+
+/// `12 η A l²` of eq. 2.211 (the engine's law): the film force per gap rate times h³.
+#[pyfunction]
+fn squeeze_film_coefficient(eta: f64, length: f64, area: f64) -> PyResult<f64> {
+    positive(&[("eta", eta), ("length", length), ("area", area)], "squeeze_film_coefficient")?;
+    Ok(mechsys_core::forces::damping::squeeze_film_coefficient(eta, length, area))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(journal_bearing_coefficient, m)?)?;
+    m.add_function(wrap_pyfunction!(squeeze_film_coefficient, m)?)?;
     m.add_function(wrap_pyfunction!(crba, m)?)?;
     m.add_function(wrap_pyfunction!(aba, m)?)?;
     m.add_function(wrap_pyfunction!(rnea, m)?)?;

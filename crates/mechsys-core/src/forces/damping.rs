@@ -8,6 +8,14 @@ use crate::math::{tilde, Mat3, Vec3};
 /// and the shaft touches the shell at ε = 1, where the film theory no longer holds.
 pub const MAX_ECCENTRICITY: f64 = 0.95;
 
+/// Largest relative rotation of a bushing (rad): its rotation vector is ambiguous at π.
+pub const MAX_BUSHING_ROTATION: f64 = 0.99 * std::f64::consts::PI;
+
+/// `12 η A l²` of eq. 2.211 (N s m²): the squeeze-film force is this over h³ times ḣ.
+pub fn squeeze_film_coefficient(eta: f64, length: f64, area: f64) -> f64 {
+    12.0 * eta * area * length * length
+}
+
 /// Torque per shaft speed of a journal bearing (eq. 2.212 with the wall speed u_w = r0 Ω):
 /// `c = 2(1 + 2ε²) / (√(1 − ε²)(1 + ε²/2)) · π r0² b η / a · r0` (N m s/rad). At ε = 0 this is
 /// Petroff's `2π r0³ b η / a`.

@@ -35,7 +35,7 @@
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::{ForceElement, Model};
-use crate::solver::{self, Lcp, Method, Workspace};
+use crate::solver::{self, Lcp, LemkeOptions, Method, Workspace};
 
 /// A set of Jenkins elements on one joint velocity (validated; see the module doc).
 #[derive(Debug, Clone, PartialEq)]
@@ -79,7 +79,7 @@ impl Jenkins {
         shaft: Option<f64>,
         offset: f64,
         slot: usize,
-    ) -> Self {
+    ) -> Result<Self> {
         let n = slip.len();
         let (mut ainv_b, mut k_ainv, mut w) = (vec![], vec![], vec![]);
         if let Some(ks) = shaft {
@@ -92,13 +92,15 @@ impl Jenkins {
                     a[(i + 1, i)] = -ks;
                 }
             }
-            // A is symmetric positive definite (diagonally dominant with k > 0)
-            let ainv = a.cholesky().map(|c| c.inverse()).unwrap_or_else(|| nalgebra::DMatrix::identity(n, n));
+            // A is symmetric positive definite when k, ks > 0 (strictly diagonally dominant)
+            let ainv = a.cholesky().map(|c| c.inverse()).ok_or_else(|| {
+                Error::Model(format!("Jenkins element '{name}': k and shaft_stiffness must be > 0 (got {k}, {ks})"))
+            })?;
             ainv_b = (0..n).map(|i| ainv[(i, 0)] * ks).collect();
             k_ainv = (0..n * n).map(|m| k * ainv[(m / n, m % n)]).collect();
             w = (0..n * n).map(|m| k * (if m / n == m % n { 1.0 } else { 0.0 } - k * ainv[(m / n, m % n)])).collect();
         }
-        Jenkins { name, joint, iq, iu, k, slip, shaft, offset, slot, ainv_b, k_ainv, w }
+        Ok(Jenkins { name, joint, iq, iu, k, slip, shaft, offset, slot, ainv_b, k_ainv, w })
     }
 
     /// Number of sliders.
@@ -193,7 +195,9 @@ pub fn evaluate(j: &Jenkins, chain: usize, data: &mut Data, q: &[f64], t: f64) -
             // λ* is kept in the output slot until Δz is known
             data.slider_force[s + r] = lam_star;
         }
-        let rep = solver::solve(&work.lcp, &Method::lemke(), &mut work.x, false, &mut work.ws)
+        // M was checked when the scratch was built and q is finite with x: Lemke directly,
+        // without the per-call validation of the generic `solver::solve`
+        let rep = solver::lemke::solve_lcp(&work.lcp, &LemkeOptions::default(), &mut work.x, &mut work.ws)
             .map_err(|e| Error::Solver(format!("Jenkins element '{}' at t = {t} s: {e}", j.name)))?;
         if !rep.converged {
             return Err(Error::Solver(format!(
@@ -234,7 +238,8 @@ pub fn commit(model: &Model, data: &mut Data, q: &[f64], t: f64) -> Result<f64> 
             }
         }
     }
-    Ok(work.max(0.0))
+    // each λ_i Δz_i ≥ 0 by the slider law (up to round-off): no clamp, a sign error must show
+    Ok(work)
 }
 
 #[cfg(test)]
@@ -242,7 +247,7 @@ mod tests {
     use super::*;
 
     fn element(slip: Vec<f64>, shaft: Option<f64>) -> Jenkins {
-        Jenkins::new("press".into(), 0, 0, 0, 100.0, slip, shaft, 0.0, 0)
+        Jenkins::new("press".into(), 0, 0, 0, 100.0, slip, shaft, 0.0, 0).unwrap()
     }
 
     #[test]
@@ -254,5 +259,8 @@ mod tests {
         let w = nalgebra::DMatrix::from_row_slice(5, 5, &j.w);
         assert!((&w - w.transpose()).norm() < 1e-12);
         assert!(w.symmetric_eigen().eigenvalues.min() > 0.0);
+        // a non-positive stiffness is an error naming the element, not a made-up matrix
+        let e = Jenkins::new("press".into(), 0, 0, 0, -100.0, vec![1.0; 3], Some(50.0), 0.0, 0).unwrap_err();
+        assert!(e.to_string().contains("'press'"), "{e}");
     }
 }

@@ -583,7 +583,7 @@ impl Model {
                         normal: nonzero_direction(normal, &format!("{what}.normal"))?,
                         body2: b2,
                         point2: finite3(point2, &format!("{what}.point2"))?,
-                        coeff: 12.0 * eta * area * length * length,
+                        coeff: crate::forces::damping::squeeze_film_coefficient(*eta, *length, *area),
                         gap: *gap,
                         gap_max: 0.1 * length,
                     }
@@ -655,7 +655,7 @@ impl Model {
                         *shaft_stiffness,
                         *offset,
                         n_sliders,
-                    );
+                    )?;
                     n_sliders += j.len();
                     ForceElement::Jenkins(j)
                 }
