@@ -64,7 +64,15 @@ impl Step {
     }
 
     /// Tries the step `[t, t + h]` from `y`; returns the scaled error norm (≤ 1 accepts).
-    pub fn attempt<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64], h: f64, rtol: f64, atol: f64) -> Result<f64> {
+    pub fn attempt<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        rtol: f64,
+        atol: f64,
+    ) -> Result<f64> {
         let n = self.n;
         let (k, tmp) = (&mut self.k, &mut self.tmp);
         macro_rules! stage {

@@ -178,8 +178,7 @@ impl MoreauJean {
     pub fn with_assembly(model: &Model, h: f64, method: Method, assembly: Assembly) -> Result<Self> {
         crate::ensure!(h.is_finite() && h > 0.0, Settings, "integrator.dt: must be > 0, got {h}");
         let (nu, np) = (model.nu, model.n_contact_points);
-        let planar =
-            model.contacts.iter().all(|c| c.pair.is_planar()) && model.contact_groups.iter().all(|g| g.planar);
+        let planar = model.contacts.iter().all(|c| c.pair.is_planar()) && model.contact_groups.iter().all(|g| g.planar);
         let dim = if planar { 2 } else { 3 };
         crate::ensure!(
             !(assembly == Assembly::Sparse && model.nc > 0),
@@ -354,8 +353,7 @@ impl MoreauJean {
         }
         for (gi, group) in model.contact_groups.iter().enumerate() {
             let ph = &mut self.groups[gi];
-            ph.update(group, data, h, CONTACT_MARGIN)
-                .map_err(|e| Error::Solver(format!("at t = {tm:.6} s: {e}")))?;
+            ph.update(group, data, h, CONTACT_MARGIN).map_err(|e| Error::Solver(format!("at t = {tm:.6} s: {e}")))?;
             let mut pen = self.group_stats[gi].max_penetration;
             for &slot in &ph.live {
                 let sl = &ph.slots[slot];

@@ -29,7 +29,13 @@ fn tree_model() -> Model {
         contact("s1_floor", "s1", &sphere(0.05), "ground", plane),
         contact("s1_s2", "s2", &sphere(0.05), "s1", &sphere(0.05)),
         contact("s2_tip", "s2", &sphere(0.05), "arm2", tip),
-        contact("slide_floor", "slider", r#"{"type": "sphere", "center": [0, 0, -0.1], "radius": 0.04}"#, "ground", plane),
+        contact(
+            "slide_floor",
+            "slider",
+            r#"{"type": "sphere", "center": [0, 0, -0.1], "radius": 0.04}"#,
+            "ground",
+            plane,
+        ),
     ]
     .join(",");
     let json = format!(

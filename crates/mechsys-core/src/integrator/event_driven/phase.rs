@@ -1,0 +1,453 @@
+//! The smooth phase: the motion with a fixed contact structure, its forces and its event functions.
+
+use nalgebra::DMatrix;
+
+use super::{EventWork, Options, Phase, PYRAMID};
+use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::forces::{Callbacks, Powers};
+use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
+use crate::integrator::OdeSystem;
+use crate::math::linalg::solve_min_norm;
+use crate::math::Vec3;
+use crate::model::contact::FrictionLaw;
+use crate::model::Model;
+use crate::solver::{Delassus, FrictionContact, Lcp, Workspace};
+use crate::spatial::Motion;
+
+impl<'a> Phase<'a> {
+    /// A phase for `model` with every point open.
+    pub fn new(model: &'a Model, cb: &'a dyn Callbacks, opts: Options) -> Result<Self> {
+        opts.validate()?;
+        let (nu, np) = (model.nu, model.n_contact_points);
+        let d = if model.contacts.iter().all(|c| c.pair.is_planar()) { 2 } else { 3 };
+        // the LCP has at most np (1 + K + 1) unknowns
+        let k = if d == 2 { 2 } else { PYRAMID };
+        let rmax = (np * (k + 1)).max(d * np).max(1);
+        Ok(Phase {
+            model,
+            cb,
+            opts,
+            data: Data::new(model),
+            d,
+            status: vec![OPEN; np],
+            dir: vec![[0.0; 2]; np],
+            kin: vec![ContactKinematics::default(); np],
+            lam_n: vec![0.0; np],
+            lam_t: vec![[0.0; 2]; np],
+            friction_power: 0.0,
+            unk: Vec::with_capacity(d * np),
+            rows: DMatrix::zeros(rmax, nu),
+            cols: DMatrix::zeros(rmax, nu),
+            x: vec![0.0; rmax * nu],
+            mat: vec![0.0; (rmax + np) * (rmax + np)],
+            rhs: vec![0.0; rmax + np],
+            aat: vec![0.0; (rmax + np) * (rmax + np)],
+            piv_r: vec![0; rmax + np],
+            piv_c_work: vec![0.0; rmax + np],
+            a_free: vec![0.0; nu],
+            tmp: vec![0.0; nu],
+            evaluations: 0,
+            log: Vec::new(),
+            lcp: Lcp { m: Vec::with_capacity((np * (k + 2)).pow(2)), q: Vec::with_capacity(np * (k + 2)) },
+            fc: FrictionContact {
+                dim: d,
+                w: Delassus::Dense(Vec::with_capacity(d * d * np * np)),
+                q: Vec::with_capacity(d * np),
+                mu: Vec::with_capacity(np),
+            },
+            ws: Workspace::new(),
+            z: Vec::with_capacity(np * (k + 2)),
+            ev: EventWork {
+                before: Vec::with_capacity(d * np),
+                lam: Vec::with_capacity(d * np),
+                total: Vec::with_capacity(d * np),
+                after_c: Vec::with_capacity(d * np),
+                stored: Vec::with_capacity(d * np),
+                extra: Vec::with_capacity(d * np),
+                unresolved: Vec::with_capacity(np),
+                stick: Vec::with_capacity(np),
+                touching: Vec::with_capacity(np),
+                closing: Vec::with_capacity(np),
+                old: Vec::with_capacity(np),
+                old_dir: Vec::with_capacity(np),
+                apex: vec![ContactKinematics::default(); model.contacts.iter().map(|c| c.points()).max().unwrap_or(0)],
+            },
+        })
+    }
+
+    /// Length of the integrated state.
+    pub fn state_len(&self) -> usize {
+        self.model.nq + self.model.nu + 3 + 3 * self.model.n_contact_points
+    }
+
+    /// The motion without contact forces: kinematics, smooth forces, the mass matrix factored,
+    /// the accelerations `a_free` under the bilateral constraints, and every point's kinematics
+    /// with `w̄` (velocity-product accelerations in `data.a`).
+    pub(super) fn free_motion(&mut self, t: f64, q: &[f64], u: &[f64]) -> Result<Powers> {
+        let (model, nc) = (self.model, self.model.nc);
+        let data = &mut self.data;
+        let mut p = crate::dynamics::prepare(model, data, t, q, u, self.cb)?;
+        if nc > 0 {
+            crate::constraints::positions(model, data, t, q, self.cb)?;
+        }
+        data.a[0] = Motion::ZERO;
+        let zero = std::mem::take(&mut data.zero_u);
+        crate::kinematics::accelerations(model, data, &zero);
+        data.zero_u = zero;
+        if nc > 0 {
+            crate::constraints::accelerations(model, data, t, q, u, self.cb)?;
+        }
+        let mut c = std::mem::take(&mut self.a_free);
+        crate::dynamics::rnea::rnea_inward(model, data, &mut c);
+        for v in c.iter_mut() {
+            *v = -*v;
+        }
+        {
+            let Data { inertia, s, ic, saddle, .. } = &mut *data;
+            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| saddle.put_mass(r, col, v));
+        }
+        if !data.saddle.factor_mass() {
+            self.a_free = c;
+            return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));
+        }
+        data.saddle.solve_mass(&mut c);
+        if nc > 0 {
+            data.saddle.gather_g(&data.g);
+            data.saddle.assemble_schur(true);
+            if !data.saddle.factor_schur(1e-12) {
+                self.a_free = c;
+                return Err(Error::Settings(format!(
+                    "integrator: the event-driven scheme needs independent bilateral constraints; they are redundant at t = {t:.6} s (use MoreauJean)"
+                )));
+            }
+            data.saddle.g_times(&c, &mut data.lambda);
+            for r in 0..nc {
+                data.lambda[r] = data.gamma[r] - data.lambda[r];
+            }
+            data.saddle.solve_schur(&mut data.lambda);
+            data.saddle.add_constraint_accelerations(&data.lambda, &mut c);
+            for k in 0..nc {
+                p.external += data.lambda[k] * data.b[k];
+            }
+        }
+        self.a_free = c;
+        for con in &model.contacts {
+            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
+            contact_kinematics(&con.pair, &b1, &b2, &mut self.kin[con.first..con.first + con.points()])
+                .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.6} s: {e}", con.name)))?;
+        }
+        Ok(p)
+    }
+
+    /// `x ← M̃⁻¹ x`: the accelerations a generalized force `x` causes under the bilateral
+    /// constraints; `lambda`, if given, receives the multipliers it adds.
+    pub(super) fn inverse_mass(data: &mut Data, nc: usize, x: &mut [f64], lambda: Option<&mut [f64]>) {
+        data.saddle.solve_mass(x);
+        if nc > 0 {
+            let mut y = std::mem::take(&mut data.work2);
+            y.resize(nc.max(y.len()), 0.0);
+            data.saddle.g_times(x, &mut y[..nc]);
+            for v in y[..nc].iter_mut() {
+                *v = -*v;
+            }
+            data.saddle.solve_schur(&mut y[..nc]);
+            data.saddle.add_constraint_accelerations(&y[..nc], x);
+            if let Some(l) = lambda {
+                for k in 0..nc {
+                    l[k] += y[k];
+                }
+            }
+            data.work2 = y;
+        }
+    }
+
+    /// Generalized direction of a force `dir` at point `pt` (body 1 pushed along `dir`, body 2
+    /// back) into row `r` of `m`.
+    pub(super) fn put_row(
+        model: &Model,
+        data: &Data,
+        kin: &[ContactKinematics],
+        pt: usize,
+        dir: &Vec3,
+        m: &mut DMatrix<f64>,
+        r: usize,
+    ) {
+        for i in 0..model.nu {
+            m[(r, i)] = 0.0;
+        }
+        let con = model.contact_of_point(pt);
+        let k = &kin[pt].point;
+        crate::constraints::add_point_rows(model, &data.s, con.body1, &k.p1, 1.0, Some(dir), m, r);
+        crate::constraints::add_point_rows(model, &data.s, con.body2, &k.p2, -1.0, Some(dir), m, r);
+    }
+
+    /// World tangent direction of (t1, t2) components `c` at point `pt`.
+    pub(super) fn tangent(&self, pt: usize, c: [f64; 2]) -> Vec3 {
+        let k = &self.kin[pt].point;
+        k.t1 * c[0] + if self.d == 3 { k.t2 * c[1] } else { Vec3::zeros() }
+    }
+
+    /// Sliding velocity (t1, t2 components; t2 = 0 for planar pairs) and speed of point `pt`.
+    pub(super) fn sliding(&self, pt: usize) -> ([f64; 2], f64) {
+        let g = self.kin[pt].gd_t;
+        let g = if self.d == 3 { g } else { [g[0], 0.0] };
+        (g, (g[0] * g[0] + g[1] * g[1]).sqrt())
+    }
+
+    /// Unit sliding direction of a slipping point: the current one above `velocity_tol`, else the
+    /// one the last transition found (sliding starts from rest along the relative acceleration).
+    pub(super) fn slip_direction(&self, pt: usize) -> [f64; 2] {
+        let (g, s) = self.sliding(pt);
+        if s > self.opts.velocity_tol {
+            [g[0] / s, g[1] / s]
+        } else {
+            self.dir[pt]
+        }
+    }
+
+    pub(super) fn mu_sliding(&self, pt: usize) -> f64 {
+        let (_, s) = self.sliding(pt);
+        match &self.model.contact_of_point(pt).friction {
+            FrictionLaw::None => 0.0,
+            law => law.mu(s.max(f64::MIN_POSITIVE)),
+        }
+    }
+
+    /// `M̃⁻¹` times the first `n` rows of `cols` into `x`.
+    pub(super) fn solve_columns(&mut self, n: usize) {
+        let nu = self.model.nu;
+        for j in 0..n {
+            let x = &mut self.x[j * nu..(j + 1) * nu];
+            for i in 0..nu {
+                x[i] = self.cols[(j, i)];
+            }
+            Self::inverse_mass(&mut self.data, self.model.nc, x, None);
+        }
+    }
+
+    /// `rows_i · x_j`.
+    pub(super) fn coupling(&self, i: usize, j: usize) -> f64 {
+        let nu = self.model.nu;
+        let x = &self.x[j * nu..(j + 1) * nu];
+        (0..nu).map(|k| self.rows[(i, k)] * x[k]).sum()
+    }
+
+    /// One evaluation with the current contact structure: forces and `u̇` (into `data.udot`,
+    /// body accelerations into `data.a`). Returns the smooth power balance.
+    pub fn evaluate(&mut self, t: f64, q: &[f64], u: &[f64]) -> Result<Powers> {
+        self.evaluations += 1;
+        let p = self.free_motion(t, q, u)?;
+        let (model, nu, np) = (self.model, self.model.nu, self.model.n_contact_points);
+        self.unk.clear();
+        for pt in 0..np {
+            self.lam_n[pt] = 0.0;
+            self.lam_t[pt] = [0.0; 2];
+            if self.status[pt] == OPEN {
+                continue;
+            }
+            self.unk.push((pt, 0));
+            if self.status[pt] == STICK {
+                for k in 1..self.d {
+                    self.unk.push((pt, k));
+                }
+            }
+        }
+        let n = self.unk.len();
+        self.friction_power = 0.0;
+        let mut udot = std::mem::take(&mut self.data.udot);
+        udot.copy_from_slice(&self.a_free);
+        if n > 0 {
+            // rows: the constrained directions; columns: the force directions
+            for j in 0..n {
+                let (pt, k) = self.unk[j];
+                let kp = &self.kin[pt].point;
+                let row_dir = match k {
+                    0 => kp.n,
+                    1 => kp.t1,
+                    _ => kp.t2,
+                };
+                Self::put_row(model, &self.data, &self.kin, pt, &row_dir, &mut self.rows, j);
+                let col_dir = if k == 0 && self.status[pt] == SLIP {
+                    let s = self.slip_direction(pt);
+                    kp.n - self.tangent(pt, s) * self.mu_sliding(pt)
+                } else {
+                    row_dir
+                };
+                Self::put_row(model, &self.data, &self.kin, pt, &col_dir, &mut self.cols, j);
+            }
+            self.solve_columns(n);
+            for i in 0..n {
+                for j in 0..n {
+                    self.mat[i * n + j] = self.coupling(i, j);
+                }
+                let (pt, k) = self.unk[i];
+                let wbar = match k {
+                    0 => self.kin[pt].wbar_n,
+                    k => self.kin[pt].wbar_t[k - 1],
+                };
+                let ra: f64 = (0..nu).map(|c| self.rows[(i, c)] * self.a_free[c]).sum();
+                self.rhs[i] = -(ra + wbar);
+            }
+            solve_min_norm(
+                &self.mat[..n * n],
+                n,
+                &mut self.rhs[..n],
+                &mut self.aat,
+                &mut self.piv_r,
+                &mut self.piv_c_work,
+                1e-13,
+            );
+            for j in 0..n {
+                let l = self.rhs[j];
+                let x = &self.x[j * nu..(j + 1) * nu];
+                for i in 0..nu {
+                    udot[i] += x[i] * l;
+                }
+                let (pt, k) = self.unk[j];
+                if k == 0 {
+                    self.lam_n[pt] = l;
+                } else {
+                    self.lam_t[pt][k - 1] = l;
+                }
+            }
+            for pt in 0..np {
+                if self.status[pt] == SLIP {
+                    let (s, mu) = (self.slip_direction(pt), self.mu_sliding(pt));
+                    self.lam_t[pt] = [-mu * self.lam_n[pt] * s[0], -mu * self.lam_n[pt] * s[1]];
+                    self.friction_power += mu * self.lam_n[pt] * self.sliding(pt).1;
+                }
+            }
+            if model.nc > 0 {
+                // the multipliers of the bilateral constraints gain what the contact forces add
+                let mut f = std::mem::take(&mut self.tmp);
+                f.fill(0.0);
+                for j in 0..n {
+                    for i in 0..nu {
+                        f[i] += self.cols[(j, i)] * self.rhs[j];
+                    }
+                }
+                let mut lam = std::mem::take(&mut self.data.lambda);
+                Self::inverse_mass(&mut self.data, model.nc, &mut f, Some(&mut lam));
+                self.data.lambda = lam;
+                self.tmp = f;
+            }
+        }
+        self.data.a[0] = Motion::ZERO;
+        crate::kinematics::accelerations(model, &mut self.data, &udot);
+        self.data.udot = udot;
+        Ok(p)
+    }
+
+    /// Event functions of the last evaluation, two per point; an event is a sign change from
+    /// positive to non-positive.
+    pub fn event_values(&self, out: &mut [f64]) {
+        for pt in 0..self.status.len() {
+            let (e0, e1) = if self.status[pt] == OPEN {
+                (self.kin[pt].point.g_n, 1.0)
+            } else if self.status[pt] == STICK {
+                let lt = (self.lam_t[pt][0].powi(2) + self.lam_t[pt][1].powi(2)).sqrt();
+                (self.lam_n[pt], self.model.contact_of_point(pt).friction.mu0() * self.lam_n[pt] - lt)
+            } else if self.mu_sliding(pt) > 0.0 {
+                let (g, _) = self.sliding(pt);
+                (self.lam_n[pt], g[0] * self.dir[pt][0] + g[1] * self.dir[pt][1])
+            } else {
+                (self.lam_n[pt], 1.0)
+            };
+            out[2 * pt] = e0;
+            out[2 * pt + 1] = e1;
+        }
+    }
+
+    /// After an accepted step: slipping points remember their current direction, and the step
+    /// is capped so that an open point moving apart cannot come back within one step unseen
+    /// (the time to its apex, from `g̈_N` at the step's end). Uses the last evaluation.
+    pub fn after_step(&mut self) -> Result<f64> {
+        let np = self.status.len();
+        let mut cap = f64::INFINITY;
+        for pt in 0..np {
+            if self.status[pt] == SLIP {
+                let (g, s) = self.sliding(pt);
+                if s > self.opts.velocity_tol {
+                    self.dir[pt] = [g[0] / s, g[1] / s];
+                }
+            }
+        }
+        // full accelerations are in data.a: contact_kinematics then gives g̈_N in wbar_n
+        for con in &self.model.contacts {
+            let pts = con.first..con.first + con.points();
+            if !pts.clone().any(|pt| self.status[pt] == OPEN && self.kin[pt].gd_n > 0.0) {
+                continue;
+            }
+            // (every contact's points, not a fixed-size buffer: none may be skipped)
+            let k = &mut self.ev.apex;
+            let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
+            let n = con.points();
+            contact_kinematics(&con.pair, &b1, &b2, &mut k[..n])?;
+            for (j, kk) in k[..n].iter().enumerate() {
+                let pt = con.first + j;
+                if self.status[pt] == OPEN && kk.gd_n > 0.0 && kk.wbar_n < 0.0 {
+                    cap = cap.min(kk.gd_n / -kk.wbar_n);
+                }
+            }
+        }
+        Ok(cap)
+    }
+
+    /// The recorded state of point `pt`: a closed frictionless point that does not slide reads as
+    /// sticking, as in the time-stepping scheme.
+    pub fn state_code(&self, pt: usize) -> f64 {
+        if self.status[pt] == SLIP && self.mu_sliding(pt) == 0.0 && self.sliding(pt).1 <= self.opts.velocity_tol {
+            STICK
+        } else {
+            self.status[pt]
+        }
+    }
+
+    pub(super) fn names(&self, pts: &[usize]) -> Vec<String> {
+        let mut v: Vec<String> = pts.iter().map(|&pt| self.model.contact_of_point(pt).name.clone()).collect();
+        v.dedup();
+        v
+    }
+}
+
+impl OdeSystem for Phase<'_> {
+    fn dim(&self) -> usize {
+        self.state_len()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
+        let (nq, nu, np) = (self.model.nq, self.model.nu, self.model.n_contact_points);
+        let (q, rest) = y.split_at(nq);
+        let u = &rest[..nu];
+        let p = self.evaluate(t, q, u)?;
+        self.model.qdot(q, u, &mut dy[..nq]);
+        dy[nq..nq + nu].copy_from_slice(&self.data.udot);
+        let e = nq + nu;
+        dy[e] = p.dissipated;
+        dy[e + 1] = p.external;
+        dy[e + 2] = self.friction_power;
+        for pt in 0..np {
+            dy[e + 3 + pt] = self.lam_n[pt];
+            dy[e + 3 + np + 2 * pt] = self.lam_t[pt][0];
+            dy[e + 3 + np + 2 * pt + 1] = self.lam_t[pt][1];
+        }
+        Ok(())
+    }
+    fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        if self.model.n_sliders > 0 {
+            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, &y[..nq], t)?;
+        }
+        Ok(())
+    }
+    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        self.model.normalize(&mut y[..nq]);
+        if self.model.nc > 0 {
+            let (q, rest) = y.split_at_mut(nq);
+            crate::dynamics::constrained::project(self.model, &mut self.data, t, q, &mut rest[..nu], self.cb)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,258 @@
+//! The transition problem at acceleration level (section 2.5.2): which touching points stay closed and which stick.
+
+use super::{Dissipation, Phase, PYRAMID};
+use crate::error::{Error, Result};
+use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
+use crate::model::contact::FrictionLaw;
+use crate::solver::{self, Method};
+
+impl Phase<'_> {
+    /// The transition problem at acceleration level over the touching points `pts` with zero
+    /// normal velocity: sets every point's status. Returns false when it has no solution.
+    pub(super) fn transition_lcp(&mut self, pts: &[usize]) -> Result<bool> {
+        let (model, np) = (self.model, self.model.n_contact_points);
+        let vtol = self.opts.velocity_tol;
+        for pt in 0..np {
+            self.status[pt] = OPEN;
+        }
+        if pts.is_empty() {
+            return Ok(true);
+        }
+        // stick candidates: friction and no sliding
+        let mut stick = std::mem::take(&mut self.ev.stick);
+        stick.clear();
+        stick.extend(pts.iter().copied().filter(|&pt| {
+            !matches!(model.contact_of_point(pt).friction, FrictionLaw::None) && self.sliding(pt).1 <= vtol
+        }));
+        let ok = self.transition_lcp_with(pts, &stick);
+        self.ev.stick = stick;
+        ok
+    }
+
+    pub(super) fn transition_lcp_with(&mut self, pts: &[usize], stick: &[usize]) -> Result<bool> {
+        let (model, nu, d) = (self.model, self.model.nu, self.d);
+        let kdirs = if d == 2 { 2 } else { PYRAMID };
+        let (nc, ns) = (pts.len(), stick.len());
+        let nb = nc + ns * kdirs; // rows/columns with a force direction
+        let n = nb + ns;
+        let pyramid = |k: usize| -> [f64; 2] {
+            if d == 2 {
+                [if k == 0 { 1.0 } else { -1.0 }, 0.0]
+            } else {
+                let a = 2.0 * std::f64::consts::PI * k as f64 / kdirs as f64;
+                [a.cos(), a.sin()]
+            }
+        };
+        for (a, &pt) in pts.iter().enumerate() {
+            let kp = self.kin[pt].point;
+            Self::put_row(model, &self.data, &self.kin, pt, &kp.n, &mut self.rows, a);
+            let col = if stick.contains(&pt) {
+                kp.n
+            } else {
+                let (g, s) = self.sliding(pt);
+                let mu = self.mu_sliding(pt);
+                if s > 0.0 {
+                    kp.n - self.tangent(pt, [g[0] / s, g[1] / s]) * mu
+                } else {
+                    kp.n
+                }
+            };
+            Self::put_row(model, &self.data, &self.kin, pt, &col, &mut self.cols, a);
+        }
+        for (b, &pt) in stick.iter().enumerate() {
+            for k in 0..kdirs {
+                let dir = self.tangent(pt, pyramid(k));
+                let r = nc + b * kdirs + k;
+                Self::put_row(model, &self.data, &self.kin, pt, &dir, &mut self.rows, r);
+                Self::put_row(model, &self.data, &self.kin, pt, &dir, &mut self.cols, r);
+            }
+        }
+        self.solve_columns(nb);
+        let m = &mut self.lcp.m;
+        m.clear();
+        m.resize(n * n, 0.0);
+        self.lcp.q.clear();
+        self.lcp.q.resize(n, 0.0);
+        for i in 0..nb {
+            for j in 0..nb {
+                let v: f64 = {
+                    let x = &self.x[j * nu..(j + 1) * nu];
+                    (0..nu).map(|c| self.rows[(i, c)] * x[c]).sum()
+                };
+                self.lcp.m[i * n + j] = v;
+            }
+            let ra: f64 = (0..nu).map(|c| self.rows[(i, c)] * self.a_free[c]).sum();
+            let wbar = if i < nc {
+                self.kin[pts[i]].wbar_n
+            } else {
+                let (b, k) = ((i - nc) / kdirs, (i - nc) % kdirs);
+                let pd = pyramid(k);
+                let w = self.kin[stick[b]].wbar_t;
+                pd[0] * w[0] + pd[1] * w[1]
+            };
+            self.lcp.q[i] = ra + wbar;
+        }
+        for (b, &pt) in stick.iter().enumerate() {
+            let g = nb + b;
+            let a = pts.iter().position(|&p| p == pt).unwrap_or(0);
+            for k in 0..kdirs {
+                let r = nc + b * kdirs + k;
+                self.lcp.m[r * n + g] = 1.0; // γ: the sliding acceleration
+                self.lcp.m[g * n + r] = -1.0;
+            }
+            self.lcp.m[g * n + a] = model.contact_of_point(pt).friction.mu0();
+        }
+        if self.lcp.q.iter().chain(self.lcp.m.iter()).any(|v| !v.is_finite()) {
+            return Err(Error::Solver("the transition problem has non-finite entries".into()));
+        }
+        let method = Method::lemke();
+        self.ws.reserve(&self.lcp, &method)?;
+        self.z.clear();
+        self.z.resize(n, 0.0);
+        let ok = match solver::solve(&self.lcp, &method, &mut self.z, false, &mut self.ws) {
+            Ok(r) => r.converged,
+            Err(Error::Solver(_)) => false,
+            Err(e) => return Err(e),
+        };
+        if !ok {
+            return Ok(false);
+        }
+        let scale = 1e-12 * (1.0 + self.z[..nc].iter().fold(0.0f64, |a, v| a.max(v.abs())));
+        let qscale = 1e-9 * (1.0 + self.lcp.q.iter().fold(0.0f64, |a, v| a.max(v.abs())));
+        for (a, &pt) in pts.iter().enumerate() {
+            // opens: no normal force and a separating acceleration; a point with neither (one of
+            // redundant supports that Lemke's basic solution left unloaded) stays closed and
+            // shares the load in the smooth phase's minimum-norm forces
+            let acc: f64 = (0..n).map(|j| self.lcp.m[a * n + j] * self.z[j]).sum::<f64>() + self.lcp.q[a];
+            if self.z[a] <= scale && acc > qscale {
+                continue;
+            }
+            match stick.iter().position(|&p| p == pt) {
+                Some(b) => {
+                    let gamma = self.z[nb + b];
+                    let gscale = 1e-12 * (1.0 + self.lcp.q.iter().fold(0.0f64, |a, v| a.max(v.abs())));
+                    if gamma <= gscale {
+                        self.status[pt] = STICK;
+                    } else {
+                        // sliding starts against the friction force the pyramid found
+                        let mut f = [0.0; 2];
+                        for k in 0..kdirs {
+                            let pd = pyramid(k);
+                            let beta = self.z[nc + b * kdirs + k];
+                            f[0] += beta * pd[0];
+                            f[1] += beta * pd[1];
+                        }
+                        let s = (f[0] * f[0] + f[1] * f[1]).sqrt();
+                        self.status[pt] = SLIP;
+                        self.dir[pt] = if s > 0.0 { [-f[0] / s, -f[1] / s] } else { [1.0, 0.0] };
+                    }
+                }
+                None => {
+                    let (g, s) = self.sliding(pt);
+                    self.status[pt] = SLIP;
+                    self.dir[pt] = if s > 0.0 { [g[0] / s, g[1] / s] } else { [1.0, 0.0] };
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    /// Everything that happens at an event at (t, y): impacts, then the new contact structure.
+    /// Impulses are added to `imp`; warnings (a Painlevé situation passed) to `warnings`.
+    pub fn transition(
+        &mut self,
+        t: f64,
+        y: &mut [f64],
+        imp: &mut [f64],
+        warnings: &mut Vec<String>,
+    ) -> Result<Dissipation> {
+        let mut ev = std::mem::take(&mut self.ev);
+        let (mut touching, mut closing) = (std::mem::take(&mut ev.touching), std::mem::take(&mut ev.closing));
+        let (mut old, mut old_dir) = (std::mem::take(&mut ev.old), std::mem::take(&mut ev.old_dir));
+        self.ev = ev;
+        let r = self.transition_with(t, y, imp, warnings, (&mut touching, &mut closing, &mut old, &mut old_dir));
+        self.ev.touching = touching;
+        self.ev.closing = closing;
+        self.ev.old = old;
+        self.ev.old_dir = old_dir;
+        r
+    }
+
+    #[allow(clippy::type_complexity)]
+    pub(super) fn transition_with(
+        &mut self,
+        t: f64,
+        y: &mut [f64],
+        imp: &mut [f64],
+        warnings: &mut Vec<String>,
+        (touching, closing, old, old_dir): (&mut Vec<usize>, &mut Vec<usize>, &mut Vec<f64>, &mut Vec<[f64; 2]>),
+    ) -> Result<Dissipation> {
+        let (nq, nu, np) = (self.model.nq, self.model.nu, self.model.n_contact_points);
+        let vtol = self.opts.velocity_tol;
+        let (q, rest) = y.split_at_mut(nq);
+        let u = &mut rest[..nu];
+        self.free_motion(t, q, u)?;
+        touching.clear();
+        touching.extend((0..np).filter(|&pt| self.kin[pt].point.g_n <= self.opts.gap_tol));
+        old.clear();
+        old.extend_from_slice(&self.status);
+        old_dir.clear();
+        old_dir.extend_from_slice(&self.dir);
+        let mut diss = Dissipation::default();
+        if touching.iter().any(|&pt| self.kin[pt].gd_n < -vtol) {
+            for &pt in touching.iter() {
+                if self.kin[pt].gd_n < -vtol {
+                    self.log.push((t, pt, "impact"));
+                }
+            }
+            let d = self.impact(t, u, touching, false, imp)?;
+            diss.impact += d.impact;
+            diss.friction += d.friction;
+            self.free_motion(t, q, u)?;
+        }
+        closing.clear();
+        closing.extend(touching.iter().copied().filter(|&pt| self.kin[pt].gd_n.abs() <= vtol));
+        if !self.transition_lcp(closing)? {
+            let names = self.names(closing);
+            if !self.opts.continue_on_painleve {
+                return Err(Error::Solver(format!(
+                    "Painlevé situation at t = {t:.9} s: the contact problem of {names:?} has no solution at acceleration level (sliding friction too large for the geometry); set continue_on_painleve to stop the sliding by an impulse and go on"
+                )));
+            }
+            warnings.push(format!(
+                "Painlevé situation at t = {t:.9} s in contacts {names:?}: the sliding was stopped by an impulse (an impact without collision)"
+            ));
+            let d = self.impact(t, u, closing, true, imp)?;
+            diss.impact += d.impact;
+            diss.friction += d.friction;
+            self.free_motion(t, q, u)?;
+            closing.retain(|&pt| self.kin[pt].gd_n.abs() <= vtol);
+            if !self.transition_lcp(closing)? {
+                return Err(Error::Solver(format!(
+                    "Painlevé situation at t = {t:.9} s: the contact problem of {names:?} has no solution even after an impulsive stop"
+                )));
+            }
+        }
+        let d = self.settle(u, imp);
+        diss.impact += d.impact;
+        diss.friction += d.friction;
+        for pt in 0..np {
+            let (was, now) = (old[pt], self.status[pt]);
+            let (a, b) = (old_dir[pt], self.dir[pt]);
+            let reversed = was == SLIP && now == SLIP && a[0] * b[0] + a[1] * b[1] < 0.0;
+            if was != now || reversed {
+                let what = if now == OPEN {
+                    "open"
+                } else if was == OPEN {
+                    "close"
+                } else if now == STICK {
+                    "stick"
+                } else {
+                    "slip"
+                };
+                self.log.push((t, pt, what));
+            }
+        }
+        Ok(diss)
+    }
+}
