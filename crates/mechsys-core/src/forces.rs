@@ -279,7 +279,8 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                         damping::MAX_BUSHING_ROTATION
                     )));
                 }
-                let dr_dot = a1.transpose() * (point_velocity(data, b2, &frame2.r) - point_velocity(data, b1, &frame1.r))
+                let dr_dot = a1.transpose()
+                    * (point_velocity(data, b2, &frame2.r) - point_velocity(data, b1, &frame1.r))
                     - (a1.transpose() * w1).cross(&dr);
                 let w_rel = a1.transpose() * (data.v[b2].w - w1);
                 let x = nalgebra::Vector6::new(dr.x, dr.y, dr.z, theta.x, theta.y, theta.z);

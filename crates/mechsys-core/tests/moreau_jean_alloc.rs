@@ -43,7 +43,9 @@ fn allocations() -> usize {
 /// solves.
 #[test]
 fn group_steps_do_not_allocate_after_warm_up() {
-    let model = Model::from_description(ModelDescription::from_json(&sphere_pile(27, 0.05, 0.1, 0.17, 0.3, 0.2, 3)).unwrap()).unwrap();
+    let model =
+        Model::from_description(ModelDescription::from_json(&sphere_pile(27, 0.05, 0.1, 0.17, 0.3, 0.2, 3)).unwrap())
+            .unwrap();
     let h = 1e-3;
     let method = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();

@@ -179,7 +179,6 @@ impl GroupPhase {
         }
         Ok(())
     }
-
 }
 
 /// A model fixture for tests and benchmarks: `n` spheres of radius `radius` and mass `mass` on
@@ -210,9 +209,15 @@ pub fn sphere_pile(n: usize, radius: f64, mass: f64, half_width: f64, mu: f64, e
     let h = half_width;
     let walls = [
         r#"{"body": "ground", "contour": {"type": "plane", "normal": [0, 0, 1]}}"#.to_string(),
-        format!(r#"{{"body": "ground", "contour": {{"type": "plane", "point": [{}, 0, 0], "normal": [1, 0, 0]}}}}"#, -h),
+        format!(
+            r#"{{"body": "ground", "contour": {{"type": "plane", "point": [{}, 0, 0], "normal": [1, 0, 0]}}}}"#,
+            -h
+        ),
         format!(r#"{{"body": "ground", "contour": {{"type": "plane", "point": [{h}, 0, 0], "normal": [-1, 0, 0]}}}}"#),
-        format!(r#"{{"body": "ground", "contour": {{"type": "plane", "point": [0, {}, 0], "normal": [0, 1, 0]}}}}"#, -h),
+        format!(
+            r#"{{"body": "ground", "contour": {{"type": "plane", "point": [0, {}, 0], "normal": [0, 1, 0]}}}}"#,
+            -h
+        ),
         format!(r#"{{"body": "ground", "contour": {{"type": "plane", "point": [0, {h}, 0], "normal": [0, -1, 0]}}}}"#),
     ];
     format!(

@@ -43,8 +43,10 @@ pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
             ForceElement::Bushing { body1, frame1, body2, frame2, k, travel, .. } => {
                 let a1 = data.x_abs[*body1].a * frame1.a;
                 let a2 = data.x_abs[*body2].a * frame2.a;
-                let dr = a1.transpose() * (point_position(data, *body2, &frame2.r) - point_position(data, *body1, &frame1.r));
-                let th = crate::math::rotation::matrix_to_rotvec(&(a1.transpose() * a2)).unwrap_or_else(|_| Vec3::zeros());
+                let dr = a1.transpose()
+                    * (point_position(data, *body2, &frame2.r) - point_position(data, *body1, &frame1.r));
+                let th =
+                    crate::math::rotation::matrix_to_rotvec(&(a1.transpose() * a2)).unwrap_or_else(|_| Vec3::zeros());
                 let x = nalgebra::Vector6::new(dr.x, dr.y, dr.z, th.x, th.y, th.z);
                 v += match travel {
                     None => 0.5 * x.dot(&(k * x)),

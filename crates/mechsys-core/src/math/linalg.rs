@@ -148,7 +148,15 @@ pub fn cholesky_semidefinite_solve(a: &[f64], n: usize, perm: &[usize], rank: us
 /// of the largest count as zero). Redundant contact constraints (a block resting on four corners)
 /// then share their load evenly instead of one taking all. `b` receives x; `aat` (`n²`), `perm`
 /// and `work` (`n`) are scratch. Returns the rank.
-pub fn solve_min_norm(a: &[f64], n: usize, b: &mut [f64], aat: &mut [f64], perm: &mut [usize], work: &mut [f64], tol: f64) -> usize {
+pub fn solve_min_norm(
+    a: &[f64],
+    n: usize,
+    b: &mut [f64],
+    aat: &mut [f64],
+    perm: &mut [usize],
+    work: &mut [f64],
+    tol: f64,
+) -> usize {
     for r in 0..n {
         for c in 0..=r {
             let v: f64 = (0..n).map(|k| a[r * n + k] * a[c * n + k]).sum();

@@ -313,9 +313,11 @@ pub(super) fn validate_group(
     crate::ensure!(!d.name.trim().is_empty(), Model, "contact_groups[{index}]: name must not be empty");
     crate::ensure!(!d.members.is_empty(), Model, "{what}.members: a group needs at least one member");
     let any_planar = d.members.iter().chain(&d.against).any(|m| planar(&m.contour));
-    let any_spatial = d.members.iter().chain(&d.against).any(|m| {
-        !planar(&m.contour) && !matches!(m.contour, ContourDescription::Point { .. })
-    });
+    let any_spatial = d
+        .members
+        .iter()
+        .chain(&d.against)
+        .any(|m| !planar(&m.contour) && !matches!(m.contour, ContourDescription::Point { .. }));
     crate::ensure!(
         !(any_planar && any_spatial),
         Model,

@@ -574,7 +574,14 @@ impl FrictionContact {
 
     /// [`FrictionContact::contact_state`] with the scales `1 + ‖r‖∞` and `1 + ‖q‖∞` computed
     /// by the caller once for all contacts (the plain call costs O(n) per contact).
-    pub fn contact_state_scaled(&self, i: usize, r: &[f64], tol: f64, r_scale: f64, q_scale: f64) -> Result<ContactState> {
+    pub fn contact_state_scaled(
+        &self,
+        i: usize,
+        r: &[f64],
+        tol: f64,
+        r_scale: f64,
+        q_scale: f64,
+    ) -> Result<ContactState> {
         let (ri, u) = self.local(i, r)?;
         Ok(if ri[0] <= tol * r_scale {
             ContactState::Open
