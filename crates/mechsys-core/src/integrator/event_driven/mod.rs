@@ -127,6 +127,9 @@ pub struct Phase<'a> {
     pub status: Vec<f64>,
     /// Sliding direction (t1, t2 components) of slipping points, for speeds below `velocity_tol`.
     dir: Vec<[f64; 2]>,
+    /// Added to an open point's gap in its event function: a point that left its contact at an
+    /// event (gap zero to round-off) must see a return to zero, not start on it (m).
+    gap_offset: Vec<f64>,
     /// Contact kinematics of the last evaluation (`w̄` with the velocity-product accelerations).
     pub kin: Vec<ContactKinematics>,
     /// Normal forces of the last evaluation (N).
@@ -175,6 +178,13 @@ struct EventWork {
     closing: Vec<usize>,
     old: Vec<f64>,
     old_dir: Vec<[f64; 2]>,
+    /// Per point: its normal force reached zero at this event (it leaves unless held).
+    leaving: Vec<bool>,
+    /// Per point: its friction reserve reached zero at this event (it slides unless held).
+    breaking: Vec<bool>,
+    /// Per point: the tangential force before the event (t1, t2), the direction a break-away
+    /// slides against.
+    lam_t_before: Vec<[f64; 2]>,
     /// Full-acceleration kinematics of one contact's points (the apex cap).
     apex: Vec<ContactKinematics>,
 }
@@ -214,13 +224,17 @@ pub fn integrate<'a>(
     let mut imp = vec![0.0; 3 * np];
     let mut diss = Dissipation::default();
     let (mut e_start, mut e_end, mut e_try) = (vec![0.0; 2 * np], vec![0.0; 2 * np], vec![0.0; 2 * np]);
+    // θ of each event function's root in the step (infinite where it has none), and which of
+    // them ended the phase
+    let mut roots = vec![f64::INFINITY; 2 * np];
+    let mut triggered = vec![false; 2 * np];
     let mut t = t0;
     let mut next = 0usize;
     let mut events = 0usize;
     let (mut last_event, mut same_instant) = (f64::NEG_INFINITY, 0usize);
 
     phase.project(t, &mut y)?;
-    let d = phase.transition(t, &mut y, &mut imp, warnings)?;
+    let d = phase.transition(t, &mut y, &mut imp, warnings, &triggered)?;
     diss.impact += d.impact;
     diss.friction += d.friction;
     phase.rhs(t, &y, &mut st.k[0])?;
@@ -271,11 +285,19 @@ pub fn integrate<'a>(
         // the earliest event in the step
         let mut theta = f64::INFINITY;
         for i in 0..2 * np {
+            roots[i] = f64::INFINITY;
             if e_start[i] > 0.0 && e_end[i] <= 0.0 {
                 let th = locate(phase, &st, (t, h), (i, e_start[i], e_end[i]), &mut yout, &mut e_try, &mut scratch)?;
                 stats.evaluations += 1;
+                roots[i] = th;
                 theta = theta.min(th);
             }
+        }
+        // every indicator whose root falls on the event (to the location's resolution) ends the
+        // phase there: the transition switches it even where its value is zero to round-off
+        let resolution = 1e-12 * t.abs().max(1.0) / h;
+        for i in 0..2 * np {
+            triggered[i] = roots[i] <= theta + resolution;
         }
         let t_new = if theta.is_finite() { t + theta * h } else { t + h };
         // outputs inside the step (up to and including an event's time)
@@ -317,7 +339,7 @@ pub fn integrate<'a>(
                     phase.names(&what)
                 )));
             }
-            let d = phase.transition(t, &mut y, &mut imp, warnings)?;
+            let d = phase.transition(t, &mut y, &mut imp, warnings, &triggered)?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             phase.rhs(t, &y, &mut st.k[0])?;

@@ -33,6 +33,7 @@ impl<'a> Phase<'a> {
             d,
             status: vec![OPEN; np],
             dir: vec![[0.0; 2]; np],
+            gap_offset: vec![0.0; np],
             kin: vec![ContactKinematics::default(); np],
             lam_n: vec![0.0; np],
             lam_t: vec![[0.0; 2]; np],
@@ -72,6 +73,9 @@ impl<'a> Phase<'a> {
                 closing: Vec::with_capacity(np),
                 old: Vec::with_capacity(np),
                 old_dir: Vec::with_capacity(np),
+                leaving: vec![false; np],
+                breaking: vec![false; np],
+                lam_t_before: vec![[0.0; 2]; np],
                 apex: vec![ContactKinematics::default(); model.contacts.iter().map(|c| c.points()).max().unwrap_or(0)],
             },
         })
@@ -345,7 +349,7 @@ impl<'a> Phase<'a> {
     pub fn event_values(&self, out: &mut [f64]) {
         for pt in 0..self.status.len() {
             let (e0, e1) = if self.status[pt] == OPEN {
-                (self.kin[pt].point.g_n, 1.0)
+                (self.kin[pt].point.g_n + self.gap_offset[pt], 1.0)
             } else if self.status[pt] == STICK {
                 let lt = (self.lam_t[pt][0].powi(2) + self.lam_t[pt][1].powi(2)).sqrt();
                 (self.lam_n[pt], self.model.contact_of_point(pt).friction.mu0() * self.lam_n[pt] - lt)

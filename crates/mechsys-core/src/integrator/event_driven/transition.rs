@@ -1,6 +1,7 @@
 //! The transition problem at acceleration level (section 2.5.2): which touching points stay closed and which stick.
 
 use super::{Dissipation, Phase, PYRAMID};
+use crate::contact::{contact_kinematics, BodyMotion};
 use crate::error::{Error, Result};
 use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
 use crate::model::contact::FrictionLaw;
@@ -124,14 +125,17 @@ impl Phase<'_> {
             // redundant supports that Lemke's basic solution left unloaded) stays closed and
             // shares the load in the smooth phase's minimum-norm forces
             let acc: f64 = (0..n).map(|j| self.lcp.m[a * n + j] * self.z[j]).sum::<f64>() + self.lcp.q[a];
-            if self.z[a] <= scale && acc > qscale {
+            // (a point whose force reached zero at this event leaves unless it must push)
+            if self.z[a] <= scale && (acc > qscale || (self.ev.leaving[pt] && acc >= -qscale)) {
                 continue;
             }
             match stick.iter().position(|&p| p == pt) {
                 Some(b) => {
                     let gamma = self.z[nb + b];
                     let gscale = 1e-12 * (1.0 + self.lcp.q.iter().fold(0.0f64, |a, v| a.max(v.abs())));
-                    if gamma <= gscale {
+                    // (a point whose friction reserve reached zero at this event slides: at the
+                    // root the sliding acceleration is zero to round-off)
+                    if gamma <= gscale && !self.ev.breaking[pt] {
                         self.status[pt] = STICK;
                     } else {
                         // sliding starts against the friction force the pyramid found
@@ -144,7 +148,15 @@ impl Phase<'_> {
                         }
                         let s = (f[0] * f[0] + f[1] * f[1]).sqrt();
                         self.status[pt] = SLIP;
-                        self.dir[pt] = if s > 0.0 { [-f[0] / s, -f[1] / s] } else { [1.0, 0.0] };
+                        let [l1, l2] = self.ev.lam_t_before[pt];
+                        let lt = (l1 * l1 + l2 * l2).sqrt();
+                        self.dir[pt] = if s > 0.0 {
+                            [-f[0] / s, -f[1] / s]
+                        } else if lt > 0.0 {
+                            [-l1 / lt, -l2 / lt]
+                        } else {
+                            [1.0, 0.0]
+                        };
                     }
                 }
                 None => {
@@ -165,12 +177,13 @@ impl Phase<'_> {
         y: &mut [f64],
         imp: &mut [f64],
         warnings: &mut Vec<String>,
+        triggered: &[bool],
     ) -> Result<Dissipation> {
         let mut ev = std::mem::take(&mut self.ev);
         let (mut touching, mut closing) = (std::mem::take(&mut ev.touching), std::mem::take(&mut ev.closing));
         let (mut old, mut old_dir) = (std::mem::take(&mut ev.old), std::mem::take(&mut ev.old_dir));
         self.ev = ev;
-        let r = self.transition_with(t, y, imp, warnings, (&mut touching, &mut closing, &mut old, &mut old_dir));
+        let r = self.transition_with(t, y, imp, warnings, triggered, (&mut touching, &mut closing, &mut old, &mut old_dir));
         self.ev.touching = touching;
         self.ev.closing = closing;
         self.ev.old = old;
@@ -185,13 +198,26 @@ impl Phase<'_> {
         y: &mut [f64],
         imp: &mut [f64],
         warnings: &mut Vec<String>,
+        triggered: &[bool],
         (touching, closing, old, old_dir): (&mut Vec<usize>, &mut Vec<usize>, &mut Vec<f64>, &mut Vec<[f64; 2]>),
     ) -> Result<Dissipation> {
         let (nq, nu, np) = (self.model.nq, self.model.nu, self.model.n_contact_points);
         let vtol = self.opts.velocity_tol;
         let (q, rest) = y.split_at_mut(nq);
         let u = &mut rest[..nu];
-        self.free_motion(t, q, u)?;
+        // the forces of the ending phase: a closed point whose normal force reached zero leaves,
+        // a sticking one whose friction reserve reached zero breaks away (section 2.5.2); at the
+        // located root both are zero to round-off, so the transition problem alone cannot tell
+        self.evaluate(t, q, u)?;
+        for pt in 0..np {
+            let closed = self.status[pt] != OPEN;
+            let stick = self.status[pt] == STICK;
+            let [l1, l2] = self.lam_t[pt];
+            let reserve = self.model.contact_of_point(pt).friction.mu0() * self.lam_n[pt] - (l1 * l1 + l2 * l2).sqrt();
+            self.ev.leaving[pt] = closed && (triggered[2 * pt] || self.lam_n[pt] <= 0.0);
+            self.ev.breaking[pt] = stick && (triggered[2 * pt + 1] || reserve <= 0.0);
+            self.ev.lam_t_before[pt] = self.lam_t[pt];
+        }
         touching.clear();
         touching.extend((0..np).filter(|&pt| self.kin[pt].point.g_n <= self.opts.gap_tol));
         old.clear();
@@ -209,6 +235,9 @@ impl Phase<'_> {
             diss.impact += d.impact;
             diss.friction += d.friction;
             self.free_motion(t, q, u)?;
+            // after an impulse the forces are new: nothing is decided by the old ones
+            self.ev.leaving.fill(false);
+            self.ev.breaking.fill(false);
         }
         closing.clear();
         closing.extend(touching.iter().copied().filter(|&pt| self.kin[pt].gd_n.abs() <= vtol));
@@ -236,6 +265,18 @@ impl Phase<'_> {
         let d = self.settle(u, imp);
         diss.impact += d.impact;
         diss.friction += d.friction;
+        self.check_switches(t, q, u, old)?;
+        // a point left open on its contact (gap zero to round-off, not moving apart) must see its
+        // gap return to zero: its event function starts just above zero
+        for pt in 0..np {
+            let k = &self.kin[pt];
+            self.gap_offset[pt] = if self.status[pt] == OPEN && k.point.g_n <= self.opts.gap_tol && k.gd_n <= vtol {
+                let scale = 1.0 + k.point.p1.amax().max(k.point.p2.amax());
+                (-k.point.g_n).max(0.0) + 4.0 * f64::EPSILON * scale
+            } else {
+                0.0
+            };
+        }
         for pt in 0..np {
             let (was, now) = (old[pt], self.status[pt]);
             let (a, b) = (old_dir[pt], self.dir[pt]);
@@ -254,5 +295,69 @@ impl Phase<'_> {
             }
         }
         Ok(diss)
+    }
+    /// The switches an event's indicators forced (a point left open because its normal force
+    /// reached zero, a sticking one set sliding because its reserve did) must agree with the
+    /// motion they start: an opened point may not accelerate into its contact, a sliding one not
+    /// against its sliding direction; one that does is switched back. In space the direction a
+    /// break-away slides in is the one along which the sliding acceleration points under the
+    /// friction force opposing it (the cone's direction, found by fixed-point iteration).
+    pub(super) fn check_switches(&mut self, t: f64, q: &[f64], u: &[f64], old: &[f64]) -> Result<()> {
+        let np = self.status.len();
+        let forced = |s: &Self, pt: usize| {
+            (s.ev.leaving[pt] && old[pt] != OPEN && s.status[pt] == OPEN) || (s.ev.breaking[pt] && s.status[pt] == SLIP)
+        };
+        if !(0..np).any(|pt| forced(self, pt)) {
+            return Ok(());
+        }
+        for _ in 0..50 {
+            self.evaluate(t, q, u)?;
+            let tol = 1e-8 * (1.0 + self.a_free.iter().fold(0.0f64, |a, v| a.max(v.abs())));
+            let (mut reverted, mut turned) = (false, false);
+            for con in &self.model.contacts {
+                let pts = con.first..con.first + con.points();
+                if !pts.clone().any(|pt| forced(self, pt)) {
+                    continue;
+                }
+                let n = con.points();
+                let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
+                contact_kinematics(&con.pair, &b1, &b2, &mut self.ev.apex[..n])
+                    .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.9} s: {e}", con.name)))?;
+                for pt in pts {
+                    if !forced(self, pt) {
+                        continue;
+                    }
+                    // with the full accelerations in data.a, w̄ holds g̈_N and g̈_T
+                    let k = &self.ev.apex[pt - con.first];
+                    if self.status[pt] == OPEN {
+                        if k.wbar_n < -tol {
+                            self.status[pt] = old[pt];
+                            reverted = true;
+                        }
+                        continue;
+                    }
+                    let g = if self.d == 3 { k.wbar_t } else { [k.wbar_t[0], 0.0] };
+                    let dir = self.dir[pt];
+                    let along = g[0] * dir[0] + g[1] * dir[1];
+                    if along < -tol {
+                        self.status[pt] = STICK;
+                        reverted = true;
+                        continue;
+                    }
+                    let size = (g[0] * g[0] + g[1] * g[1]).sqrt();
+                    if self.d == 3 && size > tol {
+                        let new = [g[0] / size, g[1] / size];
+                        if (new[0] - dir[0]).abs() + (new[1] - dir[1]).abs() > 1e-12 {
+                            self.dir[pt] = new;
+                            turned = true;
+                        }
+                    }
+                }
+            }
+            if !reverted && !turned {
+                break;
+            }
+        }
+        Ok(())
     }
 }
