@@ -5,6 +5,9 @@ their secant stiffness falls as slip spreads from the loaded end. For each ampli
 dissipated per cycle (eq. 2.213) and the equivalent viscous damping of equal loop area (Fig. 2.37).
 
     .venv/bin/python examples/press_fit.py     # writes results/press_fit_loops.png
+
+As a model file (`mechsys run examples/press_fit.py`), the module-level `model` is the fit
+twisted at the middle amplitude (0.5 mrad) over two cycles, sampled at every step.
 """
 
 from __future__ import annotations
@@ -18,6 +21,9 @@ import mechsys as ms
 K, K_SHAFT, SLIP = 2.0e4, 5.0e4, [3.0] * 5  # N m/rad, N m/rad, N m
 OMEGA = 2 * np.pi * 5.0  # rad/s
 STEPS = 2000  # per cycle
+PERIOD = 2 * np.pi / OMEGA
+DT = PERIOD / STEPS
+AMPLITUDES = (3e-4, 5e-4, 8e-4)  # rad
 
 
 def press_fit(amplitude: float) -> ms.Model:
@@ -31,12 +37,15 @@ def press_fit(amplitude: float) -> ms.Model:
 
 def one_cycle(amplitude: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Twist and torque over the second cycle, and the sliders' dissipation over it."""
-    period = 2 * np.pi / OMEGA
-    dt = period / STEPS
-    res = ms.simulate(press_fit(amplitude), t_end=2 * period, output_dt=dt, integrator=ms.RK4(dt=dt))
+    res = ms.simulate(press_fit(amplitude), **simulation)
     last = slice(STEPS, 2 * STEPS + 1)
     diss = res["energy/dissipated"]
     return res["force/press/deflection"][last], res["force/press/force"][last], float(diss[2 * STEPS] - diss[STEPS])
+
+
+# the model file's model and simulation (`mechsys run examples/press_fit.py`): the middle amplitude
+model = press_fit(AMPLITUDES[1])
+simulation = dict(t_end=2 * PERIOD, output_dt=DT, integrator=ms.RK4(dt=DT))
 
 
 def main() -> None:
@@ -49,7 +58,7 @@ def main() -> None:
     out.mkdir(exist_ok=True)
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     print(f"{'amplitude (mrad)':>17} {'W_D (mJ)':>10} {'secant (N m/rad)':>17} {'d_eq (N m s/rad)':>17}")
-    for amp in (3e-4, 5e-4, 8e-4):
+    for amp in AMPLITUDES:
         x, f, w_slider = one_cycle(amp)
         w_loop = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(x)))  # eq. 2.213: the loop's area
         secant = (f.max() - f.min()) / (x.max() - x.min())

@@ -263,3 +263,86 @@ def test_simulation_kwargs_defaults_and_errors():
         simulation_kwargs({"t_end": float("nan")})
     with pytest.raises(SettingsError, match="unknown override"):
         simulation_kwargs({"t_end": 1.0}, t_final=2.0)
+
+
+# ---- integrator objects and tables for contact models ---------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "source, integrator",
+    [
+        ("ms.MoreauJean(dt=1e-3)", ms.MoreauJean(dt=1e-3)),
+        ("ms.MoreauJean(1e-3, solver=ms.Lemke(facets=4))", ms.MoreauJean(1e-3, solver=ms.Lemke(facets=4))),
+        ("ms.MoreauJean(1e-3, ms.Newton(tol=1e-9, max_iter=50))", ms.MoreauJean(1e-3, solver=ms.Newton(tol=1e-9, max_iter=50))),
+        ("ms.EventDriven(rtol=1e-8, atol=1e-10, max_events=10, continue_on_painleve=True)",
+         ms.EventDriven(rtol=1e-8, atol=1e-10, max_events=10, continue_on_painleve=True)),
+        ("ms.Radau5(dt=1e-3)", ms.Radau5(dt=1e-3)),
+        ("ms.DOPRI5(rtol=1e-6)", ms.DOPRI5(rtol=1e-6)),
+        ("{'type': 'moreau_jean', 'dt': 1e-3, 'solver': ms.Newton()}", ms.MoreauJean(1e-3, solver=ms.Newton())),
+    ],
+    ids=lambda x: x if isinstance(x, str) else "",
+)
+def test_python_file_accepts_every_integrator_object(tmp_path, source, integrator):
+    _, sim = load_model(write(tmp_path, PENDULUM_PY.replace("ms.RK4(dt=1e-3)", source), "objects.py"))
+    assert simulation_kwargs(sim)["integrator"] == integrator
+
+
+@pytest.mark.parametrize(
+    "value, expected",
+    [
+        ("ms.MoreauJean(dt=-1e-3)", r"simulation\.integrator\.dt: must be > 0, got -0\.001"),
+        ("ms.MoreauJean(dt='small')", r"simulation\.integrator\.dt: expected a number, got a string 'small'"),
+        ("ms.MoreauJean(1e-3, solver='nsgs')", r"simulation\.integrator\.solver: expected mechsys\.NSGS, Newton or Lemke"),
+        ("ms.MoreauJean(1e-3, solver=ms.NSGS(tol=0.0))", r"simulation\.integrator\.solver\.tol: must be > 0"),
+        ("ms.MoreauJean(1e-3, solver=ms.Lemke(facets=2))", r"simulation\.integrator\.solver\.facets: expected an integer >= 3"),
+        ("ms.EventDriven(max_events=0)", r"simulation\.integrator\.max_events: expected an integer >= 1, got 0"),
+        ("ms.EventDriven(continue_on_painleve='yes')", r"simulation\.integrator\.continue_on_painleve: expected true or false"),
+        ("ms.EventDriven(rtol=float('nan'))", r"simulation\.integrator\.rtol: must be finite"),
+        ("ms.NSGS()", r"simulation\.integrator: expected mechsys\.RK4, DOPRI5, Radau5, MoreauJean or EventDriven, got NSGS"),
+        ("3", r"simulation\.integrator: expected mechsys\.RK4, .* got an integer"),
+        ("{'type': 'moreau_jean', 'dt': 1e-3, 'solver': {'type': 'nsgs', 'tole': 1}}",
+         r"simulation\.integrator\.solver\.tole: unknown key for nsgs; expected one of type, tol, max_iter, relaxation"),
+        ("{'type': 'moreau_jean', 'dt': 1e-3, 'solver': 'gauss'}", r"simulation\.integrator\.solver\.type: expected nsgs, newton or lemke"),
+    ],
+)
+def test_python_file_bad_integrator_names_the_key(tmp_path, value, expected):
+    p = write(tmp_path, PENDULUM_PY.replace("ms.RK4(dt=1e-3)", value), "bad_integrator.py")
+    with pytest.raises(ModelError, match=expected) as e:
+        load_model(p)
+    assert str(e.value).startswith(f"{p}: ")
+
+
+def test_toml_contact_integrator_tables(tmp_path):
+    text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }',
+                                 '{ type = "moreau_jean", dt = 1e-3, solver = { type = "nsgs", tol = 1e-8, max_iter = 50 } }')
+    _, sim = load_model(write(tmp_path, text))
+    assert sim["integrator"] == {"type": "moreau_jean", "dt": 1e-3,
+                                 "solver": {"type": "nsgs", "tol": 1e-8, "max_iter": 50, "relaxation": 1.0}}
+    assert simulation_kwargs(sim)["integrator"] == ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-8, max_iter=50))
+    text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }', '{ type = "event_driven", max_events = 10, continue_on_painleve = true }')
+    _, sim = load_model(write(tmp_path, text))
+    assert simulation_kwargs(sim)["integrator"] == ms.EventDriven(max_events=10, continue_on_painleve=True)
+    text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }', '{ type = "event_driven", max_events = 1.5 }')
+    with pytest.raises(ModelError, match=r"simulation\.integrator\.max_events: expected an integer >= 1, got 1\.5"):
+        load_model(write(tmp_path, text))
+
+
+def test_simulation_kwargs_overrides_an_integrator_object():
+    defaults = {"t_end": 1.0, "integrator": ms.MoreauJean(1e-5, solver=ms.NSGS(tol=1e-6, max_iter=100))}
+    assert simulation_kwargs(defaults, dt=1e-4)["integrator"] == ms.MoreauJean(1e-4, solver=ms.NSGS(tol=1e-6, max_iter=100))
+    # naming the file's own solver keeps its settings; another solver replaces it
+    assert simulation_kwargs(defaults, solver="nsgs")["integrator"] == defaults["integrator"]
+    assert simulation_kwargs(defaults, solver="lemke")["integrator"] == ms.MoreauJean(1e-5, solver=ms.Lemke())
+    assert simulation_kwargs(defaults, integrator="event_driven", rtol=1e-6)["integrator"] == ms.EventDriven(rtol=1e-6)
+    assert simulation_kwargs(defaults, integrator="radau5")["integrator"] == ms.Radau5(dt=1e-5)  # the step carries over
+    ed = {"t_end": 1.0, "integrator": ms.EventDriven(rtol=1e-8, max_events=7, continue_on_painleve=True)}
+    assert simulation_kwargs(ed, atol=1e-9)["integrator"] == ms.EventDriven(rtol=1e-8, atol=1e-9, max_events=7,
+                                                                            continue_on_painleve=True)
+    with pytest.raises(SettingsError, match=r"--solver does not apply to integrator event_driven"):
+        simulation_kwargs(ed, solver="nsgs")
+    with pytest.raises(SettingsError, match=r"--solver does not apply to integrator dopri5"):
+        simulation_kwargs({"t_end": 1.0}, solver="nsgs")
+    with pytest.raises(SettingsError, match=r"--dt: must be > 0, got -1"):
+        simulation_kwargs(defaults, dt=-1.0)
+    with pytest.raises(SettingsError, match=r"--solver\.type: expected nsgs, newton or lemke, got 'gauss'"):
+        simulation_kwargs(defaults, solver="gauss")

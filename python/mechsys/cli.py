@@ -103,7 +103,16 @@ def _split_signals(values: Sequence[str]) -> list[str]:
 def _describe_integrator(settings: dict) -> str:
     integ = dict(settings.get("integrator") or {})
     kind = integ.pop("type", "?")
-    params = ", ".join(f"{k}={v:g}" for k, v in integ.items() if isinstance(v, (int, float)) and v)
+    parts = []
+    for k, v in integ.items():
+        if isinstance(v, bool):
+            if v:
+                parts.append(f"{k}=true")
+        elif isinstance(v, (int, float)) and v:
+            parts.append(f"{k}={v:g}")
+        elif isinstance(v, dict) and "type" in v:  # moreau_jean's contact solver
+            parts.append(f"{k}={v['type']}")
+    params = ", ".join(parts)
     return f"{kind}({params})" if params else str(kind)
 
 
@@ -128,7 +137,7 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.option("--dt", type=float, help="Step of rk4/radau5/moreau_jean (s); alone it selects rk4.")
 @click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5", "moreau_jean", "event_driven"], case_sensitive=False),
               help="Integration scheme (moreau_jean: time-stepping for models with contacts; event_driven: located contact events).")
-@click.option("--solver", type=click.Choice(["nsgs", "newton", "lemke"], case_sensitive=False), help="Contact solver of moreau_jean.")
+@click.option("--solver", type=click.Choice(["nsgs", "newton", "lemke"], case_sensitive=False), help="Contact solver of moreau_jean; overrides the model file's.")
 @click.option("--rtol", type=float, help="Relative tolerance of dopri5 and event_driven.")
 @click.option("--atol", type=float, help="Absolute tolerance of dopri5 and event_driven.")
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
@@ -170,7 +179,8 @@ def run(
         t_end=t_end,
         t0=t0,
         output_dt=output_dt,
-        integrator={"type": integrator, "solver": solver} if integrator and solver else integrator,
+        integrator=integrator,
+        solver=solver,
         dt=dt,
         rtol=rtol,
         atol=atol,
@@ -306,6 +316,8 @@ def info(model_file: Path) -> None:
         click.echo("")
         click.echo("simulation defaults:")
         for k, v in sim.items():
+            if k == "integrator" and hasattr(v, "describe"):  # an integrator object (Python model files)
+                v = v.describe()
             if isinstance(v, dict) and "type" in v:
                 v = _describe_integrator({"integrator": v})
             click.echo(f"  {k} = {v}")

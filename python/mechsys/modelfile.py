@@ -27,7 +27,10 @@ engine's schema (``name``, ``gravity``, ``[[bodies]]``, ``[[joints]]``, ``[[forc
 
 A **Python** model file is executed and must define a module-level ``model`` (a
 :class:`mechsys.Model`); an optional ``simulation`` dict has the same keys as the TOML table, and
-its ``integrator`` may also be an integrator object such as ``ms.RK4(dt=1e-3)``. The file runs with
+its ``integrator`` may also be an integrator object: ``ms.RK4(dt=1e-3)``, ``ms.DOPRI5(...)``,
+``ms.Radau5(...)``, ``ms.MoreauJean(dt=1e-4, solver=ms.NSGS(...))`` or ``ms.EventDriven(...)``,
+checked like a table (``simulation.integrator.dt: must be > 0, ...``). In a table, moreau_jean's
+``solver`` is a name or a table (``solver = { type = "nsgs", tol = 1e-8 }``). The file runs with
 ``__name__ == "__mechsys_model__"``, so an ``if __name__ == "__main__":`` block is skipped, and
 with its folder on ``sys.path``, so it can import modules next to it.
 
@@ -43,6 +46,7 @@ import numbers
 import runpy
 import sys
 import tomllib
+from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
@@ -64,20 +68,64 @@ INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
 
 _INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5, "moreau_jean": MoreauJean, "event_driven": EventDriven}
 _SOLVER_CLASSES = {"nsgs": NSGS, "newton": Newton, "lemke": Lemke}
+#: What an integrator object in a Python model file may be.
+_INTEGRATOR_OBJECTS = "mechsys.RK4, DOPRI5, Radau5, MoreauJean or EventDriven"
+#: Parameters of integrators and solvers: integers (with their least value), booleans, and numbers
+#: that must be > 0; all other parameters are numbers >= 0.
+_INTEGER_KEYS = {"max_events": 1, "max_iter": 1, "facets": 3}
+_BOOLEAN_KEYS = ("continue_on_painleve",)
+_POSITIVE_KEYS = ("dt", "rtol", "newton_tol", "tol", "pivot_tol", "relaxation")
+#: Keys of a solver table, per solver type (besides ``type``).
+SOLVER_KEYS: dict[str, tuple[str, ...]] = {"nsgs": ("tol", "max_iter", "relaxation"), "newton": ("tol", "max_iter"),
+                                           "lemke": ("facets", "pivot_tol")}
 
 
-def _solver(spec: Any):
-    """A contact solver from a name or a table (``{type = "nsgs", tol = 1e-10}``)."""
-    if spec is None or hasattr(spec, "describe"):
-        return spec
-    table = {"type": spec} if isinstance(spec, str) else dict(spec) if isinstance(spec, dict) else None
-    if table is None or str(table.get("type", "")).lower() not in _SOLVER_CLASSES:
-        raise SettingsError(f"integrator.solver: expected nsgs, newton or lemke (a name or a table with type), got {spec!r}")
-    kind = str(table.pop("type")).lower()
-    try:
-        return _SOLVER_CLASSES[kind](**table)
-    except TypeError as e:
-        raise SettingsError(f"integrator.solver ({kind}): {e}") from None
+def _solver(spec: Any, where: str = "integrator.solver", error: type[MechsysError] = SettingsError):
+    """A contact solver from a solver object, a name or a table (``{type = "nsgs", tol = 1e-10}``);
+    ``None`` stays ``None``. Bad input raises ``error`` with ``where`` in front of the message."""
+    if spec is None:
+        return None
+    if isinstance(spec, tuple(_SOLVER_CLASSES.values())):
+        table = _fields(spec, _SOLVER_CLASSES)  # the fields as given (describe() would convert them first)
+    elif isinstance(spec, str):
+        table = {"type": spec}
+    elif isinstance(spec, dict):
+        table = dict(spec)
+    else:
+        raise error(f"{where}: expected mechsys.NSGS, Newton or Lemke, a name (nsgs, newton, lemke) or a table with type, "
+                    f"got {_tname(spec)}")
+    kind = table.pop("type", None)
+    if not isinstance(kind, str) or kind.lower() not in _SOLVER_CLASSES:
+        shown = "missing" if kind is None else repr(kind)
+        raise error(f"{where}.type: expected nsgs, newton or lemke, got {shown}")
+    kind = kind.lower()
+    args = {key: _parameter(value, key, SOLVER_KEYS[kind], kind, f"{where}.{key}", error) for key, value in table.items()}
+    return _SOLVER_CLASSES[kind](**args)
+
+
+def _parameter(value: Any, key: str, allowed: tuple[str, ...], kind: str, where: str, error: type[MechsysError]) -> Any:
+    """One parameter of an integrator or solver table, checked and converted."""
+    if key not in allowed:
+        raise error(f"{where}: unknown key for {kind}; expected one of type, {', '.join(allowed)}")
+    if key == "solver":
+        return _solver(value, where, error)
+    if key in _BOOLEAN_KEYS:
+        if not isinstance(value, bool):
+            raise error(f"{where}: expected true or false, got {_tname(value)} {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise error(f"{where}: expected a number, got {_tname(value)} {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise error(f"{where}: must be finite, got {x}")
+    if key in _INTEGER_KEYS:
+        if x != int(x) or x < _INTEGER_KEYS[key]:
+            raise error(f"{where}: expected an integer >= {_INTEGER_KEYS[key]}, got {value!r}")
+        return int(x)
+    if x < 0 or (x == 0 and key in _POSITIVE_KEYS):
+        raise error(f"{where}: must be {'>' if key in _POSITIVE_KEYS else '>='} 0, got {x:g}")
+    return x
+
 
 # top-level keys of the description that must be arrays of tables
 _LIST_KEYS = ("bodies", "joints", "forces", "ground_markers")
@@ -197,15 +245,35 @@ def _number(v: Any, where: str) -> float:
 
 
 def _check_integrator(spec: Any, allow_objects: bool) -> Any:
+    """Checks ``simulation.integrator``: a name, a table or (Python files) an integrator object.
+
+    A table comes back normalised (numbers as floats, a solver as a table); an object comes back
+    as an equal object whose parameters passed the same checks as a table's."""
     where = "simulation.integrator"
-    if allow_objects and hasattr(spec, "describe") and not isinstance(spec, dict):
-        if not isinstance(spec, (RK4, DOPRI5, Radau5)):
-            raise ModelError(f"{where}: expected mechsys.RK4, DOPRI5 or Radau5, got {_tname(spec)}")
-        return spec
+    if allow_objects and isinstance(spec, tuple(_INTEGRATOR_CLASSES.values())):
+        solver = getattr(spec, "solver", None)
+        if isinstance(spec, MoreauJean) and not isinstance(solver, tuple(_SOLVER_CLASSES.values())):
+            raise ModelError(f"{where}.solver: expected mechsys.NSGS, Newton or Lemke, got {_tname(solver)} {solver!r}")
+        # the fields as given (describe() would convert them and hide, e.g., a string dt)
+        table = _check_integrator_table(_fields(spec, _INTEGRATOR_CLASSES), where)
+        table.pop("type")
+        if "solver" in table:
+            table["solver"] = _solver(table["solver"], f"{where}.solver", ModelError)
+        return type(spec)(**table)
+    if allow_objects and isinstance(spec, tuple(_SOLVER_CLASSES.values())):
+        raise ModelError(f"{where}: expected {_INTEGRATOR_OBJECTS}, got {type(spec).__name__} (a contact solver: "
+                         f"give it to the integrator, e.g. ms.MoreauJean(dt=1e-3, solver=ms.{type(spec).__name__}()))")
     if isinstance(spec, str):
         spec = {"type": spec}
     if not isinstance(spec, dict):
-        raise ModelError(f"{where}: expected a table like {{ type = \"rk4\", dt = 1e-3 }}, got {_tname(spec)}")
+        wanted = f"{_INTEGRATOR_OBJECTS}, a name or a dict like {{'type': 'rk4', 'dt': 1e-3}}" if allow_objects \
+            else 'a table like { type = "rk4", dt = 1e-3 }'
+        got = _tname(spec) if type(spec) in (list, str, bool, int, float) else type(spec).__name__
+        raise ModelError(f"{where}: expected {wanted}, got {got}")
+    return _check_integrator_table(spec, where)
+
+
+def _check_integrator_table(spec: dict, where: str) -> dict:
     if "type" not in spec:
         raise ModelError(f"{where}.type: missing; expected one of {', '.join(INTEGRATOR_KEYS)}")
     kind = spec["type"]
@@ -217,12 +285,8 @@ def _check_integrator(spec: Any, allow_objects: bool) -> Any:
     for key, value in spec.items():
         if key == "type":
             continue
-        if key not in allowed:
-            raise ModelError(f"{where}.{key}: unknown key for {kind}; expected one of type, {', '.join(allowed)}")
-        x = _number(value, f"{where}.{key}")
-        if x < 0 or (x == 0 and key in ("dt", "rtol", "newton_tol")):
-            raise ModelError(f"{where}.{key}: must be > 0, got {x:g}")
-        out[key] = x
+        x = _parameter(value, key, allowed, kind, f"{where}.{key}", ModelError)
+        out[key] = x.describe() if key == "solver" else x
     return out
 
 
@@ -277,6 +341,14 @@ def _check_simulation(sim: dict, model: Model, allow_objects: bool) -> dict:
     return out
 
 
+def _fields(obj: Any, classes: dict[str, type]) -> dict | None:
+    """An integrator or solver object as a table of its fields as given (``None`` if it is neither)."""
+    kind = next((k for k, c in classes.items() if isinstance(obj, c)), None)
+    if kind is None:
+        return None
+    return {"type": kind, **{f.name: getattr(obj, f.name) for f in fields(obj)}}
+
+
 def _integrator_dict(spec: Any) -> dict | None:
     if spec is None:
         return None
@@ -284,9 +356,11 @@ def _integrator_dict(spec: Any) -> dict | None:
         return dict(spec)
     if isinstance(spec, str):
         return {"type": spec.lower()}
-    if hasattr(spec, "describe"):
-        return spec.describe()
-    raise SettingsError(f"integrator: expected rk4, dopri5, radau5 or an integrator object, got {_tname(spec)}")
+    table = _fields(spec, _INTEGRATOR_CLASSES)
+    if table is not None:
+        return table
+    raise SettingsError(f"integrator: expected a name ({', '.join(INTEGRATOR_KEYS)}), a table or {_INTEGRATOR_OBJECTS}, "
+                        f"got {_tname(spec) if type(spec) in (list, bool, int, float) else type(spec).__name__}")
 
 
 def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
@@ -294,10 +368,13 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
 
     ``defaults`` is the dict returned by :func:`load_model`. ``overrides`` (None values are
     ignored) may be ``t_end``, ``t0``, ``output_dt``, ``q0``, ``u0``, ``integrator`` (a name
-    ``"rk4"``/``"dopri5"``/``"radau5"``, a table or an integrator object) and the integrator
-    parameters ``dt``, ``rtol``, ``atol``. Changing the integrator type keeps the parameters that
-    still apply (a file's ``dt`` carries over from rk4 to radau5). Without any integrator the
-    engine's default (DOPRI5) is used, or RK4 when only ``dt`` is given.
+    ``"rk4"``/``"dopri5"``/``"radau5"``/``"moreau_jean"``/``"event_driven"``, a table or an
+    integrator object), the integrator parameters ``dt``, ``rtol``, ``atol`` and ``solver``
+    (moreau_jean's contact solver: a name, a table or a solver object; naming the file's own
+    solver keeps its settings). Changing the integrator type keeps the parameters that still
+    apply (a file's ``dt`` carries over from rk4 to radau5). Without any integrator the engine's
+    default (DOPRI5) is used, or RK4 when only ``dt`` is given. Every parameter is checked, with
+    the option or key in the message (``--dt: must be > 0, got -1``).
 
     Raises :class:`mechsys.SettingsError` when ``t_end`` is missing, a fixed-step scheme has no
     step, or a parameter does not apply to the chosen scheme.
@@ -307,7 +384,7 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
     """
     defaults = dict(defaults or {})
     over = {k: v for k, v in overrides.items() if v is not None}
-    known = set(SIMULATION_KEYS) | {"dt", "rtol", "atol"}
+    known = set(SIMULATION_KEYS) | {"dt", "rtol", "atol", "solver"}
     unknown = sorted(set(over) - known)
     if unknown:
         raise SettingsError(f"simulation_kwargs: unknown override {', '.join(unknown)}; expected one of {', '.join(sorted(known))}")
@@ -336,7 +413,7 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
     base = _integrator_dict(defaults.get("integrator"))
     chosen = _integrator_dict(over.get("integrator"))
     params = {k: over[k] for k in ("dt", "rtol", "atol") if k in over}
-    if chosen is None and base is None and not params:
+    if chosen is None and base is None and not params and "solver" not in over:
         return kwargs  # the engine's default integrator
     if chosen is None:
         spec = base if base is not None else {"type": "rk4" if "dt" in params else "dopri5"}
@@ -358,9 +435,20 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
         spec[key] = value
     if "dt" in allowed and spec.get("dt") is None:
         raise SettingsError(f"integrator {kind} needs a step: set simulation.integrator.dt or pass --dt")
-    args = {k: (_solver(v) if k == "solver" else float(v)) for k, v in spec.items() if k in allowed}
-    if args.get("solver", "") is None:
-        args.pop("solver")
+    solver = over.get("solver")
+    if solver is not None:
+        if "solver" not in allowed:
+            raise SettingsError(f"--solver does not apply to integrator {kind} (only moreau_jean has a contact solver)")
+        previous = spec.get("solver")
+        previous = _fields(previous, _SOLVER_CLASSES) or previous
+        same = isinstance(solver, str) and isinstance(previous, dict) and str(previous.get("type", "")).lower() == solver.lower()
+        if not same:  # naming the file's own solver again keeps its settings
+            spec["solver"] = solver
+    args = {}
+    for key, value in spec.items():
+        if key in allowed and value is not None:
+            where = f"--{key}" if key in params or (key == "solver" and solver is not None) else f"integrator.{key}"
+            args[key] = _parameter(value, key, allowed, kind, where, SettingsError)
     try:
         kwargs["integrator"] = _INTEGRATOR_CLASSES[kind](**args)
     except (TypeError, ValueError) as e:
