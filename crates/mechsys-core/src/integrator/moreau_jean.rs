@@ -150,6 +150,9 @@ pub struct MoreauJean {
     rotating: Vec<(usize, usize, usize)>,
     tmp_u: Vec<f64>,
     gd_before: Vec<f64>,
+    /// Per active point: it took the static coefficient µ0 (it was not sliding) while its law
+    /// slides with less; a break-away in the step is solved again with the sliding coefficient.
+    static_mu: Vec<bool>,
     /// Energy dissipated so far by normal impulses (J).
     pub dissipated_impact: f64,
     /// Energy dissipated so far by tangential impulses (J).
@@ -223,6 +226,7 @@ impl MoreauJean {
                 .collect(),
             tmp_u: vec![0.0; nu],
             gd_before: vec![0.0; dim * np],
+            static_mu: Vec::with_capacity(np),
             dissipated_impact: 0.0,
             dissipated_friction: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
@@ -450,6 +454,7 @@ impl MoreauJean {
             // the local problem: restitution, gap allowance, friction coefficients, warm start
             self.problem.dim = d;
             self.problem.mu.clear();
+            self.static_mu.clear();
             self.r.clear();
             for (ai, a) in self.act.iter().enumerate() {
                 let (friction, impact, gd_t, prev, prev_state) = match a.source {
@@ -476,6 +481,8 @@ impl MoreauJean {
                     (law, s) if s == SLIP => law.mu(slip_speed.max(f64::MIN_POSITIVE)),
                     (law, _) => law.mu0(),
                 };
+                let sliding_less = !matches!(friction, FrictionLaw::None) && prev_state != SLIP && friction.mu(f64::MIN_POSITIVE) < mu;
+                self.static_mu.push(sliding_less);
                 self.problem.mu.push(mu);
                 self.r.extend_from_slice(&prev[..d]);
             }
@@ -485,6 +492,37 @@ impl MoreauJean {
                 let names = self.active_names(model);
                 Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
             })?;
+            // µ0 decides whether a contact that was not sliding sticks; where it breaks away in
+            // this step the slide takes the sliding coefficient at its new speed (a step of µ0
+            // would lag the motion by h (µ0 - µ) λ_N / m for good)
+            let mut report = report;
+            if self.static_mu.iter().any(|s| *s) {
+                let r_scale = 1.0 + self.r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                let q_scale = 1.0 + self.problem.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                let mut again = false;
+                for ai in 0..m {
+                    if !self.static_mu[ai] {
+                        continue;
+                    }
+                    let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
+                    if self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip {
+                        let v = self.problem.local_velocity(ai, &self.r)?;
+                        let speed = (v[1] * v[1] + v[2] * v[2]).sqrt();
+                        let law = match self.act[ai].source {
+                            Source::Point(pt) => &model.contact_of_point(pt).friction,
+                            Source::Group { group, .. } => &model.contact_groups[group].friction,
+                        };
+                        self.problem.mu[ai] = law.mu(speed.max(f64::MIN_POSITIVE));
+                        again = true;
+                    }
+                }
+                if again {
+                    report = solver::solve(&self.problem, &self.method, &mut self.r, true, &mut self.ws).map_err(|e| {
+                        let names = self.active_names(model);
+                        Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
+                    })?;
+                }
+            }
             if !report.converged {
                 self.unconverged.0 += 1;
                 self.unconverged.1 = self.unconverged.1.max(report.residual);

@@ -565,6 +565,11 @@ impl FrictionContact {
         Ok((ri, u))
     }
 
+    /// The local velocity `(W r + q)_i` of contact `i` (normal, then tangents).
+    pub fn local_velocity(&self, i: usize, r: &[f64]) -> Result<[f64; 3]> {
+        Ok(self.local(i, r)?.1)
+    }
+
     /// The friction reserve `μ r_N − |r_T|` of contact `i` (section 2.5.2, fig. 2.30): positive
     /// inside the cone, zero on it.
     pub fn friction_reserve(&self, i: usize, r: &[f64]) -> Result<f64> {
