@@ -150,6 +150,8 @@ pub struct Phase<'a> {
     aat: Vec<f64>,
     piv_r: Vec<usize>,
     piv_c_work: Vec<f64>,
+    /// The force distribution that moves nothing, when there is one (see `redistribute`).
+    null: Vec<f64>,
     a_free: Vec<f64>,
     tmp: Vec<f64>,
     /// Right-hand-side evaluations.
@@ -466,7 +468,7 @@ mod tests {
         // resting: λ_N = m g at the last sample, state stick (frictionless, not sliding)
         let last = rec.contact_lambda_n.last().unwrap();
         assert!((last - 2.0 * 9.81).abs() < 1e-10, "{last}");
-        assert_eq!(*rec.contact_state.last().unwrap(), super::STICK);
+        assert_eq!(*rec.contact_state.last().unwrap(), crate::integrator::moreau_jean::STICK);
     }
 
     #[test]

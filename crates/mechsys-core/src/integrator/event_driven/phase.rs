@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::forces::{Callbacks, Powers};
 use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
 use crate::integrator::OdeSystem;
-use crate::math::linalg::solve_min_norm;
+use crate::math::linalg::{cholesky_semidefinite, solve_min_norm};
 use crate::math::Vec3;
 use crate::model::contact::FrictionLaw;
 use crate::model::Model;
@@ -47,6 +47,7 @@ impl<'a> Phase<'a> {
             aat: vec![0.0; (rmax + np) * (rmax + np)],
             piv_r: vec![0; rmax + np],
             piv_c_work: vec![0.0; rmax + np],
+            null: vec![0.0; rmax + np],
             a_free: vec![0.0; nu],
             tmp: vec![0.0; nu],
             evaluations: 0,
@@ -303,6 +304,9 @@ impl<'a> Phase<'a> {
                 &mut self.piv_c_work,
                 1e-13,
             );
+            if self.unk.iter().any(|&(_, k)| k > 0) {
+                self.redistribute(n);
+            }
             for j in 0..n {
                 let l = self.rhs[j];
                 let x = &self.x[j * nu..(j + 1) * nu];
@@ -342,6 +346,105 @@ impl<'a> Phase<'a> {
         crate::kinematics::accelerations(model, &mut self.data, &udot);
         self.data.udot = udot;
         Ok(p)
+    }
+
+    /// Sticking points can be statically indeterminate (two corners of a sleeve jammed on a
+    /// pole): the forces in `rhs[..n]` are then fixed only up to a distribution that moves
+    /// nothing. The minimum-norm one is kept while every friction reserve and normal force it
+    /// gives is positive; once it is not, and one free distribution remains (`M̃⁻¹` times the
+    /// force directions has a null space of dimension one), the one that maximizes the smallest
+    /// of them is taken, so that the phase ends (a reserve or a normal force reaches zero) only
+    /// when no admissible distribution is left. Larger null spaces keep the minimum norm.
+    fn redistribute(&mut self, n: usize) {
+        let nu = self.model.nu;
+        // Gram matrix of the accelerations each force direction causes
+        for i in 0..n {
+            for j in 0..=i {
+                let v: f64 = (0..nu).map(|c| self.x[i * nu + c] * self.x[j * nu + c]).sum();
+                self.aat[i * n + j] = v;
+                self.aat[j * n + i] = v;
+            }
+        }
+        if self.smallest_margin(n, 0.0) > 0.0 {
+            return;
+        }
+        let rank = cholesky_semidefinite(&mut self.aat[..n * n], n, &mut self.piv_r, 1e-10);
+        if rank + 1 != n {
+            return;
+        }
+        // null vector: in pivoted order [x; 1] with L11ᵀ x = -l21
+        let a = &self.aat;
+        let w = &mut self.piv_c_work;
+        for r in 0..rank {
+            w[r] = -a[(n - 1) * n + r];
+        }
+        for r in (0..rank).rev() {
+            let mut s = w[r];
+            for c in r + 1..rank {
+                s -= a[c * n + r] * w[c];
+            }
+            w[r] = s / a[r * n + r];
+        }
+        w[rank] = 1.0;
+        let norm = w[..n].iter().map(|v| v * v).sum::<f64>().sqrt();
+        for i in 0..n {
+            self.null[self.piv_r[i]] = w[i] / norm;
+        }
+        // the smallest margin is concave in the amount s of the null distribution: golden section
+        let scale = 1.0 + self.rhs[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let (mut lo, mut hi) = (-1e3 * scale, 1e3 * scale);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        let (mut f1, mut f2) = (self.smallest_margin(n, x1), self.smallest_margin(n, x2));
+        for _ in 0..200 {
+            if hi - lo <= 1e-15 * scale {
+                break;
+            }
+            if f1 < f2 {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + g * (hi - lo);
+                f2 = self.smallest_margin(n, x2);
+            } else {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - g * (hi - lo);
+                f1 = self.smallest_margin(n, x1);
+            }
+        }
+        let s = 0.5 * (lo + hi);
+        if s.abs() > 0.999e3 * scale {
+            // unbounded (an internal squeeze that only adds reserve): keep the minimum norm
+            return;
+        }
+        for j in 0..n {
+            self.rhs[j] += s * self.null[j];
+        }
+    }
+
+    /// The smallest normal force and friction reserve of the forces `rhs + s · null`.
+    fn smallest_margin(&self, n: usize, s: f64) -> f64 {
+        let mut m = f64::INFINITY;
+        let mut j = 0;
+        while j < n {
+            let (pt, _) = self.unk[j];
+            let lam_n = self.rhs[j] + s * self.null[j];
+            m = m.min(lam_n);
+            if self.status[pt] == STICK {
+                let mut t2 = 0.0;
+                for k in 1..self.d {
+                    let v = self.rhs[j + k] + s * self.null[j + k];
+                    t2 += v * v;
+                }
+                m = m.min(self.model.contact_of_point(pt).friction.mu0() * lam_n - t2.sqrt());
+                j += self.d;
+            } else {
+                j += 1;
+            }
+        }
+        m
     }
 
     /// Event functions of the last evaluation, two per point; an event is a sign change from
