@@ -23,6 +23,11 @@ class SolverError(MechsysError, RuntimeError):
     """The numerical solution failed (divergence, step-size underflow, non-convergence)."""
 
 
+class PainleveError(SolverError):
+    """A Painleve situation: with the sliding friction the contact problem has no solution (or
+    several); the message names the contacts, the time, mu and the critical mu."""
+
+
 class SingularityError(MechsysError, ValueError):
     """A kinematic parametrization met its singularity (e.g. Euler angles at theta = 0)."""
 
@@ -40,6 +45,7 @@ __all__ = [
     "ModelError",
     "SettingsError",
     "SolverError",
+    "PainleveError",
     "SingularityError",
     "CallbackError",
     "ResultsError",

@@ -88,13 +88,18 @@ class Lemke:
 class MoreauJean:
     """Moreau-Jean time-stepping with step ``dt`` (s): impulses and velocities, so impacts,
     stick-slip and accumulations of impacts need no event detection; ``solver`` solves each
-    step's friction-contact problem."""
+    step's friction-contact problem. A Painleve situation (a sliding contact pressed on with
+    friction above its critical coefficient) is passed by the impulse the step's problem gives
+    (an impact without collision), on record as a ``painleve`` event with a warning; with
+    ``continue_on_painleve=False`` it raises :class:`mechsys.PainleveError` instead."""
 
     dt: float
     solver: NSGS | Newton | Lemke = NSGS()
+    continue_on_painleve: bool = True
 
     def describe(self) -> dict:
-        return {"type": "moreau_jean", "dt": float(self.dt), "solver": self.solver.describe()}
+        return {"type": "moreau_jean", "dt": float(self.dt), "solver": self.solver.describe(),
+                "continue_on_painleve": bool(self.continue_on_painleve)}
 
 
 @dataclass(frozen=True)
@@ -104,8 +109,10 @@ class EventDriven:
     impacts by Newton's or Poisson's law and the acceleration-level transition problem at each
     event. Points within ``gap_tol`` (m) touch; relative velocities within ``velocity_tol``
     (m/s) count as zero (an approach that slow closes without impact: the end of an
-    accumulation of impacts). A Painleve situation raises ``SolverError`` unless
-    ``continue_on_painleve``. Accurate where Moreau-Jean is robust; for few contacts."""
+    accumulation of impacts). A Painleve situation (no solution at acceleration level) raises
+    :class:`mechsys.PainleveError` naming the contact, mu and the critical mu, unless
+    ``continue_on_painleve``: then the sliding is stopped by an impulse (an impact without
+    collision). Non-unique states are taken with a warning and a ``painleve`` event. Accurate where Moreau-Jean is robust; for few contacts."""
 
     rtol: float = 1e-10
     atol: float = 1e-12

@@ -62,7 +62,7 @@ INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
     "rk4": ("dt",),
     "dopri5": ("rtol", "atol", "max_step", "first_step"),
     "radau5": ("dt", "newton_tol"),
-    "moreau_jean": ("dt", "solver"),
+    "moreau_jean": ("dt", "solver", "continue_on_painleve"),
     "event_driven": ("rtol", "atol", "max_step", "gap_tol", "velocity_tol", "max_events", "continue_on_painleve"),
 }
 
@@ -423,7 +423,8 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
         spec = dict(chosen)
         if base is not None:
             allowed = INTEGRATOR_KEYS.get(str(spec.get("type")), ())
-            spec = {**{k: v for k, v in base.items() if k in allowed}, **spec}
+            # (not the Painleve choice: its default differs between the two contact schemes)
+            spec = {**{k: v for k, v in base.items() if k in allowed and k != "continue_on_painleve"}, **spec}
     kind = str(spec.get("type", "")).lower()
     if kind not in INTEGRATOR_KEYS:
         raise SettingsError(f"integrator: unknown type {spec.get('type')!r}; expected one of {', '.join(INTEGRATOR_KEYS)}")

@@ -240,9 +240,15 @@ class Results:
 
     @property
     def events(self) -> list[dict]:
-        """Contact events of an event-driven run, in time order: dicts with ``t`` (s), ``contact``,
-        ``point`` (candidate index within the contact) and ``event`` (``impact``, ``close``,
-        ``open``, ``stick``, ``slip``). Empty for other integrators."""
+        """Contact events of a contact run (event-driven or Moreau-Jean), in time order: dicts with
+        ``t`` (s), ``contact``, ``point`` (candidate index within the contact), ``event``
+        (``impact``, ``close``, ``open``, ``stick``, ``slip``, ``painleve``), the event's impulses
+        ``impulse_n`` and ``impulse_t`` (N s, t1 and t2), the kinetic ``energy`` its impulses
+        took (J) and ``steps`` (Moreau-Jean steps merged into it; 1 for the event-driven scheme).
+        Impacts add the generalized velocities ``u_before`` and ``u_after``; Painleve situations
+        add ``mu``, ``mu_critical``, ``situation`` (``inconsistent`` or ``non-unique``),
+        ``solutions`` (the points closed in each solution of a non-unique state, as
+        ``"contact[k]"``) and ``resolved_by_impulse``. Empty for the smooth integrators."""
         return json.loads(self.attrs.get("events", "[]"))
 
     def __repr__(self) -> str:

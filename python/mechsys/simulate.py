@@ -121,7 +121,7 @@ def simulate(
         "model": core.description_json(),
         "settings": text,
         "stats": json.dumps(raw.pop("stats")),
-        "events": json.dumps([{"t": t, "contact": c, "point": k, "event": e} for t, c, k, e in raw.pop("events", [])]),
+        "events": json.dumps(raw.pop("events", [])),
         "mechsys_version": _core.__version__,
     }
     body_names = core.body_names[1:]

@@ -6,6 +6,10 @@
 //!   normal, points, tangents);
 //! - `narrow/sphere_plane_kinematics/1000`: [`contact_kinematics`] for the same pairs, moving
 //!   (adds `ġ_N`, `ġ_T`, `w̄_N`, `w̄_T`);
+//! - `narrow/box_box_evaluate/100`, `narrow/box_box_kinematics/100`: the same two for 100 box–box
+//!   pairs (the upper box turned and tilted by up to 0.2 rad over the lower one, overlapping by up
+//!   to 1 mm: clipped face manifolds of 4 to 8 points, a few edge–edge points), both boxes moving;
+//!   half of the pairs in the reversed order (box of body 2 first);
 //! - `broad/sap/N`, N = 1000, 10000: one step of the broad phase for N spheres in a unit box (volume
 //!   fraction 0.3) plus its six walls: world boxes from the poses ([`Contour::aabb`]) and
 //!   [`SweepAndPrune::update`], alternating between two configurations one small step apart, as
@@ -101,6 +105,77 @@ fn bench_narrow(c: &mut Criterion) {
                 contact_kinematics(p, body, &BodyMotion::GROUND, std::slice::from_mut(out)).expect("room for 1");
             }
             black_box(&kin);
+        })
+    });
+    g.finish();
+    bench_box_box(c);
+}
+
+/// 100 box–box pairs near contact, moving: [`evaluate`] and [`contact_kinematics`] per pair.
+fn bench_box_box(c: &mut Criterion) {
+    let n = 100;
+    let mut rng = Rng(0x0bad_5eed_1234_5678);
+    let rot = |axis: Vec3, angle: f64| {
+        nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle).into_inner()
+    };
+    let upper = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.2, 0.15, 0.1) };
+    let lower = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.25, 0.2, 0.1) };
+    let mut cases = Vec::with_capacity(n);
+    for i in 0..n {
+        let tilt = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 0.0);
+        let a = rot(Vec3::z(), rng.uniform(-0.8, 0.8)) * rot(tilt, rng.uniform(0.0, 0.2));
+        // the upper box's lowest point 1 mm below the lower box's top face at most
+        let low = (0..8)
+            .map(|k| {
+                let s = |b: usize| if k & (1 << b) != 0 { 1.0 } else { -1.0 };
+                (a * Vec3::new(s(0) * 0.2, s(1) * 0.15, s(2) * 0.1)).z
+            })
+            .fold(f64::INFINITY, f64::min);
+        let r = Vec3::new(rng.uniform(-0.15, 0.15), rng.uniform(-0.1, 0.1), 0.1 - low - rng.uniform(0.0, 1e-3));
+        let motion = |rng: &mut Rng, pose: Pose| BodyMotion {
+            pose,
+            twist: Motion::new(
+                Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)),
+                Vec3::new(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5)),
+            ),
+            acc: Motion::new(Vec3::zeros(), Vec3::new(0.0, 0.0, -9.81)),
+        };
+        let (b_up, b_low) = (motion(&mut rng, Pose::new(a, r)), motion(&mut rng, Pose::IDENTITY));
+        if i % 2 == 0 {
+            cases.push((ContactPair::new("bb", upper.clone(), lower.clone()).expect("valid pair"), b_up, b_low));
+        } else {
+            cases.push((ContactPair::new("bb", lower.clone(), upper.clone()).expect("valid pair"), b_low, b_up));
+        }
+    }
+    let mut points = [ContactPoint::default(); 8];
+    let (mut used, mut touching) = (0, 0);
+    for (p, b1, b2) in &cases {
+        evaluate(p, &b1.pose, &b2.pose, &mut points).expect("room for 8");
+        used += points.iter().filter(|c| c.g_n < 0.1).count();
+        touching += usize::from(points.iter().any(|c| c.g_n <= 0.0));
+    }
+    eprintln!("narrow/box_box: {used} candidates in use over {n} pairs, {touching} pairs overlapping");
+    let mut g = c.benchmark_group("narrow");
+    g.throughput(Throughput::Elements(n as u64));
+    g.bench_with_input(BenchmarkId::new("box_box_evaluate", n), &n, |b, _| {
+        b.iter(|| {
+            let mut s = 0.0;
+            for (p, b1, b2) in &cases {
+                evaluate(p, &b1.pose, &b2.pose, &mut points).expect("room for 8");
+                s += points[0].g_n;
+            }
+            black_box(s)
+        })
+    });
+    let mut kin = [ContactKinematics::default(); 8];
+    g.bench_with_input(BenchmarkId::new("box_box_kinematics", n), &n, |b, _| {
+        b.iter(|| {
+            let mut s = 0.0;
+            for (p, b1, b2) in &cases {
+                contact_kinematics(p, b1, b2, &mut kin).expect("room for 8");
+                s += kin[0].wbar_n;
+            }
+            black_box(s)
         })
     });
     g.finish();

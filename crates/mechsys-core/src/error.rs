@@ -31,6 +31,10 @@ pub enum Error {
     /// The numerical solution failed (divergence, step size underflow, NaN state).
     #[error("{0}")]
     Solver(String),
+    /// A Painlevé situation: with the sliding friction, the contact problem has no solution (the
+    /// message names the contacts, the time, µ and the critical µ).
+    #[error("{0}")]
+    Painleve(String),
     /// A user-supplied callback failed.
     #[error("{0}")]
     Callback(String),

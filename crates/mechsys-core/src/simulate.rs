@@ -151,11 +151,74 @@ pub struct Recording {
     /// Contact groups: impulse of the `against` contours on the members summed since the
     /// previous sample, world components (n_out × n_groups × 3), N s.
     pub group_impulse_against: Vec<f64>,
-    /// Contact events of the event-driven scheme: (time, contact, point of the contact, what:
-    /// impact, close, open, stick, slip).
-    pub events: Vec<(f64, String, usize, String)>,
+    /// Contact events of either contact scheme, in time order.
+    pub events: Vec<EventRecord>,
     /// Integrator counters.
     pub stats: Stats,
+}
+
+/// One contact event of a run ([`crate::integrator::events`]), with its contact named.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EventRecord {
+    /// Time (s).
+    pub t: f64,
+    /// The contact's name.
+    pub contact: String,
+    /// The point of the contact (0 for single-point contours).
+    pub point: usize,
+    /// impact, close, open, stick, slip or painleve.
+    pub kind: &'static str,
+    /// Normal and tangential impulses of the event at the point (N s).
+    pub impulse: [f64; 3],
+    /// Kinetic energy its impulses took (J).
+    pub energy: f64,
+    /// Generalized velocities before and after (impacts; empty otherwise).
+    pub u_before: Vec<f64>,
+    /// See `u_before`.
+    pub u_after: Vec<f64>,
+    /// Painlevé situations: µ, the critical µ, whether the state was non-unique (else
+    /// inconsistent), the points closed in both solutions of a non-unique state ("contact[k]"),
+    /// and whether the sliding was stopped by an impulse.
+    pub painleve: Option<(f64, f64, bool, [Vec<String>; 2], bool)>,
+    /// Consecutive time steps merged into the event (1 for the event-driven scheme).
+    pub steps: usize,
+}
+
+impl EventRecord {
+    fn from_log(model: &Model, log: &crate::integrator::events::EventLog) -> Vec<EventRecord> {
+        let name = |pt: usize| {
+            let c = model.contact_of_point(pt);
+            format!("{}[{}]", c.name, pt - c.first)
+        };
+        log.events
+            .iter()
+            .map(|e| {
+                let c = model.contact_of_point(e.point);
+                let (u_before, u_after) = match e.velocities {
+                    Some(at) => {
+                        let (b, a) = log.velocities_at(at, model.nu);
+                        (b.to_vec(), a.to_vec())
+                    }
+                    None => (Vec::new(), Vec::new()),
+                };
+                EventRecord {
+                    t: e.t,
+                    contact: c.name.clone(),
+                    point: e.point - c.first,
+                    kind: e.kind.as_str(),
+                    impulse: e.impulse,
+                    energy: e.energy,
+                    u_before,
+                    u_after,
+                    painleve: e.painleve.as_ref().map(|p| {
+                        let names = |v: &Vec<usize>| v.iter().map(|&pt| name(pt)).collect::<Vec<_>>();
+                        (p.mu, p.mu_critical, p.non_unique, [names(&p.solutions[0]), names(&p.solutions[1])], p.resolved_by_impulse)
+                    }),
+                    steps: e.steps,
+                }
+            })
+            .collect()
+    }
 }
 
 /// Progress and cancellation shared with another thread (the Python progress bar).
@@ -432,8 +495,8 @@ pub fn simulate(
         _ => {}
     }
     let contacts = !model.contacts.is_empty();
-    if let IntegratorKind::MoreauJean { dt, solver } = settings.integrator {
-        return time_stepping(model, settings, cb, progress, &t_out, y0, dt, solver, rec);
+    if let IntegratorKind::MoreauJean { dt, solver, continue_on_painleve } = settings.integrator {
+        return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve), rec);
     }
     crate::ensure!(
         model.contact_groups.is_empty() || matches!(settings.integrator, IntegratorKind::MoreauJean { .. }),
@@ -482,8 +545,7 @@ fn time_stepping(
     progress: Option<&Progress>,
     t_out: &[f64],
     y0: Vec<f64>,
-    dt: f64,
-    solver: crate::solver::Method,
+    (dt, solver, continue_on_painleve): (f64, crate::solver::Method, bool),
     mut rec: Recording,
 ) -> Result<Recording> {
     use crate::integrator::moreau_jean::MoreauJean;
@@ -516,6 +578,11 @@ fn time_stepping(
     let mut acc_t = vec![[0.0; 2]; np];
     let mut step = 0u64;
     let mut stats = crate::integrator::Stats::default();
+    let mut log = crate::integrator::events::EventLog::default();
+    let mut states = vec![OPEN_STATE; np];
+    // per point: the index of its last event and the step it was last extended at
+    let mut last_event: Vec<Option<(usize, u64)>> = vec![None; np];
+    let mut last_painleve: Vec<Option<(usize, u64)>> = vec![None; np];
     for (k, &t_rec) in t_out.iter().enumerate() {
         if k > 0 {
             for _ in 0..every {
@@ -536,6 +603,27 @@ fn time_stepping(
                 }
                 for i in 0..nu {
                     udot[i] = (u[i] - u_start[i]) / dt;
+                }
+                let t_end = t + dt;
+                log_step(model, &stepper, step, t_end, (&u_start, u), &mut states, &mut last_event, &mut log);
+                for &(pt, mu, crit, non_unique) in &stepper.painleve {
+                    if !non_unique && !continue_on_painleve {
+                        let c = model.contact_of_point(pt);
+                        return Err(Error::Painleve(format!(
+                            "Painlevé situation at t = {t:.9} s: contact '{}' (point {}) slides with µ = {mu} above the critical µ = {crit:.6}; pressed into its contact, the contact problem has no solution at acceleration level (Moreau-Jean would stop the sliding by an impulse: set continue_on_painleve to go on)",
+                            c.name,
+                            pt - c.first
+                        )));
+                    }
+                    let fresh = painleve_event(&stepper, pt, (mu, crit, non_unique), step, t_end, &mut last_painleve, &mut log);
+                    if fresh {
+                        let c = model.contact_of_point(pt);
+                        rec.warnings.push(if non_unique {
+                            format!("Painlevé situation at t = {t:.9} s: contact '{}' (point {}) slides with µ = {mu} above the critical µ = {crit:.6}; the contact problem has two solutions (open, or closed pressing itself on): the time-stepping took one", c.name, pt - c.first)
+                        } else {
+                            format!("Painlevé situation at t = {t:.9} s: contact '{}' (point {}) slides with µ = {mu} above the critical µ = {crit:.6}; the sliding was stopped by an impulse (an impact without collision)", c.name, pt - c.first)
+                        });
+                    }
                 }
                 crate::integrator::check_finite(t + dt, &y)?;
                 step += 1;
@@ -593,6 +681,7 @@ fn time_stepping(
         }
         report_progress(progress, rec.t.len(), t_rec)?;
     }
+    rec.events = EventRecord::from_log(model, &log);
     if stepper.unconverged.0 > 0 {
         rec.warnings.push(format!(
             "the contact solver did not reach its tolerance in {} of {} steps (worst residual {:.1e}); tighten the solver or shorten dt",
@@ -660,15 +749,110 @@ fn event_driven(
     let stats = event_driven::integrate(&mut phase, settings.t0, &y, t_out, &mut warnings, &mut sample)?;
     rec.stats = stats;
     rec.warnings.extend(warnings);
-    rec.events = phase
-        .log
-        .iter()
-        .map(|&(t, pt, what)| {
-            let c = model.contact_of_point(pt);
-            (t, c.name.clone(), pt - c.first, what.to_string())
-        })
-        .collect();
+    rec.events = EventRecord::from_log(model, &phase.log);
     Ok(rec)
+}
+
+const OPEN_STATE: f64 = crate::integrator::moreau_jean::OPEN;
+
+/// Moreau–Jean's events of one step ending at `t`: every change of a point's state (an impact
+/// where a point closes approaching faster than 1e-8 m/s), with the step's impulses and the
+/// energy they took; an impact spread over consecutive steps is one event.
+#[allow(clippy::too_many_arguments)]
+fn log_step(
+    model: &Model,
+    stepper: &crate::integrator::moreau_jean::MoreauJean,
+    step: u64,
+    t: f64,
+    (u_before, u_after): (&[f64], &[f64]),
+    states: &mut [f64],
+    last_event: &mut [Option<(usize, u64)>],
+    log: &mut crate::integrator::events::EventLog,
+) {
+    use crate::integrator::events::EventKind;
+    use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
+    let _ = model;
+    for (pt, r) in stepper.results.iter().enumerate() {
+        let (was, now) = (states[pt], r.state);
+        states[pt] = now;
+        let impact = now != OPEN && r.gd_n_before < -1e-8 && r.impulse_n > 0.0;
+        // an impact that goes on from the previous step joins its event
+        if impact {
+            if let Some((k, s)) = last_event[pt] {
+                let e = &mut log.events[k];
+                if e.kind == EventKind::Impact && s + 1 == step {
+                    e.impulse[0] += r.impulse_n;
+                    e.impulse[1] += r.impulse_t[0];
+                    e.impulse[2] += r.impulse_t[1];
+                    e.energy += r.energy;
+                    e.steps += 1;
+                    if let Some(at) = e.velocities {
+                        let nu = u_after.len();
+                        log.velocities[at + nu..at + 2 * nu].copy_from_slice(u_after);
+                    }
+                    last_event[pt] = Some((k, step));
+                    continue;
+                }
+            }
+        }
+        let kind = if impact && was == OPEN {
+            EventKind::Impact
+        } else if was == now {
+            continue;
+        } else if now == OPEN {
+            EventKind::Open
+        } else if was == OPEN {
+            EventKind::Close
+        } else if now == STICK {
+            EventKind::Stick
+        } else if now == SLIP {
+            EventKind::Slip
+        } else {
+            continue;
+        };
+        let at = (kind == EventKind::Impact).then(|| log.store_velocities(u_before, u_after));
+        let e = log.push(t, pt, kind);
+        e.impulse = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
+        e.energy = r.energy;
+        e.velocities = at;
+        last_event[pt] = Some((log.events.len() - 1, step));
+    }
+}
+
+/// A Painlevé situation found in the step ending at `t`: a new event, or the point's last one
+/// extended if it was found in the previous step too. Returns true for a new one.
+fn painleve_event(
+    stepper: &crate::integrator::moreau_jean::MoreauJean,
+    pt: usize,
+    (mu, mu_critical, non_unique): (f64, f64, bool),
+    step: u64,
+    t: f64,
+    last_painleve: &mut [Option<(usize, u64)>],
+    log: &mut crate::integrator::events::EventLog,
+) -> bool {
+    use crate::integrator::events::{EventKind, Painleve};
+    if let Some((k, s)) = last_painleve[pt] {
+        if s + 1 == step {
+            log.events[k].steps += 1;
+            last_painleve[pt] = Some((k, step));
+            return false;
+        }
+    }
+    let r = &stepper.results[pt];
+    let e = log.push(t, pt, EventKind::Painleve);
+    e.impulse = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
+    e.energy = r.energy;
+    let closed = if r.state != crate::integrator::moreau_jean::OPEN { vec![pt] } else { Vec::new() };
+    let other = if closed.is_empty() { vec![pt] } else { Vec::new() };
+    e.painleve = Some(Painleve {
+        mu,
+        mu_critical,
+        non_unique,
+        solutions: if non_unique { [closed, other] } else { [Vec::new(), Vec::new()] },
+        resolved_by_impulse: !non_unique,
+    });
+    last_painleve[pt] = Some((log.events.len() - 1, step));
+    true
 }
 
 /// Tells the progress watcher how many samples are recorded; an error if it asked to cancel.

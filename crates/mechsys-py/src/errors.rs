@@ -32,6 +32,7 @@ impl From<PyMechsysError> for PyErr {
             Error::Model(_) | Error::Description { .. } => "ModelError",
             Error::Settings(_) => "SettingsError",
             Error::Solver(_) => "SolverError",
+            Error::Painleve(_) => "PainleveError",
             Error::Singular(_) => "SingularityError",
             Error::Callback(_) => "CallbackError",
         };

@@ -238,7 +238,31 @@ fn simulate<'py>(
         put("force_deflection", rec.force_deflection, &[n, m.n_force_outputs])?;
     }
     d.set_item("warnings", rec.warnings)?;
-    d.set_item("events", rec.events)?;
+    let events = pyo3::types::PyList::empty(py);
+    for e in &rec.events {
+        let ev = PyDict::new(py);
+        ev.set_item("t", e.t)?;
+        ev.set_item("contact", &e.contact)?;
+        ev.set_item("point", e.point)?;
+        ev.set_item("event", e.kind)?;
+        ev.set_item("impulse_n", e.impulse[0])?;
+        ev.set_item("impulse_t", [e.impulse[1], e.impulse[2]])?;
+        ev.set_item("energy", e.energy)?;
+        ev.set_item("steps", e.steps)?;
+        if !e.u_before.is_empty() {
+            ev.set_item("u_before", e.u_before.clone())?;
+            ev.set_item("u_after", e.u_after.clone())?;
+        }
+        if let Some((mu, crit, non_unique, sol, by_impulse)) = &e.painleve {
+            ev.set_item("mu", mu)?;
+            ev.set_item("mu_critical", crit)?;
+            ev.set_item("situation", if *non_unique { "non-unique" } else { "inconsistent" })?;
+            ev.set_item("solutions", [sol[0].clone(), sol[1].clone()])?;
+            ev.set_item("resolved_by_impulse", by_impulse)?;
+        }
+        events.append(ev)?;
+    }
+    d.set_item("events", events)?;
     let np = m.n_contact_points;
     if !m.contacts.is_empty() || !m.contact_groups.is_empty() {
         put("contact_gap", rec.contact_gap, &[n, np])?;

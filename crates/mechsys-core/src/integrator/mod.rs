@@ -12,6 +12,7 @@
 
 pub mod dopri5;
 pub mod event_driven;
+pub mod events;
 pub mod moreau_jean;
 pub mod radau5;
 pub mod rk4;
@@ -81,9 +82,18 @@ pub enum IntegratorKind {
         /// The contact solver.
         #[serde(default = "crate::solver::Method::nsgs")]
         solver: crate::solver::Method,
+        /// On a Painlevé situation (a sliding point whose contact problem has no solution), go on
+        /// with the impulse the step's problem gives (an impact without collision, on record as
+        /// a `painleve` event and a warning) instead of raising.
+        #[serde(default = "default_true")]
+        continue_on_painleve: bool,
     },
     /// Event-driven integration of contact models ([`event_driven`]).
     EventDriven(event_driven::Options),
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn default_rtol() -> f64 {

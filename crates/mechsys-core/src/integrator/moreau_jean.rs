@@ -73,6 +73,10 @@ pub struct PointResult {
     pub impulse_t: [f64; 2],
     /// State code ([`OPEN`], [`STICK`], [`SLIP`]).
     pub state: f64,
+    /// Normal relative velocity at the start of the step (m/s).
+    pub gd_n_before: f64,
+    /// Kinetic energy the point's impulses took in the step (J).
+    pub energy: f64,
 }
 
 /// How the local contact problem is assembled.
@@ -153,6 +157,11 @@ pub struct MoreauJean {
     /// Per active point: it took the static coefficient µ0 (it was not sliding) while its law
     /// slides with less; a break-away in the step is solved again with the sliding coefficient.
     static_mu: Vec<bool>,
+    /// Painlevé situations of the last step: (point, µ, critical µ, non-unique) for each
+    /// explicit point that slid into the step with a non-positive normal velocity change per
+    /// unit normal impulse under its sliding friction; non-unique if its free motion separates
+    /// it, else (pressed on) the step's problem stops the sliding impulsively.
+    pub painleve: Vec<(usize, f64, f64, bool)>,
     /// Energy dissipated so far by normal impulses (J).
     pub dissipated_impact: f64,
     /// Energy dissipated so far by tangential impulses (J).
@@ -227,6 +236,7 @@ impl MoreauJean {
             tmp_u: vec![0.0; nu],
             gd_before: vec![0.0; dim * np],
             static_mu: Vec::with_capacity(np),
+            painleve: Vec::with_capacity(np),
             dissipated_impact: 0.0,
             dissipated_friction: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
@@ -455,6 +465,7 @@ impl MoreauJean {
             self.problem.dim = d;
             self.problem.mu.clear();
             self.static_mu.clear();
+            self.painleve.clear();
             self.r.clear();
             for (ai, a) in self.act.iter().enumerate() {
                 let (friction, impact, gd_t, prev, prev_state) = match a.source {
@@ -472,6 +483,25 @@ impl MoreauJean {
                         (&g.friction, &g.impact, sl.kin[k].gd_t, prev, st)
                     }
                 };
+                // Painlevé test of a point sliding into the step (see crate::integrator::events)
+                if let (Source::Point(pt), true) = (a.source, prev_state == SLIP) {
+                    let gt = &self.gd_before[ai * d + 1..(ai + 1) * d];
+                    let speed = gt.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    if speed > 0.0 && !matches!(friction, FrictionLaw::None) {
+                        let mut s = [0.0; 2];
+                        for (k, v) in gt.iter().enumerate() {
+                            s[k] = v / speed;
+                        }
+                        let mu = friction.mu(speed);
+                        let mut blk = [0.0; 9];
+                        self.problem.w.diag_block(d, ai, &mut blk);
+                        let (c, crit) = crate::integrator::events::painleve_margin(&blk[..d * d], d, mu, s);
+                        if c <= 1e-12 * blk[0].abs() {
+                            let free_change = self.problem.q[ai * d] - self.gd_before[ai * d];
+                            self.painleve.push((pt, mu, crit, free_change > 0.0));
+                        }
+                    }
+                }
                 // a point still open by less than the margin may close within the step, not beyond
                 let gap_allowance = a.point.g_n.max(0.0) / h;
                 self.problem.q[ai * d] += impact.eps() * self.gd_before[ai * d].min(0.0) + gap_allowance;
@@ -558,7 +588,13 @@ impl MoreauJean {
                 imp[..d].copy_from_slice(&self.r[ai * d..(ai + 1) * d]);
                 match self.act[ai].source {
                     Source::Point(pt) => {
-                        self.results[pt] = PointResult { impulse_n: imp[0], impulse_t: [imp[1], imp[2]], state: code };
+                        self.results[pt] = PointResult {
+                            impulse_n: imp[0],
+                            impulse_t: [imp[1], imp[2]],
+                            state: code,
+                            gd_n_before: self.gd_before[ai * d],
+                            energy: 0.0,
+                        };
                     }
                     Source::Group { group, slot, k } => {
                         let sl = &mut self.groups[group].slots[slot];
@@ -589,12 +625,18 @@ impl MoreauJean {
                         *af = (0..nu).map(|i| self.w_rows[(a, i)] * u[i]).sum();
                     }
                 }
+                let mut e_point = 0.0;
                 for row in 0..d {
                     let a = ai * d + row;
-                    dw_n += -self.r[a] * 0.5 * (after[row] + self.gd_before[a]);
+                    let e = -self.r[a] * 0.5 * (after[row] + self.gd_before[a]);
+                    e_point += e;
+                    dw_n += e;
                     if row > 0 {
                         dw_t += -self.r[a] * after[row];
                     }
+                }
+                if let Source::Point(pt) = self.act[ai].source {
+                    self.results[pt].energy = e_point;
                 }
             }
         } else {

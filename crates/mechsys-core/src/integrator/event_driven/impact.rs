@@ -156,9 +156,13 @@ impl Phase<'_> {
             }
         }
         let mut diss = Dissipation::default();
+        for &pt in pts {
+            ev.point_energy[pt] = 0.0;
+        }
         for a in 0..dm {
             let after: f64 = (0..nu).map(|i| self.rows[(a, i)] * u[i]).sum();
             let e = -total[a] * 0.5 * (after + before[a]);
+            ev.point_energy[pts[a / d]] += e;
             if a % d == 0 {
                 diss.impact += e;
             } else {

@@ -40,6 +40,7 @@ use crate::contact::ContactKinematics;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
+use crate::integrator::events::EventLog;
 use crate::integrator::moreau_jean::OPEN;
 use crate::model::Model;
 use crate::solver::{FrictionContact, Lcp, Workspace};
@@ -156,8 +157,8 @@ pub struct Phase<'a> {
     tmp: Vec<f64>,
     /// Right-hand-side evaluations.
     pub evaluations: usize,
-    /// Every contact event: (time, point, what happened: impact, close, open, stick, slip).
-    pub log: Vec<(f64, usize, &'static str)>,
+    /// Every contact event, in time order.
+    pub log: EventLog,
     lcp: Lcp,
     fc: FrictionContact,
     ws: Workspace,
@@ -187,6 +188,16 @@ struct EventWork {
     /// Per point: the tangential force before the event (t1, t2), the direction a break-away
     /// slides against.
     lam_t_before: Vec<[f64; 2]>,
+    /// Per point: kinetic energy taken by the last impact (J).
+    point_energy: Vec<f64>,
+    /// Impulses per point (3 each) before the last impact, and the points it hit.
+    imp_before: Vec<f64>,
+    hit: Vec<usize>,
+    /// Generalized velocities before the last impact.
+    u_before: Vec<f64>,
+    /// Sliding points of the last transition problem whose normal acceleration per unit normal
+    /// force is not positive: (point, that coefficient, µ, critical µ, free normal acceleration).
+    painleve: Vec<(usize, f64, f64, f64, f64)>,
     /// Full-acceleration kinematics of one contact's points (the apex cap).
     apex: Vec<ContactKinematics>,
 }
@@ -462,7 +473,7 @@ mod tests {
         let opts = Options { velocity_tol: 1e-10, ..Options::default() };
         let rec = simulate(&m, &settings(2.0, opts), &NoCallbacks, None).unwrap();
         let t_inf = (2.0 * h0 / 9.81f64).sqrt() * (1.0 + eps) / (1.0 - eps);
-        let closes: Vec<f64> = rec.events.iter().filter(|e| e.3 == "close").map(|e| e.0).collect();
+        let closes: Vec<f64> = rec.events.iter().filter(|e| e.kind == "close").map(|e| e.t).collect();
         assert_eq!(closes.len(), 1);
         assert!((closes[0] - t_inf).abs() < 1e-9 * t_inf, "{} vs {t_inf}", closes[0]);
         // resting: λ_N = m g at the last sample, state stick (frictionless, not sliding)
@@ -477,7 +488,7 @@ mod tests {
         // sliding v² / (2 mu g), and the friction took m v² / 2
         let m = drop(0.0, 0.0, 1.0, 0.5);
         let rec = simulate(&m, &settings(0.5, Options::default()), &NoCallbacks, None).unwrap();
-        let stick: Vec<f64> = rec.events.iter().filter(|e| e.3 == "stick").map(|e| e.0).collect();
+        let stick: Vec<f64> = rec.events.iter().filter(|e| e.kind == "stick").map(|e| e.t).collect();
         assert_eq!(stick.len(), 1);
         assert!((stick[0] - 1.0 / (0.5 * 9.81)).abs() < 1e-9, "{stick:?}");
         let nb = rec.n_bodies;

@@ -3,6 +3,7 @@
 use nalgebra::DMatrix;
 
 use super::{EventWork, Options, Phase, PYRAMID};
+use crate::integrator::events::EventLog;
 use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -51,7 +52,7 @@ impl<'a> Phase<'a> {
             a_free: vec![0.0; nu],
             tmp: vec![0.0; nu],
             evaluations: 0,
-            log: Vec::new(),
+            log: EventLog::default(),
             lcp: Lcp { m: Vec::with_capacity((np * (k + 2)).pow(2)), q: Vec::with_capacity(np * (k + 2)) },
             fc: FrictionContact {
                 dim: d,
@@ -77,6 +78,11 @@ impl<'a> Phase<'a> {
                 leaving: vec![false; np],
                 breaking: vec![false; np],
                 lam_t_before: vec![[0.0; 2]; np],
+                point_energy: vec![0.0; np],
+                imp_before: vec![0.0; 3 * np],
+                hit: Vec::with_capacity(np),
+                u_before: vec![0.0; model.nu],
+                painleve: Vec::with_capacity(np),
                 apex: vec![ContactKinematics::default(); model.contacts.iter().map(|c| c.points()).max().unwrap_or(0)],
             },
         })

@@ -2,6 +2,7 @@
 
 use super::{Dissipation, Phase, PYRAMID};
 use crate::contact::{contact_kinematics, BodyMotion};
+use crate::integrator::events::{EventKind, Painleve};
 use crate::error::{Error, Result};
 use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
 use crate::model::contact::FrictionLaw;
@@ -105,6 +106,30 @@ impl Phase<'_> {
         }
         if self.lcp.q.iter().chain(self.lcp.m.iter()).any(|v| !v.is_finite()) {
             return Err(Error::Solver("the transition problem has non-finite entries".into()));
+        }
+        // Painlevé test of the sliding points: the normal acceleration per unit normal force with
+        // the sliding friction, c = w_Nᵀ M̃⁻¹ (w_N − µ W_T ŝ); c ≤ 0 is a Painlevé situation, and
+        // the critical µ is where it vanishes, µ W_NN / (W_NN − c)
+        self.ev.painleve.clear();
+        for (a, &pt) in pts.iter().enumerate() {
+            if stick.contains(&pt) {
+                continue;
+            }
+            let c = self.lcp.m[a * n + a];
+            let kp = self.kin[pt].point;
+            let spare = nb;
+            Self::put_row(model, &self.data, &self.kin, pt, &kp.n, &mut self.cols, spare);
+            let x = &mut self.x[spare * nu..(spare + 1) * nu];
+            for i in 0..nu {
+                x[i] = self.cols[(spare, i)];
+            }
+            Self::inverse_mass(&mut self.data, model.nc, x, None);
+            let w_nn: f64 = (0..nu).map(|i| self.rows[(a, i)] * self.x[spare * nu + i]).sum();
+            if c <= 1e-12 * w_nn.abs() {
+                let mu = self.mu_sliding(pt);
+                let crit = if w_nn - c > 0.0 { mu * w_nn / (w_nn - c) } else { f64::INFINITY };
+                self.ev.painleve.push((pt, c, mu, crit, self.lcp.q[a]));
+            }
         }
         let method = Method::lemke();
         self.ws.reserve(&self.lcp, &method)?;
@@ -226,12 +251,12 @@ impl Phase<'_> {
         old_dir.extend_from_slice(&self.dir);
         let mut diss = Dissipation::default();
         if touching.iter().any(|&pt| self.kin[pt].gd_n < -vtol) {
-            for &pt in touching.iter() {
-                if self.kin[pt].gd_n < -vtol {
-                    self.log.push((t, pt, "impact"));
-                }
-            }
-            let d = self.impact(t, u, touching, false, imp)?;
+            let mut hit = std::mem::take(&mut self.ev.hit);
+            hit.clear();
+            hit.extend(touching.iter().copied().filter(|&pt| self.kin[pt].gd_n < -vtol));
+            let r = self.impact_logged(t, u, touching, false, imp, &hit, EventKind::Impact);
+            self.ev.hit = hit;
+            let d = r?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             self.free_motion(t, q, u)?;
@@ -242,24 +267,65 @@ impl Phase<'_> {
         closing.clear();
         closing.extend(touching.iter().copied().filter(|&pt| self.kin[pt].gd_n.abs() <= vtol));
         if !self.transition_lcp(closing)? {
-            let names = self.names(closing);
+            // no solution: the sliding points pressed into their contacts with a non-positive
+            // normal acceleration per unit normal force are the cause (all sliding ones if none is)
+            let mut culprits = std::mem::take(&mut self.ev.hit);
+            culprits.clear();
+            culprits.extend(self.ev.painleve.iter().filter(|p| p.4 <= 0.0).map(|p| p.0));
+            if culprits.is_empty() {
+                culprits.extend(closing.iter().copied().filter(|&pt| self.sliding(pt).1 > vtol));
+            }
+            let what = self.painleve_text(&culprits);
             if !self.opts.continue_on_painleve {
-                return Err(Error::Solver(format!(
-                    "Painlevé situation at t = {t:.9} s: the contact problem of {names:?} has no solution at acceleration level (sliding friction too large for the geometry); set continue_on_painleve to stop the sliding by an impulse and go on"
+                self.ev.hit = culprits;
+                return Err(Error::Painleve(format!(
+                    "Painlevé situation at t = {t:.9} s: {what}; pressed into its contact, the contact problem has no solution at acceleration level. Set continue_on_painleve to stop the sliding by an impulse (an impact without collision) and go on"
                 )));
             }
             warnings.push(format!(
-                "Painlevé situation at t = {t:.9} s in contacts {names:?}: the sliding was stopped by an impulse (an impact without collision)"
+                "Painlevé situation at t = {t:.9} s: {what}; the sliding was stopped by an impulse (an impact without collision)"
             ));
-            let d = self.impact(t, u, closing, true, imp)?;
+            let r = self.impact_logged(t, u, closing, true, imp, &culprits, EventKind::Painleve);
+            let first = self.log.events.len() - culprits.len();
+            for k in first..self.log.events.len() {
+                let (mu, mu_critical) = self.painleve_mu(self.log.events[k].point);
+                self.log.events[k].painleve =
+                    Some(Painleve { mu, mu_critical, non_unique: false, solutions: [Vec::new(), Vec::new()], resolved_by_impulse: true });
+            }
+            self.ev.hit = culprits;
+            let d = r?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             self.free_motion(t, q, u)?;
             closing.retain(|&pt| self.kin[pt].gd_n.abs() <= vtol);
             if !self.transition_lcp(closing)? {
-                return Err(Error::Solver(format!(
+                let names = self.names(closing);
+                return Err(Error::Painleve(format!(
                     "Painlevé situation at t = {t:.9} s: the contact problem of {names:?} has no solution even after an impulsive stop"
                 )));
+            }
+        } else {
+            // several solutions: a sliding point with a non-positive coefficient and a separating
+            // free acceleration may open (the solution taken) or stay closed pressing itself on
+            for i in 0..self.ev.painleve.len() {
+                let (pt, c, mu, mu_critical, acc) = self.ev.painleve[i];
+                if acc <= 0.0 {
+                    continue;
+                }
+                let taken: Vec<usize> = closing.iter().copied().filter(|&p| self.status[p] != OPEN).collect();
+                let mut other: Vec<usize> = taken.iter().copied().filter(|&p| p != pt).collect();
+                if !taken.contains(&pt) && -acc / c >= 0.0 {
+                    other.push(pt);
+                    other.sort_unstable();
+                }
+                let what = self.painleve_text(&[pt]);
+                warnings.push(format!(
+                    "Painlevé situation at t = {t:.9} s: {what}; the contact problem has two solutions (points closed: {:?} or {:?}), the first was taken",
+                    self.point_names(&taken),
+                    self.point_names(&other)
+                ));
+                self.log.push(t, pt, EventKind::Painleve).painleve =
+                    Some(Painleve { mu, mu_critical, non_unique: true, solutions: [taken, other], resolved_by_impulse: false });
             }
         }
         let d = self.settle(u, imp);
@@ -282,20 +348,21 @@ impl Phase<'_> {
             let (a, b) = (old_dir[pt], self.dir[pt]);
             let reversed = was == SLIP && now == SLIP && a[0] * b[0] + a[1] * b[1] < 0.0;
             if was != now || reversed {
-                let what = if now == OPEN {
-                    "open"
+                let kind = if now == OPEN {
+                    EventKind::Open
                 } else if was == OPEN {
-                    "close"
+                    EventKind::Close
                 } else if now == STICK {
-                    "stick"
+                    EventKind::Stick
                 } else {
-                    "slip"
+                    EventKind::Slip
                 };
-                self.log.push((t, pt, what));
+                self.log.push(t, pt, kind);
             }
         }
         Ok(diss)
     }
+
     /// The switches an event's indicators forced (a point left open because its normal force
     /// reached zero, a sticking one set sliding because its reserve did) must agree with the
     /// motion they start: an opened point may not accelerate into its contact, a sliding one not
@@ -359,5 +426,72 @@ impl Phase<'_> {
             }
         }
         Ok(())
+    }
+    /// [`Self::impact`] with its events on record: one of `kind` per point of `hit`, with the
+    /// point's impulses and the energy its impulses took, and the generalized velocities around
+    /// the impact.
+    #[allow(clippy::too_many_arguments)]
+    fn impact_logged(
+        &mut self,
+        t: f64,
+        u: &mut [f64],
+        pts: &[usize],
+        plastic: bool,
+        imp: &mut [f64],
+        hit: &[usize],
+        kind: EventKind,
+    ) -> Result<Dissipation> {
+        self.ev.u_before.copy_from_slice(u);
+        for &pt in hit {
+            self.ev.imp_before[3 * pt..3 * pt + 3].copy_from_slice(&imp[3 * pt..3 * pt + 3]);
+        }
+        let d = self.impact(t, u, pts, plastic, imp)?;
+        let at = self.log.store_velocities(&self.ev.u_before, u);
+        for &pt in hit {
+            let e = self.log.push(t, pt, kind);
+            for r in 0..3 {
+                e.impulse[r] = imp[3 * pt + r] - self.ev.imp_before[3 * pt + r];
+            }
+            e.energy = self.ev.point_energy[pt];
+            e.velocities = Some(at);
+        }
+        Ok(d)
+    }
+
+    /// µ and the critical µ of point `pt` from the last transition problem (NaN if it was not
+    /// found there).
+    fn painleve_mu(&self, pt: usize) -> (f64, f64) {
+        match self.ev.painleve.iter().find(|p| p.0 == pt) {
+            Some(p) => (p.2, p.3),
+            None => (self.mu_sliding(pt), f64::NAN),
+        }
+    }
+
+    /// "contact 'tip' (point 0) slides with µ = 3 above the critical µ = 2.502" for each point.
+    fn painleve_text(&self, pts: &[usize]) -> String {
+        let parts: Vec<String> = pts
+            .iter()
+            .map(|&pt| {
+                let con = self.model.contact_of_point(pt);
+                let (mu, crit) = self.painleve_mu(pt);
+                let crit = if crit.is_finite() { format!(" above the critical µ = {crit:.6}") } else { String::new() };
+                format!("contact '{}' (point {}) slides with µ = {mu}{crit}", con.name, pt - con.first)
+            })
+            .collect();
+        if parts.is_empty() {
+            "the sliding contacts".to_string()
+        } else {
+            parts.join(", ")
+        }
+    }
+
+    /// "tip[0]" names of points.
+    fn point_names(&self, pts: &[usize]) -> Vec<String> {
+        pts.iter()
+            .map(|&pt| {
+                let con = self.model.contact_of_point(pt);
+                format!("{}[{}]", con.name, pt - con.first)
+            })
+            .collect()
     }
 }
