@@ -120,8 +120,8 @@ pub fn contact_kinematics(
 ) -> Result<()> {
     pair.check_len(out.len())?;
     let (tw1, tw2) = (&b1.twist, &b2.twist);
-    for (k, o) in out[..pair.candidates()].iter_mut().enumerate() {
-        let r = pair.candidate(k, &b1.pose, &b2.pose, Some((tw1, tw2)));
+    // one evaluation of the pair: shared work (a box–box manifold) is done once for all candidates
+    pair.each_candidate(&b1.pose, &b2.pose, Some((tw1, tw2)), |k, r| {
         let t = pair.tangents(&b2.pose, &r.n, Some((&tw2.w, &r.nd)));
         let (v1, v2) = (b1.point_velocity(&r.p1), b2.point_velocity(&r.p2));
         let dv = v1 - v2;
@@ -129,7 +129,7 @@ pub fn contact_kinematics(
         let (s1, s2) = (r.p1d - v1, r.p2d - v2);
         // d/dt v_i(P_i(t)) = a_i(P_i) + ω_i × σ_i
         let da = b1.point_acceleration(&r.p1) - b2.point_acceleration(&r.p2) + tw1.w.cross(&s1) - tw2.w.cross(&s2);
-        *o = ContactKinematics {
+        out[k] = ContactKinematics {
             point: ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 },
             gd_n: r.n.dot(&dv),
             gd_t: [t.t1.dot(&dv), t.t2.dot(&dv)],
@@ -137,7 +137,7 @@ pub fn contact_kinematics(
             wbar_n: r.nd.dot(&dv) + r.n.dot(&da),
             wbar_t: [t.t1d.dot(&dv) + t.t1.dot(&da), t.t2d.dot(&dv) + t.t2.dot(&da)],
         };
-    }
+    });
     Ok(())
 }
 

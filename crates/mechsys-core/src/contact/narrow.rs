@@ -142,6 +142,14 @@ pub(crate) struct Raw {
     pub p2d: Vec3,
 }
 
+impl Raw {
+    /// The candidate seen from the other body: normal flipped, points exchanged.
+    #[inline]
+    fn reversed(&self) -> Raw {
+        Raw { g: self.g, n: -self.n, p1: self.p2, p2: self.p1, nd: -self.nd, p1d: self.p2d, p2d: self.p1d }
+    }
+}
+
 /// Tangents and their rates.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Tangents {
@@ -214,9 +222,6 @@ fn vel(t: &Motion, p: &Vec3) -> Vec3 {
     t.v + t.w.cross(p)
 }
 
-/// Room for the candidates [`evaluate`] computes in one pass (box–box manifolds).
-const MAX_SHARED: usize = 8;
-
 /// Lengths below this are treated as zero (coincident centres, crossing axes).
 const TINY: f64 = 1e-12;
 
@@ -252,7 +257,22 @@ impl ContactPair {
     #[cfg(test)]
     pub(crate) fn box_feature(&self, x1: &Pose, x2: &Pose) -> Option<box_box::Feature> {
         match &self.geometry {
-            Geometry::BoxBox { a, b, scale } => Some(box_box::feature(x1, x2, a, b, *scale).0),
+            Geometry::BoxBox { a, b, scale } => {
+                let (x1, x2) = if self.swapped { (x2, x1) } else { (x1, x2) };
+                Some(box_box::feature(x1, x2, a, b, *scale).0)
+            }
+            _ => None,
+        }
+    }
+
+    /// The box–box feature pair and what each candidate is (caller's order of candidates; tests).
+    #[cfg(test)]
+    pub(crate) fn box_kinds(&self, x1: &Pose, x2: &Pose) -> Option<(box_box::Feature, [box_box::Kind; box_box::POINTS])> {
+        match &self.geometry {
+            Geometry::BoxBox { a, b, scale } => {
+                let (x1, x2) = if self.swapped { (x2, x1) } else { (x1, x2) };
+                Some(box_box::kinds(x1, x2, a, b, *scale))
+            }
             _ => None,
         }
     }
@@ -299,9 +319,8 @@ impl ContactPair {
         if !self.swapped {
             return self.raw(k, x1, x2, twists);
         }
-        // canonical body 1 is the caller's body 2: flip the normal, exchange the points
-        let r = self.raw(k, x2, x1, twists.map(|(a, b)| (b, a)));
-        Raw { g: r.g, n: -r.n, p1: r.p2, p2: r.p1, nd: -r.nd, p1d: r.p2d, p2d: r.p1d }
+        // canonical body 1 is the caller's body 2
+        self.raw(k, x2, x1, twists.map(|(a, b)| (b, a))).reversed()
     }
 
     /// All candidates in the caller's order into `out[..self.candidates()]`, computing work the
@@ -313,11 +332,40 @@ impl ContactPair {
         if let Geometry::BoxBox { a, b, scale } = &self.geometry {
             if !self.swapped {
                 box_box::box_box_all(x1, x2, twists, a, b, *scale, out);
-                return;
+            } else {
+                box_box::box_box_all(x2, x1, twists.map(|(t1, t2)| (t2, t1)), a, b, *scale, out);
+                for o in out.iter_mut() {
+                    *o = o.reversed();
+                }
             }
+            return;
         }
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.candidate(k, x1, x2, twists);
+        }
+    }
+
+    /// Calls `f(k, candidate k)` for every candidate in the caller's order, with one evaluation of
+    /// the work the candidates share (the box–box manifold: one separating-axis test and one
+    /// clipping per call); no allocation.
+    #[inline]
+    pub(crate) fn each_candidate(
+        &self,
+        x1: &Pose,
+        x2: &Pose,
+        twists: Option<(&Motion, &Motion)>,
+        mut f: impl FnMut(usize, &Raw),
+    ) {
+        if matches!(self.geometry, Geometry::BoxBox { .. }) {
+            let mut buf = [Raw::default(); box_box::POINTS];
+            self.candidates_into(x1, x2, twists, &mut buf);
+            for (k, r) in buf[..self.count].iter().enumerate() {
+                f(k, r);
+            }
+        } else {
+            for k in 0..self.count {
+                f(k, &self.candidate(k, x1, x2, twists));
+            }
         }
     }
 
@@ -707,16 +755,10 @@ fn circle_circle(
 /// at `x2` (world placements). No allocation; an error only when `out` is too short.
 pub fn evaluate(pair: &ContactPair, x1: &Pose, x2: &Pose, out: &mut [ContactPoint]) -> Result<()> {
     pair.check_len(out.len())?;
-    let mut raw = [Raw::default(); MAX_SHARED];
-    let shared = matches!(pair.geometry, Geometry::BoxBox { .. }) && pair.count <= MAX_SHARED;
-    if shared {
-        pair.candidates_into(x1, x2, None, &mut raw);
-    }
-    for (k, o) in out[..pair.count].iter_mut().enumerate() {
-        let r = if shared { raw[k] } else { pair.candidate(k, x1, x2, None) };
+    pair.each_candidate(x1, x2, None, |k, r| {
         let t = pair.tangents(x2, &r.n, None);
-        *o = ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 };
-    }
+        out[k] = ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 };
+    });
     Ok(())
 }
 

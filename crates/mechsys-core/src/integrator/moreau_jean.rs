@@ -534,8 +534,12 @@ impl MoreauJean {
                     if !self.static_mu[ai] {
                         continue;
                     }
+                    // on the cone's boundary: the static friction is used up (a slide that starts
+                    // from rest is slower than any velocity tolerance within its first steps)
                     let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
-                    if self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip {
+                    let saturated = self.r[ai * d] > 0.0
+                        && self.problem.friction_reserve(ai, &self.r)? <= 1e-9 * self.problem.mu[ai] * self.r[ai * d];
+                    if saturated || self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip {
                         let v = self.problem.local_velocity(ai, &self.r)?;
                         let speed = (v[1] * v[1] + v[2] * v[2]).sqrt();
                         let law = match self.act[ai].source {

@@ -194,15 +194,44 @@ impl Vertex {
     }
 }
 
+/// What a candidate of a box–box pair is: which features meet there (module docs, "Contact
+/// points").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) enum Kind {
+    /// A corner of the incident face against the reference face.
+    IncidentCorner,
+    /// A corner of the reference face against the incident face.
+    ReferenceCorner,
+    /// An edge of the incident face crossing a side plane of the reference face.
+    Crossing,
+    /// The edge–edge point.
+    EdgeEdge,
+    /// Not used by the manifold.
+    Unused,
+}
+
+impl Vertex {
+    /// The features of a clipped vertex, from the two planes that define it.
+    fn kind(&self) -> Kind {
+        match (self.labels[0].on_ref, self.labels[1].on_ref) {
+            (false, false) => Kind::IncidentCorner,
+            (true, true) => Kind::ReferenceCorner,
+            _ => Kind::Crossing,
+        }
+    }
+}
+
 /// The clipped incident face of a face contact: vertices, the reference normal `m` (outward of
-/// the reference face, fixed in the reference body) and a point `p_ref` of the reference face;
-/// `f` the incident face's outward normal.
+/// the reference face, fixed in the reference body) and the centre `p_ref` of the reference face;
+/// `f` the incident face's outward normal and `fc` its centre.
 struct Manifold {
     v: [Vertex; POINTS],
     count: usize,
     m: Vec3,
     p_ref: Vec3,
     f: Vec3,
+    fc: Vec3,
 }
 
 /// Clips the incident box's face most opposed to the reference face `axis` of `rf`.
@@ -287,9 +316,9 @@ fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
         // or separated ones): keep its corner deepest along -m, a material point
         let at = |n: usize| corner(&fc, &u1, &u2, inc.h[j1], inc.h[j2], n, j1, j2);
         let deepest = (0..4).min_by(|&p, &q| at(p).p.dot(&m).total_cmp(&at(q).p.dot(&m))).unwrap_or(0);
-        return Manifold { v: [at(deepest); POINTS], count: 1, m, p_ref, f };
+        return Manifold { v: [at(deepest); POINTS], count: 1, m, p_ref, f, fc };
     }
-    Manifold { v: buf[cur], count, m, p_ref, f }
+    Manifold { v: buf[cur], count, m, p_ref, f, fc }
 }
 
 /// Corner `n` of the incident face (cyclic order (-,-), (+,-), (+,+), (-,+) along `u1`, `u2`),
@@ -303,7 +332,9 @@ fn corner(fc: &Vec3, u1: &Vec3, u2: &Vec3, e1: f64, e2: f64, n: usize, j1: usize
     v
 }
 
-/// Candidate `k` of two boxes, canonical order (A on body 1, B on body 2).
+/// Candidate `k` of two boxes, canonical order (A on body 1, B on body 2): the whole manifold is
+/// built for it, so this is for single look-ups and tests; evaluations of a pair fill all
+/// candidates at once with [`box_box_all`].
 pub(super) fn box_box(
     x1: &Pose,
     x2: &Pose,
@@ -318,7 +349,14 @@ pub(super) fn box_box(
     out[k]
 }
 
-/// All [`POINTS`] candidates of two boxes into `out`, canonical order.
+#[cfg(test)]
+thread_local! {
+    /// Manifolds built on this thread (tests count them per evaluation).
+    pub(crate) static BUILDS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// All [`POINTS`] candidates of two boxes into `out`, canonical order: one separating-axis test
+/// and one clipping for all of them.
 pub(super) fn box_box_all(
     x1: &Pose,
     x2: &Pose,
@@ -328,6 +366,8 @@ pub(super) fn box_box_all(
     scale: f64,
     out: &mut [Raw],
 ) {
+    #[cfg(test)]
+    BUILDS.with(|b| b.set(b.get() + 1));
     let (a, b) = (Placed::new(sa, x1), Placed::new(sb, x2));
     let (feature, _) = choose(&a, &b, scale);
     match feature {
@@ -338,7 +378,7 @@ pub(super) fn box_box_all(
             let n = if ref_a { -mf.m } else { mf.m };
             for (k, o) in out.iter_mut().enumerate().take(POINTS) {
                 *o = if k < mf.count {
-                    face_point(&mf, &mf.v[k], ref_a, &a, &b, n, tw)
+                    face_point(&mf, &mf.v[k], ref_a, rf, inc, tw)
                 } else {
                     unused(&a, &b, n, tw, ref_a)
                 };
@@ -354,49 +394,67 @@ pub(super) fn box_box_all(
     }
 }
 
-/// One vertex of a face manifold as a candidate, with rates.
+/// One vertex of a face manifold as a candidate, with rates: a corner of the reference face
+/// against the incident face, or the incident box's point at the vertex against the reference
+/// face (module docs, "Contact points").
 fn face_point(
     mf: &Manifold,
     vx: &Vertex,
     ref_a: bool,
-    a: &Placed,
-    b: &Placed,
-    n: Vec3,
+    rf: &Placed,
+    inc: &Placed,
     tw: Option<(&Motion, &Motion)>,
 ) -> Raw {
-    let g = mf.m.dot(&(vx.p - mf.p_ref));
-    let q = vx.p - mf.m * g;
-    let mut out = if ref_a {
-        Raw { g, n, p1: q, p2: vx.p, ..Default::default() }
-    } else {
-        Raw { g, n, p1: vx.p, p2: q, ..Default::default() }
-    };
-    if let Some((t1, t2)) = tw {
-        let (t_ref, t_inc) = if ref_a { (t1, t2) } else { (t2, t1) };
-        let (r_ref, r_inc) = if ref_a { (&a.r, &b.r) } else { (&b.r, &a.r) };
-        // m_k·v̇ = m_k·v_X(v) for the incident face and the vertex's two defining planes
-        let planes = [(mf.f, false), plane(&vx.labels[0], r_ref, r_inc), plane(&vx.labels[1], r_ref, r_inc)];
-        let rhs = planes.map(|(nk, on_ref)| nk.dot(&vel(if on_ref { t_ref } else { t_inc }, &vx.p)));
-        let (c0, c1, c2) =
-            (planes[1].0.cross(&planes[2].0), planes[2].0.cross(&planes[0].0), planes[0].0.cross(&planes[1].0));
-        let det = planes[0].0.dot(&c0);
-        let vd = if vx.count >= 2 && det.abs() > 1e-12 {
-            (c0 * rhs[0] + c1 * rhs[1] + c2 * rhs[2]) / det
-        } else {
-            vel(t_inc, &vx.p)
-        };
-        let md = t_ref.w.cross(&mf.m);
-        let gd = md.dot(&(vx.p - mf.p_ref)) + mf.m.dot(&(vd - vel(t_ref, &mf.p_ref)));
-        let qd = vd - mf.m * gd - md * g;
-        if ref_a {
-            out.nd = -md;
-            out.p1d = qd;
-            out.p2d = vd;
-        } else {
-            out.nd = md;
-            out.p1d = vd;
-            out.p2d = qd;
+    let twists = tw.map(|(t1, t2)| if ref_a { (t1, t2) } else { (t2, t1) });
+    // the point on the reference box, the point on the incident box, the normal from the
+    // reference box towards the incident one, the gap; then their rates
+    let (p_ref, p_inc, nr, g, rates) = if vx.kind() == Kind::ReferenceCorner {
+        // the corner q of the reference face, a material point of the reference box, against the
+        // incident face's plane (normal f, fixed in the incident box): g = f·(q - c_f), n = -f
+        let mut q = mf.p_ref;
+        for l in &vx.labels[..2] {
+            let s = if l.positive { 1.0 } else { -1.0 };
+            q += rf.axis(l.axis as usize) * (s * rf.h[l.axis as usize]);
         }
+        let g = mf.f.dot(&(q - mf.fc));
+        let foot = q - mf.f * g;
+        let rates = twists.map(|(t_ref, t_inc)| {
+            let qd = vel(t_ref, &q);
+            let fd = t_inc.w.cross(&mf.f);
+            let gd = fd.dot(&(q - mf.fc)) + mf.f.dot(&(qd - vel(t_inc, &mf.fc)));
+            (qd, qd - mf.f * gd - fd * g, -fd)
+        });
+        (q, foot, -mf.f, g, rates)
+    } else {
+        // the incident box's point v at the vertex against the reference face's plane (normal m,
+        // fixed in the reference box): g = m·(v - p_ref), n = m
+        let g = mf.m.dot(&(vx.p - mf.p_ref));
+        let foot = vx.p - mf.m * g;
+        let rates = twists.map(|(t_ref, t_inc)| {
+            // the vertex stays on the incident face and on its two defining planes, each fixed in
+            // its box: m_k·v̇ = m_k·v_X(v), solved for v̇ (for a corner of the incident face its
+            // material velocity; a crossing also moves along the incident edge)
+            let planes = [(mf.f, false), plane(&vx.labels[0], rf, inc), plane(&vx.labels[1], rf, inc)];
+            let rhs = planes.map(|(nk, on_ref)| nk.dot(&vel(if on_ref { t_ref } else { t_inc }, &vx.p)));
+            let (c0, c1, c2) =
+                (planes[1].0.cross(&planes[2].0), planes[2].0.cross(&planes[0].0), planes[0].0.cross(&planes[1].0));
+            let det = planes[0].0.dot(&c0);
+            let vd = if vx.count >= 2 && det.abs() > 1e-12 {
+                (c0 * rhs[0] + c1 * rhs[1] + c2 * rhs[2]) / det
+            } else {
+                vel(t_inc, &vx.p)
+            };
+            let md = t_ref.w.cross(&mf.m);
+            let gd = md.dot(&(vx.p - mf.p_ref)) + mf.m.dot(&(vd - vel(t_ref, &mf.p_ref)));
+            (vd - mf.m * gd - md * g, vd, md)
+        });
+        (foot, vx.p, mf.m, g, rates)
+    };
+    // the pair's normal points from B towards A
+    let (n, p1, p2) = if ref_a { (-nr, p_ref, p_inc) } else { (nr, p_inc, p_ref) };
+    let mut out = Raw { g, n, p1, p2, ..Default::default() };
+    if let Some((p_ref_d, p_inc_d, nr_d)) = rates {
+        (out.nd, out.p1d, out.p2d) = if ref_a { (-nr_d, p_ref_d, p_inc_d) } else { (nr_d, p_inc_d, p_ref_d) };
     }
     out
 }
@@ -452,12 +510,11 @@ fn edge_point(a: &Placed, b: &Placed, i: usize, j: usize, tw: Option<(&Motion, &
     out
 }
 
-/// World normal of a labelled plane and whether the reference body carries it.
+/// World normal of a labelled plane and whether the reference box carries it.
 #[inline]
-fn plane(l: &Label, r_ref: &Mat3, r_inc: &Mat3) -> (Vec3, bool) {
-    let axis = if l.on_ref { r_ref.column(l.axis as usize) } else { r_inc.column(l.axis as usize) };
-    let s = if l.positive { 1.0 } else { -1.0 };
-    (axis * s, l.on_ref)
+fn plane(l: &Label, rf: &Placed, inc: &Placed) -> (Vec3, bool) {
+    let axis = if l.on_ref { rf.axis(l.axis as usize) } else { inc.axis(l.axis as usize) };
+    (if l.positive { axis } else { -axis }, l.on_ref)
 }
 
 /// An unused candidate: never active, finite (see the module docs).
@@ -479,4 +536,23 @@ fn unused(a: &Placed, b: &Placed, n: Vec3, tw: Option<(&Motion, &Motion)>, ref_a
 #[cfg(test)]
 pub(super) fn feature(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> (Feature, f64) {
     choose(&Placed::new(sa, x1), &Placed::new(sb, x2), scale)
+}
+
+/// The chosen feature and what each candidate is, at body placements `x1`, `x2` (tests).
+#[cfg(test)]
+pub(super) fn kinds(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> (Feature, [Kind; POINTS]) {
+    let (a, b) = (Placed::new(sa, x1), Placed::new(sb, x2));
+    let (feature, _) = choose(&a, &b, scale);
+    let mut out = [Kind::Unused; POINTS];
+    match feature {
+        Feature::Face { ref_a, axis } => {
+            let (rf, inc) = if ref_a { (&a, &b) } else { (&b, &a) };
+            let mf = clip(rf, inc, axis, scale);
+            for (o, v) in out.iter_mut().zip(&mf.v[..mf.count]) {
+                *o = v.kind();
+            }
+        }
+        Feature::Edge { .. } => out[0] = Kind::EdgeEdge,
+    }
+    (feature, out)
 }

@@ -366,9 +366,10 @@ impl Phase<'_> {
     /// The switches an event's indicators forced (a point left open because its normal force
     /// reached zero, a sticking one set sliding because its reserve did) must agree with the
     /// motion they start: an opened point may not accelerate into its contact, a sliding one not
-    /// against its sliding direction; one that does is switched back. In space the direction a
-    /// break-away slides in is the one along which the sliding acceleration points under the
-    /// friction force opposing it (the cone's direction, found by fixed-point iteration).
+    /// against its sliding direction; one that does is switched back. In space a break-away
+    /// slides along the direction ŝ in which its sliding acceleration points under the friction
+    /// force −µ λ_N ŝ (the cone's direction, not the pyramid's): the angle of ŝ is found by the
+    /// secant method (the plain fixed-point iteration diverges once µ > (µ0 − µ)).
     pub(super) fn check_switches(&mut self, t: f64, q: &[f64], u: &[f64], old: &[f64]) -> Result<()> {
         let np = self.status.len();
         let forced = |s: &Self, pt: usize| {
@@ -377,56 +378,85 @@ impl Phase<'_> {
         if !(0..np).any(|pt| forced(self, pt)) {
             return Ok(());
         }
-        for _ in 0..50 {
-            self.evaluate(t, q, u)?;
-            let tol = 1e-8 * (1.0 + self.a_free.iter().fold(0.0f64, |a, v| a.max(v.abs())));
-            let (mut reverted, mut turned) = (false, false);
-            for con in &self.model.contacts {
-                let pts = con.first..con.first + con.points();
-                if !pts.clone().any(|pt| forced(self, pt)) {
-                    continue;
-                }
-                let n = con.points();
-                let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
-                contact_kinematics(&con.pair, &b1, &b2, &mut self.ev.apex[..n])
-                    .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.9} s: {e}", con.name)))?;
-                for pt in pts {
-                    if !forced(self, pt) {
-                        continue;
-                    }
-                    // with the full accelerations in data.a, w̄ holds g̈_N and g̈_T
-                    let k = &self.ev.apex[pt - con.first];
-                    if self.status[pt] == OPEN {
-                        if k.wbar_n < -tol {
-                            self.status[pt] = old[pt];
-                            reverted = true;
-                        }
-                        continue;
-                    }
-                    let g = if self.d == 3 { k.wbar_t } else { [k.wbar_t[0], 0.0] };
-                    let dir = self.dir[pt];
-                    let along = g[0] * dir[0] + g[1] * dir[1];
-                    if along < -tol {
-                        self.status[pt] = STICK;
-                        reverted = true;
-                        continue;
-                    }
-                    let size = (g[0] * g[0] + g[1] * g[1]).sqrt();
-                    if self.d == 3 && size > tol {
-                        let new = [g[0] / size, g[1] / size];
-                        if (new[0] - dir[0]).abs() + (new[1] - dir[1]).abs() > 1e-12 {
-                            self.dir[pt] = new;
-                            turned = true;
-                        }
-                    }
+        if self.d == 3 {
+            for pt in 0..np {
+                if self.ev.breaking[pt] && self.status[pt] == SLIP {
+                    self.cone_direction(t, q, u, pt)?;
                 }
             }
-            if !reverted && !turned {
+        }
+        for _ in 0..np + 1 {
+            self.evaluate(t, q, u)?;
+            let tol = 1e-8 * (1.0 + self.a_free.iter().fold(0.0f64, |a, v| a.max(v.abs())));
+            let mut reverted = false;
+            for pt in 0..np {
+                if !forced(self, pt) {
+                    continue;
+                }
+                let (gn, gt) = self.relative_acceleration(t, pt)?;
+                if self.status[pt] == OPEN {
+                    if gn < -tol {
+                        self.status[pt] = old[pt];
+                        reverted = true;
+                    }
+                } else if gt[0] * self.dir[pt][0] + gt[1] * self.dir[pt][1] < -tol {
+                    self.status[pt] = STICK;
+                    reverted = true;
+                }
+            }
+            if !reverted {
                 break;
             }
         }
         Ok(())
     }
+
+    /// Relative normal and tangential accelerations (g̈_N, g̈_T) of point `pt` from the last
+    /// evaluation (its full accelerations are in `data.a`, so w̄ holds them).
+    fn relative_acceleration(&mut self, t: f64, pt: usize) -> Result<(f64, [f64; 2])> {
+        let con = self.model.contact_of_point(pt);
+        let n = con.points();
+        let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
+        contact_kinematics(&con.pair, &b1, &b2, &mut self.ev.apex[..n])
+            .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.9} s: {e}", con.name)))?;
+        let k = &self.ev.apex[pt - con.first];
+        Ok((k.wbar_n, if self.d == 3 { k.wbar_t } else { [k.wbar_t[0], 0.0] }))
+    }
+
+    /// The sliding direction of a break-away in space: the angle φ of ŝ with
+    /// f(φ) = angle from ŝ to g̈_T(ŝ) = 0, by the secant method from the transition's guess.
+    fn cone_direction(&mut self, t: f64, q: &[f64], u: &[f64], pt: usize) -> Result<()> {
+        let f = |s: &mut Self, phi: f64| -> Result<f64> {
+            s.dir[pt] = [phi.cos(), phi.sin()];
+            s.evaluate(t, q, u)?;
+            let (_, g) = s.relative_acceleration(t, pt)?;
+            let d = s.dir[pt];
+            Ok((d[0] * g[1] - d[1] * g[0]).atan2(d[0] * g[0] + d[1] * g[1]))
+        };
+        let start = self.dir[pt];
+        let mut p0 = start[1].atan2(start[0]);
+        let mut f0 = f(self, p0)?;
+        // a small first step along the error, then secants
+        let mut p1 = p0 + 0.25 * f0;
+        let mut f1 = f(self, p1)?;
+        for _ in 0..60 {
+            if f1.abs() < 1e-14 || f1 == f0 {
+                break;
+            }
+            let p2 = p1 - f1 * (p1 - p0) / (f1 - f0);
+            (p0, f0) = (p1, f1);
+            p1 = p2;
+            f1 = f(self, p1)?;
+        }
+        if !(f1.abs() < 1e-9) {
+            // no direction along which the slide can start found: keep the transition's guess
+            self.dir[pt] = start;
+        } else {
+            self.dir[pt] = [p1.cos(), p1.sin()];
+        }
+        Ok(())
+    }
+
     /// [`Self::impact`] with its events on record: one of `kind` per point of `hit`, with the
     /// point's impulses and the energy its impulses took, and the generalized velocities around
     /// the impact.
