@@ -201,7 +201,7 @@ impact = { type = "newton", eps = 0.5 }
         (lambda c: c.update(body1="nobody"), ["contacts[0] 'floor'", "body1", "nobody"]),
         (lambda c: c.update(body2="ball"), ["'floor'", "same body"]),
         (lambda c: c["contour1"].update(radius=-1.0), ["'floor'", "radius"]),
-        (lambda c: c.update(friction={"type": "coulomb", "mu": 0.4, "mu0": 0.3}), ["'floor'", "mu0", ">= mu"]),
+        (lambda c: c.update(friction={"type": "coulomb", "mu": 0.4, "mu0": -0.3}), ["'floor'", "mu0", ">= 0"]),
         (lambda c: c.update(friction={"type": "coulomb", "mu": -0.1}), ["'floor'", "friction.mu"]),
         (lambda c: c.update(impact={"type": "newton", "eps": 1.5}), ["'floor'", "impact.eps", "[0, 1]"]),
         (lambda c: c.update(impact={"type": "poisson", "eps": 0.5, "eps_t": float("nan")}), ["contacts[0]", "eps_t"]),
@@ -217,6 +217,32 @@ def test_bad_contacts_name_the_item(change, fragments):
         ms.Model.from_dict(d).build()
     for f in fragments:
         assert f in str(e.value), (f, str(e.value))
+
+
+def test_static_below_sliding_is_accepted_with_a_warning_and_sticks_up_to_mu():
+    """mu0 = 0.3 < mu = 0.4: warned, naming the contact; a block pulled by 0.35 m g stays put in
+    both schemes (a slide against 0.4 m g could not start), and 0.45 m g slides with mu."""
+    for integ in (ms.EventDriven(), ms.MoreauJean(1e-3)):
+        for pull, moves in ((0.35, False), (0.45, True)):
+            m = ms.Model("weak", gravity=(0, -G, 0))
+            b = m.add_body("block", 1.0, ms.inertia.sphere(1.0, 0.1))
+            m.add_joint(ms.joints.Planar("pl", m.ground, b))
+            m.add_contact(ms.Contact("base", b.contour(ms.contours.Point()), m.ground.contour(ms.contours.Line(normal=(0, 1, 0))),
+                                     friction=ms.laws.Coulomb(mu=0.4, mu0=0.3)))
+            m.add_force(ms.forces.JointForce("pull", "pl", value=[pull * G, 0.0, 0.0]))
+            with pytest.warns(UserWarning, match=r"contact 'base'.*mu0 = 0.3.*mu = 0.4"):
+                res = ms.simulate(m, 0.5, integ, output_dt=1e-2)
+            x = res["joint/pl/q"][:, 0]
+            if moves:
+                np.testing.assert_allclose(x[-1], 0.5 * (0.45 - 0.4) * G * 0.5**2, rtol=1e-9 if isinstance(integ, ms.EventDriven) else 1e-2)
+            else:
+                assert np.abs(x).max() < 1e-12
+
+
+def test_poisson_law_under_moreau_jean_is_refused_naming_the_contact():
+    m = cradle(0.5, ms.laws.Poisson)
+    with pytest.raises(ms.SettingsError, match=r"contact 'c0': Poisson's impact law needs the event-driven scheme"):
+        ms.simulate(m, 0.1, ms.MoreauJean(1e-3), output_dt=1e-2)
 
 
 def test_bad_contact_objects_in_python():

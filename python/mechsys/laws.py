@@ -4,12 +4,14 @@
 - :class:`Signorini`: the normal corner law g_N >= 0, lambda_N >= 0, g_N lambda_N = 0 (the only
   normal law; contacts are rigid and unilateral).
 - :class:`Coulomb`: the double-corner law (2.200) with sliding coefficient ``mu`` and static
-  coefficient ``mu0`` (>= mu; equal to mu if omitted).
+  coefficient ``mu0`` (equal to mu if omitted; below mu it is accepted with a warning and the
+  contact sticks up to mu).
 - :class:`Stribeck`: mu(v) = mu + (mu0 - mu) exp(-(|v| / v_s)^exponent) (2.201).
 - :class:`FrictionTable`: mu(|v|) tabulated, linear in between.
 - :class:`Newton`: g_N' after = -eps g_N' before (2.202), normal direction only.
 - :class:`Poisson`: expansion impulse = eps times the compression impulse (2.203), normal and,
-  with ``eps_t``, tangential.
+  with ``eps_t``, tangential; event-driven scheme only (Moreau-Jean refuses it: a time step's
+  impulse mixes the impact with the step's smooth forces).
 """
 
 from __future__ import annotations

@@ -205,6 +205,7 @@ class Model:
             desc, callbacks = self.describe()
             text = json.dumps(desc, allow_nan=True)
             self._built = (text, _core.Model(text), callbacks)
+            _warn_static_below_sliding(desc)
         return self._built[1]
 
     def _invalidate(self) -> None:
@@ -311,3 +312,18 @@ class Model:
 
 
 __all__ = ["Model", "Body"]
+
+
+def _warn_static_below_sliding(desc: dict) -> None:
+    """mu0 < mu is accepted (a measured Stribeck curve may rise from rest), with a warning: the
+    contact then sticks up to mu, since a slide against more friction than held it cannot start."""
+    import warnings
+
+    for kind in ("contacts", "contact_groups"):
+        for c in desc.get(kind, []):
+            f = c.get("friction") or {}
+            mu, mu0 = f.get("mu"), f.get("mu0")
+            if isinstance(mu, (int, float)) and isinstance(mu0, (int, float)) and mu0 < mu:
+                what = "contact" if kind == "contacts" else "contact group"
+                warnings.warn(f"{what} '{c.get('name')}': the static coefficient mu0 = {mu0} is below the sliding "
+                              f"one mu = {mu}; it sticks up to mu", UserWarning, stacklevel=3)

@@ -496,6 +496,22 @@ pub fn simulate(
     }
     let contacts = !model.contacts.is_empty();
     if let IntegratorKind::MoreauJean { dt, solver, continue_on_painleve } = settings.integrator {
+        // Poisson's law (2.203) relates the impulses of an impact's compression and expansion
+        // phases; a time step's impulse mixes the impact with the step's smooth forces, so the
+        // scheme cannot apply it: refused rather than replaced by Newton's law unseen
+        let poisson = |law: &crate::model::contact::ImpactLaw| matches!(law, crate::model::contact::ImpactLaw::Poisson { .. });
+        if let Some(c) = model.contacts.iter().find(|c| poisson(&c.impact)) {
+            return Err(Error::Settings(format!(
+                "contact '{}': Poisson's impact law needs the event-driven scheme (integrator EventDriven); MoreauJean applies restitution at velocity level, as Newton's law: give this contact laws.Newton(eps) to use it",
+                c.name
+            )));
+        }
+        if let Some(g) = model.contact_groups.iter().find(|g| poisson(&g.impact)) {
+            return Err(Error::Settings(format!(
+                "contact group '{}': Poisson's impact law needs the event-driven scheme, which does not take contact groups; give the group laws.Newton(eps)",
+                g.name
+            )));
+        }
         return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve), rec);
     }
     crate::ensure!(

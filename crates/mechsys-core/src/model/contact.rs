@@ -69,9 +69,11 @@ impl FrictionLaw {
         }
     }
 
-    /// Static coefficient µ0 (the limit of µ at zero sliding speed).
+    /// Static coefficient µ0 (the limit of µ at zero sliding speed, eq. 2.201). Given below the
+    /// sliding coefficient (accepted with a warning), a contact still sticks up to the sliding
+    /// one: a slide against more friction than held it could not start.
     pub fn mu0(&self) -> f64 {
-        self.mu(0.0)
+        self.mu(0.0).max(self.mu(f64::MIN_POSITIVE))
     }
 }
 
@@ -218,18 +220,15 @@ fn friction_law(friction: &FrictionDescription, what: &str) -> Result<FrictionLa
             let mu = finite(*mu, &format!("{what}.friction.mu"))?;
             let mu0 = finite(mu0.unwrap_or(mu), &format!("{what}.friction.mu0"))?;
             crate::ensure!(mu >= 0.0, Model, "{what}.friction.mu: must be >= 0, got {mu}");
-            crate::ensure!(
-                mu0 >= mu,
-                Model,
-                "{what}.friction.mu0: the static coefficient must be >= mu = {mu}, got {mu0}"
-            );
+            // (µ0 < µ is accepted; the Python layer warns, and mu0() holds up to µ)
+            crate::ensure!(mu0 >= 0.0, Model, "{what}.friction.mu0: must be >= 0, got {mu0}");
             FrictionLaw::Coulomb { mu, mu0 }
         }
         FrictionDescription::Stribeck { mu0, mu, v_s, exponent } => {
             let w = format!("{what}.friction");
             let (mu0, mu) = (finite(*mu0, &format!("{w}.mu0"))?, finite(*mu, &format!("{w}.mu"))?);
             crate::ensure!(mu >= 0.0, Model, "{w}.mu: must be >= 0, got {mu}");
-            crate::ensure!(mu0 >= mu, Model, "{w}.mu0: the static coefficient must be >= mu = {mu}, got {mu0}");
+            crate::ensure!(mu0 >= 0.0, Model, "{w}.mu0: must be >= 0, got {mu0}");
             crate::ensure!(v_s.is_finite() && *v_s > 0.0, Model, "{w}.v_s: must be > 0, got {v_s}");
             crate::ensure!(exponent.is_finite() && *exponent > 0.0, Model, "{w}.exponent: must be > 0, got {exponent}");
             FrictionLaw::Stribeck { mu0, mu, v_s: *v_s, exponent: *exponent }
