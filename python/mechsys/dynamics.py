@@ -59,8 +59,22 @@ def energies(model: Model, q, u, t: float = 0.0, point=(0.0, 0.0, 0.0)) -> dict:
     return _core.energies(model.engine()[0], _arr(q), _arr(u), t, [float(x) for x in point])
 
 
+def contact_matrices(model: Model, q, u=None, t: float = 0.0) -> dict:
+    """The contact quantities of every contact point at one state (sections 2.2.7, 2.5): ``gap``
+    (points, m), ``velocity`` (points x 3: g_N', g_T1', g_T2'), the rows ``w`` (points x 3 x nu:
+    normal, t1, t2; g' = w u), the Delassus matrix ``delassus`` (3 points square, W^T M~^-1 W with
+    the bilateral constraints' reactions: relative acceleration per unit contact force, the matrix
+    of the transition and impact problems), ``wbar`` (points x 3, the velocity-product terms) and
+    ``free_acceleration`` (points x 3, the relative accelerations without contact forces). Points
+    are ordered as the contacts and their candidates; ``u`` defaults to zero."""
+    core, callbacks = model.engine()
+    u = np.zeros(model.nu) if u is None else u
+    return _core.contact_matrices(core, _arr(q), _arr(u), t, callbacks)
+
+
 aba = forward_dynamics
 crba = mass_matrix
 rnea = inverse_dynamics
 
-__all__ = ["mass_matrix", "forward_dynamics", "inverse_dynamics", "nonlinear_effects", "energies", "aba", "crba", "rnea"]
+__all__ = ["mass_matrix", "forward_dynamics", "inverse_dynamics", "nonlinear_effects", "energies", "contact_matrices", "aba",
+           "crba", "rnea"]

@@ -241,7 +241,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(linearize, m)?)?;
     register_reactions(m)?;
     register_constraints(m)?;
-    register_constraint_gamma(m)
+    register_constraint_gamma(m)?;
+    register_contact_matrices(m)
 }
 
 /// Joint reaction wrenches for a whole recorded run: for each sample (t, q, u, udot) the wrench
@@ -352,4 +353,42 @@ fn constraint_gamma<'py>(
 
 pub fn register_constraint_gamma(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constraint_gamma, m)?)
+}
+
+/// The contact matrices at (q, u, t) for every contact point: gaps, relative velocities, the rows
+/// W (points × 3 × nu: normal, t1, t2), the Delassus matrix Wᵀ M̃⁻¹ W (3 points square, with the
+/// bilateral constraints' reactions), w̄ and the free relative accelerations (points × 3).
+#[pyfunction]
+#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None))]
+fn contact_matrices<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: &Bound<'py, PyAny>,
+    u: &Bound<'py, PyAny>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechsys_core::integrator::event_driven::{Options, Phase};
+    let m = &model.model;
+    let q = q_slice(model, q)?;
+    let u = fast_slice(u, m.nu, "u")?;
+    let cb = self::callbacks(model, callbacks)?;
+    let mut phase = Phase::new(m, &cb, Options::default()).map_err(PyMechsysError::from)?;
+    let c = phase.contact_matrices(t, q, u).map_err(PyMechsysError::from)?;
+    let np = c.points;
+    let d = PyDict::new(py);
+    let shaped = |v: Vec<f64>, shape: &[usize]| -> PyResult<Bound<'py, PyAny>> {
+        Ok(PyArray1::from_vec(py, v).reshape(shape.to_vec())?.into_any())
+    };
+    d.set_item("gap", shaped(c.gap, &[np])?)?;
+    d.set_item("velocity", shaped(c.velocity, &[np, 3])?)?;
+    d.set_item("w", shaped(c.w, &[np, 3, m.nu])?)?;
+    d.set_item("delassus", shaped(c.delassus, &[3 * np, 3 * np])?)?;
+    d.set_item("wbar", shaped(c.wbar, &[np, 3])?)?;
+    d.set_item("free_acceleration", shaped(c.free_acceleration, &[np, 3])?)?;
+    Ok(d)
+}
+
+pub fn register_contact_matrices(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(contact_matrices, m)?)
 }

@@ -28,8 +28,11 @@
 //! slower than `velocity_tol` closes the contact without impact.
 
 mod impact;
+mod matrices;
 mod phase;
 mod transition;
+
+pub use matrices::ContactMatrices;
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
