@@ -212,7 +212,13 @@ impl EventRecord {
                     u_after,
                     painleve: e.painleve.as_ref().map(|p| {
                         let names = |v: &Vec<usize>| v.iter().map(|&pt| name(pt)).collect::<Vec<_>>();
-                        (p.mu, p.mu_critical, p.non_unique, [names(&p.solutions[0]), names(&p.solutions[1])], p.resolved_by_impulse)
+                        (
+                            p.mu,
+                            p.mu_critical,
+                            p.non_unique,
+                            [names(&p.solutions[0]), names(&p.solutions[1])],
+                            p.resolved_by_impulse,
+                        )
                     }),
                     steps: e.steps,
                 }
@@ -499,7 +505,8 @@ pub fn simulate(
         // Poisson's law (2.203) relates the impulses of an impact's compression and expansion
         // phases; a time step's impulse mixes the impact with the step's smooth forces, so the
         // scheme cannot apply it: refused rather than replaced by Newton's law unseen
-        let poisson = |law: &crate::model::contact::ImpactLaw| matches!(law, crate::model::contact::ImpactLaw::Poisson { .. });
+        let poisson =
+            |law: &crate::model::contact::ImpactLaw| matches!(law, crate::model::contact::ImpactLaw::Poisson { .. });
         if let Some(c) = model.contacts.iter().find(|c| poisson(&c.impact)) {
             return Err(Error::Settings(format!(
                 "contact '{}': Poisson's impact law needs the event-driven scheme (integrator EventDriven); MoreauJean applies restitution at velocity level, as Newton's law: give this contact laws.Newton(eps) to use it",
@@ -631,7 +638,8 @@ fn time_stepping(
                             pt - c.first
                         )));
                     }
-                    let fresh = painleve_event(&stepper, pt, (mu, crit, non_unique), step, t_end, &mut last_painleve, &mut log);
+                    let fresh =
+                        painleve_event(&stepper, pt, (mu, crit, non_unique), step, t_end, &mut last_painleve, &mut log);
                     if fresh {
                         let c = model.contact_of_point(pt);
                         rec.warnings.push(if non_unique {

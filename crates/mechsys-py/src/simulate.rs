@@ -291,6 +291,8 @@ fn simulate<'py>(
     st.set_item("evaluations", rec.stats.evaluations)?;
     st.set_item("jacobians", rec.stats.jacobians)?;
     st.set_item("events", rec.stats.events)?;
+    st.set_item("transitions", rec.stats.transitions)?;
+    st.set_item("transition_seconds", rec.stats.transition_seconds)?;
     d.set_item("stats", st)?;
     Ok(d)
 }

@@ -120,6 +120,13 @@ pub struct Stats {
     /// Contact events (event-driven scheme).
     #[serde(default)]
     pub events: usize,
+    /// Transitions solved (event-driven scheme: impacts, transition problems, checks of the
+    /// switches) and the wall time they took (s), for the cost per transition.
+    #[serde(default)]
+    pub transitions: usize,
+    /// See `transitions`.
+    #[serde(default)]
+    pub transition_seconds: f64,
 }
 
 /// Runs the chosen scheme from (t0, y0) through all `t_out` (increasing, ≥ t0).

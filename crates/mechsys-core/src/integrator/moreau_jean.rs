@@ -511,7 +511,8 @@ impl MoreauJean {
                     (law, s) if s == SLIP => law.mu(slip_speed.max(f64::MIN_POSITIVE)),
                     (law, _) => law.mu0(),
                 };
-                let sliding_less = !matches!(friction, FrictionLaw::None) && prev_state != SLIP && friction.mu(f64::MIN_POSITIVE) < mu;
+                let sliding_less =
+                    !matches!(friction, FrictionLaw::None) && prev_state != SLIP && friction.mu(f64::MIN_POSITIVE) < mu;
                 self.static_mu.push(sliding_less);
                 self.problem.mu.push(mu);
                 self.r.extend_from_slice(&prev[..d]);
@@ -539,7 +540,9 @@ impl MoreauJean {
                     let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
                     let saturated = self.r[ai * d] > 0.0
                         && self.problem.friction_reserve(ai, &self.r)? <= 1e-9 * self.problem.mu[ai] * self.r[ai * d];
-                    if saturated || self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip {
+                    if saturated
+                        || self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip
+                    {
                         let v = self.problem.local_velocity(ai, &self.r)?;
                         let speed = (v[1] * v[1] + v[2] * v[2]).sqrt();
                         let law = match self.act[ai].source {
@@ -551,10 +554,11 @@ impl MoreauJean {
                     }
                 }
                 if again {
-                    report = solver::solve(&self.problem, &self.method, &mut self.r, true, &mut self.ws).map_err(|e| {
-                        let names = self.active_names(model);
-                        Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
-                    })?;
+                    report =
+                        solver::solve(&self.problem, &self.method, &mut self.r, true, &mut self.ws).map_err(|e| {
+                            let names = self.active_names(model);
+                            Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
+                        })?;
                 }
             }
             if !report.converged {

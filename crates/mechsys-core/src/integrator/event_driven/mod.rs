@@ -250,7 +250,10 @@ pub fn integrate<'a>(
     let (mut last_event, mut same_instant) = (f64::NEG_INFINITY, 0usize);
 
     phase.project(t, &mut y)?;
+    let clock = std::time::Instant::now();
     let d = phase.transition(t, &mut y, &mut imp, warnings, &triggered)?;
+    stats.transitions += 1;
+    stats.transition_seconds += clock.elapsed().as_secs_f64();
     diss.impact += d.impact;
     diss.friction += d.friction;
     phase.rhs(t, &y, &mut st.k[0])?;
@@ -355,7 +358,10 @@ pub fn integrate<'a>(
                     phase.names(&what)
                 )));
             }
+            let clock = std::time::Instant::now();
             let d = phase.transition(t, &mut y, &mut imp, warnings, &triggered)?;
+            stats.transitions += 1;
+            stats.transition_seconds += clock.elapsed().as_secs_f64();
             diss.impact += d.impact;
             diss.friction += d.friction;
             phase.rhs(t, &y, &mut st.k[0])?;

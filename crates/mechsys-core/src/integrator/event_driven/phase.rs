@@ -3,11 +3,11 @@
 use nalgebra::DMatrix;
 
 use super::{EventWork, Options, Phase, PYRAMID};
-use crate::integrator::events::EventLog;
 use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::{Callbacks, Powers};
+use crate::integrator::events::EventLog;
 use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
 use crate::integrator::OdeSystem;
 use crate::math::linalg::{cholesky_semidefinite, solve_min_norm};

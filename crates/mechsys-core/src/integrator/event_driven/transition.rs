@@ -2,8 +2,8 @@
 
 use super::{Dissipation, Phase, PYRAMID};
 use crate::contact::{contact_kinematics, BodyMotion};
-use crate::integrator::events::{EventKind, Painleve};
 use crate::error::{Error, Result};
+use crate::integrator::events::{EventKind, Painleve};
 use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
 use crate::model::contact::FrictionLaw;
 use crate::solver::{self, Method};
@@ -208,7 +208,8 @@ impl Phase<'_> {
         let (mut touching, mut closing) = (std::mem::take(&mut ev.touching), std::mem::take(&mut ev.closing));
         let (mut old, mut old_dir) = (std::mem::take(&mut ev.old), std::mem::take(&mut ev.old_dir));
         self.ev = ev;
-        let r = self.transition_with(t, y, imp, warnings, triggered, (&mut touching, &mut closing, &mut old, &mut old_dir));
+        let r =
+            self.transition_with(t, y, imp, warnings, triggered, (&mut touching, &mut closing, &mut old, &mut old_dir));
         self.ev.touching = touching;
         self.ev.closing = closing;
         self.ev.old = old;
@@ -289,8 +290,13 @@ impl Phase<'_> {
             let first = self.log.events.len() - culprits.len();
             for k in first..self.log.events.len() {
                 let (mu, mu_critical) = self.painleve_mu(self.log.events[k].point);
-                self.log.events[k].painleve =
-                    Some(Painleve { mu, mu_critical, non_unique: false, solutions: [Vec::new(), Vec::new()], resolved_by_impulse: true });
+                self.log.events[k].painleve = Some(Painleve {
+                    mu,
+                    mu_critical,
+                    non_unique: false,
+                    solutions: [Vec::new(), Vec::new()],
+                    resolved_by_impulse: true,
+                });
             }
             self.ev.hit = culprits;
             let d = r?;
@@ -324,8 +330,13 @@ impl Phase<'_> {
                     self.point_names(&taken),
                     self.point_names(&other)
                 ));
-                self.log.push(t, pt, EventKind::Painleve).painleve =
-                    Some(Painleve { mu, mu_critical, non_unique: true, solutions: [taken, other], resolved_by_impulse: false });
+                self.log.push(t, pt, EventKind::Painleve).painleve = Some(Painleve {
+                    mu,
+                    mu_critical,
+                    non_unique: true,
+                    solutions: [taken, other],
+                    resolved_by_impulse: false,
+                });
             }
         }
         let d = self.settle(u, imp);
