@@ -708,3 +708,11 @@ def test_woodpecker_schemes_agree_on_the_descent_speed(woodpecker_runs):
     print(f"\nwoodpecker descent speed (last 0.6 s): ED {s_ed:.5f} m/s, MJ {s_mj:.5f} m/s, difference {100 * (s_ed / s_mj - 1):.2f} %")
     assert s_ed < 0 and s_mj < 0
     assert abs(s_ed / s_mj - 1) < 0.01
+
+
+def test_moreau_jean_default_sampling_falls_on_steps():
+    """Without output_dt a Moreau-Jean run samples at the whole multiple of dt nearest to 1/1000 of
+    the span (here 0.37 s / 1000 / 1e-4 = 3.7 -> 4 steps): 926 samples, 4e-4 s apart."""
+    res = ms.simulate(pulled_mass(), 0.37, ms.MoreauJean(1e-4))
+    assert len(res.t) == 926
+    np.testing.assert_allclose(np.diff(res.t), 4e-4, rtol=1e-9)

@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _core
 from .errors import SettingsError
-from .integrators import DOPRI5, RK4, Radau5
+from .integrators import DOPRI5, RK4, MoreauJean, Radau5
 from .model import Model
 from .results import Results
 
@@ -20,7 +20,8 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
     if integrator is None:
         integrator = DOPRI5()
     if not hasattr(integrator, "describe"):
-        raise SettingsError(f"integrator: expected mechsys.RK4, DOPRI5 or Radau5, got {type(integrator).__name__}")
+        raise SettingsError("integrator: expected mechsys.RK4, DOPRI5, Radau5, MoreauJean or EventDriven, "
+                            f"got {type(integrator).__name__}")
     try:
         t_end = float(t_end)
         t0 = float(t0)
@@ -34,6 +35,9 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
     if output_dt is None:
         if isinstance(integrator, (RK4, Radau5)):
             output_dt = integrator.dt
+        elif isinstance(integrator, MoreauJean):
+            # samples fall on steps: the whole multiple of dt nearest to 1/1000 of the span
+            output_dt = max(1, round((t_end - t0) / 1000.0 / integrator.dt)) * integrator.dt
         else:
             output_dt = (t_end - t0) / 1000.0 if t_end > t0 else 1.0
     try:
@@ -69,9 +73,12 @@ def simulate(
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
-    ``integrator``: :class:`mechsys.RK4`, :class:`mechsys.DOPRI5` (default) or :class:`mechsys.Radau5`.
-    ``output_dt``: sampling interval of the results (default: the step of a fixed-step scheme,
-    else 1/1000 of the span). ``q0``/``u0``: full vectors or ``{joint name: value}`` dicts
+    ``integrator``: :class:`mechsys.RK4`, :class:`mechsys.DOPRI5` (default) or
+    :class:`mechsys.Radau5` for smooth models; :class:`mechsys.MoreauJean` (time-stepping) or
+    :class:`mechsys.EventDriven` for models with contacts (their events in ``res.events``).
+    ``output_dt``: sampling interval of the results (default: the step of RK4 and Radau5, the
+    whole multiple of the step nearest to 1/1000 of the span for MoreauJean, else 1/1000 of the
+    span). ``q0``/``u0``: full vectors or ``{joint name: value}`` dicts
     (the joints' own q0/u0 elsewhere). ``progress``: show a progress bar (default: only when
     the run takes longer than about a second and stderr is a terminal). ``keep``: joints whose
     q0 and u0 stay as given when a constrained model is assembled to a consistent start (the
