@@ -118,8 +118,10 @@ fn bench_box_box(c: &mut Criterion) {
     let rot = |axis: Vec3, angle: f64| {
         nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle).into_inner()
     };
-    let upper = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.2, 0.15, 0.1) };
-    let lower = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.25, 0.2, 0.1) };
+    let upper =
+        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.2, 0.15, 0.1) };
+    let lower =
+        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.25, 0.2, 0.1) };
     let mut cases = Vec::with_capacity(n);
     for i in 0..n {
         let tilt = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 0.0);

@@ -5,8 +5,9 @@
 //! `a_i(x) = a_i + α_i × x + ω_i × v_i(x)` its acceleration (world convention, see
 //! [`crate::kinematics`]):
 //!
-//! - `ġ_N = n·(v_1(P1) - v_2(P2))` (eqs. 2.110, 2.122) — exactly `d g_N/dt`, because
-//!   `P1 - P2 = g_N n` and the contact points slide tangentially over their contours;
+//! - `ġ_N = n·(v_1(P1) - v_2(P2))` (eqs. 2.110, 2.122): the rate of the gap between the material
+//!   points at `P1` and `P2` — exactly `d g_N/dt`, because `P1 - P2 = g_N n` and the contact
+//!   points slide tangentially over their contours (one exception below);
 //! - `ġ_T,k = t_k·(v_1(P1) - v_2(P2))` — body 1's sliding velocity relative to body 2;
 //! - `g̈_N = n·(a_1(P1) - a_2(P2)) + ṅ·Δv + n·(ω_1 × σ_1 - ω_2 × σ_2)`, where `Δv` is the relative
 //!   velocity above and `σ_i = Ṗ_i - v_i(P_i)` the velocity of the contact point over contour i
@@ -28,7 +29,11 @@
 //! those are smooth (a fixed face/edge/corner region of a box, fixed clamping of capsule segment
 //! parameters). Not exact: at the degenerate configurations listed in [`super::narrow`] (the
 //! normal is then taken as turning with body 2) and for exactly parallel capsule axes, where the
-//! overlap-midpoint rule fixes the parameter on segment 1.
+//! overlap-midpoint rule fixes the parameter on segment 1. Box–box: every candidate has
+//! `ġ_N = d g_N/dt` but a crossing of the clipped manifold (an incident edge crossing a side plane
+//! of the reference face), whose `ġ_N` is the rate of the incident box's material point there;
+//! the crossing's own gap changes by `(m·e) ṡ` more when that edge is tilted against the reference
+//! face and the crossing slides along it (see [`super::narrow::box_box`]).
 
 use crate::data::Data;
 use crate::error::Result;

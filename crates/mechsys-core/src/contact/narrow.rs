@@ -15,7 +15,7 @@
 //! | point, sphere – sphere | 1 | along the centre line |
 //! | point, sphere, capsule – capsule | 1 | closest points of the axis segments |
 //! | point, sphere – box | 1 | closest point of the box (deepest face when the centre is inside) |
-//! | box – box | 8 | separating axes; the clipped incident face, or one edge–edge point ([`box_box`]) |
+//! | box – box | 8 | separating axes; the clipped incident face (each vertex a point against a face), or one edge–edge point ([`box_box`]) |
 //! | point2, circle, polygon – line | 1, 1, vertices | as the spatial point/sphere – plane |
 //! | point2, circle – circle | 1 | along the centre line in the x-y plane |
 //!
@@ -89,8 +89,8 @@ enum Geometry {
     Swept { a1: Vec3, d1: Vec3, r1: f64, a2: Vec3, d2: Vec3, r2: f64, across: Vec3 },
     /// A sphere (or point, radius 0) on body 1 against a box on body 2.
     SphereBox { center: Vec3, radius: f64, box_center: Vec3, box_rotation: Mat3, half: Vec3 },
-    /// Two boxes (body 1's, body 2's), a manifold of up to [`box_box::POINTS`] points with one
-    /// normal; `scale` is the largest half extent (tolerances of ties).
+    /// Two boxes (body 1's, body 2's), a manifold of up to [`box_box::POINTS`] points; `scale` is
+    /// the largest half extent (tolerances of ties).
     BoxBox { a: BoxShape, b: BoxShape, scale: f64 },
     /// Planar: circles (or points, radius 0) extruded along body 2's z axis.
     CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
@@ -257,22 +257,20 @@ impl ContactPair {
     #[cfg(test)]
     pub(crate) fn box_feature(&self, x1: &Pose, x2: &Pose) -> Option<box_box::Feature> {
         match &self.geometry {
-            Geometry::BoxBox { a, b, scale } => {
-                let (x1, x2) = if self.swapped { (x2, x1) } else { (x1, x2) };
-                Some(box_box::feature(x1, x2, a, b, *scale).0)
-            }
+            Geometry::BoxBox { a, b, scale } => Some(box_box::feature(x1, x2, a, b, *scale).0),
             _ => None,
         }
     }
 
-    /// The box–box feature pair and what each candidate is (caller's order of candidates; tests).
+    /// The box–box feature pair and what each candidate is (tests; box–box pairs are never swapped).
     #[cfg(test)]
-    pub(crate) fn box_kinds(&self, x1: &Pose, x2: &Pose) -> Option<(box_box::Feature, [box_box::Kind; box_box::POINTS])> {
+    pub(crate) fn box_kinds(
+        &self,
+        x1: &Pose,
+        x2: &Pose,
+    ) -> Option<(box_box::Feature, [box_box::Kind; box_box::POINTS])> {
         match &self.geometry {
-            Geometry::BoxBox { a, b, scale } => {
-                let (x1, x2) = if self.swapped { (x2, x1) } else { (x1, x2) };
-                Some(box_box::kinds(x1, x2, a, b, *scale))
-            }
+            Geometry::BoxBox { a, b, scale } => Some(box_box::kinds(x1, x2, a, b, *scale)),
             _ => None,
         }
     }
@@ -329,15 +327,9 @@ impl ContactPair {
     pub(crate) fn candidates_into(&self, x1: &Pose, x2: &Pose, twists: Option<(&Motion, &Motion)>, out: &mut [Raw]) {
         debug_assert!(out.len() >= self.count, "candidates_into: room for {} of {}", out.len(), self.count);
         let out = &mut out[..self.count];
-        if let Geometry::BoxBox { a, b, scale } = &self.geometry {
-            if !self.swapped {
-                box_box::box_box_all(x1, x2, twists, a, b, *scale, out);
-            } else {
-                box_box::box_box_all(x2, x1, twists.map(|(t1, t2)| (t2, t1)), a, b, *scale, out);
-                for o in out.iter_mut() {
-                    *o = o.reversed();
-                }
-            }
+        // box–box is canonical in either order (never swapped)
+        if let (Geometry::BoxBox { a, b, scale }, false) = (&self.geometry, self.swapped) {
+            box_box::box_box_all(x1, x2, twists, a, b, *scale, out);
             return;
         }
         for (k, o) in out.iter_mut().enumerate() {

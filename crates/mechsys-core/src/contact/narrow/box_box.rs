@@ -1,4 +1,4 @@
-//! Box against box: the separating-axis test and a contact manifold with one normal per pair.
+//! Box against box: the separating-axis test and a contact manifold of clipped face vertices.
 //!
 //! Box A is the canonical body 1's, box B body 2's; `d = c_A - c_B` joins their centres. Along a
 //! unit axis `u` the two boxes' projections are separated by
@@ -20,35 +20,73 @@
 //!
 //! **Face manifold.** On the reference face (outward unit normal `m`, pointing towards the other
 //! box, fixed in the reference body) the other box's incident face is the one whose outward
-//! normal is most opposed to `m`. Its four corners are clipped against the reference face's four
-//! side planes (Sutherland–Hodgman): at most 8 vertices `v`, each on the incident face. Each
-//! becomes one candidate with gap `g = m·(v - p_ref)` (`p_ref` on the reference face), the point
-//! `v` on the incident box and `v - g m` on the reference face's plane. Should the incident face
-//! miss the reference face's side planes altogether, its corner deepest along `-m` is the one
-//! candidate (so overlapping boxes are never left without one). The normal of every candidate is
-//! the pair's normal: `m` when B is the reference, `-m` when A is. A vertex within
-//! [`TIE`]` · scale` of a side plane counts as lying on it (no near-duplicate vertex is made), so
-//! equal boxes stacked exactly keep four corner candidates.
+//! normal `f` is most opposed to `m`. Its four corners are clipped against the reference face's
+//! four side planes (Sutherland–Hodgman): at most 8 vertices `v`, each on the incident face and
+//! labelled with the two planes besides the incident face that define it. Each vertex becomes one
+//! candidate (see "Contact points"). Should the incident face miss the reference face's side
+//! planes altogether, its corner deepest along `-m` is the one candidate (so overlapping boxes are
+//! never left without one). A vertex within [`TIE`]` · scale` of a side plane counts as lying on
+//! it (no near-duplicate vertex is made), so equal boxes stacked exactly keep four corner
+//! candidates.
+//!
+//! **Contact points.** The engine's normal rate is `ġ_N = n·(v_1(P1) - v_2(P2))` (eq. 2.110,
+//! `w_Nᵀ u`): the rate of the gap between the material points of the two boxes at `P1` and `P2`,
+//! held in their bodies. It is the rate of the candidate's own gap exactly when each contact point
+//! moves over its contour perpendicular to `n` — the contact conditions of eqs. 2.102–2.103: the
+//! normal is the normal of the surface over which the other body's point slides, the same rule as
+//! for point contours (a box corner against a plane takes the plane's normal). Each vertex is
+//! therefore a point of one box against a face of the other:
+//!
+//! | vertex (its two defining planes) | point | against | normal, reference box → incident box | `g_N` |
+//! | --- | --- | --- | --- | --- |
+//! | corner of the incident face (two incident side planes) | that corner | reference face | `m` | `m·(v - p_ref)` |
+//! | corner of the reference face (two reference side planes) | that corner `q` | incident face | `-f` | `f·(q - c_f)` |
+//! | crossing: an incident edge and a reference side plane | incident box's point at `v` | reference face | `m` | `m·(v - p_ref)` |
+//!
+//! (`p_ref` the reference face's centre, `c_f` the incident face's.) The other contact point is
+//! the point's foot on the face's plane, `g_N` away along the normal; the pair's normal (from B
+//! towards A) is the table's when B carries the reference face, reversed when A does. For the two
+//! kinds of corners the point is a material point and its foot slides in the face's plane,
+//! perpendicular to the normal: `ġ_N = d g_N/dt` exactly, and `w̄_N`, `w̄_T` are the time
+//! derivatives of `ġ_N`, `ġ_T` along the motion (eqs. 2.114–2.115). Faces parallel (`f = -m`):
+//! all three rows give the same gap and normal. Tilted by `τ` against each other, a reference
+//! corner's normal is the incident face's (the direction of the force on a corner pressed on a
+//! face) and its gap is `cos τ` times the gap along `m`; its foot lies on the incident face's
+//! plane, within `|g_N| sin τ` of the face itself.
+//!
+//! A crossing is no material point of either box: it moves along the incident edge (direction
+//! `e`, rate `ṡ` relative to the incident box) and along the reference face's edge. It is taken
+//! as the incident box's material point there, against the reference face: `ġ_N` is exactly the
+//! rate of that point's gap (and `w̄_N`, `w̄_T` the exact derivatives of `ġ_N`, `ġ_T` as the engine
+//! evaluates them, following the crossing), while the crossing's own gap changes at
+//! `d g_N/dt = ġ_N + (m·e) ṡ`. The extra term vanishes when the incident edge lies in the
+//! reference face's plane (an edge resting on a face, or faces parallel) and is otherwise of the
+//! order of the tilt times the sliding speed along the edge. No face normal removes it: the only
+//! direction perpendicular to both sliding directions is the edges' common normal `e × e_ref`,
+//! which turns over as the edges become parallel; the edge–edge candidate below uses it when the
+//! separating-axis test picks that axis.
 //!
 //! **Edge–edge.** For the axis `u ∝ a_i × b_j` oriented from B to A, the edge of A parallel to
 //! `a_i` farthest along `-u` and the edge of B parallel to `b_j` farthest along `+u`; one
-//! candidate between the closest points of their lines (`P1 - P2 = g u`, `g = s(u)`).
+//! candidate between the closest points of their lines (`P1 - P2 = g u`, `g = s(u)`). Both points
+//! slide along their edges, perpendicular to `u`: `ġ_N = d g_N/dt` exactly.
 //!
 //! **Unused candidates.** A pair has [`POINTS`] candidates; those the manifold does not use get the
 //! gap `|d| + |hA| + |hB|` (more than the distance between any two points of the boxes, never
 //! active) with `P2` at B's centre, `P1 = P2 + g n`; their rates are not meaningful.
 //!
-//! **Rates.** A clipped vertex is the intersection of the incident face's plane with two more
-//! planes, each a side plane of the incident face (fixed in the incident body) or of the
-//! reference face (fixed in the reference body). A point kept on a plane fixed in body X moves, normal to
-//! that plane, with body X's material velocity there: `m_k·v̇ = m_k·v_X(v)` for the three planes,
-//! solved for `v̇`. A corner of the incident face is then a material point; a reference corner or
-//! an incident edge crossing a reference side plane slides over the incident face. The gap of
-//! such a sliding vertex changes also by `n·σ` (σ its velocity over the incident face) when that
-//! face is tilted against the reference face, so there `d g_N/dt = n·(v_1(P1) - v_2(P2)) + n·σ`
-//! and the relative normal velocity of the material points (what the time-stepping constrains)
-//! differs from the rate of the gap by a term of the order of the tilt times the sliding speed.
-//! Corners and edge–edge points have `d g_N/dt = ġ_N` exactly.
+//! **Rates.** `Ṗ1`, `Ṗ2`, `ṅ` are the time derivatives of the candidate's points and normal. A
+//! corner of the reference face moves with the reference box, the incident face's plane (its
+//! normal, the foot) with the incident box. The other vertices are intersections of the incident
+//! face's plane with two more planes, each a side plane of the incident face (fixed in the
+//! incident box) or of the reference face (fixed in the reference box); a point kept on a plane
+//! fixed in box X moves, normal to that plane, with X's material velocity there:
+//! `m_k·v̇ = m_k·v_X(v)` for the three planes, solved for `v̇` (for a corner of the incident face,
+//! its material velocity); `m` turns with the reference box.
+//!
+//! **One evaluation per pair.** One separating-axis test and one clipping fill all candidates of
+//! a pair: [`super::evaluate`] and [`crate::contact::contact_kinematics`] build the manifold once
+//! per call, on the stack (no allocation).
 
 use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::contact::contour::Vec2;
-use crate::contact::test_util::{random_poses, rot, sample, sdf, Rng, PAIRS};
+use crate::contact::test_util::{close, random_poses, rot, sample, sdf, Rng, PAIRS};
 
 fn eval(pair: &ContactPair, x1: &Pose, x2: &Pose) -> Vec<ContactPoint> {
     let mut out = vec![ContactPoint::default(); pair.candidates()];
@@ -319,12 +319,18 @@ fn degenerate_configurations_are_defined() {
     let ci = Contour::Circle { center: Vec2::zeros(), radius: 0.5 };
     let c = eval(&ContactPair::new("d", ci.clone(), ci).unwrap(), &Pose::IDENTITY, &Pose::IDENTITY)[0];
     assert!(finite(&c) && c.g_n == -1.0 && c.n == Vec3::x() && c.t1 == Vec3::y());
-    // NaN poses propagate NaN but do not panic
+    // NaN poses do not panic, and give no finite gap: every candidate is NaN (never active)
     let nan = Pose::new(Mat3::repeat(f64::NAN), Vec3::repeat(f64::NAN));
-    for (a, b) in PAIRS {
+    let half_nan = Pose::new(Mat3::identity(), Vec3::new(0.0, f64::NAN, 0.0));
+    for (a, b) in PAIRS.iter().chain(&[("box", "box_b")]) {
         let pair = ContactPair::new("n", sample(a), sample(b)).unwrap();
-        let _ = eval(&pair, &nan, &Pose::IDENTITY);
-        let _ = eval(&pair, &Pose::IDENTITY, &nan);
+        for (x1, x2) in
+            [(nan, Pose::IDENTITY), (Pose::IDENTITY, nan), (half_nan, Pose::IDENTITY), (Pose::IDENTITY, half_nan)]
+        {
+            for (k, c) in eval(&pair, &x1, &x2).iter().enumerate() {
+                assert!(!c.g_n.is_finite(), "{a}–{b} candidate {k}: a finite gap from a NaN pose {c:?}");
+            }
+        }
     }
 }
 
@@ -486,8 +492,8 @@ fn box_box_random_configurations() {
     let pair = ContactPair::new("bb", ca.clone(), cb.clone()).unwrap();
     let rev = ContactPair::new("bb", cb.clone(), ca.clone()).unwrap();
     let mut rng = Rng::new(123);
-    let (mut faces, mut edges, mut exact, mut fallback) = (0, 0, 0, 0);
-    let corners = |c: &Contour, x: &Pose| -> Vec<Vec3> {
+    let (mut faces, mut edges, mut exact, mut fallback, mut corners) = (0, 0, 0, 0, 0);
+    let corners_of = |c: &Contour, x: &Pose| -> Vec<Vec3> {
         let Contour::Box { center, rotation, half_extents: h } = c else { unreachable!() };
         (0..8)
             .map(|i| {
@@ -503,6 +509,13 @@ fn box_box_random_configurations() {
         let rs = eval(&rev, &x2, &x1);
         let Geometry::BoxBox { a, b, scale } = &pair.geometry else { unreachable!() };
         let (feature, s) = box_box::feature(&x1, &x2, a, b, *scale);
+        let (_, kinds) = pair.box_kinds(&x1, &x2).unwrap();
+        // the reference face's normal (the normal of every candidate but the reference corners)
+        let m = match feature {
+            box_box::Feature::Face { ref_a: true, axis } => (x1.a * a.rotation).column(axis).into_owned(),
+            box_box::Feature::Face { ref_a: false, axis } => (x2.a * b.rotation).column(axis).into_owned(),
+            _ => Vec3::zeros(),
+        };
         let is_face = matches!(feature, box_box::Feature::Face { .. });
         if is_face {
             faces += 1
@@ -524,13 +537,28 @@ fn box_box_random_configurations() {
                 continue;
             }
             gmin = gmin.min(c.g_n);
-            assert!(c.g_n >= s - 1e-12, "{tag}: a candidate's gap {} below the separation {s}", c.g_n);
+            // a reference corner's gap is measured along the incident face's normal, at cos τ of
+            // the gap along m (τ the tilt between the faces)
+            let corner = kinds[k] == box_box::Kind::ReferenceCorner;
+            let (cos, sin) = (c.n.dot(&m).abs(), c.n.cross(&m).norm());
+            let bound = if corner { s.min(s * cos) } else { s };
+            assert!(c.g_n >= bound - 1e-12, "{tag}: a candidate's gap {} below the separation {s}", c.g_n);
+            if is_face && !corner {
+                assert!((c.n.dot(&m).abs() - 1.0).abs() < 1e-12, "{tag}: normal ∥ the reference face's");
+            }
             if let box_box::Feature::Face { ref_a, .. } = feature {
-                // the incident point on its box; the reference point on the reference face, or
-                // (the fallback when the clipped face is empty: one candidate) on its plane
+                // the incident point on its box (a reference corner's foot on the incident face's
+                // plane, within |g| sin τ of the face); the reference point on the reference face,
+                // or (the fallback when the clipped face is empty: one candidate) on its plane
                 let (d1, d2) = (sdf(&ca, &x1, &c.p1), sdf(&cb, &x2, &c.p2));
                 let (d_inc, d_ref) = if ref_a { (d2, d1) } else { (d1, d2) };
-                assert!(d_inc.abs() < 5e-10, "{tag}: incident point off its box by {d_inc}");
+                if corner {
+                    corners += 1;
+                    let slack = c.g_n.abs() * sin * (1.0 + 1e-9);
+                    assert!(d_inc > -5e-10 && d_inc < slack + 5e-10, "{tag}: foot off its face by {d_inc}");
+                } else {
+                    assert!(d_inc.abs() < 5e-10, "{tag}: incident point off its box by {d_inc}");
+                }
                 let in_use = cs.iter().filter(|c| c.g_n < far).count();
                 if d_ref.abs() > 5e-10 {
                     assert!(in_use == 1 && d_ref > 0.0, "{tag}: reference point off its face by {d_ref}");
@@ -544,7 +572,7 @@ fn box_box_random_configurations() {
         }
         // separated: the distance by brute force (corners against the other box, edges against edges)
         if gmin.is_finite() && s > 1e-6 {
-            let (k1, k2) = (corners(&ca, &x1), corners(&cb, &x2));
+            let (k1, k2) = (corners_of(&ca, &x1), corners_of(&cb, &x2));
             let mut dist = k1
                 .iter()
                 .map(|p| sdf(&cb, &x2, p))
@@ -578,6 +606,7 @@ fn box_box_random_configurations() {
     assert!(faces > 50 && edges > 10, "faces {faces}, edges {edges}");
     assert!(exact > 30, "exact distances {exact}");
     assert!((1..10).contains(&fallback), "empty clipped faces {fallback}");
+    assert!(corners > 20, "reference corners {corners}");
 }
 
 /// The one-pass evaluation of all candidates equals the candidate-by-candidate one (values and
@@ -616,11 +645,29 @@ fn box_box_degenerate_inputs() {
     let h = Vec3::new(0.2, 0.15, 0.1);
     let pair = ContactPair::new("bb", cuboid(h), cuboid(Vec3::new(0.05, 0.05, 0.3))).unwrap();
     let nan = Pose::new(Mat3::repeat(f64::NAN), Vec3::repeat(f64::NAN));
-    let _ = eval(&pair, &nan, &Pose::IDENTITY);
-    let _ = eval(&pair, &Pose::IDENTITY, &nan);
+    for (x1, x2) in [(nan, Pose::IDENTITY), (Pose::IDENTITY, nan)] {
+        assert!(eval(&pair, &x1, &x2).iter().all(|c| !c.g_n.is_finite()), "NaN pose: a finite gap");
+    }
     let mut out = [Raw::default(); 8];
     let tw = Motion::new(Vec3::repeat(f64::NAN), Vec3::zeros());
     pair.candidates_into(&Pose::IDENTITY, &nan, Some((&tw, &tw)), &mut out);
+    assert!(out.iter().all(|r| !r.g.is_finite()), "NaN pose: a finite gap {out:?}");
+    // finite, overlapping placements with a NaN angular velocity: the candidates in use (gap ≤ 0)
+    // have NaN rates, the others stay inactive (a finite gap larger than the boxes)
+    {
+        use crate::contact::kinematics::{contact_kinematics, BodyMotion, ContactKinematics};
+        let x1 = Pose::new(rot(&Vec3::new(1.0, 0.5, 0.0), 0.1), Vec3::new(0.02, 0.01, 0.39));
+        let b1 = BodyMotion { pose: x1, twist: tw, acc: Motion::ZERO };
+        let b2 = BodyMotion { pose: Pose::IDENTITY, twist: Motion::ZERO, acc: Motion::ZERO };
+        let mut kin = [ContactKinematics::default(); 8];
+        contact_kinematics(&pair, &b1, &b2, &mut kin).unwrap();
+        assert!(kin.iter().any(|c| c.point.g_n <= 0.0), "{kin:?}");
+        for c in &kin {
+            let rates = [c.gd_n, c.gd_t[0], c.gd_t[1], c.wbar_n, c.wbar_t[0], c.wbar_t[1]];
+            assert!(c.point.g_n.is_finite(), "{c:?}");
+            assert!(c.point.g_n > 0.5 || rates.iter().all(|v| !v.is_finite()), "NaN twist: finite rates {c:?}");
+        }
+    }
     // a thin post (body 2, half 0.05 x 0.05 x 0.3) pushed into the middle of a plate's long side
     // (body 1), overlapping by 0.01 along x: the least overlap is along x, the post's face x is the
     // reference (it is smaller, but the plate's faces overlap more), and the plate's side face
@@ -633,4 +680,383 @@ fn box_box_degenerate_inputs() {
     for c in &cs {
         assert!((c.n - Vec3::x()).norm() < 1e-14);
     }
+}
+
+/// The pose `x` advanced by `t` with the constant world twist `tw`: the screw motion in which
+/// every material point moves with `v + ω × x`, `x(t) = R(t) x0 + S(t) v`,
+/// `R = exp(ω̃ t)`, `S = ∫_0^t R`.
+fn advance(x: &Pose, tw: &Motion, t: f64) -> Pose {
+    let wn = tw.w.norm();
+    let (r, s) = if wn == 0.0 {
+        (Mat3::identity(), Mat3::identity() * t)
+    } else {
+        let k = crate::math::tilde(&(tw.w / wn));
+        let th = wn * t;
+        let k2 = k * k;
+        (
+            Mat3::identity() + k * th.sin() + k2 * (1.0 - th.cos()),
+            Mat3::identity() * t + k * ((1.0 - th.cos()) / wn) + k2 * (t - th.sin() / wn),
+        )
+    };
+    Pose::new(r * x.a, r * x.r + s * tw.v)
+}
+
+/// A tilted box (turned 0.2 rad about x and 0.1 rad about y, and about the vertical) resting on
+/// another, penetrating it by 1 mm, over its middle and overhanging its edges and corners, larger
+/// and smaller than the lower box, both boxes moving with generic twists, in both orders of the
+/// pair. For every candidate, against central differences (δ = 1e-5) along the screw motions:
+///
+/// - `ġ_N` is the rate of the gap of the candidate's material point: the corner for a corner of
+///   either face, the incident box's point for a crossing (module docs of `box_box`). Its gap at
+///   `t ± δ` is measured against the plane of the matched candidate there (same kind, nearest
+///   point: the same corner, or the crossing on the same edge): the other point `P'` and normal
+///   `n'`. For corners that gap is the matched candidate's `g_N` itself (to 1e-13), so there
+///   `ġ_N = d g_N/dt` of the candidate; for the edge–edge point `ġ_N = d g_N/dt` too;
+/// - for a crossing, the rate of its own gap is `ġ_N + n·σ`, `σ` the crossing's velocity
+///   relative to the incident box (differenced), and `n·σ ≠ 0` on the tilted face (the documented
+///   part no face normal removes);
+/// - `ġ_T = t·Δv` of the same material points at `P1`, `P2`;
+/// - `w̄_N`, `w̄_T` (full accelerations: zero spatial accelerations for constant twists) against
+///   the differences of `ġ_N`, `ġ_T` of the matched candidates, and `w̄_N` against the second
+///   difference of `g_N` where the candidate is a material point.
+///
+/// All to 1e-7 relative (1e-6 for second differences).
+#[test]
+fn box_box_rates_on_a_tilted_face_match_finite_differences() {
+    use crate::contact::kinematics::{contact_kinematics, BodyMotion, ContactKinematics};
+    use box_box::{Feature, Kind};
+    let mut rng = Rng::new(2718);
+    let lower = Contour::Box {
+        center: Vec3::new(0.01, -0.02, 0.0),
+        rotation: rot(&Vec3::z(), 0.1),
+        half_extents: Vec3::new(0.3, 0.2, 0.1),
+    };
+    let (delta, delta2) = (1e-5, 1e-4);
+    let kin = |pair: &ContactPair, b1: &BodyMotion, b2: &BodyMotion| {
+        let mut out = [ContactKinematics::default(); 8];
+        contact_kinematics(pair, b1, b2, &mut out).unwrap();
+        out
+    };
+    let body = |x: Pose, tw: Motion| BodyMotion { pose: x, twist: tw, acc: Motion::ZERO };
+    let mut met = [0usize; 4];
+    let (mut configs, mut switched, mut defect_max) = (0, 0, 0.0f64);
+    for half in [Vec3::new(0.2, 0.15, 0.08), Vec3::new(0.42, 0.3, 0.06), Vec3::new(0.5, 0.4, 0.04)] {
+        let upper =
+            Contour::Box { center: Vec3::new(-0.01, 0.02, 0.01), rotation: Mat3::identity(), half_extents: half };
+        for yaw in [0.0, 0.5] {
+            let a = rot(&Vec3::z(), yaw) * rot(&Vec3::x(), 0.2) * rot(&Vec3::y(), 0.1);
+            for off in [(0.0, 0.0), (0.33, 0.02), (0.28, 0.21), (-0.3, 0.12), (0.05, -0.27), (-0.4, -0.27)] {
+                for order in 0..2 {
+                    let pair = if order == 0 {
+                        ContactPair::new("bb", upper.clone(), lower.clone()).unwrap()
+                    } else {
+                        ContactPair::new("bb", lower.clone(), upper.clone()).unwrap()
+                    };
+                    // the upper box at xu, lowered until the least gap is -1 mm
+                    let mut xu = Pose::new(a, Vec3::new(off.0, off.1, 0.3));
+                    let xl = Pose::new(rot(&Vec3::new(0.2, -0.1, 1.0), 0.05), Vec3::new(0.0, 0.0, 0.0));
+                    let poses = |xu: &Pose| if order == 0 { (*xu, xl) } else { (xl, *xu) };
+                    for _ in 0..8 {
+                        let (x1, x2) = poses(&xu);
+                        let gmin = eval(&pair, &x1, &x2).iter().map(|c| c.g_n).fold(f64::INFINITY, f64::min);
+                        xu.r.z -= gmin + 1e-3;
+                    }
+                    let (x1, x2) = poses(&xu);
+                    let gmin = eval(&pair, &x1, &x2).iter().map(|c| c.g_n).fold(f64::INFINITY, f64::min);
+                    assert!((gmin + 1e-3).abs() < 1e-4, "half {half:?} yaw {yaw} offset {off:?}: penetration {gmin}");
+                    let twist = |rng: &mut Rng, x: &Pose| {
+                        let w = rng.vec3(1.0);
+                        // the centre moves at up to 0.5 m/s
+                        Motion::new(w, rng.vec3(0.5) - w.cross(&x.r))
+                    };
+                    let (t1, t2) = (twist(&mut rng, &x1), twist(&mut rng, &x2));
+                    let at = |t: f64| (advance(&x1, &t1, t), advance(&x2, &t2, t));
+                    let state = |t: f64| {
+                        let (y1, y2) = at(t);
+                        let (feature, kinds) = pair.box_kinds(&y1, &y2).unwrap();
+                        (y1, y2, feature, kinds, kin(&pair, &body(y1, t1), &body(y2, t2)))
+                    };
+                    let s0 = state(0.0);
+                    let (sp, sm, sp2, sm2) = (state(delta), state(-delta), state(delta2), state(-delta2));
+                    let kinds0 = s0.3;
+                    if [&sp, &sm, &sp2, &sm2].iter().any(|s| s.2 != s0.2 || s.3 != kinds0) {
+                        switched += 1; // a vertex appears or leaves within δ: no derivative
+                        continue;
+                    }
+                    configs += 1;
+                    // whether body 1 carries the reference face (box–box pairs keep the caller's order)
+                    let ref_is_1 = matches!(s0.2, Feature::Face { ref_a: true, .. });
+                    for (k, c) in s0.4.iter().enumerate() {
+                        let kind = kinds0[k];
+                        let tag =
+                            format!("half {half:?} yaw {yaw} offset {off:?} order {order} candidate {k} ({kind:?})");
+                        // the body whose material point the candidate is (1 or 2), none for edge–edge
+                        let material = match kind {
+                            Kind::Unused => continue,
+                            Kind::EdgeEdge => 0,
+                            Kind::ReferenceCorner => {
+                                if ref_is_1 {
+                                    1
+                                } else {
+                                    2
+                                }
+                            }
+                            Kind::IncidentCorner | Kind::Crossing => {
+                                if ref_is_1 {
+                                    2
+                                } else {
+                                    1
+                                }
+                            }
+                        };
+                        met[match kind {
+                            Kind::IncidentCorner => 0,
+                            Kind::ReferenceCorner => 1,
+                            Kind::Crossing => 2,
+                            _ => 3,
+                        }] += 1;
+                        let p = |c: &ContactKinematics, b: usize| if b == 2 { c.point.p2 } else { c.point.p1 };
+                        // the same material point(s) at t: X_i(t) = x_i(t) x_i(0)⁻¹ P_i
+                        let (p1b, p2b) =
+                            (x1.inverse().point_to_parent(&c.point.p1), x2.inverse().point_to_parent(&c.point.p2));
+                        let mat = |s: &(Pose, Pose, Feature, [Kind; 8], [ContactKinematics; 8]), b: usize| {
+                            if b == 2 {
+                                s.1.point_to_parent(&p2b)
+                            } else {
+                                s.0.point_to_parent(&p1b)
+                            }
+                        };
+                        // the matched candidate at t: same kind, point on the material body (P1 for
+                        // edge–edge) nearest the material point
+                        let matched = |s: &(Pose, Pose, Feature, [Kind; 8], [ContactKinematics; 8])| {
+                            let b = material.max(1);
+                            let x = mat(s, b);
+                            let mut d: Vec<(f64, usize)> =
+                                (0..8).filter(|&j| s.3[j] == kind).map(|j| ((p(&s.4[j], b) - x).norm(), j)).collect();
+                            d.sort_by(|a, b| a.0.total_cmp(&b.0));
+                            assert!(
+                                d[0].0 < 1e-3 && d.get(1).map_or(true, |e| e.0 > 1e-2),
+                                "{tag}: no unique match {d:?}"
+                            );
+                            s.4[d[0].1]
+                        };
+                        let (cp, cm, cp2, cm2) = (matched(&sp), matched(&sm), matched(&sp2), matched(&sm2));
+                        // the gap of the material point against the matched candidate's plane
+                        let gap_of = |s: &(Pose, Pose, Feature, [Kind; 8], [ContactKinematics; 8]),
+                                      m: &ContactKinematics| {
+                            match material {
+                                1 => m.point.n.dot(&(mat(s, 1) - m.point.p2)),
+                                2 => m.point.n.dot(&(m.point.p1 - mat(s, 2))),
+                                _ => m.point.g_n,
+                            }
+                        };
+                        let (gp, gm) = (gap_of(&sp, &cp), gap_of(&sm, &cm));
+                        let gd = (gp - gm) / (2.0 * delta);
+                        assert!(close(c.gd_n, gd, 1e-7), "{tag}: ġ_N {} vs the material point's {gd}", c.gd_n);
+                        let own = (cp.point.g_n - cm.point.g_n) / (2.0 * delta);
+                        if kind == Kind::Crossing {
+                            // the crossing's own gap: ġ_N + n·σ
+                            let bi = if ref_is_1 { 2 } else { 1 };
+                            let (pi0, pip, pim) = (p(c, bi), p(&cp, bi), p(&cm, bi));
+                            let vi = if bi == 1 { t1.v + t1.w.cross(&pi0) } else { t2.v + t2.w.cross(&pi0) };
+                            let sigma = (pip - pim) / (2.0 * delta) - vi;
+                            let defect = c.point.n.dot(&sigma) * if bi == 1 { 1.0 } else { -1.0 };
+                            assert!(
+                                close(own, c.gd_n + defect, 1e-7),
+                                "{tag}: d g/dt {own} vs ġ_N {} + n·σ {defect}",
+                                c.gd_n
+                            );
+                            defect_max = defect_max.max(defect.abs());
+                        } else {
+                            // a material point: the candidate's own gap is that point's gap
+                            assert!((gp - cp.point.g_n).abs() < 1e-13 && (gm - cm.point.g_n).abs() < 1e-13, "{tag}");
+                            assert!(close(c.gd_n, own, 1e-7), "{tag}: ġ_N {} vs d g_N/dt {own}", c.gd_n);
+                            let gdd = (cp2.point.g_n - 2.0 * c.point.g_n + cm2.point.g_n) / (delta2 * delta2);
+                            assert!(close(c.wbar_n, gdd, 1e-6), "{tag}: g̈_N {} vs second difference {gdd}", c.wbar_n);
+                        }
+                        // ġ_T of the material points at P1, P2; w̄ against differences of ġ
+                        let dv = (mat(&sp, 1) - mat(&sm, 1) - mat(&sp, 2) + mat(&sm, 2)) / (2.0 * delta);
+                        for (j, t) in [c.point.t1, c.point.t2].iter().enumerate() {
+                            assert!(
+                                close(c.gd_t[j], t.dot(&dv), 1e-7),
+                                "{tag}: ġ_T[{j}] {} vs {}",
+                                c.gd_t[j],
+                                t.dot(&dv)
+                            );
+                            let d = (cp.gd_t[j] - cm.gd_t[j]) / (2.0 * delta);
+                            assert!(close(c.wbar_t[j], d, 1e-7), "{tag}: w̄_T[{j}] {} vs difference {d}", c.wbar_t[j]);
+                        }
+                        let d = (cp.gd_n - cm.gd_n) / (2.0 * delta);
+                        assert!(close(c.wbar_n, d, 1e-7), "{tag}: w̄_N {} vs difference of ġ_N {d}", c.wbar_n);
+                    }
+                }
+            }
+        }
+    }
+    assert!(configs >= 60 && switched <= 4, "configurations {configs}, skipped {switched}");
+    assert!(met[0] >= 40 && met[1] >= 12 && met[2] >= 40, "incident corners, reference corners, crossings: {met:?}");
+    assert!(defect_max > 1e-2, "crossings on the tilted face slide off the normal: largest n·σ {defect_max}");
+}
+
+/// The box–box manifold against a brute-force construction of the clipped incident face at
+/// random placements (face features): the incident face's corners inside the reference face's
+/// side planes, the reference face's corners whose line along `m` meets the incident face inside
+/// it, and the crossings of the incident face's edges with the side planes inside the other two;
+/// each with its kind, gap, normal and points (module docs of `box_box`), to 1e-12. Placements
+/// where a point lies within 1e-7 of a side plane are left out (the clipping merges such points
+/// by its tie rule).
+#[test]
+fn box_box_manifold_matches_brute_force_clipping() {
+    use box_box::{Feature, Kind};
+    let (ca, cb) = (sample("box"), sample("box_b"));
+    let pair = ContactPair::new("bb", ca.clone(), cb.clone()).unwrap();
+    let placed = |c: &Contour, x: &Pose| {
+        let Contour::Box { center, rotation, half_extents } = c else { unreachable!() };
+        (x.point_to_parent(center), x.a * rotation, *half_extents)
+    };
+    let mut rng = Rng::new(99);
+    let (mut compared, mut skipped, mut kinds_met) = (0, 0, [0usize; 3]);
+    for _ in 0..600 {
+        let (x1, mut x2) = random_poses(&mut rng, false);
+        x2.r = x1.r + (x2.r - x1.r).normalize() * rng.uniform(0.15, 0.6);
+        let (feature, kinds) = pair.box_kinds(&x1, &x2).unwrap();
+        let Feature::Face { ref_a, axis } = feature else { continue };
+        let ((c_a, r_a, h_a), (c_b, r_b, h_b)) = (placed(&ca, &x1), placed(&cb, &x2));
+        let ((cr, rr, hr), (ci, ri, hi)) =
+            if ref_a { ((c_a, r_a, h_a), (c_b, r_b, h_b)) } else { ((c_b, r_b, h_b), (c_a, r_a, h_a)) };
+        let ax = |r: &Mat3, k: usize| r.column(k).into_owned();
+        let m = ax(&rr, axis) * if (ci - cr).dot(&ax(&rr, axis)) >= 0.0 { 1.0 } else { -1.0 };
+        let p_ref = cr + m * hr[axis];
+        let j = (0..3).max_by(|&p, &q| ax(&ri, p).dot(&m).abs().total_cmp(&ax(&ri, q).dot(&m).abs())).unwrap();
+        let f = ax(&ri, j) * if ax(&ri, j).dot(&m) > 0.0 { -1.0 } else { 1.0 };
+        let fc = ci + f * hi[j];
+        let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+        let (k1, k2) = ((axis + 1) % 3, (axis + 2) % 3);
+        // signed distances beyond the side planes (≤ 0 inside)
+        let out_ref = |x: &Vec3, k: usize| (x - cr).dot(&ax(&rr, k)).abs() - hr[k];
+        let out_inc = |x: &Vec3, k: usize| (x - fc).dot(&ax(&ri, k)).abs() - hi[k];
+        let mut margin = f64::INFINITY;
+        // (kind, point on the reference box, point on the incident box, normal from the reference box)
+        let mut expect: Vec<(Kind, Vec3, Vec3, Vec3, f64)> = vec![];
+        let on_ref_plane = |v: Vec3| {
+            let g = m.dot(&(v - p_ref));
+            (v - m * g, v, m, g)
+        };
+        let corners: Vec<Vec3> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(s1, s2)| fc + ax(&ri, j1) * (s1 * hi[j1]) + ax(&ri, j2) * (s2 * hi[j2]))
+            .collect();
+        for v in &corners {
+            let d = out_ref(v, k1).max(out_ref(v, k2));
+            margin = margin.min(d.abs());
+            if d < 0.0 {
+                let (pr, pi, n, g) = on_ref_plane(*v);
+                expect.push((Kind::IncidentCorner, pr, pi, n, g));
+            }
+        }
+        for (s1, s2) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            let q = p_ref + ax(&rr, k1) * (s1 * hr[k1]) + ax(&rr, k2) * (s2 * hr[k2]);
+            let v = q + m * (f.dot(&(fc - q)) / f.dot(&m));
+            let d = out_inc(&v, j1).max(out_inc(&v, j2));
+            margin = margin.min(d.abs());
+            if d < 0.0 {
+                let g = f.dot(&(q - fc));
+                expect.push((Kind::ReferenceCorner, q, q - f * g, -f, g));
+            }
+        }
+        for e in 0..4 {
+            let (p, q) = (corners[e], corners[(e + 1) % 4]);
+            for (k, other) in [(k1, k2), (k2, k1)] {
+                for sgn in [1.0, -1.0] {
+                    let dist = |x: &Vec3| sgn * (x - cr).dot(&ax(&rr, k)) - hr[k];
+                    let (dp, dq) = (dist(&p), dist(&q));
+                    if dp * dq < 0.0 {
+                        let v = p + (q - p) * (dp / (dp - dq));
+                        let d = out_ref(&v, other);
+                        margin = margin.min(d.abs());
+                        if d < 0.0 {
+                            let (pr, pi, n, g) = on_ref_plane(v);
+                            expect.push((Kind::Crossing, pr, pi, n, g));
+                        }
+                    }
+                }
+            }
+        }
+        if expect.is_empty() {
+            // the incident face misses the reference face's side planes: its deepest corner
+            let v = *corners.iter().min_by(|p, q| p.dot(&m).total_cmp(&q.dot(&m))).unwrap();
+            let (pr, pi, n, g) = on_ref_plane(v);
+            expect.push((Kind::IncidentCorner, pr, pi, n, g));
+        }
+        if margin < 1e-7 {
+            skipped += 1;
+            continue;
+        }
+        compared += 1;
+        let cs = eval(&pair, &x1, &x2);
+        let used = kinds.iter().filter(|&&k| k != Kind::Unused).count();
+        assert_eq!(
+            used,
+            expect.len(),
+            "{feature:?}: {kinds:?} vs {:?}",
+            expect.iter().map(|e| e.0).collect::<Vec<_>>()
+        );
+        for (kind, pr, pi, nr, g) in expect {
+            let (n, p1, p2) = if ref_a { (-nr, pr, pi) } else { (nr, pi, pr) };
+            let k = (0..8)
+                .find(|&k| kinds[k] == kind && (cs[k].p1 - p1).norm() < 1e-12 && (cs[k].p2 - p2).norm() < 1e-12)
+                .unwrap_or_else(|| panic!("{feature:?}: no {kind:?} at {p1:?}, {p2:?} in {cs:?}"));
+            assert!(
+                (cs[k].g_n - g).abs() < 1e-12 && (cs[k].n - n).norm() < 1e-12,
+                "{kind:?}: {:?} vs {g}, {n:?}",
+                cs[k]
+            );
+            kinds_met[kind as usize] += 1;
+        }
+    }
+    assert!(compared > 400 && skipped < 10, "compared {compared}, skipped {skipped}");
+    assert!(kinds_met.iter().all(|&n| n > 50), "incident corners, reference corners, crossings {kinds_met:?}");
+}
+
+/// One evaluation of a box–box pair builds its manifold once ([`evaluate`] and
+/// [`crate::contact::contact_kinematics`] alike, face and edge features), and fills the same
+/// candidates as asking for each one separately (the path that built the manifold once per
+/// candidate): geometry, `ġ_N` and `ġ_T` of the material points, bit for bit.
+#[test]
+fn box_box_pair_is_clipped_once_per_evaluation() {
+    use crate::contact::kinematics::{contact_kinematics, BodyMotion, ContactKinematics};
+    let builds = || box_box::BUILDS.with(|b| b.get());
+    let mut rng = Rng::new(4);
+    let mut features = [0usize; 2];
+    for (c1, c2) in [(sample("box"), sample("box_b")), (sample("box_b"), sample("box"))] {
+        let pair = ContactPair::new("bb", c1, c2).unwrap();
+        for _ in 0..40 {
+            let (x1, mut x2) = random_poses(&mut rng, false);
+            x2.r = x1.r + (x2.r - x1.r).normalize() * rng.uniform(0.15, 0.5);
+            let body = |rng: &mut Rng, x: Pose| BodyMotion {
+                pose: x,
+                twist: Motion::new(rng.vec3(1.0), rng.vec3(1.0)),
+                acc: Motion::new(rng.vec3(1.0), rng.vec3(1.0)),
+            };
+            let (b1, b2) = (body(&mut rng, x1), body(&mut rng, x2));
+            let mut points = [ContactPoint::default(); 8];
+            let mut kin = [ContactKinematics::default(); 8];
+            let n0 = builds();
+            evaluate(&pair, &x1, &x2, &mut points).unwrap();
+            assert_eq!(builds() - n0, 1, "evaluate builds the manifold once");
+            contact_kinematics(&pair, &b1, &b2, &mut kin).unwrap();
+            assert_eq!(builds() - n0, 2, "contact_kinematics builds the manifold once");
+            features[usize::from(matches!(pair.box_feature(&x1, &x2), Some(box_box::Feature::Edge { .. })))] += 1;
+            for k in 0..8 {
+                let r = pair.candidate(k, &x1, &x2, None);
+                let rt = pair.candidate(k, &x1, &x2, Some((&b1.twist, &b2.twist)));
+                let (c, kk) = (&points[k], &kin[k]);
+                assert!(c.g_n == r.g && c.n == r.n && c.p1 == r.p1 && c.p2 == r.p2, "candidate {k}");
+                assert!(kk.point == *c, "candidate {k}");
+                let dv = b1.point_velocity(&rt.p1) - b2.point_velocity(&rt.p2);
+                assert!(kk.gd_n == rt.n.dot(&dv) && kk.gd_t == [c.t1.dot(&dv), c.t2.dot(&dv)], "candidate {k}");
+            }
+        }
+    }
+    assert!(features[0] > 20 && features[1] > 5, "face, edge features {features:?}");
 }
