@@ -21,7 +21,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
 use mechsys_core::data::Data;
-use mechsys_core::dynamics::{aba, crba::mass_matrix, rnea};
+use mechsys_core::dynamics::{aba, crba::mass_matrix, rnea, Workspace};
 use mechsys_core::fixtures::chain;
 use mechsys_core::forces::NoCallbacks;
 use mechsys_core::integrator::{IntegratorKind, OdeSystem};
@@ -61,14 +61,14 @@ fn bench_algorithms(c: &mut Criterion) {
     let mut g = c.benchmark_group("rnea");
     for &n in &SIZES {
         let model = chain(n, "revolute");
-        let mut data = Data::new(&model);
+        let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
         let (q, u) = state(&model);
         let udot: Vec<f64> = (0..model.nu).map(|k| 1.0 - 0.1 * (k % 7) as f64).collect();
         let mut tau = vec![0.0; model.nu];
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
-                rnea(&model, &mut data, 0.0, black_box(&q), black_box(&u), black_box(&udot), &cb, &mut tau)
+                rnea(&model, &mut data, &mut ws, 0.0, black_box(&q), black_box(&u), black_box(&udot), &cb, &mut tau)
                     .expect("rnea");
                 black_box(&tau);
             })
@@ -79,12 +79,12 @@ fn bench_algorithms(c: &mut Criterion) {
     let mut g = c.benchmark_group("aba");
     for &n in &SIZES {
         let model = chain(n, "revolute");
-        let mut data = Data::new(&model);
+        let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
         let (q, u) = state(&model);
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
-                aba(&model, &mut data, 0.0, black_box(&q), black_box(&u), None, &cb).expect("aba");
+                aba(&model, &mut data, &mut ws, 0.0, black_box(&q), black_box(&u), None, &cb).expect("aba");
                 black_box(&data.udot);
             })
         });

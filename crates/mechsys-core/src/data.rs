@@ -1,11 +1,14 @@
 //! The workspace: every quantity derived from a model during one evaluation, allocated once.
 //!
 //! Each field says which stage fills it and its shape. `Data::new(&model)` sizes everything; the
-//! algorithms then run without allocating.
+//! algorithms then run without allocating. `Data` holds the quantities the stages share, as plain
+//! arrays; a stage's private working memory whose form only that stage knows (the factorization of
+//! the constrained solve, the Jenkins chains' slider problems) is the stage's own workspace
+//! ([`crate::dynamics::Workspace`], [`crate::forces::Workspace`]), kept next to the `Data`.
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::model::Model;
+use crate::model::{constraint, Model};
 use crate::spatial::{Force, Motion, Pose, RigidInertia, M6, V6};
 
 /// The state of a simulation: time, coordinates, velocities (`q̇ = H*(q) u`, eq. 2.34).
@@ -68,6 +71,12 @@ pub struct Data {
     pub phi: Vec<f64>,
     /// constraints: G = Wᵀ, rows of the velocity form G u = b (nc × nu).
     pub g: DMatrix<f64>,
+    /// constraints: pattern of G, row pointers: row r may be nonzero only at the velocities
+    /// `g_row_idx[g_row_ptr[r]..g_row_ptr[r + 1]]`, planned once from each constraint's reach
+    /// ([`constraint::row_pattern`]) (nc + 1).
+    pub g_row_ptr: Vec<usize>,
+    /// constraints: pattern of G, velocity indices of each row, ascending (entries of the pattern).
+    pub g_row_idx: Vec<usize>,
     /// constraints: velocity right-hand side b (nc).
     pub b: Vec<f64>,
     /// constraints: acceleration right-hand side γ of G u̇ = γ (nc).
@@ -102,8 +111,6 @@ pub struct Data {
     pub perm_null: Vec<usize>,
     /// minimum-norm multipliers: scratch (nc).
     pub null_scratch: Vec<f64>,
-    /// constrained solve: the sparse plan and its workspace.
-    pub saddle: crate::dynamics::sparse::Saddle,
     /// constraints: rows found dependent at the last solve (nc).
     pub dependent: Vec<bool>,
     /// forces: committed positions of the Jenkins sliders, the history of the dry friction (n_sliders).
@@ -112,8 +119,6 @@ pub struct Data {
     pub slider_trial: Vec<f64>,
     /// forces: slider forces λ at the last force evaluation (n_sliders).
     pub slider_force: Vec<f64>,
-    /// forces: solver scratch of each Jenkins chain (press fits).
-    pub jenkins_work: Vec<crate::forces::jenkins::ChainWork>,
     /// forces: each element's force at the last evaluation, resisting its deflection (n_force_outputs).
     pub element_force: Vec<f64>,
     /// forces: each element's deflection at the last evaluation (n_force_outputs).
@@ -125,6 +130,7 @@ impl Data {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbodies();
         let nu = model.nu;
+        let (g_row_ptr, g_row_idx) = constraint::row_pattern(model);
         Data {
             x_abs: vec![Pose::IDENTITY; nb],
             x_joint: vec![Pose::IDENTITY; nb],
@@ -149,6 +155,8 @@ impl Data {
             zero_u: vec![0.0; nu],
             phi: vec![0.0; model.nc],
             g: DMatrix::zeros(model.nc, nu),
+            g_row_ptr,
+            g_row_idx,
             b: vec![0.0; model.nc],
             gamma: vec![0.0; model.nc],
             lambda: vec![0.0; model.nc],
@@ -166,21 +174,10 @@ impl Data {
             null_gram: vec![0.0; model.nc * model.nc],
             perm_null: vec![0; model.nc],
             null_scratch: vec![0.0; model.nc],
-            saddle: crate::dynamics::sparse::Saddle::new(model),
             dependent: vec![false; model.nc],
             slider: vec![0.0; model.n_sliders],
             slider_trial: vec![0.0; model.n_sliders],
             slider_force: vec![0.0; model.n_sliders],
-            jenkins_work: model
-                .forces
-                .iter()
-                .filter_map(|f| match f {
-                    crate::model::ForceElement::Jenkins(j) if j.shaft.is_some() => {
-                        Some(crate::forces::jenkins::ChainWork::new(j))
-                    }
-                    _ => None,
-                })
-                .collect(),
             element_force: vec![0.0; model.n_force_outputs],
             element_deflection: vec![0.0; model.n_force_outputs],
         }

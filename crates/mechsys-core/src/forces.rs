@@ -182,8 +182,34 @@ fn wrench_power(data: &Data, b: usize, f: &Force) -> f64 {
     data.v[b].dot(f)
 }
 
-/// Force stage: fills `f_ext` and `tau_applied`. Requires the kinematics of (q, u).
-pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<Powers> {
+/// The force stage's own working memory, kept next to the [`Data`] (whose force fields every later
+/// stage reads): the slider problem of each Jenkins chain. Sized once per model by
+/// [`Workspace::new`]; the evaluations then do not allocate.
+#[derive(Debug, Clone, Default)]
+pub struct Workspace {
+    /// Lemke scratch of each Jenkins chain (press fits), in the order of the model's force
+    /// elements ([`jenkins::chains`]).
+    pub jenkins: Vec<jenkins::ChainWork>,
+}
+
+impl Workspace {
+    /// Allocates the force stage's workspace for `model`.
+    pub fn new(model: &Model) -> Self {
+        Workspace { jenkins: jenkins::chains(model) }
+    }
+}
+
+/// Force stage: fills `f_ext` and `tau_applied`. Requires the kinematics of (q, u); `ws` is the
+/// stage's own scratch.
+pub fn evaluate(
+    model: &Model,
+    data: &mut Data,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+) -> Result<Powers> {
     data.f_ext.iter_mut().for_each(|f| *f = Force::ZERO);
     data.tau_applied.iter_mut().for_each(|x| *x = 0.0);
     let mut p_diss = 0.0;
@@ -345,7 +371,7 @@ pub fn evaluate(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb
                 data.element_deflection[o] = q[j.iq];
             }
             ForceElement::Jenkins(jk) => {
-                let f = jenkins::evaluate(jk, chain, data, q, t)?;
+                let f = jenkins::evaluate(jk, chain, data, &mut ws.jenkins, q, t)?;
                 if jk.shaft.is_some() {
                     chain += 1;
                 }

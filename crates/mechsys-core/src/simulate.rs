@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use serde::{Deserialize, Serialize};
 
 use crate::data::Data;
+use crate::dynamics::sparse::Saddle;
 use crate::dynamics::{self, energy};
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -241,6 +242,8 @@ pub struct MultibodySystem<'a> {
     model: &'a Model,
     /// The workspace (public so that observers can read the last evaluation).
     pub data: Data,
+    /// The dynamics stage's own workspace (the factorization of the constrained solve).
+    pub ws: dynamics::Workspace,
     cb: &'a dyn Callbacks,
     stabilization: Stabilization,
     /// Dependent rows and pivots of the constraint factorization at the first evaluation (a rank
@@ -258,6 +261,7 @@ impl<'a> MultibodySystem<'a> {
         MultibodySystem {
             model,
             data: Data::new(model),
+            ws: dynamics::Workspace::new(model),
             cb,
             stabilization: Stabilization::Projection,
             start: None,
@@ -288,7 +292,7 @@ impl MultibodySystem<'_> {
     /// change point of the mechanism), and notes passages near such a configuration.
     fn check_singular(&mut self, t: f64) -> Result<()> {
         let dep = &self.data.dependent;
-        let (pivots, rows) = self.data.saddle.pivots();
+        let (pivots, rows) = self.ws.saddle.pivots();
         let Some((d0, p0)) = &self.start else {
             self.start = Some((dep.clone(), pivots.to_vec()));
             return Ok(());
@@ -331,7 +335,7 @@ impl OdeSystem for MultibodySystem<'_> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         let (q, rest) = y.split_at(nq);
         let u = &rest[..nu];
-        let p = dynamics::forward_dynamics(self.model, &mut self.data, t, q, u, None, self.cb)?;
+        let p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
         if self.model.nc > 0 {
             self.check_singular(t)?;
         }
@@ -344,7 +348,8 @@ impl OdeSystem for MultibodySystem<'_> {
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         if self.model.n_sliders > 0 {
-            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, &y[..nq], t)?;
+            let chains = &mut self.ws.forces.jenkins;
+            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, chains, &y[..nq], t)?;
         }
         Ok(())
     }
@@ -353,7 +358,15 @@ impl OdeSystem for MultibodySystem<'_> {
         self.model.normalize(&mut y[..nq]);
         if self.model.nc > 0 && self.stabilization == Stabilization::Projection {
             let (q, rest) = y.split_at_mut(nq);
-            crate::dynamics::constrained::project(self.model, &mut self.data, t, q, &mut rest[..nu], self.cb)?;
+            crate::dynamics::constrained::project(
+                self.model,
+                &mut self.data,
+                &mut self.ws,
+                t,
+                q,
+                &mut rest[..nu],
+                self.cb,
+            )?;
         }
         Ok(())
     }
@@ -543,14 +556,22 @@ pub fn simulate(
     model.normalize(&mut y0[..model.nq]);
     if model.nc > 0 {
         let (q, rest) = y0.split_at_mut(model.nq);
-        crate::dynamics::constrained::project(model, &mut sys.data, settings.t0, q, &mut rest[..model.nu], cb)?;
+        crate::dynamics::constrained::project(
+            model,
+            &mut sys.data,
+            &mut sys.ws,
+            settings.t0,
+            q,
+            &mut rest[..model.nu],
+            cb,
+        )?;
     }
     let mut scratch = vec![0.0; sys.dim()];
     let mut observer = |sys: &mut MultibodySystem, t: f64, y: &[f64], fresh: bool| -> Result<()> {
         if !fresh {
             sys.rhs(t, y, &mut scratch)?;
         }
-        record(model, &sys.data, t, y, &mut rec);
+        record(model, &sys.data, &sys.ws.saddle, t, y, &mut rec);
         report_progress(progress, rec.t.len(), t)
     };
     let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
@@ -577,12 +598,12 @@ fn time_stepping(
     let every = (settings.output_dt / dt).round() as u64;
     let mut stepper = MoreauJean::new(model, dt, solver)?;
     let mut group_stats = vec![crate::integrator::moreau_jean::GroupStats::default(); model.contact_groups.len()];
-    let mut data = Data::new(model);
+    let (mut data, mut ws) = (Data::new(model), dynamics::Workspace::new(model));
     let mut y = y0;
     model.normalize(&mut y[..nq]);
     if model.nc > 0 {
         let (q, rest) = y.split_at_mut(nq);
-        crate::dynamics::constrained::project(model, &mut data, settings.t0, q, &mut rest[..nu], cb)?;
+        crate::dynamics::constrained::project(model, &mut data, &mut ws, settings.t0, q, &mut rest[..nu], cb)?;
     }
     for v in [
         &mut rec.contact_gap,
@@ -613,7 +634,7 @@ fn time_stepping(
                 let (q, rest) = y.split_at_mut(nq);
                 let (u, energy) = rest.split_at_mut(nu);
                 u_start.copy_from_slice(u);
-                let (work, diss) = stepper.step(model, &mut data, t, q, u, cb)?;
+                let (work, diss) = stepper.step(model, &mut data, &mut ws, t, q, u, cb)?;
                 for (pt, r) in stepper.results.iter().enumerate() {
                     acc_n[pt] += r.impulse_n;
                     acc_t[pt][0] += r.impulse_t[0];
@@ -622,7 +643,7 @@ fn time_stepping(
                 energy[0] += diss;
                 energy[1] += work;
                 if model.n_sliders > 0 {
-                    energy[0] += crate::forces::jenkins::commit(model, &mut data, q, t + dt)?;
+                    energy[0] += crate::forces::jenkins::commit(model, &mut data, &mut ws.forces.jenkins, q, t + dt)?;
                 }
                 for i in 0..nu {
                     udot[i] = (u[i] - u_start[i]) / dt;
@@ -657,10 +678,10 @@ fn time_stepping(
         // the sample: kinematics and forces at the state, averaged accelerations of the last step
         let (q, rest) = y.split_at(nq);
         let u = &rest[..nu];
-        crate::dynamics::prepare(model, &mut data, t_rec, q, u, cb)?;
+        crate::dynamics::prepare(model, &mut data, &mut ws, t_rec, q, u, cb)?;
         if model.nc > 0 {
             crate::constraints::positions(model, &mut data, t_rec, q, cb)?;
-            data.saddle.gather_g(&data.g);
+            ws.saddle.gather_g(&data.g);
             for (l, mu) in data.lambda.iter_mut().zip(&stepper.bilateral_impulse) {
                 *l = mu / dt;
             }
@@ -670,7 +691,7 @@ fn time_stepping(
         let ud = std::mem::take(&mut data.udot);
         crate::kinematics::accelerations(model, &mut data, &ud);
         data.udot = ud;
-        record(model, &data, t_rec, &y, &mut rec);
+        record(model, &data, &ws.saddle, t_rec, &y, &mut rec);
         stepper.measure(model, &data)?;
         for (pt, kk) in stepper.kinematics().iter().enumerate() {
             let r = &stepper.results[pt];
@@ -742,7 +763,7 @@ fn event_driven(
     let (mut e_impact, mut e_impulsive_friction) = (0.0, 0.0);
     let mut warnings = Vec::new();
     let mut sample = |ph: &mut Phase, t: f64, y: &[f64], imp: &[f64], d: event_driven::Dissipation| -> Result<()> {
-        record(model, &ph.data, t, y, &mut rec);
+        record(model, &ph.data, &ph.dynamics.saddle, t, y, &mut rec);
         e_impact += d.impact;
         e_impulsive_friction += d.friction;
         for pt in 0..np {
@@ -890,8 +911,9 @@ fn report_progress(progress: Option<&Progress>, samples: usize, t: f64) -> Resul
     Ok(())
 }
 
-/// The record stage: appends one sample of every signal from an evaluated workspace.
-fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
+/// The record stage: appends one sample of every signal from an evaluated workspace (`saddle`:
+/// the constrained solve's factorization, holding G as last gathered, for `G u - b`).
+fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &mut Recording) {
     let (nq, nu) = (model.nq, model.nu);
     let nb_rec = model.nbodies() - 1;
     rec.t.push(t);
@@ -942,7 +964,7 @@ fn record(model: &Model, data: &Data, t: f64, y: &[f64], rec: &mut Recording) {
     rec.constraint_velocity_violation.resize(k + model.nc, 0.0);
     if model.nc > 0 {
         let out = &mut rec.constraint_velocity_violation[k..];
-        data.saddle.g_times(&y[nq..nq + nu], out);
+        saddle.g_times(&y[nq..nq + nu], out);
         for (o, b) in out.iter_mut().zip(&data.b) {
             *o -= b;
         }

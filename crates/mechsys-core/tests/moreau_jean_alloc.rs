@@ -6,6 +6,7 @@ use std::cell::Cell;
 
 use mechsys_core::contact::group::sphere_pile;
 use mechsys_core::data::Data;
+use mechsys_core::dynamics::Workspace;
 use mechsys_core::forces::NoCallbacks;
 use mechsys_core::integrator::moreau_jean::MoreauJean;
 use mechsys_core::model::{Model, ModelDescription};
@@ -50,23 +51,23 @@ fn group_steps_do_not_allocate_after_warm_up() {
     let method = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();
     assert!(st.is_sparse());
-    let mut data = Data::new(&model);
+    let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
     let mut stats = vec![Default::default(); 1];
-    let mut run = |st: &mut MoreauJean, data: &mut Data| -> (usize, usize) {
+    let mut run = |st: &mut MoreauJean, data: &mut Data, ws: &mut Workspace| -> (usize, usize) {
         let (mut q, mut u) = (model.q0(), model.u0());
         let mut contacts = 0;
         let before = allocations();
         for k in 0..400 {
-            st.step(&model, data, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
+            st.step(&model, data, ws, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
             st.take_group_stats(&mut stats);
             contacts += stats[0].closed;
         }
         (allocations() - before, contacts)
     };
-    let (first, contacts) = run(&mut st, &mut data);
+    let (first, contacts) = run(&mut st, &mut data, &mut ws);
     assert!(first > 0, "the first pass creates the pairs");
     assert!(contacts > 5000, "only {contacts} closed contact points over the run");
-    let (second, contacts2) = run(&mut st, &mut data);
+    let (second, contacts2) = run(&mut st, &mut data, &mut ws);
     assert_eq!(contacts2, contacts, "the repeated run is the same run");
     assert_eq!(second, 0, "{second} allocations in 400 steps after warm-up");
 }

@@ -49,11 +49,13 @@ fn aba<'py>(
         _ => None,
     };
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let mut ws = model.ws.lock().map_err(|_| settings("model workspace is poisoned"))?;
     if m.n_callbacks == 0 && callbacks.is_none() {
-        dynamics::aba(m, &mut data, t, q, u, tau, &mechsys_core::forces::NoCallbacks).map_err(PyMechsysError::from)?;
+        dynamics::aba(m, &mut data, &mut ws, t, q, u, tau, &mechsys_core::forces::NoCallbacks)
+            .map_err(PyMechsysError::from)?;
     } else {
         let cb = self::callbacks(model, callbacks)?;
-        dynamics::aba(m, &mut data, t, q, u, tau, &cb).map_err(PyMechsysError::from)?;
+        dynamics::aba(m, &mut data, &mut ws, t, q, u, tau, &cb).map_err(PyMechsysError::from)?;
     }
     match out {
         // write into the caller's array: no allocation per call
@@ -92,8 +94,9 @@ fn rnea<'py>(
     let ud = check_len(&udot, m.nu, "udot")?;
     let cb = self::callbacks(model, callbacks)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let mut ws = model.ws.lock().map_err(|_| settings("model workspace is poisoned"))?;
     let mut tau = vec![0.0; m.nu];
-    dynamics::inverse_dynamics(m, &mut data, t, q, u, ud, &cb as &dyn Callbacks, &mut tau)
+    dynamics::inverse_dynamics(m, &mut data, &mut ws, t, q, u, ud, &cb as &dyn Callbacks, &mut tau)
         .map_err(PyMechsysError::from)?;
     Ok(PyArray1::from_vec(py, tau))
 }
@@ -114,7 +117,8 @@ fn nonlinear_effects<'py>(
     let u = check_len(&u, m.nu, "u")?;
     let cb = self::callbacks(model, callbacks)?;
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
-    dynamics::nonlinear_effects(m, &mut data, t, q, u, &cb).map_err(PyMechsysError::from)?;
+    let mut ws = model.ws.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    dynamics::nonlinear_effects(m, &mut data, &mut ws, t, q, u, &cb).map_err(PyMechsysError::from)?;
     Ok(PyArray1::from_slice(py, data.h.as_slice()))
 }
 
@@ -274,6 +278,7 @@ fn joint_reactions<'py>(
     let cb = self::callbacks(model, callbacks)?;
     let nj = m.joints.len();
     let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let mut ws = model.ws.lock().map_err(|_| settings("model workspace is poisoned"))?;
     let mut fo = vec![mechsys_core::math::Vec3::zeros(); nj];
     let mut to = vec![mechsys_core::math::Vec3::zeros(); nj];
     let mut force = Vec::with_capacity(n * nj * 3);
@@ -282,7 +287,7 @@ fn joint_reactions<'py>(
         let (qk, uk, ak) =
             (&q[k * m.nq..(k + 1) * m.nq], &u[k * m.nu..(k + 1) * m.nu], &udot[k * m.nu..(k + 1) * m.nu]);
         m.check_q(qk, "q").map_err(PyMechsysError::from)?;
-        dynamics::joint_reactions(m, &mut data, t[k], qk, uk, ak, &cb, &mut fo, &mut to)
+        dynamics::joint_reactions(m, &mut data, &mut ws, t[k], qk, uk, ak, &cb, &mut fo, &mut to)
             .map_err(PyMechsysError::from)?;
         for j in 0..nj {
             force.extend_from_slice(fo[j].as_slice());

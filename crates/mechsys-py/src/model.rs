@@ -3,6 +3,7 @@
 use std::sync::Mutex;
 
 use mechsys_core::data::Data;
+use mechsys_core::dynamics::Workspace;
 use mechsys_core::model::Model;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -16,6 +17,8 @@ pub struct PyModel {
     pub model: Model,
     /// Workspace for single calls (aba, crba, ...); simulations use their own.
     pub data: Mutex<Data>,
+    /// The dynamics stage's own workspace for single calls, next to `data` (locked after it).
+    pub ws: Mutex<Workspace>,
 }
 
 #[pymethods]
@@ -23,8 +26,8 @@ impl PyModel {
     #[new]
     fn new(description_json: &str) -> PyResult<Self> {
         let model = Model::from_json(description_json).map_err(PyMechsysError::from)?;
-        let data = Mutex::new(Data::new(&model));
-        Ok(PyModel { model, data })
+        let (data, ws) = (Mutex::new(Data::new(&model)), Mutex::new(Workspace::new(&model)));
+        Ok(PyModel { model, data, ws })
     }
     #[getter]
     fn name(&self) -> &str {

@@ -180,13 +180,13 @@ fn acceleration_rows_are_the_second_derivative_of_the_violation() {
 #[test]
 fn constrained_accelerations_satisfy_the_constraints_and_dalembert() {
     let model = model_with_all_kinds();
-    let mut data = Data::new(&model);
+    let (mut data, mut ws) = (Data::new(&model), crate::dynamics::Workspace::new(&model));
     let mut q = model.q0();
     let mut u: Vec<f64> = (0..model.nu).map(|i| 0.1 * (i as f64).sin()).collect();
     let t = 0.25;
-    crate::dynamics::constrained::project(&model, &mut data, t, &mut q, &mut u, &NoCallbacks).unwrap();
+    crate::dynamics::constrained::project(&model, &mut data, &mut ws, t, &mut q, &mut u, &NoCallbacks).unwrap();
     assert!(data.phi.iter().all(|v| v.abs() < 1e-12));
-    crate::dynamics::forward_dynamics(&model, &mut data, t, &q, &u, None, &NoCallbacks).unwrap();
+    crate::dynamics::forward_dynamics(&model, &mut data, &mut ws, t, &q, &u, None, &NoCallbacks).unwrap();
     let udot = data.udot.clone();
     let lambda = data.lambda.clone();
     // G u̇ = γ
@@ -197,7 +197,7 @@ fn constrained_accelerations_satisfy_the_constraints_and_dalembert() {
     // M u̇ - h = Gᵀ λ (the multipliers are the generalized constraint forces)
     let g = data.g.clone();
     let mut tau = vec![0.0; model.nu];
-    crate::dynamics::inverse_dynamics(&model, &mut data, t, &q, &u, &udot, &NoCallbacks, &mut tau).unwrap();
+    crate::dynamics::inverse_dynamics(&model, &mut data, &mut ws, t, &q, &u, &udot, &NoCallbacks, &mut tau).unwrap();
     for i in 0..model.nu {
         let gl: f64 = (0..model.nc).map(|r| g[(r, i)] * lambda[r]).sum();
         assert!((tau[i] - gl).abs() < 1e-9 * (1.0 + gl.abs()), "dof {i}: M u̇ - h = {} vs Gᵀλ = {gl}", tau[i]);

@@ -173,14 +173,16 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
 }
 
 /// Forward dynamics for state (t, q, u) and extra actuation `tau`: fills `data.udot`.
+#[allow(clippy::too_many_arguments)]
 pub fn aba(
     model: &Model,
     data: &mut Data,
+    ws: &mut super::Workspace,
     t: f64,
     q: &[f64],
     u: &[f64],
     tau: Option<&[f64]>,
     cb: &dyn Callbacks,
 ) -> Result<()> {
-    super::forward_dynamics(model, data, t, q, u, tau, cb).map(|_| ())
+    super::forward_dynamics(model, data, ws, t, q, u, tau, cb).map(|_| ())
 }

@@ -19,14 +19,17 @@ use crate::model::Model;
 use crate::spatial::Motion;
 
 use super::sparse::Saddle;
+use super::Workspace;
 
 /// Relative size below which a pivot counts as zero (dependent rows, singular mass matrix).
 const RANK_TOL: f64 = 1e-12;
 
 /// Forward dynamics of a constrained model; fills `data.udot`, `data.lambda`, `data.phi`.
+#[allow(clippy::too_many_arguments)]
 pub fn forward_dynamics(
     model: &Model,
     data: &mut Data,
+    ws: &mut Workspace,
     t: f64,
     q: &[f64],
     u: &[f64],
@@ -34,7 +37,7 @@ pub fn forward_dynamics(
     cb: &dyn Callbacks,
 ) -> Result<Powers> {
     let nc = model.nc;
-    let mut p = super::prepare(model, data, t, q, u, cb)?;
+    let mut p = super::prepare(model, data, ws, t, q, u, cb)?;
     constraints::positions(model, data, t, q, cb)?;
     // velocity-product accelerations (u̇ = 0, no gravity) for γ
     data.a[0] = Motion::ZERO;
@@ -49,10 +52,7 @@ pub fn forward_dynamics(
         *ci = tau.map_or(0.0, |x| x[i]) - *ci;
     }
     data.udot = c;
-    let mut sp = std::mem::take(&mut data.saddle);
-    let sparse = solve_sparse(model, data, &mut sp, t, u);
-    data.saddle = sp;
-    if !sparse? {
+    if !solve_sparse(model, data, &mut ws.saddle, t, u)? {
         solve_dense(model, data, t)?;
     }
     for k in 0..nc {
@@ -239,15 +239,14 @@ fn min_norm_multipliers(data: &mut Data, nc: usize) {
 }
 
 /// Minimum-norm correction of a residual `r` (`data.work2[..nc]`): solves `(G Gᵀ) μ = r` and
-/// writes `Gᵀ μ` into `data.scratch_u`, with G as last gathered into `data.saddle`. Dependent rows
+/// writes `Gᵀ μ` into `data.scratch_u`, with G as last gathered into `sp`. Dependent rows
 /// get zero. With `holonomic_only` the non-holonomic rows are left out (their rows of G count as
 /// zero, so their μ is zero): the position Newton then solves only `Φ_h = 0` and is not restricted
 /// by velocity-only rows. With `reuse`, the sparse factor of `G Gᵀ` from the previous call is kept
 /// (a simplified Newton step: G moved by the last correction only, O(|Φ|)). Returns whether the
 /// sparse factor was used (false: the dense pivoted one, for redundant rows; it is not kept).
-fn min_norm_correction(model: &Model, data: &mut Data, holonomic_only: bool, reuse: bool) -> bool {
+fn min_norm_correction(model: &Model, data: &mut Data, sp: &mut Saddle, holonomic_only: bool, reuse: bool) -> bool {
     let (nu, nc) = (model.nu, model.nc);
-    let mut sp = std::mem::take(&mut data.saddle);
     if holonomic_only {
         for con in &model.constraints {
             let rows = con.row + con.kind.holonomic_rows()..con.row + con.kind.rows();
@@ -284,7 +283,6 @@ fn min_norm_correction(model: &Model, data: &mut Data, holonomic_only: bool, reu
         }
         data.work2 = rhs;
     }
-    data.saddle = sp;
     sparse
 }
 
@@ -317,7 +315,16 @@ fn dense_gram_factor(model: &Model, data: &mut Data, holonomic_only: bool) {
 /// Projects (q, u) at time t onto `Φ(q, t) = 0` and `G u = b`: Newton iterations with minimum-norm
 /// corrections (the pseudo-inverse relation of eq. 2.68) over the holonomic rows only, then one
 /// velocity correction over all rows (holonomic and non-holonomic).
-pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f64], cb: &dyn Callbacks) -> Result<()> {
+pub fn project(
+    model: &Model,
+    data: &mut Data,
+    ws: &mut Workspace,
+    t: f64,
+    q: &mut [f64],
+    u: &mut [f64],
+    cb: &dyn Callbacks,
+) -> Result<()> {
+    let sp = &mut ws.saddle;
     let nc = model.nc;
     if nc == 0 {
         return Ok(());
@@ -338,13 +345,13 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
             break;
         }
         data.work2[..nc].copy_from_slice(&data.phi);
-        data.saddle.gather_g(&data.g);
+        sp.gather_g(&data.g);
         // a frozen factor only for the small corrections after a step; full Newton from afar
         let small = worst.0 < 1e-8;
-        let used = min_norm_correction(model, data, true, small && factor);
+        let used = min_norm_correction(model, data, sp, true, small && factor);
         // keep only a well-conditioned sparse factor: with nearly dependent rows (a redundancy that
         // is exact only on the manifold) a frozen factor amplifies the change of G
-        factor = used && data.saddle.well_conditioned(1e-8);
+        factor = used && sp.well_conditioned(1e-8);
         // a factor taken far from the manifold does not serve the velocity correction
         factor_far = !small;
         // Δu = -Gᵀ μ, applied on the configuration manifold
@@ -362,14 +369,14 @@ pub fn project(model: &Model, data: &mut Data, t: f64, q: &mut [f64], u: &mut [f
         )));
     }
     // velocities: u ← u - Gᵀ (G Gᵀ)⁺ (G u - b), with G at the projected q
-    data.saddle.gather_g(&data.g);
+    sp.gather_g(&data.g);
     let mut r = std::mem::take(&mut data.work2);
-    data.saddle.g_times(u, &mut r[..nc]);
+    sp.g_times(u, &mut r[..nc]);
     for k in 0..nc {
         r[k] -= data.b[k];
     }
     data.work2 = r;
-    min_norm_correction(model, data, false, all_holonomic && !factor_far && factor);
+    min_norm_correction(model, data, sp, false, all_holonomic && !factor_far && factor);
     for (v, d) in u.iter_mut().zip(&data.scratch_u) {
         *v -= d;
     }

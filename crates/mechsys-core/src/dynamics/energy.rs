@@ -4,6 +4,7 @@
 
 use crate::data::Data;
 use crate::forces::damping::progressive_energy;
+use crate::forces::jenkins;
 use crate::forces::spring_energy;
 use crate::kinematics::point_position;
 use crate::math::Vec3;
@@ -53,7 +54,7 @@ pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
                     Some(s) => (0..6).map(|i| progressive_energy(k[(i, i)], x[i], s[i])).sum(),
                 };
             }
-            ForceElement::Jenkins(j) => v += j.energy(data, q),
+            ForceElement::Jenkins(j) => v += jenkins::energy(j, data, q),
             _ => {}
         }
     }

@@ -19,6 +19,7 @@ use crate::model::Model;
 pub fn joint_reactions(
     model: &Model,
     data: &mut Data,
+    ws: &mut super::Workspace,
     t: f64,
     q: &[f64],
     u: &[f64],
@@ -30,13 +31,13 @@ pub fn joint_reactions(
     let mut tmp = std::mem::take(&mut data.scratch_u);
     if model.nc > 0 {
         // the loop closures and drives load the bodies too: solve for λ and add Gᵀ λ
-        super::constrained::forward_dynamics(model, data, t, q, u, None, cb)?;
+        super::constrained::forward_dynamics(model, data, ws, t, q, u, None, cb)?;
         crate::constraints::apply_forces(model, data);
         let ud = std::mem::take(&mut data.udot);
         super::rnea::rnea_prepared(model, data, &ud, &mut tmp);
         data.udot = ud;
     } else {
-        super::prepare(model, data, t, q, u, cb)?;
+        super::prepare(model, data, ws, t, q, u, cb)?;
         super::rnea::rnea_prepared(model, data, udot, &mut tmp);
     }
     data.scratch_u = tmp;
@@ -63,17 +64,17 @@ mod tests {
     #[test]
     fn static_chain_carries_the_weight_below_each_joint() {
         let model = fixtures::chain(3, "revolute");
-        let mut data = Data::new(&model);
+        let (mut data, mut ws) = (Data::new(&model), crate::dynamics::Workspace::new(&model));
         // straight down would be q = 0 for rods along x with gravity -z: all rods horizontal; the
         // reaction must balance gravity and the moment of the rods' weight (not an equilibrium, so
         // use the actual accelerations)
         let q = vec![0.0; 3];
         let u = vec![0.0; 3];
-        crate::dynamics::forward_dynamics(&model, &mut data, 0.0, &q, &u, None, &NoCallbacks).unwrap();
+        crate::dynamics::forward_dynamics(&model, &mut data, &mut ws, 0.0, &q, &u, None, &NoCallbacks).unwrap();
         let udot = data.udot.clone();
         let mut f = vec![Vec3::zeros(); 3];
         let mut n = vec![Vec3::zeros(); 3];
-        joint_reactions(&model, &mut data, 0.0, &q, &u, &udot, &NoCallbacks, &mut f, &mut n).unwrap();
+        joint_reactions(&model, &mut data, &mut ws, 0.0, &q, &u, &udot, &NoCallbacks, &mut f, &mut n).unwrap();
         // the joints are free about their axes: no moment along the axis (z, y, x in joint frames)
         let axes = [Vec3::z(), Vec3::y(), Vec3::x()];
         for j in 0..3 {

@@ -45,6 +45,7 @@ pub fn rnea_inward(model: &Model, data: &mut Data, out: &mut [f64]) {
 pub fn inverse_dynamics(
     model: &Model,
     data: &mut Data,
+    ws: &mut super::Workspace,
     t: f64,
     q: &[f64],
     u: &[f64],
@@ -52,7 +53,7 @@ pub fn inverse_dynamics(
     cb: &dyn Callbacks,
     tau: &mut [f64],
 ) -> Result<()> {
-    super::prepare(model, data, t, q, u, cb)?;
+    super::prepare(model, data, ws, t, q, u, cb)?;
     rnea_prepared(model, data, udot, tau);
     Ok(())
 }
@@ -65,12 +66,13 @@ pub use inverse_dynamics as rnea;
 pub fn nonlinear_effects(
     model: &Model,
     data: &mut Data,
+    ws: &mut super::Workspace,
     t: f64,
     q: &[f64],
     u: &[f64],
     cb: &dyn Callbacks,
 ) -> Result<()> {
-    super::prepare(model, data, t, q, u, cb)?;
+    super::prepare(model, data, ws, t, q, u, cb)?;
     let mut tmp = std::mem::take(&mut data.scratch_u);
     let zero = std::mem::take(&mut data.zero_u);
     rnea_prepared(model, data, &zero, &mut tmp);

@@ -16,8 +16,7 @@
 //! a combination of other nonzero rows is reported ([`Saddle::factor_schur`] returns false) so the
 //! caller can take the dense minimum-norm path.
 
-use crate::constraints::Reach;
-use crate::model::Model;
+use crate::model::{constraint, Model};
 
 /// Plan and workspace of the sparse constrained solve.
 #[derive(Debug, Clone, Default)]
@@ -62,32 +61,11 @@ pub struct Saddle {
     scratch_c: Vec<f64>,
 }
 
-/// Velocity indices of a joint-space path: the velocities of the joints from `body` to the root.
-fn path_velocities(model: &Model, body: usize, out: &mut Vec<usize>) {
-    let mut b = body;
-    while b != 0 {
-        let j = &model.joints[b - 1];
-        out.extend(j.iu..j.iu + j.nu());
-        b = j.parent;
-    }
-}
-
-/// The velocity tree's ancestor lists: within a joint each velocity hangs on the previous one, a
-/// joint's first velocity on the last velocity of the nearest ancestor joint that has any.
-/// Returns (parent velocity or `usize::MAX`, depth per velocity, CSR pointers, ancestors nearest
-/// first).
+/// The velocity tree's ancestor lists ([`Model::velocity_parents`]). Returns (parent velocity or
+/// `usize::MAX`, depth per velocity, CSR pointers, ancestors nearest first).
 pub(crate) fn velocity_ancestors(model: &Model) -> (Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>) {
     let nu = model.nu;
-    let mut parent = vec![usize::MAX; nu];
-    let mut last = vec![usize::MAX; model.nbodies()];
-    for (ji, j) in model.joints.iter().enumerate() {
-        let mut p = last[j.parent];
-        for k in 0..j.nu() {
-            parent[j.iu + k] = p;
-            p = j.iu + k;
-        }
-        last[ji + 1] = p;
-    }
+    let parent = model.velocity_parents();
     let mut depth = vec![0; nu];
     let (mut anc_ptr, mut anc_idx) = (vec![0; nu + 1], Vec::new());
     for k in 0..nu {
@@ -107,35 +85,9 @@ impl Saddle {
     /// which the time-stepping schemes use).
     pub fn new(model: &Model) -> Self {
         let (nu, nc) = (model.nu, model.nc);
-        let (parent, depth, anc_ptr, anc_idx) = velocity_ancestors(model);
-        // row patterns
-        let (mut row_ptr, mut row_idx) = (vec![0; nc + 1], Vec::new());
-        let mut buf = Vec::new();
-        for c in &model.constraints {
-            buf.clear();
-            match c.kind.reach() {
-                Reach::Bodies(b1, b2) => {
-                    path_velocities(model, b1, &mut buf);
-                    path_velocities(model, b2, &mut buf);
-                }
-                Reach::Velocities(a, b) => {
-                    for v in [a, b] {
-                        let mut x = v;
-                        while x != usize::MAX {
-                            buf.push(x);
-                            x = parent[x];
-                        }
-                    }
-                }
-                Reach::All => buf.extend(0..nu),
-            }
-            buf.sort_unstable();
-            buf.dedup();
-            for k in 0..c.kind.rows() {
-                row_idx.extend_from_slice(&buf);
-                row_ptr[c.row + k + 1] = row_idx.len();
-            }
-        }
+        let (_, depth, anc_ptr, anc_idx) = velocity_ancestors(model);
+        // row patterns (the same as `Data::g_row_ptr`, `Data::g_row_idx`)
+        let (row_ptr, row_idx) = constraint::row_pattern(model);
         // columns: rows reaching each velocity
         let mut col_ptr = vec![0; nu + 1];
         for &i in &row_idx {
@@ -334,30 +286,6 @@ impl Saddle {
                 self.g_val[p] = g[(r, self.row_idx[p])];
             }
         }
-    }
-
-    /// Zeroes the entries of the dense `G` on the row pattern: the only ones the constraint rows
-    /// ever write, so G is cleared in O(nonzeros) instead of O(nc · nu).
-    pub fn clear_pattern(&self, g: &mut nalgebra::DMatrix<f64>) {
-        for r in 0..self.nc {
-            for p in self.row_ptr[r]..self.row_ptr[r + 1] {
-                g[(r, self.row_idx[p])] = 0.0;
-            }
-        }
-    }
-
-    /// The first nonzero of the dense `G` outside the row pattern (row, velocity), if any: a
-    /// constraint kind whose [`crate::constraints::ConstraintKind::reach`] is too small.
-    pub fn outside_pattern(&self, g: &nalgebra::DMatrix<f64>) -> Option<(usize, usize)> {
-        for r in 0..self.nc {
-            let pat = &self.row_idx[self.row_ptr[r]..self.row_ptr[r + 1]];
-            for i in 0..self.nu {
-                if g[(r, i)] != 0.0 && pat.binary_search(&i).is_err() {
-                    return Some((r, i));
-                }
-            }
-        }
-        None
     }
 
     /// Zeroes the rows `rows` of the gathered G (rows left out of a projection).

@@ -98,13 +98,13 @@ fn state(model: &Model, seed: f64) -> (Vec<f64>, Vec<f64>) {
 #[test]
 fn aba_equals_mass_matrix_solve() {
     let model = mixed_tree();
-    let mut data = Data::new(&model);
+    let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
     for seed in [0.0, 1.0, 2.5] {
         let (q, u) = state(&model, seed);
         let tau: Vec<f64> = (0..model.nu).map(|i| 0.5 * (i as f64 * 0.3 + seed).sin()).collect();
-        aba(&model, &mut data, 0.0, &q, &u, Some(&tau), &NoCallbacks).unwrap();
+        aba(&model, &mut data, &mut ws, 0.0, &q, &u, Some(&tau), &NoCallbacks).unwrap();
         let udot = DVector::from_column_slice(&data.udot);
-        nonlinear_effects(&model, &mut data, 0.0, &q, &u, &NoCallbacks).unwrap();
+        nonlinear_effects(&model, &mut data, &mut ws, 0.0, &q, &u, &NoCallbacks).unwrap();
         let h = data.h.clone();
         crba::mass_matrix(&model, &mut data, 0.0, &q);
         let m = data.mass_matrix.clone();
@@ -119,13 +119,13 @@ fn aba_equals_mass_matrix_solve() {
 #[test]
 fn inverse_of_forward_dynamics_gives_tau_back() {
     let model = mixed_tree();
-    let mut data = Data::new(&model);
+    let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
     let (q, u) = state(&model, 0.7);
     let tau: Vec<f64> = (0..model.nu).map(|i| (i as f64 - 3.0) * 0.4).collect();
-    aba(&model, &mut data, 0.0, &q, &u, Some(&tau), &NoCallbacks).unwrap();
+    aba(&model, &mut data, &mut ws, 0.0, &q, &u, Some(&tau), &NoCallbacks).unwrap();
     let udot = data.udot.clone();
     let mut back = vec![0.0; model.nu];
-    inverse_dynamics(&model, &mut data, 0.0, &q, &u, &udot, &NoCallbacks, &mut back).unwrap();
+    inverse_dynamics(&model, &mut data, &mut ws, 0.0, &q, &u, &udot, &NoCallbacks, &mut back).unwrap();
     for i in 0..model.nu {
         assert!((back[i] - tau[i]).abs() < 1e-10, "τ[{i}]: {} vs {}", back[i], tau[i]);
     }
@@ -178,9 +178,9 @@ fn mass_matrix_is_hessian_of_kinetic_energy() {
 #[test]
 fn power_balance_along_the_flow() {
     let model = mixed_tree();
-    let mut data = Data::new(&model);
+    let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
     let (q, u) = state(&model, 0.2);
-    let p = forward_dynamics(&model, &mut data, 0.0, &q, &u, None, &NoCallbacks).unwrap();
+    let p = forward_dynamics(&model, &mut data, &mut ws, 0.0, &q, &u, None, &NoCallbacks).unwrap();
     let udot = data.udot.clone();
     let energy_at = |data: &mut Data, s: f64| {
         let mut qs = q.clone();

@@ -34,110 +34,12 @@
 
 use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::{ForceElement, Model};
+use crate::model::{ForceElement, Jenkins, Model};
 use crate::solver::{self, Lcp, LemkeOptions, Method, Workspace};
 
-/// A set of Jenkins elements on one joint velocity (validated; see the module doc).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Jenkins {
-    /// Name.
-    pub name: String,
-    /// Joint index.
-    pub joint: usize,
-    /// Index of the coordinate in q.
-    pub iq: usize,
-    /// Index of the velocity in u.
-    pub iu: usize,
-    /// Stiffness of each Jenkins spring.
-    pub k: f64,
-    /// Slip force of each slider (n).
-    pub slip: Vec<f64>,
-    /// Shaft segment stiffness (none: elements in parallel).
-    pub shaft: Option<f64>,
-    /// Joint coordinate at which everything is relaxed.
-    pub offset: f64,
-    /// First slider of this element in `Data::slider`.
-    pub slot: usize,
-    /// Chain only: `A⁻¹ b` (n).
-    ainv_b: Vec<f64>,
-    /// Chain only: `k A⁻¹` (n × n, row-major).
-    k_ainv: Vec<f64>,
-    /// Chain only: `W = k (E − k A⁻¹)` (n × n, row-major).
-    w: Vec<f64>,
-}
-
-impl Jenkins {
-    /// Builds the element and, for a chain, its constant matrices. Inputs are checked by the caller.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        name: String,
-        joint: usize,
-        iq: usize,
-        iu: usize,
-        k: f64,
-        slip: Vec<f64>,
-        shaft: Option<f64>,
-        offset: f64,
-        slot: usize,
-    ) -> Result<Self> {
-        let n = slip.len();
-        let (mut ainv_b, mut k_ainv, mut w) = (vec![], vec![], vec![]);
-        if let Some(ks) = shaft {
-            // A = K_shaft + k E: the load point joins node 0, node i joins node i + 1 (tridiagonal)
-            let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
-            for i in 0..n {
-                a[(i, i)] = k + ks + if i + 1 < n { ks } else { 0.0 };
-                if i + 1 < n {
-                    a[(i, i + 1)] = -ks;
-                    a[(i + 1, i)] = -ks;
-                }
-            }
-            // A is symmetric positive definite when k, ks > 0 (strictly diagonally dominant)
-            let ainv = a.cholesky().map(|c| c.inverse()).ok_or_else(|| {
-                Error::Model(format!("Jenkins element '{name}': k and shaft_stiffness must be > 0 (got {k}, {ks})"))
-            })?;
-            ainv_b = (0..n).map(|i| ainv[(i, 0)] * ks).collect();
-            k_ainv = (0..n * n).map(|m| k * ainv[(m / n, m % n)]).collect();
-            w = (0..n * n).map(|m| k * (if m / n == m % n { 1.0 } else { 0.0 } - k * ainv[(m / n, m % n)])).collect();
-        }
-        Ok(Jenkins { name, joint, iq, iu, k, slip, shaft, offset, slot, ainv_b, k_ainv, w })
-    }
-
-    /// Number of sliders.
-    pub fn len(&self) -> usize {
-        self.slip.len()
-    }
-
-    /// Whether the element has no slider (never, once validated).
-    pub fn is_empty(&self) -> bool {
-        self.slip.is_empty()
-    }
-
-    /// The force the element carries along x (Σ λ_i), resisting a positive deflection.
-    pub fn force(&self, data: &Data) -> f64 {
-        data.slider_force[self.slot..self.slot + self.len()].iter().sum()
-    }
-
-    /// Elastic energy stored at the last evaluation: the Jenkins springs and the shaft segments.
-    pub fn energy(&self, data: &Data, q: &[f64]) -> f64 {
-        let s = self.slot..self.slot + self.len();
-        let (z, lam) = (&data.slider_trial[s.clone()], &data.slider_force[s]);
-        let mut e: f64 = lam.iter().map(|l| 0.5 * l * l / self.k).sum();
-        if let Some(ks) = self.shaft {
-            let x = q[self.iq] - self.offset;
-            let node = |i: usize| z[i] + lam[i] / self.k;
-            let mut prev = x;
-            for i in 0..self.len() {
-                let d = prev - node(i);
-                e += 0.5 * ks * d * d;
-                prev = node(i);
-            }
-        }
-        e
-    }
-}
-
-/// The solver scratch of one chain (preallocated: the step loop does not allocate).
+/// The solver scratch of one chain (preallocated: the step loop does not allocate). The force
+/// stage keeps one per chain in [`crate::forces::Workspace`], in the order of the model's
+/// force elements ([`chains`]).
 #[derive(Debug, Clone)]
 pub struct ChainWork {
     lcp: Lcp,
@@ -167,9 +69,55 @@ impl ChainWork {
     }
 }
 
+/// The scratch of every chain of `model` (the elements with a shaft), in the order of its force
+/// elements.
+pub fn chains(model: &Model) -> Vec<ChainWork> {
+    model
+        .forces
+        .iter()
+        .filter_map(|f| match f {
+            ForceElement::Jenkins(j) if j.shaft.is_some() => Some(ChainWork::new(j)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The force the element carries along x (Σ λ_i) at the last evaluation, resisting a positive
+/// deflection.
+pub fn force(j: &Jenkins, data: &Data) -> f64 {
+    data.slider_force[j.slot..j.slot + j.len()].iter().sum()
+}
+
+/// Elastic energy stored at the last evaluation: the Jenkins springs and the shaft segments.
+pub fn energy(j: &Jenkins, data: &Data, q: &[f64]) -> f64 {
+    let s = j.slot..j.slot + j.len();
+    let (z, lam) = (&data.slider_trial[s.clone()], &data.slider_force[s]);
+    let mut e: f64 = lam.iter().map(|l| 0.5 * l * l / j.k).sum();
+    if let Some(ks) = j.shaft {
+        let x = q[j.iq] - j.offset;
+        let node = |i: usize| z[i] + lam[i] / j.k;
+        let mut prev = x;
+        for i in 0..j.len() {
+            let d = prev - node(i);
+            e += 0.5 * ks * d * d;
+            prev = node(i);
+        }
+    }
+    e
+}
+
 /// Solves the incremental problem of element `j` at coordinate `q` against the committed slider
-/// positions: writes `data.slider_trial` (z) and `data.slider_force` (λ) and returns Σλ.
-pub fn evaluate(j: &Jenkins, chain: usize, data: &mut Data, q: &[f64], t: f64) -> Result<f64> {
+/// positions: writes `data.slider_trial` (z) and `data.slider_force` (λ) and returns Σλ. A chain
+/// (an element with a shaft) is the `chain`-th of the model and solves in `chains[chain]`; the
+/// parallel elements need no scratch.
+pub fn evaluate(
+    j: &Jenkins,
+    chain: usize,
+    data: &mut Data,
+    chains: &mut [ChainWork],
+    q: &[f64],
+    t: f64,
+) -> Result<f64> {
     let n = j.len();
     let x = q[j.iq] - j.offset;
     let s = j.slot;
@@ -182,7 +130,7 @@ pub fn evaluate(j: &Jenkins, chain: usize, data: &mut Data, q: &[f64], t: f64) -
             data.slider_trial[s + i] = x - lam / j.k;
         }
     } else {
-        let work = &mut data.jenkins_work[chain];
+        let work = &mut chains[chain];
         // trial forces with the sliders held: λ* = k (A⁻¹ b x + k A⁻¹ z⁰ − z⁰)
         for r in 0..n {
             let mut wr = j.ainv_b[r] * x;
@@ -222,13 +170,14 @@ pub fn evaluate(j: &Jenkins, chain: usize, data: &mut Data, q: &[f64], t: f64) -
 }
 
 /// After an accepted step at configuration `q`: the sliders' positions there become the new
-/// reference. Returns the work the sliders dissipated over the step (≥ 0).
-pub fn commit(model: &Model, data: &mut Data, q: &[f64], t: f64) -> Result<f64> {
+/// reference. Returns the work the sliders dissipated over the step (≥ 0). `chains` is the force
+/// stage's scratch ([`crate::forces::Workspace::jenkins`]).
+pub fn commit(model: &Model, data: &mut Data, chains: &mut [ChainWork], q: &[f64], t: f64) -> Result<f64> {
     let mut work = 0.0;
     let mut chain = 0;
     for f in &model.forces {
         if let ForceElement::Jenkins(j) = f {
-            evaluate(j, chain, data, q, t)?;
+            evaluate(j, chain, data, chains, q, t)?;
             if j.shaft.is_some() {
                 chain += 1;
             }
@@ -240,27 +189,4 @@ pub fn commit(model: &Model, data: &mut Data, q: &[f64], t: f64) -> Result<f64> 
     }
     // each λ_i Δz_i ≥ 0 by the slider law (up to round-off): no clamp, a sign error must show
     Ok(work)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn element(slip: Vec<f64>, shaft: Option<f64>) -> Jenkins {
-        Jenkins::new("press".into(), 0, 0, 0, 100.0, slip, shaft, 0.0, 0).unwrap()
-    }
-
-    #[test]
-    fn w_is_symmetric_positive_definite_and_matches_series_springs() {
-        // one node: the shaft spring and the Jenkins spring in series, W = k ks / (k + ks)
-        let j = element(vec![1.0], Some(300.0));
-        assert!((j.w[0] - 100.0 * 300.0 / 400.0).abs() < 1e-12);
-        let j = element(vec![1.0; 5], Some(50.0));
-        let w = nalgebra::DMatrix::from_row_slice(5, 5, &j.w);
-        assert!((&w - w.transpose()).norm() < 1e-12);
-        assert!(w.symmetric_eigen().eigenvalues.min() > 0.0);
-        // a non-positive stiffness is an error naming the element, not a made-up matrix
-        let e = Jenkins::new("press".into(), 0, 0, 0, -100.0, vec![1.0; 3], Some(50.0), 0.0, 0).unwrap_err();
-        assert!(e.to_string().contains("'press'"), "{e}");
-    }
 }

@@ -266,11 +266,14 @@ impl MoreauJean {
     }
 
     /// Advances (q, u) from t by one step; returns the work of the smooth external loads and the
-    /// energy dissipated by the smooth dampers over the step (J).
+    /// energy dissipated by the smooth dampers over the step (J). `ws` is the dynamics stage's
+    /// workspace of `model` (its tree factor of M and the bilateral constraints' factorization).
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
         model: &Model,
         data: &mut Data,
+        ws: &mut crate::dynamics::Workspace,
         t: f64,
         q: &mut [f64],
         u: &mut [f64],
@@ -292,7 +295,7 @@ impl MoreauJean {
                 }
             }
             let ubar = if pass == 0 { &*u } else { &self.u_free };
-            p = crate::dynamics::prepare(model, data, tm, &self.q_mid, ubar, cb)?;
+            p = crate::dynamics::prepare(model, data, ws, tm, &self.q_mid, ubar, cb)?;
             data.a[0] = Motion::ZERO;
             let zero = std::mem::take(&mut data.zero_u);
             crate::kinematics::accelerations(model, data, &zero);
@@ -300,7 +303,8 @@ impl MoreauJean {
             let mut c = std::mem::take(&mut self.tmp_u);
             crate::dynamics::rnea::rnea_inward(model, data, &mut c);
             if pass == 0 {
-                let Data { inertia, s, ic, saddle, .. } = &mut *data;
+                let Data { inertia, s, ic, .. } = &mut *data;
+                let saddle = &mut ws.saddle;
                 let mut tree = self.sparse.as_mut().map(|sp| &mut sp.factor);
                 crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| {
                     saddle.put_mass(r, col, v);
@@ -308,7 +312,7 @@ impl MoreauJean {
                         f.put(r, col, v);
                     }
                 });
-                let ok = data.saddle.factor_mass() && self.sparse.as_mut().is_none_or(|sp| sp.factor.factor());
+                let ok = ws.saddle.factor_mass() && self.sparse.as_mut().is_none_or(|sp| sp.factor.factor());
                 if !ok {
                     return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s")));
                 }
@@ -316,7 +320,7 @@ impl MoreauJean {
             for v in c.iter_mut() {
                 *v = -*v * h;
             }
-            data.saddle.solve_mass(&mut c);
+            ws.saddle.solve_mass(&mut c);
             for i in 0..nu {
                 self.u_free[i] = u[i] + c[i];
             }
@@ -338,16 +342,16 @@ impl MoreauJean {
         if nc > 0 {
             // bilateral rows at velocity level: G u_free = b(t + h), by the impulse μ
             crate::constraints::positions(model, data, t + h, &self.q_mid, cb)?;
-            data.saddle.gather_g(&data.g);
-            data.saddle.assemble_schur(true);
-            data.saddle.factor_schur(1e-12);
+            ws.saddle.gather_g(&data.g);
+            ws.saddle.assemble_schur(true);
+            ws.saddle.factor_schur(1e-12);
             let mut mu = std::mem::take(&mut self.bilateral_impulse);
-            data.saddle.g_times(&self.u_free, &mut mu);
+            ws.saddle.g_times(&self.u_free, &mut mu);
             for k in 0..nc {
                 mu[k] = data.b[k] - mu[k];
             }
-            data.saddle.solve_schur(&mut mu);
-            data.saddle.add_constraint_accelerations(&mu, &mut self.u_free);
+            ws.saddle.solve_schur(&mut mu);
+            ws.saddle.add_constraint_accelerations(&mu, &mut self.u_free);
             self.bilateral_impulse = mu;
         }
         // ---- contacts at the midpoint: the explicit pairs, then the groups' pairs
@@ -418,15 +422,15 @@ impl MoreauJean {
                     for i in 0..nu {
                         x[i] = self.w_rows[(col, i)];
                     }
-                    data.saddle.solve_mass(x);
+                    ws.saddle.solve_mass(x);
                     if nc > 0 {
                         let mut y = std::mem::take(&mut data.lambda);
-                        data.saddle.g_times(x, &mut y);
+                        ws.saddle.g_times(x, &mut y);
                         for v in y.iter_mut() {
                             *v = -*v;
                         }
-                        data.saddle.solve_schur(&mut y);
-                        data.saddle.add_constraint_accelerations(&y, x);
+                        ws.saddle.solve_schur(&mut y);
+                        ws.saddle.add_constraint_accelerations(&y, x);
                         data.lambda = y;
                     }
                 }
@@ -483,8 +487,15 @@ impl MoreauJean {
                         (&g.friction, &g.impact, sl.kin[k].gd_t, prev, st)
                     }
                 };
+                // a point slides into the step if it slid in the last one, or if it took no
+                // impulse in the last one (the run's first step, a closing) and touches without
+                // approaching while sliding clearly (1e-6 m/s: above the creep a solver's
+                // tolerance leaves at a point of a statically indeterminate stick)
+                let slip_speed = (gd_t[0].powi(2) + if d == 3 { gd_t[1].powi(2) } else { 0.0 }).sqrt();
+                let sliding_in = prev_state == SLIP
+                    || (prev_state == OPEN && slip_speed > 1e-6 && self.gd_before[ai * d] >= -1e-9);
                 // Painlevé test of a point sliding into the step (see crate::integrator::events)
-                if let (Source::Point(pt), true) = (a.source, prev_state == SLIP) {
+                if let (Source::Point(pt), true) = (a.source, sliding_in) {
                     let gt = &self.gd_before[ai * d + 1..(ai + 1) * d];
                     let speed = gt.iter().map(|v| v * v).sum::<f64>().sqrt();
                     if speed > 0.0 && !matches!(friction, FrictionLaw::None) {
@@ -505,14 +516,13 @@ impl MoreauJean {
                 // a point still open by less than the margin may close within the step, not beyond
                 let gap_allowance = a.point.g_n.max(0.0) / h;
                 self.problem.q[ai * d] += impact.eps() * self.gd_before[ai * d].min(0.0) + gap_allowance;
-                let slip_speed = (gd_t[0].powi(2) + if d == 3 { gd_t[1].powi(2) } else { 0.0 }).sqrt();
-                let mu = match (friction, prev_state) {
-                    (FrictionLaw::None, _) => 0.0,
-                    (law, s) if s == SLIP => law.mu(slip_speed.max(f64::MIN_POSITIVE)),
-                    (law, _) => law.mu0(),
+                let mu = match friction {
+                    FrictionLaw::None => 0.0,
+                    law if sliding_in => law.mu(slip_speed.max(f64::MIN_POSITIVE)),
+                    law => law.mu0(),
                 };
                 let sliding_less =
-                    !matches!(friction, FrictionLaw::None) && prev_state != SLIP && friction.mu(f64::MIN_POSITIVE) < mu;
+                    !matches!(friction, FrictionLaw::None) && !sliding_in && friction.mu(f64::MIN_POSITIVE) < mu;
                 self.static_mu.push(sliding_less);
                 self.problem.mu.push(mu);
                 self.r.extend_from_slice(&prev[..d]);
@@ -671,7 +681,7 @@ impl MoreauJean {
         model.normalize(q);
         self.reframe(&self.q_mid, q, u);
         if nc > 0 {
-            crate::dynamics::constrained::project(model, data, t + h, q, u, cb)?;
+            crate::dynamics::constrained::project(model, data, ws, t + h, q, u, cb)?;
         }
         Ok((p.external * h, p.dissipated * h))
     }

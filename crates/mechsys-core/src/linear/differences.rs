@@ -10,6 +10,7 @@
 use nalgebra::DMatrix;
 
 use crate::data::Data;
+use crate::dynamics::Workspace;
 use crate::error::Result;
 use crate::forces::Callbacks;
 use crate::model::Model;
@@ -18,9 +19,11 @@ use crate::model::Model;
 pub(super) const STEP: f64 = 1e-5;
 
 /// `(∂u̇/∂q V, ∂u̇/∂u V)`, each nu × n, by central differences of `dynamics::forward_dynamics`.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn acceleration_derivatives(
     model: &Model,
     data: &mut Data,
+    ws: &mut Workspace,
     t: f64,
     q: &[f64],
     u: &[f64],
@@ -28,8 +31,8 @@ pub(super) fn acceleration_derivatives(
     cb: &dyn Callbacks,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
     let (nq, nu, n) = (model.nq, model.nu, v.ncols());
-    let accel = |data: &mut Data, q: &[f64], u: &[f64]| -> Result<Vec<f64>> {
-        crate::dynamics::forward_dynamics(model, data, t, q, u, None, cb)?;
+    let mut accel = |data: &mut Data, q: &[f64], u: &[f64]| -> Result<Vec<f64>> {
+        crate::dynamics::forward_dynamics(model, data, ws, t, q, u, None, cb)?;
         Ok(data.udot.clone())
     };
     let (mut qp, mut up, mut dir) = (vec![0.0; nq], u.to_vec(), vec![0.0; nu]);

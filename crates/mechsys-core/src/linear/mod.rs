@@ -154,10 +154,10 @@ pub fn linearize_with(
             true
         }
     };
-    let mut data = Data::new(model);
+    let (mut data, mut ws) = (Data::new(model), crate::dynamics::Workspace::new(model));
     // the basis of the allowed directions
     let v = if nc > 0 {
-        crate::dynamics::prepare(model, &mut data, t, q, u, cb)?;
+        crate::dynamics::prepare(model, &mut data, &mut ws, t, q, u, cb)?;
         crate::constraints::positions(model, &mut data, t, q, cb)?;
         null_space(&data.g, nu)
     } else {
@@ -174,7 +174,7 @@ pub fn linearize_with(
         )));
     }
     // the point: accelerations u̇* and multipliers λ*
-    crate::dynamics::forward_dynamics(model, &mut data, t, q, u, None, cb)?;
+    crate::dynamics::forward_dynamics(model, &mut data, &mut ws, t, q, u, None, cb)?;
     let (a0, lambda) = (data.udot.clone(), data.lambda.clone());
     // Vᵀ X; without constraints V = I and the O(nu³) products are skipped
     let identity = nc == 0;
@@ -191,7 +191,7 @@ pub fn linearize_with(
         };
         (project(du), project(dq), method)
     } else {
-        let (dq, du) = differences::acceleration_derivatives(model, &mut data, t, q, u, &v, cb)?;
+        let (dq, du) = differences::acceleration_derivatives(model, &mut data, &mut ws, t, q, u, &v, cb)?;
         (-(&vt_m * du), -(&vt_m * dq), DerivativeMethod::CentralDifferences)
     };
     let m_r = if identity { vt_m.clone() } else { &vt_m * &v };

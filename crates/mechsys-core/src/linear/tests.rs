@@ -446,8 +446,9 @@ fn generic_inverse_dynamics_equals_the_engine_rnea_for_every_joint_and_element()
     let udot: Vec<f64> = (0..model.nu).map(|i| 0.9 * ((i as f64) * 0.7 - 0.2).cos()).collect();
     let t = 0.8;
     let mut data = crate::data::Data::new(&model);
+    let mut ws = crate::dynamics::Workspace::new(&model);
     let mut want = vec![0.0; model.nu];
-    crate::dynamics::inverse_dynamics(&model, &mut data, t, &q, &u, &udot, &NoCallbacks, &mut want).unwrap();
+    crate::dynamics::inverse_dynamics(&model, &mut data, &mut ws, t, &q, &u, &udot, &NoCallbacks, &mut want).unwrap();
     let mut tree = super::ad::Tree::<f64>::new(&model);
     let mut got = vec![0.0; model.nu];
     tree.inverse_dynamics(&model, t, &q, &u, &udot, &NoCallbacks, &mut got).unwrap();

@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::description::RotationDescription;
+use super::rotation_description::RotationDescription;
 
 /// A contact between `contour1` on `body1` and `contour2` on `body2` (`ground` allowed).
 #[derive(Debug, Clone, Serialize, Deserialize)]

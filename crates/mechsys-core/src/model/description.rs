@@ -7,6 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
+use super::contact_description::{ContactDescription, ContactGroupDescription};
+pub use super::rotation_description::{AnglesDescription, RotationDescription};
+
 /// A whole model as written in a model file.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -34,11 +37,11 @@ pub struct ModelDescription {
     pub constraints: Vec<ConstraintDescription>,
     /// Unilateral contacts between contours on bodies.
     #[serde(default)]
-    pub contacts: Vec<super::contact_description::ContactDescription>,
+    pub contacts: Vec<ContactDescription>,
     /// Contact groups: every pair among a set of contours, and each of them against a set of
     /// other contours, with one friction and one impact law (pairs found by a broad phase).
     #[serde(default)]
-    pub contact_groups: Vec<super::contact_description::ContactGroupDescription>,
+    pub contact_groups: Vec<ContactGroupDescription>,
 }
 
 /// A bilateral constraint. Read through a JSON value so that a malformed entry's error names the
@@ -320,33 +323,6 @@ pub enum InertiaDescription {
     Matrix([[f64; 3]; 3]),
     /// Diagonal or six entries.
     List(Vec<f64>),
-}
-
-/// A rotation: a unit quaternion `[w, x, y, z]`, a 3×3 matrix (rows of A_PB), or named angles.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum RotationDescription {
-    /// Rotation matrix rows.
-    Matrix([[f64; 3]; 3]),
-    /// Quaternion `[w, x, y, z]` (normalised when read).
-    Quaternion([f64; 4]),
-    /// Angles by name.
-    Angles(AnglesDescription),
-}
-
-/// Named rotation angles.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AnglesDescription {
-    /// Cardan angles x-y-z (α, β, γ), eq. 2.19.
-    #[serde(default)]
-    pub cardan: Option<[f64; 3]>,
-    /// Euler angles z-x-z (ψ, ϑ, φ), eq. 2.15.
-    #[serde(default)]
-    pub euler: Option<[f64; 3]>,
-    /// Rotation vector (axis × angle).
-    #[serde(default)]
-    pub rotvec: Option<[f64; 3]>,
 }
 
 /// A frame placed on a body: position of its origin and orientation, both in the body frame.

@@ -4,16 +4,25 @@
 //! everything a user can get wrong and names the offending item. Bodies are stored in topological
 //! order (index 0 is the ground, each body's parent has a smaller index) and body `i > 0` is moved
 //! by joint `i - 1`, so the recursive algorithms are plain loops.
+//!
+//! Every model element is defined here (joints, bilateral constraints in [`constraint`], Jenkins
+//! elements in [`jenkins`], contacts in [`contact`]); the stages that evaluate them import the
+//! model, never the other way round.
 
+pub mod constraint;
 pub mod contact;
 pub mod contact_description;
 pub mod description;
+pub mod jenkins;
 pub mod joint;
+pub mod rotation_description;
 mod validate;
 
 use std::collections::HashMap;
 
+pub use constraint::{Constraint, ConstraintKind, LoopJoint, Reach};
 pub use description::ModelDescription;
+pub use jenkins::Jenkins;
 pub use joint::JointKind;
 
 use crate::math::{Mat3, Vec3};
@@ -260,8 +269,8 @@ pub enum ForceElement {
         /// Torque per shaft speed (N m s/rad).
         c: f64,
     },
-    /// Jenkins elements on one joint velocity (see [`crate::forces::jenkins`]).
-    Jenkins(crate::forces::jenkins::Jenkins),
+    /// Jenkins elements on one joint velocity (evaluated by [`crate::forces::jenkins`]).
+    Jenkins(Jenkins),
     /// Force and torque on a body.
     BodyForce {
         /// Name.
@@ -342,7 +351,7 @@ pub struct Model {
     /// Force elements.
     pub forces: Vec<ForceElement>,
     /// Bilateral constraints beyond the tree.
-    pub constraints: Vec<crate::constraints::Constraint>,
+    pub constraints: Vec<Constraint>,
     /// Unilateral contacts.
     pub contacts: Vec<contact::Contact>,
     /// Contact groups (pairs found by a broad phase at every step).
@@ -448,6 +457,22 @@ impl Model {
         for j in &self.joints {
             j.kind.qdot(&q[j.iq..j.iq + j.nq()], &u[j.iu..j.iu + j.nu()], &mut qd[j.iq..j.iq + j.nq()]);
         }
+    }
+    /// The velocity tree: within a joint each velocity hangs on the previous one, a joint's first
+    /// velocity on the last velocity of the nearest ancestor joint that has any. Returns the parent
+    /// velocity of each velocity (nu), `usize::MAX` for a root.
+    pub fn velocity_parents(&self) -> Vec<usize> {
+        let mut parent = vec![usize::MAX; self.nu];
+        let mut last = vec![usize::MAX; self.nbodies()];
+        for (ji, j) in self.joints.iter().enumerate() {
+            let mut p = last[j.parent];
+            for k in 0..j.nu() {
+                parent[j.iu + k] = p;
+                p = j.iu + k;
+            }
+            last[ji + 1] = p;
+        }
+        parent
     }
     /// q ⊕ u·dt on the configuration manifold.
     pub fn integrate(&self, q: &[f64], u: &[f64], dt: f64, out: &mut [f64]) {

@@ -645,7 +645,7 @@ impl Model {
                         crate::ensure!(ks.is_finite() && *ks > 0.0, Model, "{what}.shaft_stiffness: must be > 0, got {ks}");
                     }
                     crate::ensure!(offset.is_finite(), Model, "{what}.offset: must be finite, got {offset}");
-                    let j = crate::forces::jenkins::Jenkins::new(
+                    let j = Jenkins::new(
                         name,
                         ji,
                         jt.iq + index,
@@ -707,7 +707,6 @@ impl Model {
             Ok(ji)
         };
         for (ci, c) in desc.constraints.iter().enumerate() {
-            use crate::constraints::{Constraint, ConstraintKind};
             let name = c.name().to_string();
             let what = format!("constraints[{ci}] '{name}'");
             crate::ensure!(!name.trim().is_empty(), Model, "constraints[{ci}]: name must not be empty");
@@ -819,7 +818,6 @@ impl Model {
                 | ConstraintDescription::LoopCylindrical(LoopFrames { body1, frame1, body2, frame2, .. })
                 | ConstraintDescription::LoopUniversal(LoopFrames { body1, frame1, body2, frame2, .. })
                 | ConstraintDescription::LoopPlanar(LoopFrames { body1, frame1, body2, frame2, .. }) => {
-                    use crate::constraints::LoopJoint;
                     let b1 = body(body1, &format!("{what}.body1"))?;
                     let b2 = body(body2, &format!("{what}.body2"))?;
                     crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{body1}'");

@@ -44,7 +44,13 @@ impl Phase<'_> {
                     w[a * nu + i] = row[(0, i)];
                     x[a * nu + i] = row[(0, i)];
                 }
-                Self::inverse_mass(&mut self.data, model.nc, &mut x[a * nu..(a + 1) * nu], None);
+                Self::inverse_mass(
+                    &mut self.data,
+                    &mut self.dynamics.saddle,
+                    model.nc,
+                    &mut x[a * nu..(a + 1) * nu],
+                    None,
+                );
             }
         }
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();

@@ -125,6 +125,8 @@ pub struct Phase<'a> {
     opts: Options,
     /// The workspace of the last evaluation.
     pub data: Data,
+    /// The dynamics stage's own workspace (the factors of M and of the bilateral constraints).
+    pub dynamics: crate::dynamics::Workspace,
     /// 2 if every contact is planar, else 3 (normal and tangents per point).
     d: usize,
     /// Per point: [`OPEN`], [`STICK`] or [`SLIP`].

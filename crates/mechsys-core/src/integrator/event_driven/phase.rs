@@ -5,6 +5,7 @@ use nalgebra::DMatrix;
 use super::{EventWork, Options, Phase, PYRAMID};
 use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
 use crate::data::Data;
+use crate::dynamics::sparse::Saddle;
 use crate::error::{Error, Result};
 use crate::forces::{Callbacks, Powers};
 use crate::integrator::events::EventLog;
@@ -31,6 +32,7 @@ impl<'a> Phase<'a> {
             cb,
             opts,
             data: Data::new(model),
+            dynamics: crate::dynamics::Workspace::new(model),
             d,
             status: vec![OPEN; np],
             dir: vec![[0.0; 2]; np],
@@ -98,8 +100,9 @@ impl<'a> Phase<'a> {
     /// with `w̄` (velocity-product accelerations in `data.a`).
     pub(super) fn free_motion(&mut self, t: f64, q: &[f64], u: &[f64]) -> Result<Powers> {
         let (model, nc) = (self.model, self.model.nc);
-        let data = &mut self.data;
-        let mut p = crate::dynamics::prepare(model, data, t, q, u, self.cb)?;
+        let (data, ws) = (&mut self.data, &mut self.dynamics);
+        let mut p = crate::dynamics::prepare(model, data, ws, t, q, u, self.cb)?;
+        let sp = &mut ws.saddle;
         if nc > 0 {
             crate::constraints::positions(model, data, t, q, self.cb)?;
         }
@@ -116,29 +119,29 @@ impl<'a> Phase<'a> {
             *v = -*v;
         }
         {
-            let Data { inertia, s, ic, saddle, .. } = &mut *data;
-            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| saddle.put_mass(r, col, v));
+            let Data { inertia, s, ic, .. } = &mut *data;
+            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| sp.put_mass(r, col, v));
         }
-        if !data.saddle.factor_mass() {
+        if !sp.factor_mass() {
             self.a_free = c;
             return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));
         }
-        data.saddle.solve_mass(&mut c);
+        sp.solve_mass(&mut c);
         if nc > 0 {
-            data.saddle.gather_g(&data.g);
-            data.saddle.assemble_schur(true);
-            if !data.saddle.factor_schur(1e-12) {
+            sp.gather_g(&data.g);
+            sp.assemble_schur(true);
+            if !sp.factor_schur(1e-12) {
                 self.a_free = c;
                 return Err(Error::Settings(format!(
                     "integrator: the event-driven scheme needs independent bilateral constraints; they are redundant at t = {t:.6} s (use MoreauJean)"
                 )));
             }
-            data.saddle.g_times(&c, &mut data.lambda);
+            sp.g_times(&c, &mut data.lambda);
             for r in 0..nc {
                 data.lambda[r] = data.gamma[r] - data.lambda[r];
             }
-            data.saddle.solve_schur(&mut data.lambda);
-            data.saddle.add_constraint_accelerations(&data.lambda, &mut c);
+            sp.solve_schur(&mut data.lambda);
+            sp.add_constraint_accelerations(&data.lambda, &mut c);
             for k in 0..nc {
                 p.external += data.lambda[k] * data.b[k];
             }
@@ -154,17 +157,17 @@ impl<'a> Phase<'a> {
 
     /// `x ← M̃⁻¹ x`: the accelerations a generalized force `x` causes under the bilateral
     /// constraints; `lambda`, if given, receives the multipliers it adds.
-    pub(super) fn inverse_mass(data: &mut Data, nc: usize, x: &mut [f64], lambda: Option<&mut [f64]>) {
-        data.saddle.solve_mass(x);
+    pub(super) fn inverse_mass(data: &mut Data, sp: &mut Saddle, nc: usize, x: &mut [f64], lambda: Option<&mut [f64]>) {
+        sp.solve_mass(x);
         if nc > 0 {
             let mut y = std::mem::take(&mut data.work2);
             y.resize(nc.max(y.len()), 0.0);
-            data.saddle.g_times(x, &mut y[..nc]);
+            sp.g_times(x, &mut y[..nc]);
             for v in y[..nc].iter_mut() {
                 *v = -*v;
             }
-            data.saddle.solve_schur(&mut y[..nc]);
-            data.saddle.add_constraint_accelerations(&y[..nc], x);
+            sp.solve_schur(&mut y[..nc]);
+            sp.add_constraint_accelerations(&y[..nc], x);
             if let Some(l) = lambda {
                 for k in 0..nc {
                     l[k] += y[k];
@@ -234,7 +237,7 @@ impl<'a> Phase<'a> {
             for i in 0..nu {
                 x[i] = self.cols[(j, i)];
             }
-            Self::inverse_mass(&mut self.data, self.model.nc, x, None);
+            Self::inverse_mass(&mut self.data, &mut self.dynamics.saddle, self.model.nc, x, None);
         }
     }
 
@@ -343,7 +346,7 @@ impl<'a> Phase<'a> {
                     }
                 }
                 let mut lam = std::mem::take(&mut self.data.lambda);
-                Self::inverse_mass(&mut self.data, model.nc, &mut f, Some(&mut lam));
+                Self::inverse_mass(&mut self.data, &mut self.dynamics.saddle, model.nc, &mut f, Some(&mut lam));
                 self.data.lambda = lam;
                 self.tmp = f;
             }
@@ -550,7 +553,8 @@ impl OdeSystem for Phase<'_> {
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         if self.model.n_sliders > 0 {
-            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, &y[..nq], t)?;
+            let chains = &mut self.dynamics.forces.jenkins;
+            y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, chains, &y[..nq], t)?;
         }
         Ok(())
     }
@@ -559,7 +563,15 @@ impl OdeSystem for Phase<'_> {
         self.model.normalize(&mut y[..nq]);
         if self.model.nc > 0 {
             let (q, rest) = y.split_at_mut(nq);
-            crate::dynamics::constrained::project(self.model, &mut self.data, t, q, &mut rest[..nu], self.cb)?;
+            crate::dynamics::constrained::project(
+                self.model,
+                &mut self.data,
+                &mut self.dynamics,
+                t,
+                q,
+                &mut rest[..nu],
+                self.cb,
+            )?;
         }
         Ok(())
     }

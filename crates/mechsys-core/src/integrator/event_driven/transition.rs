@@ -123,7 +123,7 @@ impl Phase<'_> {
             for i in 0..nu {
                 x[i] = self.cols[(spare, i)];
             }
-            Self::inverse_mass(&mut self.data, model.nc, x, None);
+            Self::inverse_mass(&mut self.data, &mut self.dynamics.saddle, model.nc, x, None);
             let w_nn: f64 = (0..nu).map(|i| self.rows[(a, i)] * self.x[spare * nu + i]).sum();
             if c <= 1e-12 * w_nn.abs() {
                 let mu = self.mu_sliding(pt);

@@ -2,6 +2,7 @@
 
 use super::{Assembly, MoreauJean};
 use crate::data::Data;
+use crate::dynamics::Workspace;
 use crate::forces::NoCallbacks;
 use crate::model::{Model, ModelDescription};
 use crate::solver::{Method, NsgsOptions};
@@ -69,11 +70,11 @@ fn tree_model() -> Model {
 
 fn run(model: &Model, assembly: Assembly, steps: usize, h: f64) -> (Vec<Vec<f64>>, Vec<Vec<[f64; 3]>>, MoreauJean) {
     let mut st = MoreauJean::with_assembly(model, h, nsgs_tight(), assembly).unwrap();
-    let mut data = Data::new(model);
+    let (mut data, mut ws) = (Data::new(model), Workspace::new(model));
     let (mut q, mut u) = (model.q0(), model.u0());
     let (mut us, mut imps) = (Vec::new(), Vec::new());
     for k in 0..steps {
-        st.step(model, &mut data, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
+        st.step(model, &mut data, &mut ws, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
         let mut y = q.clone();
         y.extend_from_slice(&u);
         us.push(y);
@@ -128,13 +129,14 @@ fn block_delassus_is_w_minv_wt() {
         MoreauJean::with_assembly(&model, h, nsgs_tight(), Assembly::Dense).unwrap(),
     );
     let (mut data_s, mut data_d) = (Data::new(&model), Data::new(&model));
+    let (mut ws_s, mut ws_d) = (Workspace::new(&model), Workspace::new(&model));
     let (mut q, mut u) = (model.q0(), model.u0());
     let (mut q2, mut u2) = (q.clone(), u.clone());
     let mut checked = 0;
     for k in 0..300 {
         let t = k as f64 * h;
-        ss.step(&model, &mut data_s, t, &mut q, &mut u, &NoCallbacks).unwrap();
-        sd.step(&model, &mut data_d, t, &mut q2, &mut u2, &NoCallbacks).unwrap();
+        ss.step(&model, &mut data_s, &mut ws_s, t, &mut q, &mut u, &NoCallbacks).unwrap();
+        sd.step(&model, &mut data_d, &mut ws_d, t, &mut q2, &mut u2, &NoCallbacks).unwrap();
         let m = ss.problem.contacts();
         if m >= 3 {
             let crate::solver::Delassus::Blocks(bw) = &ss.problem.w else { panic!("blocks expected") };
