@@ -492,8 +492,10 @@ impl MoreauJean {
                 // approaching while sliding clearly (1e-6 m/s: above the creep a solver's
                 // tolerance leaves at a point of a statically indeterminate stick)
                 let slip_speed = (gd_t[0].powi(2) + if d == 3 { gd_t[1].powi(2) } else { 0.0 }).sqrt();
+                // (gd_t is the midpoint's free-motion rate; the rate at the step's start is ġ⁻)
+                let speed_before = self.gd_before[ai * d + 1..(ai + 1) * d].iter().map(|v| v * v).sum::<f64>().sqrt();
                 let sliding_in = prev_state == SLIP
-                    || (prev_state == OPEN && slip_speed > 1e-6 && self.gd_before[ai * d] >= -1e-9);
+                    || (prev_state == OPEN && speed_before > 1e-6 && self.gd_before[ai * d] >= -1e-9);
                 // Painlevé test of a point sliding into the step (see crate::integrator::events)
                 if let (Source::Point(pt), true) = (a.source, sliding_in) {
                     let gt = &self.gd_before[ai * d + 1..(ai + 1) * d];
@@ -545,16 +547,20 @@ impl MoreauJean {
                     if !self.static_mu[ai] {
                         continue;
                     }
-                    // on the cone's boundary: the static friction is used up (a slide that starts
-                    // from rest is slower than any velocity tolerance within its first steps)
+                    // on the cone's boundary and moving: the static friction is used up (a slide
+                    // that starts from rest is slower than the state tolerance within its first
+                    // steps, but faster than the solver's noise; a point of a statically
+                    // indeterminate stick may sit on its cone without moving)
                     let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
+                    let v = self.problem.local_velocity(ai, &self.r)?;
+                    let speed = (v[1] * v[1] + v[2] * v[2]).sqrt();
+                    let noise = (100.0 * report.residual).max(1e-14 * q_scale);
                     let saturated = self.r[ai * d] > 0.0
+                        && speed > noise
                         && self.problem.friction_reserve(ai, &self.r)? <= 1e-9 * self.problem.mu[ai] * self.r[ai * d];
                     if saturated
                         || self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip
                     {
-                        let v = self.problem.local_velocity(ai, &self.r)?;
-                        let speed = (v[1] * v[1] + v[2] * v[2]).sqrt();
                         let law = match self.act[ai].source {
                             Source::Point(pt) => &model.contact_of_point(pt).friction,
                             Source::Group { group, .. } => &model.contact_groups[group].friction,
