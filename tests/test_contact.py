@@ -107,10 +107,11 @@ def test_ball_with_backspin_turns_from_slipping_to_rolling():
     t_roll = res.t[np.argmax(st == 1)]
     assert abs(t_roll - t_r) < 2e-3
     assert abs(res["contact/floor/lambda_t"][-1]).max() < 1e-6  # rolling needs no friction
-    # friction dissipated what the ball lost
+    # friction dissipated what the ball lost: the kinetic energy of the slip phase (I = 0.4 m r^2)
     e = res["energy/total"] + res["energy/dissipated"]
     assert np.ptp(e) < 1e-8
-    assert res["energy/dissipated_friction"][-1] > 0.1
+    t_lost = 0.5 * (v0**2 - v_f**2) + 0.5 * 0.4 * r**2 * (w0**2 - (v_f / r) ** 2)
+    assert abs(res["energy/dissipated_friction"][-1] - t_lost) < 1e-3 * t_lost
 
 
 def cradle(eps=1.0, law=ms.laws.Newton, r=0.05):
@@ -304,7 +305,9 @@ def test_woodpecker_toy_pecks_its_way_down_in_a_repeating_cycle():
     corner meets the pole; while jammed (both diagonal corners sticking) the sleeve does not move;
     after a transient the toy settles into a cycle of two pecks (a long and a short one) that
     repeats to 2 % in period and 5 % in drop; the energy balance holds, and friction takes more
-    energy than the impacts."""
+    energy than the impacts. The model is not the published one (exact corners, the sleeve free
+    in the plane), so the cycle is held to the other scheme: the event-driven run has the same
+    two-peck period and descent speed to 1 % (measured over 2 s: 0.08 % and 0.7 %)."""
     import runpy
     from pathlib import Path
 
@@ -328,6 +331,18 @@ def test_woodpecker_toy_pecks_its_way_down_in_a_repeating_cycle():
     e = res["energy/total"] + res["energy/dissipated"] - res["energy/external_work"]
     assert np.ptp(e) < 1e-3 * res["energy/dissipated"][-1]
     assert res["energy/dissipated_friction"][-1] > res["energy/dissipated_impact"][-1] > 0
+    # against the event-driven scheme: two-peck period (the mean of sums of two consecutive peck
+    # intervals, the first left out) and descent speed over the last second
+    ed = ms.simulate(ns["model"], 2.0, ms.EventDriven(rtol=1e-8, atol=1e-10), output_dt=1e-4)
+
+    def cycle(r):
+        d = np.diff(ns["pecks"](r))
+        late = r.t >= r.t[-1] - 1.0
+        return np.mean(d[1:-1] + d[2:]), np.polyfit(r.t[late], r["joint/sleeve/q"][late, 1], 1)[0]
+
+    (p_mj, s_mj), (p_ed, s_ed) = cycle(res), cycle(ed)
+    assert abs(p_mj / p_ed - 1) < 0.01, (p_mj, p_ed)
+    assert s_mj < 0 and abs(s_mj / s_ed - 1) < 0.01, (s_mj, s_ed)
 
 
 def test_a_stack_of_boxes_rests_and_carries_the_weight():

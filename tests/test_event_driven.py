@@ -1,11 +1,13 @@
 """Event-driven integration of contact models (issue 4) against closed forms: the accumulation of
 impacts, stick and slip on an incline, the slip-to-roll transition, Newton's cradle under
-Newton's and Poisson's laws, a stick-slip oscillator (also against Moreau-Jean as dt -> 0), a
-Painleve situation, the event log, the energy balance and bad settings."""
+Newton's and Poisson's laws, a stick-slip oscillator (also against Moreau-Jean as dt -> 0),
+Painleve situations of a rod on a rough floor (inconsistent, non-unique and consistent, both
+schemes), the event log, the energy balance and bad settings."""
 
 from __future__ import annotations
 
 import json
+import re
 import warnings
 
 import numpy as np
@@ -174,32 +176,246 @@ def test_stick_slip_oscillator_against_the_closed_form_and_time_stepping():
     assert errors[1] < errors[0] / 10 and errors[1] < 1e-6
 
 
-def rod(theta=np.radians(30), mu=3.0, v=-1.0):
-    """A rod (length 1 m) leaning on a rough floor by its lower end, sliding."""
+L_ROD, M_ROD, THETA = 1.0, 1.0, np.radians(30)
+J_ROD = M_ROD * L_ROD**2 / 12  # slender rod about its centre
+L_TIP = L_ROD / 2  # centre -> tip
+
+
+def rod(theta=THETA, mu=3.0, v=-1.0, w=0.0):
+    """A slender rod (mass 1 kg, length 1 m, J = m L^2 / 12) leaning at theta on a rough floor by
+    its lower tip, the tip sliding along x with velocity v (normal velocity zero) while the rod
+    turns at w. Tip relative to the centre r = (-l cos theta, -l sin theta), l = L / 2, so
+    v_tip = v_c + w x r = v_c + w (l sin theta, -l cos theta): v_c = (v - w l sin theta, w l cos theta)."""
     m = ms.Model("painleve", gravity=(0.0, -G, 0.0))
-    b = m.add_body("rod", 1.0, ms.inertia.box(1.0, (1.0, 0.01, 0.01)))
-    m.add_joint(ms.joints.Planar("plane", m.ground, b, q0=[0.5 * np.cos(theta), 0.5 * np.sin(theta), theta],
-                                 u0=[v, 0, 0]))
-    m.add_contact(ms.Contact("tip", b.contour(ms.contours.Point(position=(-0.5, 0, 0))),
+    b = m.add_body("rod", M_ROD, ms.inertia.rod(M_ROD, L_ROD))
+    u0 = [v - w * L_TIP * np.sin(theta), w * L_TIP * np.cos(theta), w]
+    m.add_joint(ms.joints.Planar("plane", m.ground, b, q0=[L_TIP * np.cos(theta), L_TIP * np.sin(theta), theta], u0=u0))
+    m.add_contact(ms.Contact("tip", b.contour(ms.contours.Point(position=(-L_TIP, 0, 0))),
                              m.ground.contour(ms.contours.Line(normal=(0, 1, 0))), friction=ms.laws.Coulomb(mu)))
     return m
 
 
-def test_painleve_situation_raises_naming_the_contact_unless_asked_to_go_on():
-    """With the tip sliding, the normal acceleration per unit normal force is
-    1/m (1 + 3 cos(theta) (cos(theta) -+ mu sin(theta))) for the slender rod: negative for mu = 3
-    at 30 degrees in one sliding direction, so the problem at acceleration level has no solution."""
-    with pytest.raises(ms.SolverError, match=r"Painlev.*tip"):
+def tip_delassus(theta):
+    """The tip's Delassus terms in (normal y, tangent x): with q = (x, y, phi) the tip is
+    (x - l cos phi, y - l sin phi), so w_N = (0, 1, -l cos phi), w_T = (1, 0, l sin phi) and, with
+    M = diag(m, m, J), W_NN = 1/m + l^2 cos^2 / J, W_NT = -l^2 sin cos / J, W_TT = 1/m + l^2 sin^2 / J.
+    For J = m L^2 / 12 = m l^2 / 3: W_NN = (1 + 3 cos^2) / m, W_NT = -3 sin cos / m."""
+    c, s = np.cos(theta), np.sin(theta)
+    k = L_TIP**2 / J_ROD
+    return 1 / M_ROD + k * c * c, -k * s * c, 1 / M_ROD + k * s * s
+
+
+def normal_compliance(theta, mu, sgn):
+    """Normal acceleration per unit normal force with the sliding friction lambda_T = -mu sgn lambda_N
+    (sgn = sign of the tip's x velocity): c = W_NN - mu sgn W_NT = (1 + 3 cos theta (cos theta
+    + sgn mu sin theta)) / m. Negative for sgn = -1 once mu > mu_crit."""
+    w_nn, w_nt, _ = tip_delassus(theta)
+    return w_nn - mu * sgn * w_nt
+
+
+def mu_critical(theta):
+    """c = 0 for the tip sliding towards -x: mu_crit = W_NN / -W_NT = (1 + 3 cos^2) / (3 cos sin)."""
+    w_nn, w_nt, _ = tip_delassus(theta)
+    return w_nn / -w_nt
+
+
+def test_rod_closed_forms_are_those_of_the_slender_rod():
+    # the closed forms above against the textbook expressions (J = m L^2 / 12 exactly: the rod's
+    # inertia, not a thin box, whose J = m (L^2 + b^2) / 12 moves mu_crit by 8e-5)
+    c, s = np.cos(THETA), np.sin(THETA)
+    assert mu_critical(THETA) == pytest.approx((1 + 3 * c**2) / (3 * c * s), rel=1e-14)
+    assert mu_critical(THETA) == pytest.approx(2.5019, abs=1e-4)
+    for mu, sgn in ((0.5, 1), (0.5, -1), (3.0, -1)):
+        assert normal_compliance(THETA, mu, sgn) == pytest.approx(1 + 3 * c * (c + sgn * mu * s), rel=1e-14)
+    assert normal_compliance(THETA, 3.0, -1) < 0 < normal_compliance(THETA, 3.0, 1)
+
+
+def painleve_events(res):
+    return [e for e in res.events if e["event"] == "painleve"]
+
+
+def impulsive_stop(theta, v):
+    """The impact without collision that stops the sliding tip (Lambda_N, Lambda_T along +x): both
+    relative velocities to zero, W (Lambda_N, Lambda_T) = -(0, v); it lies in the cone here."""
+    w_nn, w_nt, w_tt = tip_delassus(theta)
+    return np.linalg.solve([[w_nn, w_nt], [w_nt, w_tt]], [0.0, -v])
+
+
+def test_painleve_inconsistent_event_driven_raises_naming_contact_time_and_mu():
+    """Sliding towards -x (v = -1) with mu = 3 > mu_crit = 2.5019 at 30 degrees, pressed on by
+    gravity (free normal acceleration -g, no rotation yet): no solution at acceleration level."""
+    assert normal_compliance(THETA, 3.0, -1) < 0
+    with pytest.raises(ms.PainleveError) as err:
         ms.simulate(rod(), 0.5, ED, output_dt=1e-3)
+    assert isinstance(err.value, ms.SolverError)
+    msg = str(err.value)
+    assert "'tip'" in msg and "Painlev" in msg, msg
+    assert float(re.search(r"t = ([-+0-9.eE]+) s", msg).group(1)) == 0.0, msg
+    assert re.search(r"µ = 3(?![0-9.])", msg), msg
+    crit = float(re.search(r"critical µ = ([0-9.]+)", msg).group(1))
+    assert abs(crit - mu_critical(THETA)) < 1e-6, (crit, mu_critical(THETA))
+
+
+def test_painleve_inconsistent_event_driven_goes_on_by_an_impulsive_stop():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        res = ms.simulate(rod(), 0.5, ms.EventDriven(continue_on_painleve=True), output_dt=1e-3)
-    assert any("Painlev" in str(w.message) for w in caught)
-    # the impulsive stop: the tip sticks at once
-    assert res["contact/tip/state"][0] == 1 and abs(res["contact/tip/gd_t"][0]) < 1e-12
-    # with a small coefficient both directions are regular
-    for v in (1.0, -1.0):
-        ms.simulate(rod(mu=0.5, v=v), 0.2, ED, output_dt=1e-3)
+        res = ms.simulate(rod(), 0.4, ms.EventDriven(continue_on_painleve=True), output_dt=1e-3)
+    assert any("Painlev" in str(w.message) and "'tip'" in str(w.message) for w in caught)
+    (ev,) = painleve_events(res)
+    assert ev["contact"] == "tip" and ev["t"] == 0.0 and ev["situation"] == "inconsistent"
+    assert ev["resolved_by_impulse"] is True and ev["mu"] == 3.0
+    assert ev["mu_critical"] == pytest.approx(mu_critical(THETA), rel=1e-9)
+    # the impulse of the stop and what it leaves: Lambda from W Lambda = -(0, v), inside the cone
+    lam_n, lam_t = impulsive_stop(THETA, -1.0)
+    assert 0 < abs(lam_t) < 3.0 * lam_n
+    assert ev["impulse_n"] == pytest.approx(lam_n, rel=1e-9)
+    assert abs(ev["impulse_t"][0]) == pytest.approx(abs(lam_t), rel=1e-9) and ev["impulse_t"][1] == 0.0
+    w_n = np.array([0.0, 1.0, -L_TIP * np.cos(THETA)])
+    w_t = np.array([1.0, 0.0, L_TIP * np.sin(THETA)])
+    u_b = np.array([-1.0, 0.0, 0.0])
+    u_a = u_b + (w_n * lam_n + w_t * lam_t) / np.array([M_ROD, M_ROD, J_ROD])
+    np.testing.assert_allclose(ev["u_before"], u_b, atol=1e-12)
+    np.testing.assert_allclose(ev["u_after"], u_a, atol=1e-9)
+    mass = np.array([M_ROD, M_ROD, J_ROD])
+    assert ev["energy"] == pytest.approx(0.5 * (mass * u_b**2).sum() - 0.5 * (mass * u_a**2).sum(), rel=1e-9)
+    # then the tip sticks (until the friction reserve runs out and it slips again)
+    slips = [e["t"] for e in res.events if e["event"] == "slip"]
+    t_slip = slips[0] if slips else res.t[-1]
+    assert t_slip > 0.3
+    stuck = res.t < 0.3
+    assert np.all(res["contact/tip/state"][stuck] == 1)
+    assert np.abs(res["contact/tip/gd_t"][stuck]).max() < 1e-9
+    assert np.abs(res["contact/tip/g_n"][stuck]).max() < 1e-9 and res["contact/tip/lambda_n"][stuck].min() > 0
+
+
+def test_painleve_inconsistent_moreau_jean_raises_naming_the_contact():
+    """The same state under Moreau-Jean (dt = 1e-4). Its Painleve test takes the step's midpoint
+    q + dt/2 u; the rod does not turn at the start, so the angle there is theta itself."""
+    with pytest.raises(ms.PainleveError, match=r"Painlev.*'tip'") as err:
+        ms.simulate(rod(), 0.4, ms.MoreauJean(1e-4, continue_on_painleve=False), output_dt=1e-3)
+    crit = float(re.search(r"critical µ = ([0-9.]+)", str(err.value)).group(1))
+    assert abs(crit - mu_critical(THETA)) < 1e-6, str(err.value)
+
+
+def test_painleve_inconsistent_moreau_jean_goes_on_by_an_impulsive_stop():
+    """By default Moreau-Jean passes the situation by the impulse its step gives (an impact
+    without collision), with a warning and a painleve event."""
+    dt = 1e-4
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = ms.simulate(rod(), 0.4, ms.MoreauJean(dt), output_dt=1e-3)
+    assert any("Painlev" in str(w.message) and "'tip'" in str(w.message) for w in caught)
+    evs = painleve_events(res)
+    assert len(evs) == 1, res.events[:5]
+    ev = evs[0]
+    assert ev["contact"] == "tip" and ev["t"] <= dt + 1e-15 and ev["situation"] == "inconsistent"
+    assert ev["resolved_by_impulse"] is True and ev["mu"] == 3.0 and ev["steps"] >= 1
+    assert ev["mu_critical"] == pytest.approx(mu_critical(THETA), rel=1e-6)
+    # the step's impulse is the stop plus what gravity adds over the step (at most m g dt)
+    lam_n, lam_t = impulsive_stop(THETA, -1.0)
+    assert abs(ev["impulse_n"] - lam_n) < 2 * M_ROD * G * dt
+
+
+@pytest.mark.xfail(strict=True, reason="known defect (issue 12 note): a pressed, sticking Moreau-Jean contact whose "
+                   "end-of-step gap creeps above the 1e-9 m activation margin drops out of one step and comes back "
+                   "with an impact (open/impact pairs every few ms from 0.13 s at dt = 1e-4, none at 2e-5)")
+def test_painleve_moreau_jean_tip_sticks_after_the_impulsive_stop():
+    """After the stop the tip sticks, pressed on with 1.8 to 4.4 N (the event-driven run: it slips
+    again at 0.329 s), so up to 0.3 s Moreau-Jean must record stick at every sample and no opening
+    or impact. At the step ends the tangential velocity differs from the midpoint's (held at zero)
+    by l cos(phi) phi'^2 dt / 2."""
+    dt = 1e-4
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = ms.simulate(rod(), 0.3, ms.MoreauJean(dt), output_dt=1e-3)
+    chatter = [(round(e["t"], 6), e["event"]) for e in res.events if e["event"] in ("open", "impact", "slip")]
+    assert chatter == [], f"{len(chatter)} events while the tip is pressed on: {chatter[:6]}"
+    stuck = res.t > dt
+    assert np.all(res["contact/tip/state"][stuck] == 1)
+    phidot = res["joint/plane/u"][stuck, 2]
+    assert np.all(np.abs(res["contact/tip/gd_t"][stuck]) <= L_TIP * phidot**2 * dt + 1e-9)
+    assert np.abs(res["contact/tip/g_n"][stuck]).max() < 1e-6
+
+
+W_SPIN = 8.0  # rad/s: centripetal l sin(theta) w^2 = 16 m/s^2 > g lifts the tip
+
+
+def tip_height_in_flight(t, theta=THETA, w=W_SPIN):
+    """Free flight from the non-unique state: centre y = l sin theta + w l cos theta t - g t^2 / 2,
+    angle theta + w t: the tip at y - l sin(theta + w t)."""
+    return L_TIP * np.sin(theta) + w * L_TIP * np.cos(theta) * t - G * t**2 / 2 - L_TIP * np.sin(theta + w * t)
+
+
+@pytest.mark.parametrize("scheme", ["event_driven", pytest.param("moreau_jean", marks=pytest.mark.xfail(
+    strict=True, reason="known limit (issue 12 note): the tip's free motion lifts it above the activation margin by the "
+    "step's midpoint, so it never enters Moreau-Jean's contact problem and the open solution is taken unflagged"))])
+def test_painleve_non_unique_is_a_warning_event_with_both_solutions(scheme):
+    """mu = 3 > mu_crit with the tip sliding towards -x (normal velocity zero), but the rod spins
+    at 8 rad/s: the free normal acceleration of the tip, -g + l sin(theta) w^2 = 6.19 m/s^2, lifts
+    it. With c < 0 there are two solutions: open (lambda_N = 0, the tip leaves) or closed
+    (lambda_N = -6.19 / c > 0 pressing itself on). Both schemes warn, log them and go on."""
+    b_free = -G + L_TIP * np.sin(THETA) * W_SPIN**2
+    c = normal_compliance(THETA, 3.0, -1)
+    assert b_free > 0 and c < 0 and -b_free / c > 0
+    dt = 1e-4
+    integ = ms.EventDriven() if scheme == "event_driven" else ms.MoreauJean(dt)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = ms.simulate(rod(w=W_SPIN), 0.5, integ, output_dt=1e-3)
+    assert any("Painlev" in str(w.message) and "'tip'" in str(w.message) for w in caught)
+    evs = painleve_events(res)
+    assert len(evs) == 1, res.events[:5]
+    ev = evs[0]
+    assert ev["contact"] == "tip" and ev["situation"] == "non-unique" and ev["mu"] == 3.0
+    assert ev["resolved_by_impulse"] is False
+    a, b = ev["solutions"]
+    assert a != b and sorted([a, b]) == [[], ["tip[0]"]]
+    if scheme == "event_driven":
+        assert ev["t"] == 0.0
+        assert ev["mu_critical"] == pytest.approx(mu_critical(THETA), rel=1e-9)
+    else:
+        # the midpoint of the first step has turned by w dt / 2
+        assert ev["t"] <= dt + 1e-15
+        assert ev["mu_critical"] == pytest.approx(mu_critical(THETA + W_SPIN * dt / 2), rel=1e-6)
+    # the run goes on with the open solution: the tip leaves at once and flies (lands at 0.746 s)
+    assert not [e for e in res.events if e["event"] in ("close", "impact")]
+    flying = res.t < 0.5
+    assert np.all(res["contact/tip/state"][flying] == 0) and np.all(res["contact/tip/lambda_n"][flying] == 0)
+    assert np.all(res["contact/tip/g_n"][flying & (res.t > 0)] > 0)
+    np.testing.assert_allclose(res["contact/tip/g_n"][flying], tip_height_in_flight(res.t[flying]), rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("scheme", ["event_driven", "moreau_jean"])
+@pytest.mark.parametrize("mu, v", [(0.5, 1.0), (0.5, -1.0), (3.0, 1.0)])
+def test_painleve_consistent_cases_run_with_the_closed_form_normal_force(scheme, mu, v):
+    """mu = 0.5 (below mu_crit) in both directions, and mu = 3 towards +x (friction then only adds
+    to the normal acceleration): c > 0. At rest normally and not turning, g_N'' = -g + c lambda_N
+    = 0: lambda_N = m g / (1 + 3 cos theta (cos theta + sgn mu sin theta)) with sgn = sign(v);
+    the tip's tangential acceleration is lambda_N (W_TN - sgn mu W_TT) (negative: decelerating
+    towards +x; towards -x at mu = 0.5 the falling rod drives its tip out faster)."""
+    sgn = np.sign(v)
+    c = normal_compliance(THETA, mu, sgn)
+    assert c > 0
+    lam_n = G / c  # c per unit normal force (1/kg), free normal acceleration -g
+    _, w_nt, w_tt = tip_delassus(THETA)
+    a_tip = lam_n * (w_nt - sgn * mu * w_tt)
+    dt = 1e-4
+    integ = ED if scheme == "event_driven" else ms.MoreauJean(dt)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = ms.simulate(rod(mu=mu, v=v), 0.2, integ, output_dt=dt)
+    assert not [w for w in caught if "Painlev" in str(w.message)]
+    assert painleve_events(res) == []
+    if scheme == "event_driven":
+        assert res["contact/tip/lambda_n"][0] == pytest.approx(lam_n, rel=1e-9)
+        ud = res["udot"][0]
+        assert ud[0] + L_TIP * np.sin(THETA) * ud[2] == pytest.approx(a_tip, rel=1e-9)
+        assert np.all(res["contact/tip/state"][res.t < 0.1] == 2)
+    else:
+        # the first step: lambda_N = impulse / dt and the tip's velocity change over it, O(dt)
+        assert res["contact/tip/lambda_n"][1] == pytest.approx(lam_n, rel=1e-3)
+        du = (res["u"][1] - res["u"][0]) / dt
+        assert du[0] + L_TIP * np.sin(THETA) * du[2] == pytest.approx(a_tip, rel=1e-3)
 
 
 def test_event_driven_from_a_model_file_and_the_command_line(tmp_path):
@@ -265,10 +481,21 @@ def test_too_many_events_is_an_error_naming_the_contact():
         ms.simulate(point_ball(0.8, 1.0), 5.0, ms.EventDriven(max_events=10))
 
 
+def woodpecker_cycle(pecks, res):
+    """The woodpecker's limit cycle is a long and a short peck: its period is the mean of the sums
+    of two consecutive peck intervals (the first, transient interval left out), its descent speed
+    the slope of the sleeve's height over the last 0.6 s."""
+    d = np.diff(pecks(res))
+    late = res.t >= res.t[-1] - 0.6
+    return np.mean(d[1:-1] + d[2:]), np.polyfit(res.t[late], res["joint/sleeve/q"][late, 1], 1)[0], d
+
+
 def test_woodpecker_event_driven_keeps_the_energy_balance_and_pecks():
     """The showcase toy, event-driven: hundreds of impacts, stick and slip; the energy balance
-    closes to the integration tolerance, no contour penetrates, and the bird pecks about every
-    0.16 s (the published toy: 0.15-0.17 s)."""
+    closes to the integration tolerance and no contour penetrates. The example's model is not the
+    published one (exact corners, the sleeve free in the plane), so there is no published cycle to
+    hold it to; it is held to the other scheme instead: Moreau-Jean (dt = 1e-5) gives the same
+    two-peck period and descent speed to 1 % (measured: 0.02 % and 0.04 % over 1 s)."""
     import importlib.util
     import pathlib
 
@@ -281,9 +508,13 @@ def test_woodpecker_event_driven_keeps_the_energy_balance_and_pecks():
     assert np.ptp(e) < 1e-9
     for c in ("upper_right", "lower_left", "lower_right", "upper_left", "beak"):
         assert res[f"contact/{c}/g_n"].min() > -1e-9, c
-    period = np.diff(wp.pecks(res))
-    assert len(period) >= 4 and 0.14 < period.mean() < 0.18
     assert res.stats["events"] > 100 and res["joint/sleeve/q"][-1, 1] < -0.15
+    mj = ms.simulate(wp.model, wp.event_driven["t_end"], ms.MoreauJean(1e-5, solver=ms.NSGS(tol=1e-13)),
+                     output_dt=wp.event_driven["output_dt"])
+    (p_ed, s_ed, d_ed), (p_mj, s_mj, d_mj) = woodpecker_cycle(wp.pecks, res), woodpecker_cycle(wp.pecks, mj)
+    assert len(d_ed) >= 4 and len(d_mj) >= 4
+    assert abs(p_ed / p_mj - 1) < 0.01, (p_ed, p_mj)
+    assert s_ed < 0 and abs(s_ed / s_mj - 1) < 0.01, (s_ed, s_mj)
 
 
 def test_poisson_returns_the_stored_tangential_impulse():
@@ -304,8 +535,10 @@ def test_poisson_returns_the_stored_tangential_impulse():
     assert abs(impacts[0] - t_hit) < 1e-12
     before, after = res.t < t_hit, (res.t > t_hit) & (res.t < 0.55)
     gd_t = res["contact/floor/gd_t"][:, 0]
+    # in free flight without spin the contact point slides at the ball's speed: g_T- = vx
     gt_before = gd_t[before][-1]
-    np.testing.assert_allclose(gd_t[after], -eps_t * gt_before, rtol=1e-9)
+    assert gt_before == pytest.approx(vx, abs=1e-12)
+    np.testing.assert_allclose(gd_t[after], -eps_t * vx, rtol=1e-9)
     vz = res["body/ball/velocity"][:, 2]
     v_in = G * t_hit
     np.testing.assert_allclose(vz[after][0], eps * v_in - G * (res.t[after][0] - t_hit), rtol=1e-9)
@@ -313,7 +546,7 @@ def test_poisson_returns_the_stored_tangential_impulse():
     assert np.ptp(e) < 1e-9  # the spinning ball's body-frame velocities: integration error
     # the impulses: normal (1 + eps) m v_in, tangential (1 + eps_t) (2/7) m |g_T-|
     np.testing.assert_allclose(res["contact/floor/impulse_n"].sum(), (1 + eps) * v_in, rtol=1e-9)
-    np.testing.assert_allclose(np.abs(res["contact/floor/impulse_t"][:, 0].sum()), (1 + eps_t) * 2 / 7 * abs(gt_before), rtol=1e-9)
+    np.testing.assert_allclose(np.abs(res["contact/floor/impulse_t"][:, 0].sum()), (1 + eps_t) * 2 / 7 * vx, rtol=1e-9)
 
 
 def test_bilateral_constraints_with_contacts_agree_with_the_joint_model():
