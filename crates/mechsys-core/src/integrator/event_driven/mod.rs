@@ -252,10 +252,7 @@ pub fn integrate<'a>(
     let (mut last_event, mut same_instant) = (f64::NEG_INFINITY, 0usize);
 
     phase.project(t, &mut y)?;
-    let clock = std::time::Instant::now();
-    let d = phase.transition(t, &mut y, &mut imp, warnings, &triggered)?;
-    stats.transitions += 1;
-    stats.transition_seconds += clock.elapsed().as_secs_f64();
+    let d = timed_transition(phase, t, &mut y, (&mut imp, warnings), &triggered, &mut stats)?;
     diss.impact += d.impact;
     diss.friction += d.friction;
     phase.rhs(t, &y, &mut st.k[0])?;
@@ -360,10 +357,7 @@ pub fn integrate<'a>(
                     phase.names(&what)
                 )));
             }
-            let clock = std::time::Instant::now();
-            let d = phase.transition(t, &mut y, &mut imp, warnings, &triggered)?;
-            stats.transitions += 1;
-            stats.transition_seconds += clock.elapsed().as_secs_f64();
+            let d = timed_transition(phase, t, &mut y, (&mut imp, warnings), &triggered, &mut stats)?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             phase.rhs(t, &y, &mut st.k[0])?;
@@ -395,6 +389,22 @@ pub fn integrate<'a>(
     stats.evaluations = phase.evaluations;
     stats.events = events;
     Ok(stats)
+}
+
+/// [`Phase::transition`], counted and timed in `stats` (the cost per transition).
+fn timed_transition(
+    phase: &mut Phase,
+    t: f64,
+    y: &mut [f64],
+    (imp, warnings): (&mut [f64], &mut Vec<String>),
+    triggered: &[bool],
+    stats: &mut Stats,
+) -> Result<Dissipation> {
+    let clock = std::time::Instant::now();
+    let d = phase.transition(t, y, imp, warnings, triggered)?;
+    stats.transitions += 1;
+    stats.transition_seconds += clock.elapsed().as_secs_f64();
+    Ok(d)
 }
 
 /// The root of event function `i` in the step `[t, t + h]` by Illinois' regula falsi on the
