@@ -39,7 +39,7 @@ bench: $(BUILD)
 	$(PY) benches/constraints.py --out docs/benchmarks.md
 	$(PY) benches/contacts.py --out docs/benchmarks.md
 	$(PY) benches/stack.py --out docs/benchmarks.md
-	$(PY) benches/event_driven.py --out docs/benchmarks.md
+	$(PY) benches/event_driven.py --baseline benches/baselines/event_driven_50c2cb9.json --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results
