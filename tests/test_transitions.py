@@ -716,3 +716,38 @@ def test_moreau_jean_default_sampling_falls_on_steps():
     res = ms.simulate(pulled_mass(), 0.37, ms.MoreauJean(1e-4))
     assert len(res.t) == 926
     np.testing.assert_allclose(np.diff(res.t), 4e-4, rtol=1e-9)
+
+
+def sliding_rod(law, theta=np.radians(30), v=-1.0):
+    m = ms.Model("painleve", gravity=(0.0, -G, 0.0))
+    b = m.add_body("rod", 1.0, ms.inertia.rod(1.0, 1.0))
+    m.add_joint(ms.joints.Planar("plane", m.ground, b, q0=[0.5 * np.cos(theta), 0.5 * np.sin(theta), theta], u0=[v, 0, 0]))
+    m.add_contact(ms.Contact("tip", b.contour(ms.contours.Point(position=(-0.5, 0, 0))),
+                             m.ground.contour(ms.contours.Line(normal=(0, 1, 0))), friction=law))
+    return m
+
+
+def test_a_slide_that_runs_into_the_painleve_boundary_is_flagged():
+    """A rod (slender, L = 1 m) slides on its tip with a Stribeck law rising from mu = 2 to
+    mu0 = 3 as it slows; the tip's normal acceleration per unit normal force,
+    1 + 3 cos(th) (cos(th) - mu sin(th)), falls to zero when mu reaches
+    (1 + 3 cos^2 th) / (3 cos th sin th) (2.50 near 30 degrees): the normal force grows without
+    bound (dynamic jamming). The event-driven scheme stops there with PainleveError naming the
+    contact; with continue_on_painleve the slide is stopped by an impulse, on record."""
+    law = ms.laws.Stribeck(mu0=3.0, mu=2.0, v_s=0.5)
+    with pytest.raises(ms.PainleveError, match=r"contact 'tip'.*critical µ = 2\.49.*jamming"):
+        ms.simulate(sliding_rod(law), 0.5, ED, output_dt=1e-3)
+    with pytest.warns(UserWarning, match="Painlev"):
+        res = ms.simulate(sliding_rod(law), 0.1, ms.EventDriven(continue_on_painleve=True), output_dt=1e-4)
+    ev = [e for e in res.events if e["event"] == "painleve"]
+    assert len(ev) == 1 and ev[0]["resolved_by_impulse"] and ev[0]["situation"] == "inconsistent"
+    # the critical coefficient at the rod's angle then, and the coefficient within JAM = 1e-3 of it
+    k = np.searchsorted(res.t, ev[0]["t"])
+    th = np.interp(ev[0]["t"], res.t[: k + 1], res["joint/plane/q"][: k + 1, 2])
+    crit = (1 + 3 * np.cos(th) ** 2) / (3 * np.cos(th) * np.sin(th))
+    assert ev[0]["mu_critical"] == pytest.approx(crit, rel=1e-4)
+    assert 0.0 < 1.0 - ev[0]["mu"] / ev[0]["mu_critical"] < 2e-3
+    # after the impulsive stop the tip sticks
+    after = res.t > ev[0]["t"] + 1e-3
+    assert np.all(res["contact/tip/state"][after] != 0)
+    assert np.abs(res["contact/tip/gd_t"][after]).max() < 1e-9

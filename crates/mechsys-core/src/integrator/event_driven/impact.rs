@@ -213,6 +213,9 @@ impl Phase<'_> {
         }
         let n = self.unk.len();
         let mut diss = Dissipation::default();
+        for &(pt, _) in &self.unk {
+            self.ev.point_energy[pt] = 0.0;
+        }
         if n == 0 {
             return diss;
         }
@@ -248,10 +251,15 @@ impl Phase<'_> {
             for i in 0..nu {
                 u[i] += x[i] * l;
             }
+        }
+        // the energy taken, -Λᵀ(ġ⁻ + ġ⁺)/2, with ġ⁺ after all the impulses
+        for j in 0..n {
+            let l = self.rhs[j];
             let (pt, k) = self.unk[j];
             imp[3 * pt + k] += l;
             let after: f64 = (0..nu).map(|c| self.rows[(j, c)] * u[c]).sum();
             let e = -l * 0.5 * (before[j] + after);
+            self.ev.point_energy[pt] += e;
             if k == 0 {
                 diss.impact += e;
             } else {

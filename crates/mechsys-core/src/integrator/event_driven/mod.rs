@@ -113,6 +113,11 @@ impl Options {
     }
 }
 
+/// A sliding point whose normal acceleration per unit normal force has fallen to this fraction
+/// of its value at the phase's start is taken to have reached the Painlevé boundary (dynamic
+/// jamming: its normal force grows as the inverse of that coefficient).
+const JAM: f64 = 1e-3;
+
 /// Friction directions of the pyramid in the transition problem for spatial contacts.
 const PYRAMID: usize = 8;
 
@@ -133,6 +138,12 @@ pub struct Phase<'a> {
     pub status: Vec<f64>,
     /// Sliding direction (t1, t2 components) of slipping points, for speeds below `velocity_tol`.
     dir: Vec<[f64; 2]>,
+    /// Per point: the normal acceleration per unit normal force of a sliding point under its
+    /// sliding friction (1/kg; 1 for other points), whose zero is a Painlevé situation reached.
+    slip_margin: Vec<f64>,
+    /// That coefficient at the start of the phase: the event fires when it has fallen to
+    /// [`JAM`] of it (the normal force grows as its inverse, so the phase cannot reach zero).
+    slip_margin_start: Vec<f64>,
     /// Added to an open point's gap in its event function: a point that left its contact at an
     /// event (gap zero to round-off) must see a return to zero, not start on it (m).
     gap_offset: Vec<f64>,
@@ -203,6 +214,8 @@ struct EventWork {
     /// Sliding points of the last transition problem whose normal acceleration per unit normal
     /// force is not positive: (point, that coefficient, µ, critical µ, free normal acceleration).
     painleve: Vec<(usize, f64, f64, f64, f64)>,
+    /// Per point: a sliding point reached the Painlevé boundary at this event.
+    jam: Vec<bool>,
     /// Full-acceleration kinematics of one contact's points (the apex cap).
     apex: Vec<ContactKinematics>,
 }
@@ -241,11 +254,11 @@ pub fn integrate<'a>(
     let mut scratch = vec![0.0; n];
     let mut imp = vec![0.0; 3 * np];
     let mut diss = Dissipation::default();
-    let (mut e_start, mut e_end, mut e_try) = (vec![0.0; 2 * np], vec![0.0; 2 * np], vec![0.0; 2 * np]);
+    let (mut e_start, mut e_end, mut e_try) = (vec![0.0; 3 * np], vec![0.0; 3 * np], vec![0.0; 3 * np]);
     // θ of each event function's root in the step (infinite where it has none), and which of
     // them ended the phase
-    let mut roots = vec![f64::INFINITY; 2 * np];
-    let mut triggered = vec![false; 2 * np];
+    let mut roots = vec![f64::INFINITY; 3 * np];
+    let mut triggered = vec![false; 3 * np];
     let mut t = t0;
     let mut next = 0usize;
     let mut events = 0usize;
@@ -302,7 +315,7 @@ pub fn integrate<'a>(
         st.prepare_dense(&y, h);
         // the earliest event in the step
         let mut theta = f64::INFINITY;
-        for i in 0..2 * np {
+        for i in 0..3 * np {
             roots[i] = f64::INFINITY;
             if e_start[i] > 0.0 && e_end[i] <= 0.0 {
                 let th = locate(phase, &st, (t, h), (i, e_start[i], e_end[i]), &mut yout, &mut e_try, &mut scratch)?;
@@ -314,7 +327,7 @@ pub fn integrate<'a>(
         // every indicator whose root falls on the event (to the location's resolution) ends the
         // phase there: the transition switches it even where its value is zero to round-off
         let resolution = 1e-12 * t.abs().max(1.0) / h;
-        for i in 0..2 * np {
+        for i in 0..3 * np {
             triggered[i] = roots[i] <= theta + resolution;
         }
         let t_new = if theta.is_finite() { t + theta * h } else { t + h };

@@ -2,7 +2,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{EventWork, Options, Phase, PYRAMID};
+use super::{EventWork, Options, Phase, JAM, PYRAMID};
 use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
 use crate::data::Data;
 use crate::dynamics::sparse::Saddle;
@@ -37,6 +37,8 @@ impl<'a> Phase<'a> {
             status: vec![OPEN; np],
             dir: vec![[0.0; 2]; np],
             gap_offset: vec![0.0; np],
+            slip_margin: vec![1.0; np],
+            slip_margin_start: vec![1.0; np],
             kin: vec![ContactKinematics::default(); np],
             lam_n: vec![0.0; np],
             lam_t: vec![[0.0; 2]; np],
@@ -85,6 +87,7 @@ impl<'a> Phase<'a> {
                 hit: Vec::with_capacity(np),
                 u_before: vec![0.0; model.nu],
                 painleve: Vec::with_capacity(np),
+                jam: vec![false; np],
                 apex: vec![ContactKinematics::default(); model.contacts.iter().map(|c| c.points()).max().unwrap_or(0)],
             },
         })
@@ -258,6 +261,7 @@ impl<'a> Phase<'a> {
         for pt in 0..np {
             self.lam_n[pt] = 0.0;
             self.lam_t[pt] = [0.0; 2];
+            self.slip_margin[pt] = 1.0;
             if self.status[pt] == OPEN {
                 continue;
             }
@@ -313,6 +317,11 @@ impl<'a> Phase<'a> {
                 &mut self.piv_c_work,
                 1e-13,
             );
+            for (j, &(pt, k)) in self.unk.iter().enumerate() {
+                if k == 0 && self.status[pt] == SLIP {
+                    self.slip_margin[pt] = self.mat[j * n + j];
+                }
+            }
             if self.unk.iter().any(|&(_, k)| k > 0) {
                 self.redistribute(n);
             }
@@ -456,10 +465,17 @@ impl<'a> Phase<'a> {
         m
     }
 
-    /// Event functions of the last evaluation, two per point; an event is a sign change from
-    /// positive to non-positive.
+    /// Event functions of the last evaluation, three per point (the gap or the normal force; the
+    /// friction reserve or the sliding velocity; a sliding point's normal acceleration per unit
+    /// normal force, whose zero is a Painlevé situation); an event is a sign change from positive
+    /// to non-positive.
     pub fn event_values(&self, out: &mut [f64]) {
         for pt in 0..self.status.len() {
+            out[3 * pt + 2] = if self.status[pt] == SLIP && self.slip_margin_start[pt] > 0.0 {
+                self.slip_margin[pt] - JAM * self.slip_margin_start[pt]
+            } else {
+                1.0
+            };
             let (e0, e1) = if self.status[pt] == OPEN {
                 (self.kin[pt].point.g_n + self.gap_offset[pt], 1.0)
             } else if self.status[pt] == STICK {
@@ -471,8 +487,8 @@ impl<'a> Phase<'a> {
             } else {
                 (self.lam_n[pt], 1.0)
             };
-            out[2 * pt] = e0;
-            out[2 * pt + 1] = e1;
+            out[3 * pt] = e0;
+            out[3 * pt + 1] = e1;
         }
     }
 

@@ -125,7 +125,7 @@ impl Phase<'_> {
             }
             Self::inverse_mass(&mut self.data, &mut self.dynamics.saddle, model.nc, x, None);
             let w_nn: f64 = (0..nu).map(|i| self.rows[(a, i)] * self.x[spare * nu + i]).sum();
-            if c <= 1e-12 * w_nn.abs() {
+            if c <= 1e-12 * w_nn.abs() || self.ev.jam[pt] {
                 let mu = self.mu_sliding(pt);
                 let crit = if w_nn - c > 0.0 { mu * w_nn / (w_nn - c) } else { f64::INFINITY };
                 self.ev.painleve.push((pt, c, mu, crit, self.lcp.q[a]));
@@ -240,8 +240,9 @@ impl Phase<'_> {
             let stick = self.status[pt] == STICK;
             let [l1, l2] = self.lam_t[pt];
             let reserve = self.model.contact_of_point(pt).friction.mu0() * self.lam_n[pt] - (l1 * l1 + l2 * l2).sqrt();
-            self.ev.leaving[pt] = closed && (triggered[2 * pt] || self.lam_n[pt] <= 0.0);
-            self.ev.breaking[pt] = stick && (triggered[2 * pt + 1] || reserve <= 0.0);
+            self.ev.leaving[pt] = closed && (triggered[3 * pt] || self.lam_n[pt] <= 0.0);
+            self.ev.breaking[pt] = stick && (triggered[3 * pt + 1] || reserve <= 0.0);
+            self.ev.jam[pt] = self.status[pt] == SLIP && triggered[3 * pt + 2];
             self.ev.lam_t_before[pt] = self.lam_t[pt];
         }
         touching.clear();
@@ -267,7 +268,10 @@ impl Phase<'_> {
         }
         closing.clear();
         closing.extend(touching.iter().copied().filter(|&pt| self.kin[pt].gd_n.abs() <= vtol));
-        if !self.transition_lcp(closing)? {
+        // a slide that reached the Painlevé boundary (jam) while pressed on has no continuation
+        let solved = self.transition_lcp(closing)?;
+        let jammed = self.ev.painleve.iter().any(|p| self.ev.jam[p.0] && p.4 <= 0.0);
+        if !solved || jammed {
             // no solution: the sliding points pressed into their contacts with a non-positive
             // normal acceleration per unit normal force are the cause (all sliding ones if none is)
             let mut culprits = std::mem::take(&mut self.ev.hit);
@@ -286,7 +290,26 @@ impl Phase<'_> {
             warnings.push(format!(
                 "Painlevé situation at t = {t:.9} s: {what}; the sliding was stopped by an impulse (an impact without collision)"
             ));
-            let r = self.impact_logged(t, u, closing, true, imp, &culprits, EventKind::Painleve);
+            // the impulsive stop: every touching point's relative velocity brought to zero (the
+            // impact without collision ends in stick: with µ above the critical value no slide
+            // can go on), then the transition problem from rest
+            self.ev.u_before.copy_from_slice(u);
+            for &pt in culprits.iter() {
+                self.ev.imp_before[3 * pt..3 * pt + 3].copy_from_slice(&imp[3 * pt..3 * pt + 3]);
+            }
+            for &pt in closing.iter() {
+                self.status[pt] = STICK;
+            }
+            let r: Result<Dissipation> = Ok(self.settle(u, imp));
+            let at = self.log.store_velocities(&self.ev.u_before, u);
+            for &pt in culprits.iter() {
+                let e = self.log.push(t, pt, EventKind::Painleve);
+                for k in 0..3 {
+                    e.impulse[k] = imp[3 * pt + k] - self.ev.imp_before[3 * pt + k];
+                }
+                e.energy = self.ev.point_energy[pt];
+                e.velocities = Some(at);
+            }
             let first = self.log.events.len() - culprits.len();
             for k in first..self.log.events.len() {
                 let (mu, mu_critical) = self.painleve_mu(self.log.events[k].point);
@@ -343,6 +366,9 @@ impl Phase<'_> {
         diss.impact += d.impact;
         diss.friction += d.friction;
         self.check_switches(t, q, u, old)?;
+        // the sliding points' starting coefficients, for the jam indicator
+        self.evaluate(t, q, u)?;
+        self.slip_margin_start.copy_from_slice(&self.slip_margin);
         // a point left open on its contact (gap zero to round-off, not moving apart) must see its
         // gap return to zero: its event function starts just above zero
         for pt in 0..np {
@@ -515,7 +541,13 @@ impl Phase<'_> {
             .map(|&pt| {
                 let con = self.model.contact_of_point(pt);
                 let (mu, crit) = self.painleve_mu(pt);
-                let crit = if crit.is_finite() { format!(" above the critical µ = {crit:.6}") } else { String::new() };
+                let crit = if !crit.is_finite() {
+                    String::new()
+                } else if mu >= crit {
+                    format!(" above the critical µ = {crit:.6}")
+                } else {
+                    format!(" at the critical µ = {crit:.6} (its normal force grows without bound: jamming)")
+                };
                 format!("contact '{}' (point {}) slides with µ = {mu}{crit}", con.name, pt - con.first)
             })
             .collect();
