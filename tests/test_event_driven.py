@@ -316,9 +316,6 @@ def test_painleve_inconsistent_moreau_jean_goes_on_by_an_impulsive_stop():
     assert abs(ev["impulse_n"] - lam_n) < 2 * M_ROD * G * dt
 
 
-@pytest.mark.xfail(strict=True, reason="known defect (issue 12 note): a pressed, sticking Moreau-Jean contact whose "
-                   "end-of-step gap creeps above the 1e-9 m activation margin drops out of one step and comes back "
-                   "with an impact (open/impact pairs every few ms from 0.13 s at dt = 1e-4, none at 2e-5)")
 def test_painleve_moreau_jean_tip_sticks_after_the_impulsive_stop():
     """After the stop the tip sticks, pressed on with 1.8 to 4.4 N (the event-driven run: it slips
     again at 0.329 s), so up to 0.3 s Moreau-Jean must record stick at every sample and no opening
