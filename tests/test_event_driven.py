@@ -343,9 +343,7 @@ def tip_height_in_flight(t, theta=THETA, w=W_SPIN):
     return L_TIP * np.sin(theta) + w * L_TIP * np.cos(theta) * t - G * t**2 / 2 - L_TIP * np.sin(theta + w * t)
 
 
-@pytest.mark.parametrize("scheme", ["event_driven", pytest.param("moreau_jean", marks=pytest.mark.xfail(
-    strict=True, reason="known limit (issue 12 note): the tip's free motion lifts it above the activation margin by the "
-    "step's midpoint, so it never enters Moreau-Jean's contact problem and the open solution is taken unflagged"))])
+@pytest.mark.parametrize("scheme", ["event_driven", "moreau_jean"])
 def test_painleve_non_unique_is_a_warning_event_with_both_solutions(scheme):
     """mu = 3 > mu_crit with the tip sliding towards -x (normal velocity zero), but the rod spins
     at 8 rad/s: the free normal acceleration of the tip, -g + l sin(theta) w^2 = 6.19 m/s^2, lifts

@@ -63,9 +63,10 @@ pub const CONTACT_MARGIN: f64 = 1e-9;
 /// point takes an impulse only where it would otherwise end the step inside its contact.
 pub const HOLD_MARGIN: f64 = 1e-7;
 
-/// The activation margin of a point by its state in the last step.
-fn margin(last_state: f64) -> f64 {
-    if last_state == OPEN {
+/// The activation margin of a point by its state in the last step (the run's first step holds
+/// every point that touches at the start, so that a state given as closed is treated as closed).
+fn margin(last_state: f64, first_step: bool) -> f64 {
+    if last_state == OPEN && !first_step {
         CONTACT_MARGIN
     } else {
         HOLD_MARGIN
@@ -379,7 +380,7 @@ impl MoreauJean {
                 .map_err(|e| Error::Solver(format!("contact '{}' at t = {tm:.6} s: {e}", con.name)))?;
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
-                if kk.point.g_n <= margin(self.results[pt].state) {
+                if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
                     self.act.push(Active { b1: con.body1, b2: con.body2, point: kk.point, source: Source::Point(pt) });
                 }
             }
@@ -393,7 +394,7 @@ impl MoreauJean {
                 let fresh = sl.stamp == self.steps.wrapping_sub(1);
                 for (k, kk) in sl.kin.iter().enumerate() {
                     pen = pen.max(-kk.point.g_n);
-                    if kk.point.g_n <= margin(if fresh { sl.last[k].1 } else { OPEN }) {
+                    if kk.point.g_n <= margin(if fresh { sl.last[k].1 } else { OPEN }, self.steps == 0) {
                         let source = Source::Group { group: gi, slot, k };
                         self.act.push(Active { b1: sl.body1, b2: sl.body2, point: kk.point, source });
                     }
@@ -526,8 +527,11 @@ impl MoreauJean {
                         self.problem.w.diag_block(d, ai, &mut blk);
                         let (c, crit) = crate::integrator::events::painleve_margin(&blk[..d * d], d, mu, s);
                         if c <= 1e-12 * blk[0].abs() {
-                            let free_change = self.problem.q[ai * d] - self.gd_before[ai * d];
-                            self.painleve.push((pt, mu, crit, free_change > 0.0));
+                            // the free normal acceleration times h: at the midpoint ġ⁻ holds
+                            // half a step of w̄ and ġ_free adds the step's forces, so
+                            // h (w̄ + w_Nᵀ M⁻¹ f) = ġ_free + ġ⁻ for a point closed at the start
+                            let free = self.problem.q[ai * d] + self.gd_before[ai * d];
+                            self.painleve.push((pt, mu, crit, free > 0.0));
                         }
                     }
                 }
