@@ -177,12 +177,25 @@ pub struct EventRecord {
     pub u_before: Vec<f64>,
     /// See `u_before`.
     pub u_after: Vec<f64>,
-    /// Painlevé situations: µ, the critical µ, whether the state was non-unique (else
-    /// inconsistent), the points closed in both solutions of a non-unique state ("contact[k]"),
-    /// and whether the sliding was stopped by an impulse.
-    pub painleve: Option<(f64, f64, bool, [Vec<String>; 2], bool)>,
+    /// Painlevé situations (see [`PainleveRecord`]).
+    pub painleve: Option<PainleveRecord>,
     /// Consecutive time steps merged into the event (1 for the event-driven scheme).
     pub steps: usize,
+}
+
+/// What a Painlevé event recorded, with points named ("contact[k]").
+#[derive(Debug, Clone, PartialEq)]
+pub struct PainleveRecord {
+    /// The sliding coefficient in use.
+    pub mu: f64,
+    /// The coefficient at which the normal acceleration per unit normal force vanishes.
+    pub mu_critical: f64,
+    /// True: two solutions; false: none (inconsistent).
+    pub non_unique: bool,
+    /// The points closed in each solution of a non-unique state.
+    pub solutions: [Vec<String>; 2],
+    /// The sliding was stopped by an impulse.
+    pub resolved_by_impulse: bool,
 }
 
 impl EventRecord {
@@ -213,13 +226,13 @@ impl EventRecord {
                     u_after,
                     painleve: e.painleve.as_ref().map(|p| {
                         let names = |v: &Vec<usize>| v.iter().map(|&pt| name(pt)).collect::<Vec<_>>();
-                        (
-                            p.mu,
-                            p.mu_critical,
-                            p.non_unique,
-                            [names(&p.solutions[0]), names(&p.solutions[1])],
-                            p.resolved_by_impulse,
-                        )
+                        PainleveRecord {
+                            mu: p.mu,
+                            mu_critical: p.mu_critical,
+                            non_unique: p.non_unique,
+                            solutions: [names(&p.solutions[0]), names(&p.solutions[1])],
+                            resolved_by_impulse: p.resolved_by_impulse,
+                        }
                     }),
                     steps: e.steps,
                 }

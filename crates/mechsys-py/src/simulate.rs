@@ -253,12 +253,12 @@ fn simulate<'py>(
             ev.set_item("u_before", e.u_before.clone())?;
             ev.set_item("u_after", e.u_after.clone())?;
         }
-        if let Some((mu, crit, non_unique, sol, by_impulse)) = &e.painleve {
-            ev.set_item("mu", mu)?;
-            ev.set_item("mu_critical", crit)?;
-            ev.set_item("situation", if *non_unique { "non-unique" } else { "inconsistent" })?;
-            ev.set_item("solutions", [sol[0].clone(), sol[1].clone()])?;
-            ev.set_item("resolved_by_impulse", by_impulse)?;
+        if let Some(p) = &e.painleve {
+            ev.set_item("mu", p.mu)?;
+            ev.set_item("mu_critical", p.mu_critical)?;
+            ev.set_item("situation", if p.non_unique { "non-unique" } else { "inconsistent" })?;
+            ev.set_item("solutions", [p.solutions[0].clone(), p.solutions[1].clone()])?;
+            ev.set_item("resolved_by_impulse", p.resolved_by_impulse)?;
         }
         events.append(ev)?;
     }

@@ -1,7 +1,7 @@
 //! Reaction forces at the cuts (section 2.1.2): cutting the tree at a joint exposes the wrench the
 //! parent body exerts on the child body. It follows from the Newton–Euler equations of the subtree
-//! beyond the cut, which is what the inward pass of the RNEA sums (`f_i = Σ_subtree (I a + v ×* I v
-//! - f_ext)`, gravity included through the base acceleration). Its component along the joint's
+//! beyond the cut, which is what the inward pass of the RNEA sums
+//! (`f_i = Σ_subtree (I a + v ×* I v − f_ext)`, gravity included through the base acceleration). Its component along the joint's
 //! motion subspace is the active joint force (springs, dampers, drives); the rest is the passive
 //! constraint force of the joint.
 
