@@ -104,20 +104,26 @@ def simulate(
 
     raw: dict = {}
     error: list[BaseException] = []
+    done = threading.Event()
 
     def run():
         try:
             raw.update(_core.simulate(core, text, callbacks, prog))
         except BaseException as e:  # noqa: BLE001 - re-raised in the calling thread
             error.append(e)
+        finally:
+            done.set()
 
     if callbacks:
         # callbacks need the interpreter; running in this thread keeps tracebacks simple
         run()
     else:
-        worker = threading.Thread(target=run, name="mechsys-simulate", daemon=True)
+        # not a daemon: the interpreter never ends while the engine still runs in it (a daemon
+        # thread stopped at exit inside the engine aborts the process)
+        worker = threading.Thread(target=run, name="mechsys-simulate")
         worker.start()
-        _wait(worker, prog, n_expected, progress)
+        _wait(done, prog, n_expected, progress)
+        worker.join()
     if error:
         raise error[0]
     import warnings
@@ -165,16 +171,18 @@ def _warn_redundant(model: Model, q0, t0) -> None:
         )
 
 
-def _wait(worker: threading.Thread, prog, n_expected: int, progress: bool | None) -> None:
-    """Waits for the simulation thread, showing a bar after ~1 s; Ctrl-C cancels the run."""
+def _wait(done: threading.Event, prog, n_expected: int, progress: bool | None) -> None:
+    """Waits for the simulation thread to set ``done``, showing a bar after ~1 s. Ctrl-C cancels
+    the run: the engine stops at its next sample, and the KeyboardInterrupt is raised once it has
+    (further Ctrl-C meanwhile only repeat the request). The wait is on an Event, not on
+    ``Thread.join``, whose state an interrupt can leave claiming the thread ended."""
     import sys
 
     start = time.perf_counter()
     bar = None
     try:
-        while worker.is_alive():
-            worker.join(0.05)
-            if bar is None and worker.is_alive():
+        while not done.wait(0.05):
+            if bar is None:
                 show = progress if progress is not None else sys.stderr.isatty()
                 if show and time.perf_counter() - start > 1.0:
                     from tqdm import tqdm
@@ -185,7 +193,12 @@ def _wait(worker: threading.Thread, prog, n_expected: int, progress: bool | None
                 bar.refresh()
     except KeyboardInterrupt:
         prog.cancel()
-        worker.join()
+        while True:
+            try:
+                if done.wait(0.05):
+                    break
+            except KeyboardInterrupt:
+                prog.cancel()
         raise
     finally:
         if bar is not None:

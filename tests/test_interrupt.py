@@ -1,0 +1,61 @@
+"""Ctrl-C during a run (issue 13's first item, newcomer review finding 2): the run is cancelled,
+KeyboardInterrupt reaches the script, and the process ends normally — no SIGABRT from an engine
+thread cut off at exit. Tested the way it fails: a real SIGINT to a subprocess."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+SCRIPT = r"""
+import sys
+import mechsys as ms
+m = ms.Model("chain", gravity=(0, -9.81, 0))
+parent = m.ground
+for i in range(10):
+    b = m.add_body(f"b{i}", 1.0, ms.inertia.rod(1.0, 0.1), com=(0.05, 0, 0))
+    m.add_joint(ms.joints.Revolute(f"j{i}", parent, b, axis=(0, 0, 1), parent_frame=(0.1, 0, 0) if i else None))
+    parent = b
+print("start", flush=True)
+if sys.argv[1] == "catch":
+    try:
+        ms.simulate(m, 1000.0, ms.RK4(dt=1e-5), output_dt=0.01)
+    except KeyboardInterrupt:
+        print("caught KeyboardInterrupt", flush=True)
+else:
+    ms.simulate(m, 1000.0, ms.RK4(dt=1e-5), output_dt=0.01)
+print("after", flush=True)
+"""
+
+
+def interrupted(mode: str) -> tuple[int, str, float]:
+    p = subprocess.Popen([sys.executable, "-u", "-c", SCRIPT, mode], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                         text=True)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(1.0)  # the engine is stepping (the run would take minutes)
+    p.send_signal(signal.SIGINT)
+    t0 = time.perf_counter()
+    out, _ = p.communicate(timeout=60)
+    return p.returncode, out, time.perf_counter() - t0
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_ctrl_c_cancels_the_run_and_the_script_goes_on():
+    rc, out, waited = interrupted("catch")
+    assert "FATAL" not in out and "Aborted" not in out, out
+    assert rc == 0, out
+    assert "caught KeyboardInterrupt" in out and "after" in out
+    assert waited < 10.0  # the engine stops at its next sample (0.01 s of model time)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_uncaught_ctrl_c_ends_the_process_as_an_interrupt():
+    rc, out, _ = interrupted("plain")
+    assert "FATAL" not in out, out
+    assert "KeyboardInterrupt" in out and "after" not in out
+    # Python ends an uncaught KeyboardInterrupt by re-raising SIGINT (exit status -2 / 130)
+    assert rc in (-signal.SIGINT, 128 + signal.SIGINT), (rc, out)
