@@ -12,7 +12,11 @@ import time
 import pytest
 
 SCRIPT = r"""
+import signal
 import sys
+# a shell that starts jobs in the background (as CI may) leaves SIGINT ignored in them: restore
+# Python's own handler, as an interactive session has it
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import mechsys as ms
 m = ms.Model("chain", gravity=(0, -9.81, 0))
 parent = m.ground
@@ -35,12 +39,17 @@ print("after", flush=True)
 def interrupted(mode: str) -> tuple[int, str, float]:
     p = subprocess.Popen([sys.executable, "-u", "-c", SCRIPT, mode], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                          text=True)
-    assert p.stdout.readline().strip() == "start"
-    time.sleep(1.0)  # the engine is stepping (the run would take minutes)
-    p.send_signal(signal.SIGINT)
-    t0 = time.perf_counter()
-    out, _ = p.communicate(timeout=60)
-    return p.returncode, out, time.perf_counter() - t0
+    try:
+        assert p.stdout.readline().strip() == "start"
+        time.sleep(1.0)  # the engine is stepping (the run would take minutes)
+        p.send_signal(signal.SIGINT)
+        t0 = time.perf_counter()
+        out, _ = p.communicate(timeout=60)
+        return p.returncode, out, time.perf_counter() - t0
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
