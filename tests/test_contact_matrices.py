@@ -75,3 +75,7 @@ def test_contact_matrices_bad_state_names_the_argument():
         ms.dynamics.contact_matrices(m, np.zeros(2))
     with pytest.raises(ms.SettingsError, match="u"):
         ms.dynamics.contact_matrices(m, np.zeros(3), np.zeros(5))
+    with pytest.raises(ms.SettingsError, match=r"u\[1\]: must be finite"):
+        ms.dynamics.contact_matrices(m, np.zeros(3), np.array([0.0, np.nan, 0.0]))
+    with pytest.raises(ms.SettingsError, match="t: must be finite"):
+        ms.dynamics.contact_matrices(m, np.zeros(3), np.zeros(3), t=np.inf)

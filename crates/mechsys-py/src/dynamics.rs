@@ -377,6 +377,13 @@ fn contact_matrices<'py>(
     let m = &model.model;
     let q = q_slice(model, q)?;
     let u = fast_slice(u, m.nu, "u")?;
+    // (q is checked by q_slice; a non-finite u or t would come back as NaN matrices)
+    if let Some(k) = u.iter().position(|v| !v.is_finite()) {
+        return Err(settings(format!("u[{k}]: must be finite, got {}", u[k])));
+    }
+    if !t.is_finite() {
+        return Err(settings(format!("t: must be finite, got {t}")));
+    }
     let cb = self::callbacks(model, callbacks)?;
     let mut phase = Phase::new(m, &cb, Options::default()).map_err(PyMechsysError::from)?;
     let c = phase.contact_matrices(t, q, u).map_err(PyMechsysError::from)?;

@@ -375,6 +375,11 @@ impl<'a> Phase<'a> {
     /// when no admissible distribution is left. Larger null spaces keep the minimum norm.
     fn redistribute(&mut self, n: usize) {
         let nu = self.model.nu;
+        // (checked first: this runs at every evaluation of a sticking phase, and the minimum-norm
+        // forces are admissible in all but the jammed ones)
+        if self.smallest_margin(n, 0.0) > 0.0 {
+            return;
+        }
         // Gram matrix of the accelerations each force direction causes
         for i in 0..n {
             for j in 0..=i {
@@ -382,9 +387,6 @@ impl<'a> Phase<'a> {
                 self.aat[i * n + j] = v;
                 self.aat[j * n + i] = v;
             }
-        }
-        if self.smallest_margin(n, 0.0) > 0.0 {
-            return;
         }
         let rank = cholesky_semidefinite(&mut self.aat[..n * n], n, &mut self.piv_r, 1e-10);
         if rank + 1 != n {

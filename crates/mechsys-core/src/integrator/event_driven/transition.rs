@@ -300,7 +300,7 @@ impl Phase<'_> {
             for &pt in closing.iter() {
                 self.status[pt] = STICK;
             }
-            let r: Result<Dissipation> = Ok(self.settle(u, imp));
+            let d = self.settle(u, imp);
             let at = self.log.store_velocities(&self.ev.u_before, u);
             for &pt in culprits.iter() {
                 let e = self.log.push(t, pt, EventKind::Painleve);
@@ -322,7 +322,6 @@ impl Phase<'_> {
                 });
             }
             self.ev.hit = culprits;
-            let d = r?;
             diss.impact += d.impact;
             diss.friction += d.friction;
             self.free_motion(t, q, u)?;
