@@ -86,14 +86,55 @@ class LinearModel:
     method: str = "fd"
     #: the model it came from (for re-linearizing, e.g. by :meth:`campbell`); None when built by hand
     model: Model | None = field(default=None, repr=False, compare=False)
+    #: the first-order form about the point (:class:`StateForm`; None when built by hand)
+    state: "StateForm | None" = field(default=None, repr=False, compare=False)
+    #: cyclic coordinates: joint coordinates the linearized motion does not depend on
+    cyclic: list = field(default_factory=list)
+    #: whether the point is an equilibrium or a steady motion (see :attr:`StateForm.steady`)
+    steady: bool = True
 
     @property
     def n(self) -> int:
-        """Degrees of freedom."""
-        return self.M.shape[0]
+        """Degrees of freedom of the second-order form (configuration states of the first-order
+        form when there is none)."""
+        return self.M.shape[0] if self.M is not None else self.state.n_config
+
+    @property
+    def A(self) -> np.ndarray:
+        """State matrix of the first-order form ``x' = A x + B tau`` with the cyclic coordinates
+        removed (``states`` names its entries): configuration perturbations, then velocity
+        perturbations. About an equilibrium of a holonomic model its eigenvalues are those of
+        :meth:`state_matrix`."""
+        return self._state().reduced()[0]
+
+    @property
+    def B(self) -> np.ndarray:
+        """Input matrix of the first-order form: column k is x' for a unit generalized force on
+        the joint velocity ``self.state.coordinates[k]`` (N or N m)."""
+        return self._state().reduced()[1]
+
+    @property
+    def states(self) -> list[str]:
+        """Names of the entries of the first-order state x (rates end in a prime)."""
+        return self._state().reduced()[2]
+
+    def _state(self) -> "StateForm":
+        if self.state is None:
+            raise SettingsError("this LinearModel has no first-order form (built by hand); use ms.linear.linearize")
+        return self.state
+
+    def state_space(self, inputs=None, outputs=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C)`` of ``x' = A x + B tau``, ``z = C x``: ``inputs`` are joint velocities
+        (names as in ``state.coordinates``, or indices) that receive a generalized force (all by
+        default), ``outputs`` joint coordinates or their rates (``"steer"``, ``"steer'"``; the
+        states by default). A cyclic coordinate cannot be an output."""
+        return self._state().state_space(inputs, outputs)
 
     def state_matrix(self) -> np.ndarray:
-        """A of x' = A x with x = [y, y'] (2n x 2n)."""
+        """A of x' = A x with x = [y, y'] (2n x 2n); the first-order form's A where the model
+        has no second-order form."""
+        if self.M is None:
+            return self.A
         n = self.n
         minv = np.linalg.inv(self.M)
         a = np.zeros((2 * n, 2 * n))
@@ -107,22 +148,14 @@ class LinearModel:
         damping ratios; stability from the real parts."""
         lam, vec = np.linalg.eig(self.state_matrix())
         n = self.n
-        # one of each complex pair (Im >= 0); real eigenvalues all kept
-        scale = 1.0 + np.abs(lam).max(initial=0.0)
-        keep = lam.imag >= -1e-12 * scale
-        lam, vec = lam[keep], vec[:, keep]
-        wn = np.abs(lam)
-        order = np.lexsort((lam.real, wn))
-        lam, vec, wn = lam[order], vec[:, order], wn[order]
-        shapes = vec[:n, :]
-        big = np.abs(shapes).max(axis=0)
-        big[big == 0] = 1.0
-        # scale so that the largest entry is real and 1
-        k = np.abs(shapes).argmax(axis=0)
-        shapes = shapes / (shapes[k, np.arange(shapes.shape[1])] / np.abs(shapes[k, np.arange(shapes.shape[1])])) / big
-        with np.errstate(invalid="ignore", divide="ignore"):
-            zeta = np.where(wn > 0, -lam.real / np.where(wn > 0, wn, 1.0), 0.0)
-        return Modes(lam, wn / (2 * np.pi), np.abs(lam.imag) / (2 * np.pi), zeta, shapes, self.V @ shapes)
+        if self.M is None:
+            return _modes(lam, vec, n, self.state.shape_map())
+        return _modes(lam, vec, n, self.V)
+
+    def _second_order(self, what: str) -> None:
+        if self.M is None:
+            raise SettingsError(f"{what}: this linearization has no second-order form M, D, G, K, N "
+                                f"({self.state.why_first_order}); use lin.A, lin.state_space() or lin.modes()")
 
     def frf(self, frequencies, inputs=None, outputs=None, method: str = "auto") -> np.ndarray:
         """H(j w) = [-w^2 M + j w (D + G) + (K + N)]^-1 (eq. 2.205) at ``frequencies`` (Hz, > 0),
@@ -136,6 +169,7 @@ class LinearModel:
         as with rigid-body modes); both are fast for a few inputs and outputs. ``"auto"``
         (default) takes the modal form when there are no more input-output pairs than
         coordinates and it is well conditioned, else the direct one."""
+        self._second_order("frf")
         f = np.atleast_1d(np.asarray(frequencies, dtype=float))
         if f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
             raise SettingsError("frf: frequencies must be finite and > 0 (Hz)")
@@ -211,6 +245,7 @@ class LinearModel:
 
     def with_damping(self, D) -> "LinearModel":
         """The same model with the damping matrix ``D`` (symmetric n x n) instead of its own."""
+        self._second_order("with_damping")
         D = np.asarray(D, dtype=float)
         if D.shape != self.M.shape:
             raise SettingsError(f"with_damping: D must be {self.n} x {self.n}, got {D.shape}")
@@ -242,6 +277,7 @@ class LinearModel:
         ``zeta[i]`` (one number: all modes), D = M Phi diag(2 zeta_i w_i) Phi^T M with the modes
         Phi mass-normalized (Phi^T M Phi = E). Modes in order of rising frequency; needs K
         positive definite (no rigid-body or unstable modes)."""
+        self._second_order("modal_damping")
         lam, phi = _undamped_modes(self.M, self.K)
         if lam.size and lam.min() <= 1e-12 * max(lam.max(), 1.0):
             raise SettingsError("modal_damping: K must be positive definite (a rigid-body or unstable mode has no "
@@ -256,12 +292,14 @@ class LinearModel:
 
     def dissipation(self, ydot) -> float:
         """Rayleigh's dissipation function R = y'^T D y' / 2 (eq. 2.206: the power lost is 2R)."""
+        self._second_order("dissipation")
         v = np.asarray(ydot, dtype=float)
         return 0.5 * float(v @ self.D @ v)
 
     def energy(self, y, ydot) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic and potential energy of the linear model, E_k = y'^T M y' / 2 and
         E_p = y^T K y / 2, for one state or for samples (rows of ``y`` and ``ydot``)."""
+        self._second_order("energy")
         y, v = self._samples(y, "y"), self._samples(ydot, "ydot")
         ek = 0.5 * np.einsum("ki,ij,kj->k", v, self.M, v)
         ep = 0.5 * np.einsum("ki,ij,kj->k", y, self.K, y)
@@ -358,6 +396,28 @@ class LinearModel:
         return idx[0], idx[1]
 
 
+def _modes(lam: np.ndarray, vec: np.ndarray, n: int, to_u: np.ndarray) -> Modes:
+    """Modes from the eigen-solution of a state matrix whose first n states are configurations:
+    one of each complex pair (Im >= 0), ordered by |lambda|, shapes scaled to a real unit peak."""
+    scale = 1.0 + np.abs(lam).max(initial=0.0)
+    keep = lam.imag >= -1e-12 * scale
+    lam, vec = lam[keep], vec[:, keep]
+    wn = np.abs(lam)
+    order = np.lexsort((lam.real, wn))
+    lam, vec, wn = lam[order], vec[:, order], wn[order]
+    shapes = vec[:n, :]
+    big = np.abs(shapes).max(axis=0)
+    big[big == 0] = 1.0
+    k = np.abs(shapes).argmax(axis=0)
+    cols = np.arange(shapes.shape[1])
+    peak = shapes[k, cols]
+    peak = np.where(np.abs(peak) > 0, peak / np.where(np.abs(peak) > 0, np.abs(peak), 1.0), 1.0)
+    shapes = shapes / peak / big
+    with np.errstate(invalid="ignore", divide="ignore"):
+        zeta = np.where(wn > 0, -lam.real / np.where(wn > 0, wn, 1.0), 0.0)
+    return Modes(lam, wn / (2 * np.pi), np.abs(lam.imag) / (2 * np.pi), zeta, shapes, to_u @ shapes)
+
+
 def _undamped_modes(m: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Eigenvalues w^2 (rising) and mass-normalized modes of K phi = w^2 M phi."""
     from scipy.linalg import eigh
@@ -411,46 +471,607 @@ def _names(model: Model, n_u: int) -> list[str]:
 
 
 def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: bool = False, at=None,
-              method: str = "auto") -> LinearModel:
-    """Linearizes ``model`` at (``q``, ``u``, ``t``) (the model's q0, u0 by default).
+              method: str = "auto", coordinates=None) -> LinearModel:
+    """Linearizes ``model`` at (``q``, ``u``, ``t``) (the model's q0, u0 by default): about an
+    equilibrium or about a steady motion (a relative equilibrium: straight or circular rolling, a
+    precessing top, a spinning rotor), also with non-holonomic constraints.
+
+    The result always carries the first-order form ``x' = A x + B tau`` (``lin.A``, ``lin.B``,
+    ``lin.states``, ``lin.state_space()``) with the cyclic coordinates (``lin.cyclic``: positions
+    on the plane, heading, wheel and spin angles) detected and removed, and, where the motion admits
+    it, the second-order form M y'' + (D + G) y' + (K + N) y = g (eq. 2.204):
+
+    - at rest (u = 0): in minimal coordinates y along the admissible velocities, as always;
+    - moving, holonomic: in the same coordinates, with the chart's rotation and the constraints'
+      turning with q included;
+    - non-holonomic and moving: in the coordinates you name (``coordinates=["lean", "steer"]``,
+      joint coordinate names as in ``lin.state.coordinates``), or, by default, in all non-cyclic
+      configuration coordinates, provided the remaining states (cyclic rates, a forward speed)
+      do not feed back into them; otherwise ``M`` etc. are None and ``lin.modes()`` uses A.
 
     ``method`` chooses the derivatives: ``"auto"`` (exact where the model allows, else central
     differences), ``"exact"`` (dual numbers; an error on a model with a callback force) or
     ``"fd"`` (central differences); ``LinearModel.method`` says which were used (``"exact"``,
     ``"exact+fd-constraints"`` with bilateral constraints, or ``"fd"``).
 
-    At a point that is not an equilibrium (``residual`` beyond round-off) a ``UserWarning``
-    reports the residual, unless ``operating_point=True`` says the point is meant as it is (a
-    steady motion, or a quasi-static state whose imbalance the user accepts).
+    At a point that is neither an equilibrium nor a steady motion (``lin.steady`` False: the
+    non-cyclic states change along the reference) a ``UserWarning`` says so, unless
+    ``operating_point=True`` says the point is meant as it is. A point that violates a
+    constraint is a ModelError naming it; a contact closed at the point, or a friction element
+    sticking there, is refused (their force laws are not smooth there).
 
     ``at`` chooses the point instead of ``q``/``u``: ``None`` or ``"q0"`` (the model's q0, u0),
     ``"equilibrium"`` (:func:`mechsys.analysis.static_equilibrium` from ``q``, at rest unless
-    ``u`` is given), or a dict ``{"q": ..., "u": ...}`` whose entries are full vectors or
-    ``{joint: value}`` dicts, or directly a ``{joint: q value}`` dict as ``simulate``'s q0.
-    ``q``, ``u`` also accept ``{joint: value}`` dicts. A mass matrix that is singular (a
-    coordinate without inertia) raises a ModelError naming the coordinate."""
+    ``u`` is given), a :class:`SteadyMotion` from :func:`steady_motion`, or a dict
+    ``{"q": ..., "u": ...}`` whose entries are full vectors or ``{joint: value}`` dicts, or
+    directly a ``{joint: q value}`` dict as ``simulate``'s q0. ``q``, ``u`` also accept
+    ``{joint: value}`` dicts. A mass matrix that is singular (a coordinate without inertia)
+    raises a ModelError naming the coordinate."""
     if not isinstance(model, Model):
         raise SettingsError(f"linearize: expected a mechsys.Model, got {type(model).__name__}")
-    core, cbs = model.engine()
+    if isinstance(at, SteadyMotion):
+        t = at.t
     q, u = _point(model, q, u, float(t), at)
-    raw = _core.linearize(core, q, u, float(t), cbs, method)
-    n_u = raw["V"].shape[0]
-    names = _names(model, n_u)
-    if raw["V"].shape[1] != n_u or not np.allclose(raw["V"], np.eye(n_u)):
-        names = [f"y{k}" for k in range(raw["V"].shape[1])]
-    lin = LinearModel(raw["M"], raw["D"], raw["G"], raw["K"], raw["N"], raw["V"], raw["residual"], q, u, float(t), names,
-                      raw["method"], model)
-    _check_mass(lin, model.name)
-    scale = 1.0 + np.abs(lin.K).max(initial=0.0) + np.abs(lin.M).max(initial=0.0)
-    res = float(np.abs(lin.residual).max(initial=0.0))
-    if res > 1e-8 * scale and not operating_point:
-        worst = int(np.abs(lin.residual).argmax())
-        warnings.warn(f"model '{model.name}': linearized at a point that is not an equilibrium: residual "
-                      f"{res:.3g} on coordinate '{lin.names[worst]}' (pass operating_point=True if that is meant)",
+    _refuse_nonsmooth(model, q, u, float(t))
+    coords = _names(model, model.nu)
+    nonholonomic = _nonholonomic(model) if model.engine()[0].constraints() else False
+    if coordinates is not None:
+        wanted = [coordinates] if isinstance(coordinates, (str, int, np.integer)) else list(coordinates)
+        if not wanted:
+            raise SettingsError("linearize: coordinates: name at least one joint coordinate")
+        idx = [_coordinate(coords, c, "linearize: coordinates") for c in wanted]
+        if len(set(idx)) < len(idx):
+            raise SettingsError(f"linearize: coordinates: a coordinate is named twice in {wanted!r}")
+        prefer = idx
+    else:
+        prefer = [] if nonholonomic else None
+    sf, raw = _state_form(model, q, u, float(t), method, prefer)
+    _check_constraints(model, raw, q, u)
+    moving = bool(np.any(u != 0.0))
+    steady, why = _steadiness(sf, u)
+    form, names, v_basis, residual = None, [], None, None
+    if coordinates is not None:
+        sel = []
+        for k in idx:
+            name = coords[k]
+            if name in sf.cyclic:
+                raise SettingsError(f"linearize: coordinates: '{name}' is cyclic (the linearized motion does not depend on "
+                                    f"it; cyclic: {', '.join(sf.cyclic)}); name non-cyclic coordinates")
+            if name not in sf.keep_names:
+                raise SettingsError(f"linearize: coordinates: '{name}' is not an independent coordinate here (the "
+                                    f"constraints determine it from the others); independent: {', '.join(sf.keep_names)}")
+            sel.append(sf.keep_names.index(name))
+        a_r = sf.reduced()[0]
+        form = _second_order_form(a_r, sf.n_config, sf.keep_names, sf.V, raw["mass"], sel)
+        if isinstance(form, str):
+            raise SettingsError(f"linearize: coordinates {', '.join(coords[k] for k in idx)}: {form}")
+        names = [coords[k] for k in idx]
+        v_basis = (sf.Vh @ sf.keep)[:, sel]
+    elif not moving:
+        # at rest: the second-order form in minimal coordinates (unchanged)
+        core, cbs = model.engine()
+        old = _core.linearize(core, q, u, float(t), cbs, method)
+        n_u = old["V"].shape[0]
+        names = _names(model, n_u)
+        if old["V"].shape[1] != n_u or not np.allclose(old["V"], np.eye(n_u)):
+            names = [f"y{k}" for k in range(old["V"].shape[1])]
+        form = (old["M"], old["D"] + old["G"], old["K"] + old["N"])
+        v_basis, residual = old["V"], old["residual"]
+        steady = steady and float(np.abs(residual).max(initial=0.0)) <= \
+            1e-8 * (1.0 + np.abs(old["K"]).max(initial=0.0) + np.abs(old["M"]).max(initial=0.0))
+    elif not nonholonomic:
+        # moving, holonomic: y = all configuration states (cyclic ones kept: a Campbell diagram
+        # follows the same coordinates at every speed)
+        form = _second_order_form(sf.A, sf.nq, sf.names[: sf.nq], sf.V, raw["mass"], None)
+        names, v_basis = sf.names[: sf.nq], sf.Vh
+    else:
+        form = _second_order_form(sf.reduced()[0], sf.n_config, sf.keep_names, sf.V, raw["mass"], None)
+        names, v_basis = list(sf.keep_names), sf.Vh @ sf.keep
+    if isinstance(form, str):
+        sf = replace(sf, why_first_order=form)
+        mats = (None,) * 5
+    else:
+        mm, c, s = form
+        mats = (mm, 0.5 * (c + c.T), 0.5 * (c - c.T), 0.5 * (s + s.T), 0.5 * (s - s.T))
+    if residual is None:
+        a_r, _, _ = sf.reduced()
+        residual = np.concatenate([sf.keep.T @ sf.rate[: sf.nq], sf.rate[sf.nq:]])
+    lin = LinearModel(*mats, v_basis, np.asarray(residual, dtype=float), q, u, float(t), names,
+                      raw["method"] if mats[0] is None or moving or coordinates is not None else old["method"],
+                      model, sf, list(sf.cyclic), steady)
+    if lin.M is not None:
+        _check_mass(lin, model.name)
+    if not steady and not operating_point:
+        warnings.warn(f"model '{model.name}': linearized at a point that is not an equilibrium or a steady motion: {why} "
+                      "(the linear model holds at this instant only; pass operating_point=True if that is meant)",
                       UserWarning, stacklevel=2)
-    if not np.all(np.isfinite(lin.M)):
-        raise ModelError(f"model '{model.name}': the linearized mass matrix is not finite")
     return lin
+
+
+def _steadiness(sf: StateForm, u: np.ndarray) -> tuple[bool, str]:
+    """Whether the reference is steady: its non-cyclic configuration states do not move, its
+    velocity states do not change, and the admissible subspace is invariant."""
+    scale_a = 1.0 + float(np.abs(sf.A).max(initial=0.0)) * (1.0 + float(np.abs(u).max(initial=0.0)))
+    moves = sf.keep.T @ sf.rate[: sf.nq]
+    acc = sf.rate[sf.nq:]
+    if moves.size and np.abs(moves).max() > 1e-8 * (1.0 + float(np.abs(u).max(initial=0.0))):
+        k = int(np.abs(moves).argmax())
+        return False, f"the non-cyclic coordinate '{sf.keep_names[k]}' moves at {moves[k]:.3g} per second"
+    if acc.size and np.abs(acc).max() > 1e-8 * scale_a:
+        k = int(np.abs(acc).argmax())
+        return False, f"the velocity '{sf.names[sf.nq + k]}' changes at {acc[k]:.3g} per second (residual)"
+    if sf.defect > 1e-6:
+        return False, f"the admissible motions are not invariant (defect {sf.defect:.2g})"
+    return True, ""
+
+
+def _check_constraints(model: Model, raw: dict, q: np.ndarray, u: np.ndarray) -> None:
+    """A ModelError naming the first constraint the point violates (position or velocity)."""
+    tol_q = 1e-6 * (1.0 + float(np.abs(q).max(initial=0.0)))
+    tol_u = 1e-6 * (1.0 + float(np.abs(u).max(initial=0.0)))
+    for c in model.engine()[0].constraints():
+        r0, n, nh = c["row"], c["rows"], c["holonomic_rows"]
+        phi = np.abs(raw["phi"][r0:r0 + nh])
+        if phi.size and phi.max() > tol_q:
+            raise ModelError(f"linearize: the point violates constraint '{c['name']}' (position residual "
+                             f"{phi.max():.3g} {c.get('violation_unit', '')}); give a consistent q (e.g. from the "
+                             "start of a simulation or ms.analysis.assemble)")
+        vel = np.abs(raw["velocity_residual"][r0:r0 + n])
+        if vel.size and vel.max() > tol_u:
+            raise ModelError(f"linearize: the point violates constraint '{c['name']}' (velocity residual "
+                             f"{vel.max():.3g}); give velocities the constraint admits")
+
+
+def _refuse_nonsmooth(model: Model, q: np.ndarray, u: np.ndarray, t: float) -> None:
+    """Refuses a point where a force law is not smooth: reserved for contacts and sticking
+    friction elements (filled in below)."""
+    return None
+
+
+# ---- the first-order form about a motion ---------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class StateForm:
+    """The linearization about a state (q, u, t) in first-order form, ``x' = A x + B tau``, with
+    x = (xi, eta): configuration perturbations delta = Vh xi along the directions the holonomic
+    constraints allow (quaternion joints in rotation vectors of the child frame) and velocity
+    perturbations delta_u = P xi + V eta along those all constraints allow; P keeps a perturbed
+    configuration's velocity admissible. Right for non-holonomic constraints and moving states,
+    where configuration and velocity perturbations differ in number and the reference moves.
+
+    ``A``, ``B`` here include the cyclic coordinates; :meth:`reduced` (and ``LinearModel.A``)
+    removes them."""
+
+    A: np.ndarray
+    B: np.ndarray
+    #: names of the entries of x (configuration coordinates, then rates with a prime)
+    names: list
+    #: configuration and velocity states (n_q,min, n_u,min)
+    nq: int
+    nu: int
+    Vh: np.ndarray
+    P: np.ndarray
+    V: np.ndarray
+    Lh: np.ndarray
+    Lu: np.ndarray
+    #: the joint velocities (chart coordinates) by name, model order
+    coordinates: list
+    #: the reference's own rates in x: a steady motion moves only along cyclic directions
+    rate: np.ndarray
+    #: how far the admissible subspace is from invariant under the linearized motion (round-off
+    #: about a steady motion)
+    defect: float
+    #: cyclic coordinates (names) and the xi-directions the motion does not depend on (nq x k)
+    cyclic: list
+    cyclic_basis: np.ndarray
+    #: xi-directions kept by :meth:`reduced` (nq x (nq - k)) and their names
+    keep: np.ndarray
+    keep_names: list
+    method: str = "exact"
+    #: why there is no second-order form ("" when there is one)
+    why_first_order: str = ""
+
+    @property
+    def n_config(self) -> int:
+        """Configuration states after removing the cyclic ones."""
+        return self.keep.shape[1]
+
+    def _t(self) -> np.ndarray:
+        t = np.zeros((self.nq + self.nu, self.n_config + self.nu))
+        t[: self.nq, : self.n_config] = self.keep
+        t[self.nq:, self.n_config:] = np.eye(self.nu)
+        return t
+
+    def reduced(self) -> tuple[np.ndarray, np.ndarray, list]:
+        """``(A, B, names)`` with the cyclic coordinates removed (the motion does not depend on
+        them, so the rest is closed)."""
+        t = self._t()
+        return t.T @ self.A @ t, t.T @ self.B, list(self.keep_names) + [n for n in self.names[self.nq:]]
+
+    def shape_map(self) -> np.ndarray:
+        """Reduced configuration states -> joint velocities (chart directions), for mode shapes."""
+        return self.Vh @ self.keep
+
+    def state_space(self, inputs=None, outputs=None):
+        a, b, names = self.reduced()
+        t = self._t()
+        if inputs is not None:
+            b = b[:, [_coordinate(self.coordinates, i, "inputs") for i in np.atleast_1d(inputs)]]
+        if outputs is None:
+            return a, b, np.eye(a.shape[0])
+        rows = []
+        for o in np.atleast_1d(outputs):
+            name = str(o)
+            rate = name.endswith("'")
+            k = _coordinate(self.coordinates, name[:-1] if rate else o, "outputs")
+            if self.coordinates[k] in self.cyclic and not rate:
+                raise SettingsError(f"state_space: outputs: coordinate '{self.coordinates[k]}' is cyclic (the linearized "
+                                    "motion does not depend on it and it drifts freely); name a non-cyclic coordinate or "
+                                    "its rate")
+            full = np.zeros(self.nq + self.nu)
+            if rate:
+                full[: self.nq] = self.P[k]
+                full[self.nq:] = self.V[k]
+            else:
+                full[: self.nq] = self.Vh[k]
+            rows.append(full @ t)
+        return a, b, np.array(rows)
+
+
+def _coordinate(names: list, i, what: str) -> int:
+    if isinstance(i, (str, np.str_)):
+        if str(i) not in names:
+            raise SettingsError(f"{what}: no joint coordinate named '{i}' (have {', '.join(names)})")
+        return names.index(str(i))
+    k = int(i)
+    if not 0 <= k < len(names):
+        raise SettingsError(f"{what}: coordinate index {k} out of range 0..{len(names) - 1}")
+    return k
+
+
+def _nonholonomic(model: Model) -> bool:
+    return any(c["holonomic_rows"] < c["rows"] for c in model.engine()[0].constraints())
+
+
+def _state_form(model: Model, q, u, t: float, method: str, prefer) -> tuple[StateForm, dict]:
+    """The first-order form from the core, its cyclic coordinates and their complement."""
+    core, cbs = model.engine()
+    raw = _core.state_space(core, q, u, t, cbs, method, prefer)
+    coords = _names(model, model.nu)
+    a, nq, nu = raw["A"], raw["Vh"].shape[1], raw["V"].shape[1]
+    partition = prefer is not None
+    if partition:
+        names = [coords[i] for i in raw["independent_q"]] + [coords[i] + "'" for i in raw["independent_u"]]
+    elif raw["Vh"].shape == (model.nu, model.nu) and np.allclose(raw["Vh"], np.eye(model.nu)) and \
+            raw["V"].shape == (model.nu, model.nu) and np.allclose(raw["V"], np.eye(model.nu)):
+        names = coords + [c + "'" for c in coords]
+    else:
+        names = [f"y{k}" for k in range(nq)] + [f"y{k}'" for k in range(nu)]
+    # cyclic: xi-directions whose columns of A vanish (the motion does not depend on them)
+    scale = max(float(np.abs(a).max(initial=0.0)), 1e-300)
+    tol = (1e-7 if raw["method"] == "fd" else 1e-9) * scale
+    axi = a[:, :nq]
+    if nq:
+        _, sv, vt = np.linalg.svd(axi)
+        sv = np.concatenate([sv, np.zeros(nq - sv.size)])
+        null = vt[sv <= tol].T
+    else:
+        null = np.zeros((0, 0))
+    k = null.shape[1]
+    # coordinates nothing else depends on (heading on the plane feeds only the position, itself
+    # cyclic): the largest set C of configuration states with A[rows outside C, C] = 0
+    unit = set(range(nq))
+    changed = True
+    while changed:
+        changed = False
+        for i in sorted(unit):
+            rows = [r for r in range(nq + nu) if r not in unit]
+            if rows and np.abs(a[rows, i]).max() > tol:
+                unit.discard(i)
+                changed = True
+    unit = sorted(unit)
+    cyclic = []
+    if unit:
+        cyclic = [names[i] for i in unit]
+        rest = [i for i in range(nq) if i not in unit]
+        keep = np.eye(nq)[:, rest]
+        keep_names = [names[i] for i in rest]
+    elif k:
+        # combinations only (a rotation about the vertical in a rotation-vector chart): name the
+        # joint coordinates lying in them, keep the orthogonal complement
+        for c in range(model.nu):
+            e = np.zeros(model.nu)
+            e[c] = 1.0
+            xi = raw["Lh"] @ e
+            if np.linalg.norm(raw["Vh"] @ xi - e) <= 1e-9 and \
+                    np.linalg.norm(xi - null @ (null.T @ xi)) <= 1e-6 * np.linalg.norm(xi):
+                cyclic.append(coords[c])
+        if not cyclic:
+            cyclic = [f"{k} combination{'s' if k > 1 else ''} of the coordinates"]
+        keep = np.linalg.svd(null.T)[2][k:].T
+        keep_names = [f"z{i}" for i in range(keep.shape[1])]
+    else:
+        keep, keep_names = np.eye(nq), names[:nq]
+    return StateForm(a, raw["B"], names, nq, nu, raw["Vh"], raw["P"], raw["V"], raw["Lh"], raw["Lu"], coords,
+                     raw["rate"], float(raw["defect"]), cyclic, null, keep, keep_names, raw["method"]), raw
+
+
+def _second_order_form(a: np.ndarray, n_cfg: int, cfg_names: list, v: np.ndarray, mass: np.ndarray, select):
+    """M, D+G, K+N of the second-order form in the configuration states ``select`` (indices into
+    the first ``n_cfg`` states of ``a``; all by default) where the motion admits it: the states
+    outside y = xi[select], y' must form an invariant subspace (cyclic and decoupled conserved
+    directions). Returns (M, C, S) or a str saying why not."""
+    nu = a.shape[0] - n_cfg
+    sel = list(range(n_cfg)) if select is None else list(select)
+    m = len(sel)
+    if m == 0:
+        return "no non-cyclic configuration coordinate is left"
+    y = np.zeros((2 * m, n_cfg + nu))
+    y[np.arange(m), sel] = 1.0
+    y[m:] = a[sel]
+    if np.linalg.matrix_rank(y, tol=1e-9 * max(float(np.abs(y).max()), 1.0)) < 2 * m:
+        return "the coordinates' rates are not independent velocities"
+    az = y @ a @ np.linalg.pinv(y)
+    scale = max(float(np.abs(a).max(initial=0.0)), 1e-300)
+    if np.abs(y @ a - az @ y).max(initial=0.0) > 1e-7 * scale * max(1.0, float(np.abs(y).max())):
+        names = [cfg_names[i] for i in sel]
+        return (f"the other states feed back into {', '.join(names)} (velocities without a configuration partner, "
+                "as a rolling wheel's heading rate): no second-order form in these coordinates")
+    # the mass matrix: the kinetic metric of the velocity perturbations with y' given and xi = 0,
+    # the least kinetic energy among them
+    e = a[sel, n_cfg:]
+    m_eta = v.T @ mass @ v
+    my = np.linalg.inv(e @ np.linalg.solve(m_eta, e.T))
+    my = 0.5 * (my + my.T)
+    return my, -my @ az[m:, m:], -my @ az[m:, :m]
+
+
+# ---- steady motions ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SteadyMotion:
+    """A steady motion (relative equilibrium) found by :func:`steady_motion`: every joint velocity
+    constant (child-frame components for quaternion joints), the constraints satisfied; pass it
+    as ``linearize(model, at=steady)``."""
+
+    q: np.ndarray
+    u: np.ndarray
+    t: float
+    #: the largest residual left (accelerations, constraint rows)
+    residual: float
+    iterations: int
+    #: the unknowns that were solved for (names; rates end in a prime)
+    solved: list = field(default_factory=list)
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        return {"q": self.q, "u": self.u}[key]
+
+
+def steady_motion(model: Model, q=None, u=None, t: float = 0.0, free=(), fixed=None, tol: float = 1e-10,
+                  max_iter: int = 50) -> SteadyMotion:
+    """A steady motion of ``model`` near the guess (``q``, ``u``; the model's q0, u0 by default):
+    the joint velocities constant (u' = 0; child-frame components for quaternion joints) and the
+    constraints satisfied, by Gauss-Newton on
+
+        Phi(q) = 0 (holonomic rows),  G(q) u = b,  u'(q, u) = 0.
+
+    ``free`` names what may change, as joint coordinates (``"lean"``, ``"free[3]"``: the chart
+    direction of that velocity, a rotation-vector turn for quaternion joints) or speeds with a
+    prime (``"spin'"``); ``fixed`` sets values first (``{"rear_hub'": -16.7, "lean": 0.1}``;
+    coordinates of quaternion joints cannot be set this way). Coordinates and speeds the
+    constraints determine (a wheel's height, a rolling wheel's forward speed) follow
+    automatically; everything else stays at the guess. Straight running at speed v, steady
+    circular rolling at a lean, a top's steady precession and a rotor at speed are all of this
+    kind.
+
+    Raises a SolverError naming the equation with the largest residual when it does not converge
+    within ``max_iter`` iterations (a guess too far away, or too few ``free`` unknowns)."""
+    from .errors import SolverError
+
+    if not isinstance(model, Model):
+        raise SettingsError(f"steady_motion: expected a mechsys.Model, got {type(model).__name__}")
+    core, cbs = model.engine()
+    q0 = _vector(model, q, "q", "q")
+    u0 = _vector(model, u, "u", "u")
+    coords = _names(model, model.nu)
+    joints = {j["name"]: j for j in model.joint_info()}
+    for name, value in (fixed or {}).items():
+        rate = str(name).endswith("'")
+        k = _coordinate(coords, str(name)[:-1] if rate else name, "steady_motion: fixed")
+        if not np.isfinite(value):
+            raise SettingsError(f"steady_motion: fixed['{name}'] must be finite, got {value!r}")
+        if rate:
+            u0[k] = float(value)
+        else:
+            j = next(j for j in joints.values() if j["iu"] <= k < j["iu"] + j["nu"])
+            if j["nq"] != j["nu"]:
+                raise SettingsError(f"steady_motion: fixed['{name}']: joint '{j['name']}' has quaternion coordinates; "
+                                    "give its value in the guess q instead")
+            q0[j["iq"] + k - j["iu"]] = float(value)
+    fixed_names = {str(n) for n in (fixed or {})}
+    free_q, free_u = [], []
+    for name in ([free] if isinstance(free, str) else list(free)):
+        rate = str(name).endswith("'")
+        k = _coordinate(coords, str(name)[:-1] if rate else name, "steady_motion: free")
+        (free_u if rate else free_q).append(k)
+    nc = model.nc
+    cons = core.constraints()
+    hol = np.zeros(nc, dtype=bool)
+    for c in cons:
+        hol[c["row"]:c["row"] + c["holonomic_rows"]] = True
+    phi, g, b = _core.constraint_jacobian(core, q0, t, cbs)
+    # the coordinates and speeds the constraints determine, among those neither free nor fixed
+    pinned_q = set(free_q) | {_coordinate(coords, n, "") for n in fixed_names if not n.endswith("'")}
+    pinned_u = set(free_u) | {_coordinate(coords, n[:-1], "") for n in fixed_names if n.endswith("'")}
+    dep_q = _dependent(g[hol], [k for k in range(model.nu) if k not in pinned_q])
+    dep_u = _dependent(g, [k for k in range(model.nu) if k not in pinned_u])
+    unk_q = sorted(set(free_q) | set(dep_q))
+    unk_u = sorted(set(free_u) | set(dep_u))
+    nq_x = len(unk_q)
+
+    def state(x):
+        d = np.zeros(model.nu)
+        d[unk_q] = x[:nq_x]
+        qq = np.asarray(core.integrate(q0, d, 1.0))
+        uu = u0.copy()
+        uu[unk_u] = x[nq_x:]
+        return qq, uu
+
+    def residual(x):
+        qq, uu = state(x)
+        ph, gg, bb = _core.constraint_jacobian(core, qq, t, cbs)
+        ud = _core.aba(core, qq, uu, None, t, cbs, None)
+        return np.concatenate([ph[hol], gg @ uu - bb, ud])
+
+    labels = ([f"constraint '{c['name']}' (position)" for c in cons for _ in range(c["holonomic_rows"])] +
+              [f"constraint '{c['name']}' (velocity)" for c in cons for _ in range(c["rows"])] +
+              [f"acceleration of '{n}'" for n in coords])
+    x = np.concatenate([np.zeros(nq_x), u0[unk_u]])
+    r = residual(x)
+    scale = 1.0 + float(np.abs(u0).max(initial=0.0))
+    it = 0
+    while np.abs(r).max(initial=0.0) > tol * scale and it < max_iter:
+        it += 1
+        jac = np.empty((r.size, x.size))
+        for k in range(x.size):
+            h = 1e-7 * max(1.0, abs(x[k]))
+            xp, xm = x.copy(), x.copy()
+            xp[k] += h
+            xm[k] -= h
+            jac[:, k] = (residual(xp) - residual(xm)) / (2 * h)
+        step = np.linalg.lstsq(jac, -r, rcond=1e-12)[0]
+        lam, base = 1.0, np.abs(r).max()
+        while lam > 1e-4:
+            trial = residual(x + lam * step)
+            if np.all(np.isfinite(trial)) and np.abs(trial).max() < base:
+                break
+            lam *= 0.5
+        x = x + lam * step
+        r = residual(x)
+    worst = float(np.abs(r).max(initial=0.0))
+    if not worst <= tol * scale:
+        k = int(np.nanargmax(np.abs(r)))
+        raise SolverError(f"steady_motion: model '{model.name}': no steady motion found near the guess in {it} "
+                          f"iterations: residual {worst:.3g} on {labels[k]}; free: "
+                          f"{', '.join([coords[i] for i in free_q] + [coords[i] + chr(39) for i in free_u]) or 'nothing'} "
+                          "(free more speeds or coordinates, or start closer)")
+    qq, uu = state(x)
+    return SteadyMotion(qq, uu, float(t), worst, it, [coords[i] for i in unk_q] + [coords[i] + "'" for i in unk_u])
+
+
+def _dependent(g: np.ndarray, allowed: list[int]) -> list[int]:
+    """Columns of ``g`` among ``allowed`` that the rows determine (pivoted QR)."""
+    if g.shape[0] == 0 or not allowed:
+        return []
+    from scipy.linalg import qr
+
+    sub = g[:, allowed]
+    _, r, piv = qr(sub, pivoting=True, mode="economic")
+    d = np.abs(np.diag(r))
+    rank = int(np.sum(d > 1e-10 * max(d.max(initial=0.0), 1e-300)))
+    return [allowed[i] for i in piv[:rank]]
+
+
+# ---- the self-check ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Check:
+    """Eigenvalues of a linearization set beside growth rates and frequencies fitted to
+    small-perturbation runs of the nonlinear model (:func:`check`)."""
+
+    #: the eigenvalues checked (1/s)
+    eigenvalues: np.ndarray
+    #: fitted from the nonlinear runs (1/s)
+    fitted: np.ndarray
+    #: |fitted - eigenvalue| / |eigenvalue|
+    error: np.ndarray
+    #: duration of each run (s)
+    duration: np.ndarray
+
+    @property
+    def worst(self) -> float:
+        return float(self.error.max(initial=0.0))
+
+    def table(self) -> str:
+        rows = [f"{'mode':>4}  {'eigenvalue (1/s)':>28}  {'fitted from simulate (1/s)':>28}  {'rel. error':>10}"]
+        for k, (a, b, e) in enumerate(zip(self.eigenvalues, self.fitted, self.error)):
+            rows.append(f"{k + 1:>4}  {a.real:13.7g} {a.imag:+13.7g}j  {b.real:13.7g} {b.imag:+13.7g}j  {e:10.2e}")
+        return "\n".join(rows)
+
+
+def check(lin: LinearModel, modes=None, amplitude: float = 1e-6, cycles: float = 2.0, samples: int = 400,
+          rtol: float = 1e-12) -> Check:
+    """Checks a linearization against its nonlinear model: for each non-trivial eigenvalue (one
+    of each complex pair; ``modes`` picks indices into that list), a run of ``simulate`` from
+    the point perturbed along the eigenvector (largest coordinate or speed change ``amplitude``,
+    relative to the state's scale) beside an unperturbed run; the difference of the joint
+    velocities is fitted by linear prediction (order 2 for an oscillation, 1 for a real
+    eigenvalue) over ``cycles`` periods (or e-folding times), and the fitted growth rate and
+    frequency are set beside the eigenvalue. Agreement to about ``amplitude`` (the nonlinear
+    terms) says the linear model is the nonlinear model's."""
+    from .integrators import DOPRI5
+    from .simulate import simulate
+
+    sf = lin._state()
+    model = lin.model
+    if model is None:
+        raise SettingsError("check: this LinearModel has no model (built by hand)")
+    a, _, _ = sf.reduced()
+    lam, vec = np.linalg.eig(a)
+    big = float(np.abs(lam).max(initial=0.0))
+    nontrivial = [i for i in range(lam.size) if abs(lam[i]) > 1e-6 * max(big, 1e-300) and lam[i].imag >= -1e-12 * big]
+    nontrivial.sort(key=lambda i: (abs(lam[i]), lam[i].real))
+    if modes is not None:
+        try:
+            nontrivial = [nontrivial[int(k)] for k in np.atleast_1d(modes)]
+        except IndexError:
+            raise SettingsError(f"check: modes {modes!r} out of range 0..{len(nontrivial) - 1}") from None
+    t_ = sf._t()
+    core = model.engine()[0]
+    q0, u0 = np.asarray(lin.q, float), np.asarray(lin.u, float)
+    uscale = 1.0 + float(np.abs(u0).max(initial=0.0))
+    out = []
+    for i in nontrivial:
+        x = t_ @ (vec[:, i] if lam[i].imag > 0 else vec[:, i].real)
+        x = x.real if lam[i].imag == 0 else x
+        x = np.real(x) if np.iscomplexobj(x) else x
+        d = sf.Vh @ x[: sf.nq]
+        du = sf.P @ x[: sf.nq] + sf.V @ x[sf.nq:]
+        size = max(float(np.abs(d).max(initial=0.0)), float(np.abs(du).max(initial=0.0)) / uscale, 1e-300)
+        d, du = d * amplitude / size, du * amplitude / size
+        qp = np.asarray(core.integrate(q0, d, 1.0))
+        up = u0 + du
+        li = lam[i]
+        span = cycles * (2 * np.pi / abs(li.imag) if abs(li.imag) > 1e-9 * abs(li) else 1.0 / abs(li.real))
+        kw = dict(t_end=lin.t + span, t0=lin.t, output_dt=span / samples,
+                  integrator=DOPRI5(rtol=rtol, atol=rtol * 1e-2))
+        ref = simulate(model, q0=q0, u0=u0, **kw)
+        run = simulate(model, q0=qp, u0=up, **kw)
+        s = np.asarray(run["u"]) - np.asarray(ref["u"])
+        dt = float(np.diff(np.asarray(run["t"])).mean())
+        out.append((li, _fit_rate(s, dt, li.imag != 0), span))
+    ev = np.array([o[0] for o in out], dtype=complex)
+    fit = np.array([o[1] for o in out], dtype=complex)
+    err = np.abs(fit - ev) / np.maximum(np.abs(ev), 1e-300)
+    return Check(ev, fit, err, np.array([o[2] for o in out]))
+
+
+def _fit_rate(s: np.ndarray, dt: float, oscillating: bool) -> complex:
+    """Growth rate (and frequency) of a sampled multi-channel signal s (samples x channels) of
+    one real exponential or one damped oscillation, by least-squares linear prediction."""
+    if oscillating:
+        lhs = s[2:].reshape(-1)
+        m = np.column_stack([s[1:-1].reshape(-1), s[:-2].reshape(-1)])
+        a1, a2 = np.linalg.lstsq(m, lhs, rcond=None)[0]
+        z = np.roots([1.0, -a1, -a2]).astype(complex)
+        z = z[np.argmax(z.imag)]
+    else:
+        a1 = np.linalg.lstsq(s[:-1].reshape(-1, 1), s[1:].reshape(-1), rcond=None)[0][0]
+        z = complex(a1)
+    return complex(np.log(z) / dt)
 
 
 # ---- the linearization point ---------------------------------------------------------------------
@@ -472,6 +1093,10 @@ def _vector(model: Model, values, which: str, what: str) -> np.ndarray:
 
 def _point(model: Model, q, u, t: float, at) -> tuple[np.ndarray, np.ndarray]:
     """(q, u) of the linearization point from linearize's ``q``, ``u`` and ``at``."""
+    if isinstance(at, SteadyMotion):
+        if q is not None or u is not None:
+            raise SettingsError("linearize: give the point by at= or by q=/u=, not both")
+        return _vector(model, at.q, "q", "at.q"), _vector(model, at.u, "u", "at.u")
     if at is None or (isinstance(at, str) and at == "q0"):
         return _vector(model, q, "q", "q"), _vector(model, u, "u", "u")
     if isinstance(at, str):
@@ -876,5 +1501,5 @@ def bode(lin: LinearModel, frequencies, input=0, output=0, out=None, title: str 
     return _save(fig, out)
 
 
-__all__ = ["linearize", "LinearModel", "Modes", "Campbell", "Hysteresis", "hysteresis", "bode",
+__all__ = ["linearize", "LinearModel", "StateForm", "SteadyMotion", "steady_motion", "Check", "check", "Modes", "Campbell", "Hysteresis", "hysteresis", "bode",
            "rayleigh_coefficients", "sdof_frequencies", "sdof_response"]

@@ -159,6 +159,62 @@ fn linearize<'py>(
     Ok(d)
 }
 
+/// The state form `x' = A x + B tau` about a (moving) state (see `mechsys_core::linear::motion`):
+/// `A`, `B`, the bases `Vh`, `P`, `V` and left inverses `Lh`, `Lu`, the reference's rates, the
+/// invariance defect and the velocity-constraint violation. `prefer`: None for orthonormal bases,
+/// else a partition into joint coordinates keeping these velocity indices independent.
+#[pyfunction]
+#[pyo3(signature = (model, q, u, t = 0.0, callbacks = None, method = "auto", prefer = None))]
+#[allow(clippy::too_many_arguments)]
+fn state_space<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: PyReadonlyArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+    method: &str,
+    prefer: Option<Vec<usize>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechsys_core::linear::{Basis, Derivatives};
+    let how = Derivatives::from_name(method).ok_or_else(|| {
+        let allowed = Derivatives::NAMES.map(|n| format!("'{n}'")).join(", ");
+        settings(format!("linearize: method must be one of {allowed}, got '{method}'"))
+    })?;
+    let m = &model.model;
+    let q = q_checked(model, &q)?;
+    let u = check_len(&u, m.nu, "u")?;
+    if let Some(k) = prefer.as_ref().and_then(|p| p.iter().find(|&&k| k >= m.nu)) {
+        return Err(settings(format!("linearize: coordinate index {k} out of range 0..{}", m.nu)));
+    }
+    let basis = prefer.map_or(Basis::Orthonormal, Basis::Partition);
+    let cb = self::callbacks(model, callbacks)?;
+    let s = mechsys_core::linear::state_space(m, t, q, u, &cb, how, &basis).map_err(PyMechsysError::from)?;
+    let d = PyDict::new(py);
+    let (n1, n2, nu) = (s.nq, s.nu, m.nu);
+    let nx = n1 + n2;
+    for (key, v, r, c) in [
+        ("A", &s.a, nx, nx),
+        ("B", &s.b, nx, nu),
+        ("Vh", &s.vh, nu, n1),
+        ("P", &s.p, nu, n1),
+        ("V", &s.v, nu, n2),
+        ("Lh", &s.lh, n1, nu),
+        ("Lu", &s.lu, n2, nu),
+    ] {
+        d.set_item(key, PyArray1::from_slice(py, v).reshape([r, c])?)?;
+    }
+    d.set_item("rate", PyArray1::from_slice(py, &s.rate))?;
+    d.set_item("mass", PyArray1::from_slice(py, &s.mass).reshape([nu, nu])?)?;
+    d.set_item("independent_q", s.independent_q.clone())?;
+    d.set_item("independent_u", s.independent_u.clone())?;
+    d.set_item("defect", s.defect)?;
+    d.set_item("phi", PyArray1::from_slice(py, &s.phi))?;
+    d.set_item("velocity_residual", PyArray1::from_slice(py, &s.velocity_residual))?;
+    d.set_item("method", s.method.as_str())?;
+    Ok(d)
+}
+
 /// Energies and momenta at (q, u, t): kinetic and potential energy (total and per body), linear
 /// momentum and moment of momentum about `point` (total and per body).
 #[pyfunction]
@@ -243,6 +299,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
     m.add_function(wrap_pyfunction!(linearize, m)?)?;
+    m.add_function(wrap_pyfunction!(state_space, m)?)?;
     register_reactions(m)?;
     register_constraints(m)?;
     register_constraint_gamma(m)?;

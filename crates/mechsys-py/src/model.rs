@@ -192,6 +192,7 @@ impl PyModel {
             d.set_item("type", t)?;
             d.set_item("row", c.row)?;
             d.set_item("rows", c.kind.rows())?;
+            d.set_item("holonomic_rows", c.kind.holonomic_rows())?;
             d.set_item("unit", unit)?;
             d.set_item("violation_unit", vunit)?;
             out.push(d);

@@ -38,6 +38,9 @@
 mod ad;
 mod differences;
 mod geometric;
+mod motion;
+
+pub use motion::{state_space, Basis, StateSpace};
 
 use nalgebra::{DMatrix, DVector};
 
@@ -134,26 +137,8 @@ pub fn linearize_with(
     cb: &dyn Callbacks,
     how: Derivatives,
 ) -> Result<Linearization> {
-    let (nq, nu, nc) = (model.nq, model.nu, model.nc);
-    crate::ensure!(q.len() == nq, Settings, "linearize: q has {} entries, the model {nq}", q.len());
-    crate::ensure!(u.len() == nu, Settings, "linearize: u has {} entries, the model {nu}", u.len());
-    model.check_q(q, "q")?;
-    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Settings(format!("linearize: u[{i}] is not finite ({})", u[i])));
-    }
-    let exact = match how {
-        Derivatives::CentralDifferences => false,
-        Derivatives::Auto => ad::unsupported(model).is_none(),
-        Derivatives::Exact => {
-            if let Some(name) = ad::unsupported(model) {
-                return Err(Error::Settings(format!(
-                    "linearize: exact derivatives do not cover force element '{name}' (a callback force); \
-                     use method \"auto\" or \"fd\" (central differences)"
-                )));
-            }
-            true
-        }
-    };
+    let (nu, nc) = (model.nu, model.nc);
+    let exact = check_point(model, q, u, how, "linearize")?;
     let (mut data, mut ws) = (Data::new(model), crate::dynamics::Workspace::new(model));
     // the basis of the allowed directions
     let v = if nc > 0 {
@@ -216,6 +201,30 @@ pub fn linearize_with(
         return Err(Error::Solver(format!("linearize: a matrix entry is not finite ({x})")));
     }
     Ok(lin)
+}
+
+/// Checks the point's sizes and values; returns whether the derivatives are to be exact.
+fn check_point(model: &Model, q: &[f64], u: &[f64], how: Derivatives, what: &str) -> Result<bool> {
+    let (nq, nu) = (model.nq, model.nu);
+    crate::ensure!(q.len() == nq, Settings, "{what}: q has {} entries, the model {nq}", q.len());
+    crate::ensure!(u.len() == nu, Settings, "{what}: u has {} entries, the model {nu}", u.len());
+    model.check_q(q, "q")?;
+    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Settings(format!("{what}: u[{i}] is not finite ({})", u[i])));
+    }
+    Ok(match how {
+        Derivatives::CentralDifferences => false,
+        Derivatives::Auto => ad::unsupported(model).is_none(),
+        Derivatives::Exact => {
+            if let Some(name) = ad::unsupported(model) {
+                return Err(Error::Settings(format!(
+                    "{what}: exact derivatives do not cover force element '{name}' (a callback force); \
+                     use method \"auto\" or \"fd\" (central differences)"
+                )));
+            }
+            true
+        }
+    })
 }
 
 /// An orthonormal basis of the null space of the `nc × nu` matrix `g` (columns), by SVD; rows
