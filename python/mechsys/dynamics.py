@@ -65,8 +65,9 @@ def contact_matrices(model: Model, q, u=None, t: float = 0.0) -> dict:
     normal, t1, t2; g' = w u), the Delassus matrix ``delassus`` (3 points square, W^T M~^-1 W with
     the bilateral constraints' reactions: relative acceleration per unit contact force, the matrix
     of the transition and impact problems), ``wbar`` (points x 3, the velocity-product terms) and
-    ``free_acceleration`` (points x 3, the relative accelerations without contact forces). Points
-    are ordered as the contacts and their candidates; ``u`` defaults to zero."""
+    ``free_acceleration`` (points x 3, the relative accelerations without contact forces), and
+    ``contact`` (the contact's name per point). Points are ordered as the contacts and their
+    candidates; ``u`` defaults to zero."""
     core, callbacks = model.engine()
     u = np.zeros(model.nu) if u is None else u
     return _core.contact_matrices(core, _arr(q), _arr(u), t, callbacks)

@@ -623,9 +623,38 @@ def _check_constraints(model: Model, raw: dict, q: np.ndarray, u: np.ndarray) ->
 
 
 def _refuse_nonsmooth(model: Model, q: np.ndarray, u: np.ndarray, t: float) -> None:
-    """Refuses a point where a force law is not smooth: reserved for contacts and sticking
-    friction elements (filled in below)."""
-    return None
+    """SettingsError where a force law is not smooth at the point, so no linear form exists:
+    a unilateral contact touching there (its force may jump on or off with any perturbation),
+    or a Jenkins slider at its slip limit (stick on one side, slip on the other). Open contacts
+    exert nothing and are left out; a Jenkins element well inside stick is its spring."""
+    from .forces import Jenkins
+
+    if model._contacts:
+        from .dynamics import contact_matrices
+
+        cm = contact_matrices(model, q, u, t)
+        scale = 1e-9 * (1.0 + float(np.abs(q).max(initial=0.0)))
+        for k, g in enumerate(cm["gap"]):
+            if g <= scale:
+                raise SettingsError(
+                    f"linearize: contact '{cm['contact'][k]}' is closed at the point (gap {g:.3g} m): a unilateral "
+                    "contact switches between touching and open (and stick and slip) under any perturbation, so the "
+                    "linear form does not apply there; linearize where it is open, replace it by a bilateral "
+                    "constraint, or simulate")
+    joints = {j["name"]: j for j in model.joint_info()}
+    for f in model._forces:
+        if isinstance(f, Jenkins):
+            j = joints.get(f.joint if isinstance(f.joint, str) else getattr(f.joint, "name", ""))
+            if j is None:
+                continue
+            x = float(q[j["iq"] + int(f.index)]) - float(f.offset)
+            slip = float(np.min(np.atleast_1d(f.slip)))
+            if abs(f.k * x) >= slip * (1.0 - 1e-9):
+                raise SettingsError(
+                    f"linearize: force element '{f.name}' (Jenkins) is at its slip limit at the point (spring force "
+                    f"{abs(f.k * x):.4g} >= slip force {slip:.4g}): its law sticks one way and slips the other, so the "
+                    "linear form does not apply; linearize inside stick, or use ms.linear.hysteresis for an "
+                    "equivalent linear element")
 
 
 # ---- the first-order form about a motion ---------------------------------------------------------
@@ -896,7 +925,7 @@ def steady_motion(model: Model, q=None, u=None, t: float = 0.0, free=(), fixed=N
         rate = str(name).endswith("'")
         k = _coordinate(coords, str(name)[:-1] if rate else name, "steady_motion: free")
         (free_u if rate else free_q).append(k)
-    nc = model.nc
+    nc = int(sum(c["rows"] for c in core.constraints()))
     cons = core.constraints()
     hol = np.zeros(nc, dtype=bool)
     for c in cons:
@@ -1009,7 +1038,8 @@ def check(lin: LinearModel, modes=None, amplitude: float = 1e-6, cycles: float =
     the point perturbed along the eigenvector (largest coordinate or speed change ``amplitude``,
     relative to the state's scale) beside an unperturbed run; the difference of the joint
     velocities is fitted by linear prediction (order 2 for an oscillation, 1 for a real
-    eigenvalue) over ``cycles`` periods (or e-folding times), and the fitted growth rate and
+    eigenvalue) over ``cycles`` periods (a quarter as many e-folding times for a real
+    eigenvalue), and the fitted growth rate and
     frequency are set beside the eigenvalue. Agreement to about ``amplitude`` (the nonlinear
     terms) says the linear model is the nonlinear model's."""
     from .integrators import DOPRI5
@@ -1045,7 +1075,9 @@ def check(lin: LinearModel, modes=None, amplitude: float = 1e-6, cycles: float =
         qp = np.asarray(core.integrate(q0, d, 1.0))
         up = u0 + du
         li = lam[i]
-        span = cycles * (2 * np.pi / abs(li.imag) if abs(li.imag) > 1e-9 * abs(li) else 1.0 / abs(li.real))
+        # oscillations over `cycles` periods; a real eigenvalue over a quarter of that many
+        # e-folding times (long runs of slow modes collect the nonlinear drift of the cyclic states)
+        span = cycles * (2 * np.pi / abs(li.imag) if abs(li.imag) > 1e-9 * abs(li) else 0.25 / abs(li.real))
         kw = dict(t_end=lin.t + span, t0=lin.t, output_dt=span / samples,
                   integrator=DOPRI5(rtol=rtol, atol=rtol * 1e-2))
         ref = simulate(model, q0=q0, u0=u0, **kw)
@@ -1310,6 +1342,124 @@ def _campbell(speeds, per_speed: list[dict], pair, track: str, joint: str, resid
                     whirl.astype(str), joint, residual)
 
 
+# ---- eigenvalues over a parameter ----------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Eigenvalues of a model linearized at each value of a parameter (a speed, a load), each
+    column one eigenvalue followed across the values (both of each complex pair, so a pair that
+    splits into two real ones stays two continuous columns)."""
+
+    values: np.ndarray
+    #: eigenvalues (n_values x n_modes), 1/s
+    eigenvalues: np.ndarray
+    #: the parameter's name (for plots)
+    parameter: str = "parameter"
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Whether every eigenvalue has Re <= 0 (to round-off) at each value."""
+        lam = self.eigenvalues
+        scale = 1.0 + np.nanmax(np.abs(lam), axis=1)
+        return np.all(np.nan_to_num(lam.real, nan=-1.0) <= 1e-9 * scale[:, None], axis=1)
+
+    def stable_ranges(self) -> list[tuple[float, float]]:
+        """The intervals of values with a stable linearization, their ends interpolated where a
+        real part crosses zero."""
+        out, start = [], None
+        st = self.stable
+        for k, s in enumerate(st):
+            if s and start is None:
+                start = self.values[0] if k == 0 else self._crossing(k - 1)
+            if not s and start is not None:
+                out.append((float(start), float(self._crossing(k - 1))))
+                start = None
+        if start is not None:
+            out.append((float(start), float(self.values[-1])))
+        return out
+
+    def _crossing(self, k: int) -> float:
+        """Where the largest real part crosses zero between values k and k + 1."""
+        a = np.nanmax(self.eigenvalues[k].real)
+        b = np.nanmax(self.eigenvalues[k + 1].real)
+        if a == b or a * b > 0:
+            return float(0.5 * (self.values[k] + self.values[k + 1]))
+        return float(self.values[k] + a / (a - b) * (self.values[k + 1] - self.values[k]))
+
+    def plot(self, out=None, title: str | None = None, imaginary: bool = True):
+        """Real parts (solid) and, with ``imaginary``, imaginary parts (dashed, the oscillation's
+        angular frequency) against the parameter, the stable ranges shaded. Saved to ``out`` if
+        given; returns the Figure."""
+        fig = _figure(out, (7.5, 5.0))
+        ax = fig.subplots()
+        for a, b in self.stable_ranges():
+            ax.axvspan(a, b, color="C2", alpha=0.12, lw=0)
+        for c in range(self.eigenvalues.shape[1]):
+            lam = self.eigenvalues[:, c]
+            ax.plot(self.values, lam.real, "-", color=f"C{c % 10}", lw=1.6)
+            if imaginary and np.nanmax(lam.imag, initial=0.0) > 0:
+                ax.plot(self.values, np.where(lam.imag > 0, lam.imag, np.nan), "--", color=f"C{c % 10}", lw=1.0)
+        ax.axhline(0.0, color="k", lw=0.8)
+        from matplotlib.lines import Line2D
+        from matplotlib.patches import Patch
+
+        handles = [Line2D([], [], color="k", ls="-", label="Re(lambda)"), Patch(color="C2", alpha=0.25, label="stable")]
+        if imaginary:
+            handles.insert(1, Line2D([], [], color="k", ls="--", label="Im(lambda) > 0"))
+        ax.legend(handles=handles, fontsize="small", loc="best", framealpha=0.8)
+        ax.set_xlabel(self.parameter)
+        ax.set_ylabel("eigenvalue [1/s]")
+        ax.grid(True, alpha=0.3)
+        ax.set_title(title or f"eigenvalues against {self.parameter}")
+        return _save(fig, out)
+
+
+def sweep(model, values, speed: str | None = None, free=(), coordinates=None, method: str = "auto",
+          parameter: str | None = None, rigid_tol: float = 1e-9) -> Sweep:
+    """Eigenvalues of the linearization at each of ``values``, followed from value to value.
+
+    ``model`` is a :class:`mechsys.Model` whose speed ``speed`` (a joint velocity name with a
+    prime, ``"rear_hub'"``, or a coordinate name) is set to each value, the steady motion then
+    found by :func:`steady_motion` (``free`` as there; the speeds the constraints determine
+    follow), or a function ``value -> Model`` built at its point. Eigenvalues with |lambda| below
+    ``rigid_tol`` times the largest at every value (cyclic and conserved directions) are left out.
+    ``Sweep.plot()`` draws them with the stable ranges shaded."""
+    vals = np.atleast_1d(np.asarray(values, dtype=float)).reshape(-1)
+    if vals.size == 0 or not np.all(np.isfinite(vals)):
+        raise SettingsError("sweep: values must be finite numbers")
+    per = []
+    for v in vals:
+        if callable(model) and not isinstance(model, Model):
+            m = model(float(v))
+            if not isinstance(m, Model):
+                raise SettingsError(f"sweep: the builder returned {type(m).__name__} for {v:g}, expected a mechsys.Model")
+            lin = linearize(m, operating_point=True, method=method, coordinates=coordinates)
+        elif isinstance(model, Model):
+            if speed is None:
+                raise SettingsError("sweep: name the swept speed or coordinate (speed=\"joint'\"), or pass a builder")
+            st = steady_motion(model, free=free, fixed={speed: float(v)})
+            lin = linearize(model, at=st, operating_point=True, method=method, coordinates=coordinates)
+        else:
+            raise SettingsError(f"sweep: expected a mechsys.Model or a function value -> Model, got {type(model).__name__}")
+        per.append(np.linalg.eigvals(lin.state_matrix()))
+    big = max((float(np.abs(p).max(initial=0.0)) for p in per), default=0.0)
+    per = [p[np.abs(p) > rigid_tol * big] for p in per]
+    n = max((p.size for p in per), default=0)
+    lam = np.full((vals.size, n), np.nan + 0j)
+    from scipy.optimize import linear_sum_assignment
+
+    for k, p in enumerate(per):
+        if k == 0 or not np.any(np.isfinite(lam[k - 1])):
+            lam[k, : p.size] = p
+            continue
+        prev = lam[k - 1]
+        cost = np.abs(p[:, None] - np.where(np.isfinite(prev), prev, 1e300)[None, :])
+        rows, cols = linear_sum_assignment(np.minimum(cost, 1e300))
+        lam[k, cols] = p[rows]
+    return Sweep(vals, lam, parameter or (speed or "parameter"))
+
+
 # ---- hysteresis (section 2.6.3) ------------------------------------------------------------------
 
 
@@ -1501,5 +1651,5 @@ def bode(lin: LinearModel, frequencies, input=0, output=0, out=None, title: str 
     return _save(fig, out)
 
 
-__all__ = ["linearize", "LinearModel", "StateForm", "SteadyMotion", "steady_motion", "Check", "check", "Modes", "Campbell", "Hysteresis", "hysteresis", "bode",
+__all__ = ["linearize", "LinearModel", "StateForm", "SteadyMotion", "steady_motion", "Check", "check", "Sweep", "sweep", "Modes", "Campbell", "Hysteresis", "hysteresis", "bode",
            "rayleigh_coefficients", "sdof_frequencies", "sdof_response"]

@@ -449,6 +449,8 @@ fn contact_matrices<'py>(
     let shaped = |v: Vec<f64>, shape: &[usize]| -> PyResult<Bound<'py, PyAny>> {
         Ok(PyArray1::from_vec(py, v).reshape(shape.to_vec())?.into_any())
     };
+    let names: Vec<String> = (0..np).map(|pt| m.contact_of_point(pt).name.clone()).collect();
+    d.set_item("contact", names)?;
     d.set_item("gap", shaped(c.gap, &[np])?)?;
     d.set_item("velocity", shaped(c.velocity, &[np, 3])?)?;
     d.set_item("w", shaped(c.w, &[np, 3, m.nu])?)?;
