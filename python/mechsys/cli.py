@@ -388,8 +388,18 @@ def _frequency_grid(modes: Any, fmin: float | None, fmax: float | None, n: int) 
 
 @cli.command()
 @click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
-@click.option("--at", "at", type=click.Choice(["q0", "equilibrium"]), default="q0", show_default=True,
-              help="Linearize at the model's q0/u0 or at the static equilibrium (found from q0, at rest).")
+@click.option("--at", "at", type=click.Choice(["q0", "equilibrium", "steady"]), default="q0", show_default=True,
+              help="Linearize at the model's q0/u0, at the static equilibrium (found from q0, at rest) or at the steady "
+              "motion found from q0/u0 (see --free).")
+@click.option("--free", "free", metavar="NAMES", help="With --at steady: coordinates and speeds (with a prime, spin') the "
+              "steady-motion solver may change, comma-separated.")
+@click.option("--coordinates", "coordinates", metavar="NAMES",
+              help="Joint coordinates of the second-order form (e.g. lean,steer for a non-holonomic model), comma-separated.")
+@click.option("--check", "check", is_flag=True, help="Check the eigenvalues against small-perturbation runs of the "
+              "nonlinear model (exit status 1 when one disagrees by more than 1e-3 relative).")
+@click.option("--sweep", "sweep", metavar="SPEED:START:STOP:N",
+              help="Eigenvalues at N values START..STOP of a speed (a joint velocity with a prime, e.g. rear_hub') at the "
+              "steady motion; plots them with the stable ranges shaded.")
 @click.option("--out-dir", type=click.Path(path_type=Path, file_okay=False), default=Path("results"), show_default=True,
               help="Folder for the plots.")
 @click.option("--frf", "frf", metavar="IN:OUT", help="Bode plot from a generalized force on coordinate IN to coordinate OUT "
@@ -401,18 +411,31 @@ def _frequency_grid(modes: Any, fmin: float | None, fmax: float | None, n: int) 
               help="Campbell diagram: re-linearize with the spin joint's velocity at N speeds START..STOP (rad/s).")
 @click.option("--whirl", metavar="X,Y", help="Coordinates of the whirl plane (x then y, right-handed with the spin axis) "
               "to tell forward from backward whirl.")
-def linear(model_file: Path, at: str, out_dir: Path, frf: str | None, fmin: float | None, fmax: float | None,
-           n_freq: int, campbell: str | None, whirl: str | None) -> None:
-    """Linear vibration analysis of a model file: modes, a Bode plot, a Campbell diagram."""
+def linear(model_file: Path, at: str, free: str | None, coordinates: str | None, check: bool, sweep: str | None,
+           out_dir: Path, frf: str | None, fmin: float | None, fmax: float | None, n_freq: int, campbell: str | None,
+           whirl: str | None) -> None:
+    """Linear vibration analysis of a model file about an equilibrium or a steady motion: modes,
+    a Bode plot, a Campbell diagram, eigenvalues over a speed, a check against the nonlinear model."""
     import warnings
 
     from . import linear as lin_mod
+    from .errors import SettingsError, SolverError
     from .modelfile import load_model
 
     model, _ = load_model(model_file)
+    names = [c.strip() for c in coordinates.split(",") if c.strip()] if coordinates else None
+    if free is not None and at != "steady":
+        raise CliError("--free: needs --at steady")
+    point_at: object = at
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        lin = lin_mod.linearize(model, at=at)
+        try:
+            if at == "steady":
+                point_at = lin_mod.steady_motion(model, free=[c.strip() for c in (free or "").split(",") if c.strip()])
+            lin = lin_mod.linearize(model, at=point_at, coordinates=names)
+        except (SettingsError, SolverError) as e:
+            option = "--coordinates" if "coordinates" in str(e) else "--free" if "steady_motion" in str(e) else "--at"
+            raise CliError(f"{option}: {e}") from None
     if lin.n == 0:
         raise CliError(f"{model_file}: the model has no degree of freedom to analyse")
     modes = lin.modes()
@@ -421,21 +444,49 @@ def linear(model_file: Path, at: str, out_dir: Path, frf: str | None, fmin: floa
     click.echo(f"model     {model.name} ({model_file}), {lin.n} coordinates: {', '.join(lin.names)}")
     click.echo(f"point     {'static equilibrium' if at == 'equilibrium' else 'q0, u0'}: {point or '-'}")
     click.echo(f"residual  {float(abs(lin.residual).max(initial=0.0)):.4g} (largest |V^T M u'| at the point)")
+    if bool(abs(lin.u).max(initial=0.0)):
+        click.echo(f"motion    {'steady' if lin.steady else 'NOT steady'}; cyclic: {', '.join(lin.cyclic) or '-'}; "
+                   f"first-order states: {', '.join(lin.states)}")
     for w in caught:
         click.echo(f"warning: {w.message}" + ("; try --at equilibrium" if at == "q0" else ""))
     click.echo("")
     click.echo(modes.table())
     click.echo("stable" if modes.stable else f"unstable: modes {', '.join(str(k + 1) for k in modes.unstable)}")
     click.echo("")
+    stem = _safe_name(model.name)
+    failed = False
+    if check:
+        c = lin_mod.check(lin)
+        click.echo("check against small-perturbation runs of the nonlinear model:")
+        click.echo(c.table())
+        failed = c.worst > 1e-3
+        click.echo(f"worst relative difference {c.worst:.2e}" + (" (beyond 1e-3)" if failed else ""))
+        click.echo("")
+    if sweep is not None:
+        speed, values = _sweep_option(sweep)
+        try:
+            sw = lin_mod.sweep(model, values, speed=speed, coordinates=names)
+        except (SettingsError, SolverError) as e:
+            raise CliError(f"--sweep: {e}") from None
+        sweep_path = out_dir / f"{stem}_sweep.png"
+        sw.plot(out=sweep_path, title=f"{model.name}: eigenvalues against {speed}")
+        ranges = ", ".join(f"{a:.6g} .. {b:.6g}" for a, b in sw.stable_ranges()) or "none"
+        click.echo(f"sweep     {speed} at {values.size} values {values[0]:g} .. {values[-1]:g}: stable {ranges}: {sweep_path}")
+    if lin.M is None:
+        click.echo(f"no second-order form ({lin.state.why_first_order}): no Bode plot; name coordinates with --coordinates")
+        if failed:
+            raise SystemExit(1)
+        return
     i, o = (0, 0) if frf is None else (_coordinate(lin, s, "--frf") for s in _pair(frf, "--frf", 2, "IN:OUT"))
     freqs = _frequency_grid(modes, fmin, fmax, n_freq)
-    stem = _safe_name(model.name)
     bode_path = out_dir / f"{stem}_bode.png"
     lin_mod.bode(lin, freqs, input=i, output=o, out=bode_path, title=f"{model.name}: {lin.names[i]} -> {lin.names[o]}")
     click.echo(f"bode      {lin.names[i]} -> {lin.names[o]}, {freqs.size} frequencies {freqs[0]:.4g} .. {freqs[-1]:.4g} Hz: {bode_path}")
     if campbell is None:
         if whirl is not None:
             raise CliError("--whirl: needs --campbell")
+        if failed:
+            raise SystemExit(1)
         return
     joint, speeds = _campbell_option(campbell)
     from .errors import SettingsError
@@ -452,6 +503,24 @@ def linear(model_file: Path, at: str, out_dir: Path, frf: str | None, fmin: floa
     for cs in diagram.critical_speeds():
         kind = f", {cs['whirl']} whirl" if cs["whirl"] else ""
         click.echo(f"critical  {cs['speed']:.6g} rad/s ({cs['speed'] * 30 / 3.141592653589793:.6g} rpm): mode {cs['mode'] + 1}{kind}")
+    if failed:
+        raise SystemExit(1)
+
+
+def _sweep_option(text: str):
+    """(speed, values) from SPEED:START:STOP:N."""
+    import numpy as np
+
+    parts = text.rsplit(":", 3)
+    if len(parts) != 4:
+        raise CliError(f"--sweep: expected SPEED:START:STOP:N, got {text!r}")
+    try:
+        lo, hi, n = float(parts[1]), float(parts[2]), int(parts[3])
+    except ValueError:
+        raise CliError(f"--sweep: START, STOP must be numbers and N an integer, got {text!r}") from None
+    if n < 2 or not (np.isfinite(lo) and np.isfinite(hi)) or lo == hi:
+        raise CliError(f"--sweep: need N >= 2 and finite START != STOP, got {text!r}")
+    return parts[0], np.linspace(lo, hi, n)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
