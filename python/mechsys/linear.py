@@ -600,7 +600,7 @@ def _steadiness(sf: StateForm, u: np.ndarray) -> tuple[bool, str]:
     if acc.size and np.abs(acc).max() > 1e-8 * scale_a:
         k = int(np.abs(acc).argmax())
         return False, f"the velocity '{sf.names[sf.nq + k]}' changes at {acc[k]:.3g} per second (residual)"
-    if sf.defect > 1e-6:
+    if sf.defect > 1e-4:
         return False, f"the admissible motions are not invariant (defect {sf.defect:.2g})"
     return True, ""
 
