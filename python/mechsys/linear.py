@@ -781,26 +781,24 @@ def _state_form(model: Model, q, u, t: float, method: str, prefer) -> tuple[Stat
     scale = max(float(np.abs(a).max(initial=0.0)), 1e-300)
     tol = (1e-7 if raw["method"] == "fd" else 1e-9) * scale
     axi = a[:, :nq]
-    if nq:
+    # coordinates nothing else depends on (heading on the plane feeds only the position, itself
+    # cyclic): the largest set C of configuration states with A[rows outside C, C] = 0
+    inside = np.ones(nq, dtype=bool)
+    while nq:
+        outside = np.concatenate([~inside, np.ones(nu, dtype=bool)])
+        bad = inside & (np.abs(a[outside, :nq]).max(axis=0, initial=0.0) > tol)
+        if not bad.any():
+            break
+        inside &= ~bad
+    unit = [int(i) for i in np.nonzero(inside)[0]]
+    cyclic = []
+    null = np.zeros((nq, 0))
+    if not unit and nq:
+        # no single coordinate: look for combinations the columns of A do not see
         _, sv, vt = np.linalg.svd(axi)
         sv = np.concatenate([sv, np.zeros(nq - sv.size)])
         null = vt[sv <= tol].T
-    else:
-        null = np.zeros((0, 0))
     k = null.shape[1]
-    # coordinates nothing else depends on (heading on the plane feeds only the position, itself
-    # cyclic): the largest set C of configuration states with A[rows outside C, C] = 0
-    unit = set(range(nq))
-    changed = True
-    while changed:
-        changed = False
-        for i in sorted(unit):
-            rows = [r for r in range(nq + nu) if r not in unit]
-            if rows and np.abs(a[rows, i]).max() > tol:
-                unit.discard(i)
-                changed = True
-    unit = sorted(unit)
-    cyclic = []
     if unit:
         cyclic = [names[i] for i in unit]
         rest = [i for i in range(nq) if i not in unit]
@@ -839,11 +837,19 @@ def _second_order_form(a: np.ndarray, n_cfg: int, cfg_names: list, v: np.ndarray
     y = np.zeros((2 * m, n_cfg + nu))
     y[np.arange(m), sel] = 1.0
     y[m:] = a[sel]
-    if np.linalg.matrix_rank(y, tol=1e-9 * max(float(np.abs(y).max()), 1.0)) < 2 * m:
-        return "the coordinates' rates are not independent velocities"
-    az = y @ a @ np.linalg.pinv(y)
+    if y.shape[0] == y.shape[1]:
+        # every state named (holonomic, cyclic ones kept): a change of coordinates
+        try:
+            az = np.linalg.solve(y.T, (y @ a).T).T
+        except np.linalg.LinAlgError:
+            return "the coordinates' rates are not independent velocities"
+    else:
+        if np.linalg.matrix_rank(y, tol=1e-9 * max(float(np.abs(y).max()), 1.0)) < 2 * m:
+            return "the coordinates' rates are not independent velocities"
+        az = y @ a @ np.linalg.pinv(y)
     scale = max(float(np.abs(a).max(initial=0.0)), 1e-300)
-    if np.abs(y @ a - az @ y).max(initial=0.0) > 1e-7 * scale * max(1.0, float(np.abs(y).max())):
+    if y.shape[0] < y.shape[1] and \
+            np.abs(y @ a - az @ y).max(initial=0.0) > 1e-7 * scale * max(1.0, float(np.abs(y).max())):
         names = [cfg_names[i] for i in sel]
         return (f"the other states feed back into {', '.join(names)} (velocities without a configuration partner, "
                 "as a rolling wheel's heading rate): no second-order form in these coordinates")
