@@ -128,3 +128,39 @@ def test_bad_at_and_missing_file(runner, tmp_path):
     assert result.exit_code == 2 and "--at" in result.stderr
     result = runner.invoke(cli, ["linear", str(tmp_path / "nope.toml")])
     assert result.exit_code == 2 and "nope.toml" in result.stderr
+
+
+BICYCLE = EXAMPLES / "bicycle.py"
+
+
+def test_linear_about_a_motion_on_the_command_line(runner, tmp_path):
+    # the benchmark bicycle at 5 m/s: its published eigenvalues, the self-check and a speed sweep
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import bicycle_reference as bref
+
+    r = runner.invoke(cli, ["linear", str(BICYCLE), "--coordinates", "free[3],steer", "--check",
+                            "--sweep", "rear_hub':-12:-22:11", "--out-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "motion    steady; cyclic: free[0], free[1], free[5], rear_hub, front_hub" in r.output
+    rows = re.findall(r"^\s+\d+\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s*$", r.output.split("check against")[0], flags=re.M)
+    re_parts = np.sort(np.array([float(x[3]) for x in rows]))
+    want = np.sort(np.unique(np.round(bref.eigenvalues(5.0).real, 9)))
+    np.testing.assert_allclose(re_parts, want, rtol=1e-5)
+    worst = float(re.search(r"worst relative difference (\S+)", r.output).group(1))
+    assert worst < 1e-4
+    # rear wheel -12 .. -22 rad/s is 3.6 .. 6.6 m/s: one stable range, between the weave and capsize speeds
+    lo, hi = map(float, re.search(r"stable (\S+) \.\. (\S+):", r.output).groups())
+    v1, v2 = sorted((-0.3 * lo, -0.3 * hi))
+    assert v1 == pytest.approx(bref.weave_speed(), abs=0.02) and v2 == pytest.approx(bref.capsize_speed(), abs=0.02)
+    assert (tmp_path / "bicycle_sweep.png").stat().st_size > 10_000
+
+
+def test_linear_about_a_motion_bad_options(runner, tmp_path):
+    r = runner.invoke(cli, ["linear", str(BICYCLE), "--coordinates", "free[0]", "--out-dir", str(tmp_path)])
+    assert r.exit_code != 0 and "--coordinates" in r.output and "'free[0]' is cyclic" in r.output
+    r = runner.invoke(cli, ["linear", str(BICYCLE), "--free", "steer", "--out-dir", str(tmp_path)])
+    assert r.exit_code != 0 and "--free: needs --at steady" in r.output
+    r = runner.invoke(cli, ["linear", str(BICYCLE), "--sweep", "rear_hub':0:1", "--out-dir", str(tmp_path)])
+    assert r.exit_code != 0 and "--sweep: expected SPEED:START:STOP:N" in r.output
