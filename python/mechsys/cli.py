@@ -66,7 +66,8 @@ def cli() -> None:
     """mechsys: mechanical system dynamics from the command line.
 
     Model files are TOML (the model description plus an optional [simulation] table) or Python
-    (a module-level `model` and an optional `simulation` dict).
+    (a module-level `model` and an optional `simulation` dict). A .py model file is executed as
+    Python code by run, info and linear: run only files you trust.
     """
 
 
@@ -168,7 +169,9 @@ def run(
     csv_out: Path | None,
     quiet: bool,
 ) -> None:
-    """Simulate a model file (.toml or .py) and save the results to HDF5."""
+    """Simulate a model file (.toml or .py) and save the results to HDF5.
+
+    A .py model file is executed as Python code: run only files you trust."""
     from . import simulate
     from .errors import ResultsError
     from .modelfile import load_model, simulation_kwargs
@@ -253,7 +256,9 @@ def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, tit
 @cli.command()
 @click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
 def info(model_file: Path) -> None:
-    """Describe a model file: bodies, joints, force elements, degrees of freedom."""
+    """Describe a model file: bodies, joints, force elements, degrees of freedom.
+
+    A .py model file is executed as Python code: run only files you trust."""
     from .modelfile import load_model
 
     model, sim = load_model(model_file)
@@ -415,7 +420,9 @@ def linear(model_file: Path, at: str, free: str | None, coordinates: str | None,
            out_dir: Path, frf: str | None, fmin: float | None, fmax: float | None, n_freq: int, campbell: str | None,
            whirl: str | None) -> None:
     """Linear vibration analysis of a model file about an equilibrium or a steady motion: modes,
-    a Bode plot, a Campbell diagram, eigenvalues over a speed, a check against the nonlinear model."""
+    a Bode plot, a Campbell diagram, eigenvalues over a speed, a check against the nonlinear model.
+
+    A .py model file is executed as Python code: run only files you trust."""
     import warnings
 
     from . import linear as lin_mod
