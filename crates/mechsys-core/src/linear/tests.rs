@@ -508,3 +508,150 @@ fn callback_forces_make_auto_fall_back_and_exact_name_the_element() {
     assert_eq!(Derivatives::from_name("exact"), Some(Derivatives::Exact));
     assert_eq!(Derivatives::from_name("Exact"), None);
 }
+
+// ---- the state form about a motion (module `motion`) -------------------------------------------
+
+use super::{state_space, Basis, StateSpace};
+
+fn eigenvalues(s: &StateSpace) -> Vec<nalgebra::Complex<f64>> {
+    let n = s.nq + s.nu;
+    DMatrix::from_row_slice(n, n, &s.a).complex_eigenvalues().iter().copied().collect()
+}
+
+/// A sledge on a planar joint with a knife edge at distance `a` ahead of its centre of mass,
+/// sliding straight at speed `v`: the yaw rate obeys (I + m a²) ω̇ = m a v ω (the Chaplygin
+/// sleigh), one eigenvalue m a v / (I + m a²), the others zero.
+fn sleigh(a: f64, v: f64) -> Model {
+    model(&format!(
+        r#"{{"name": "sleigh", "gravity": [0, 0, 0],
+             "bodies": [{{"name": "sled", "mass": 2.0, "inertia": [0.2, 0.2, 0.3]}}],
+             "joints": [{{"name": "p", "type": "planar", "parent": "ground", "child": "sled", "u0": [{v}, 0, 0]}}],
+             "constraints": [{{"type": "knife_edge", "name": "blade", "body": "sled", "point": [{a}, 0, 0], "direction": [0, 1, 0]}}]}}"#
+    ))
+}
+
+#[test]
+fn chaplygin_sleigh_eigenvalue_and_its_sign() {
+    for (a, v) in [(0.3, 1.5), (-0.3, 1.5), (0.2, -2.0)] {
+        let m = sleigh(a, v);
+        let (q, u) = (m.q0(), m.u0());
+        let want = 2.0 * a * v / (0.3 + 2.0 * a * a);
+        for (how, tol) in [(Derivatives::Exact, 1e-10), (Derivatives::CentralDifferences, 1e-7)] {
+            for basis in [Basis::Orthonormal, Basis::Partition(vec![])] {
+                let s = state_space(&m, 0.0, &q, &u, &NoCallbacks, how, &basis).unwrap();
+                assert_eq!((s.nq, s.nu), (3, 2), "three configuration, two velocity states");
+                let lam = eigenvalues(&s);
+                let big = lam.iter().max_by(|x, y| x.norm().total_cmp(&y.norm())).unwrap();
+                assert!((big.re - want).abs() < tol * want.abs() && big.im.abs() < tol, "{how:?} {basis:?}: {big} vs {want}");
+                assert!(s.defect < 1e-9, "steady: defect {}", s.defect);
+            }
+        }
+    }
+}
+
+#[test]
+fn partition_basis_selects_joint_coordinates() {
+    let m = sleigh(0.3, 1.0);
+    let s = state_space(&m, 0.0, &m.q0(), &m.u0(), &NoCallbacks, Derivatives::Exact, &Basis::Partition(vec![2])).unwrap();
+    // all three coordinates are configuration states; the yaw rate (preferred) stays independent
+    assert_eq!(s.independent_q, vec![0, 1, 2]);
+    assert!(s.independent_u.contains(&2) && s.independent_u.len() == 2, "{:?}", s.independent_u);
+    // L_u V = I and G (P ξ + V η) = −J ξ: the lateral velocity follows the heading at speed v
+    let v = DMatrix::from_row_slice(3, 2, &s.v);
+    let lu = DMatrix::from_row_slice(2, 3, &s.lu);
+    assert!((&lu * &v - DMatrix::<f64>::identity(2, 2)).amax() < 1e-15);
+    let p = DMatrix::from_row_slice(3, 3, &s.p);
+    // turning the sled by δθ at speed 1 along x: the blade's lateral direction turns, so the
+    // admissible velocity gains v δθ sideways (world y), taken by the dependent velocity
+    // (G = [−sin θ, cos θ, a] on (ẋ, ẏ, θ̇) in the ground's axes, J = ∂(G u*)/∂θ = −v at θ = 0)
+    assert_eq!(s.independent_u, vec![0, 2]);
+    assert!((p[(1, 2)] - 1.0).abs() < 1e-10, "P = {p}");
+    assert!((0..3).all(|r| (0..3).all(|c| (r, c) == (1, 2) || p[(r, c)].abs() < 1e-12)), "P = {p}");
+}
+
+/// The chart's rate: along a motion with constant body velocities, the rotation-vector and
+/// position chart of a free joint about the reference obeys δ̇ = Ω(u*) δ + δu, by central
+/// differences of `Model::integrate` and the chart's inverse.
+#[test]
+fn chart_rate_of_the_free_joint_by_differences() {
+    use crate::math::{Mat3, Vec3};
+    let m = model(
+        r#"{"name": "f", "gravity": [0, 0, 0], "bodies": [{"name": "b", "mass": 1, "inertia": [1, 2, 3]}],
+            "joints": [{"name": "j", "type": "free", "parent": "ground", "child": "b"}]}"#,
+    );
+    let q0 = vec![0.3, -0.2, 0.5, 0.9, 0.1, -0.3, 0.2];
+    let mut qs = q0.clone();
+    m.normalize(&mut qs);
+    let us = vec![0.7, -0.4, 0.2, 1.1, -0.6, 0.8];
+    let d = [1e-5, -2e-5, 1.5e-5, 2e-5, 1e-5, -1e-5];
+    let du = [3e-5, 1e-5, -2e-5, -1e-5, 2e-5, 1e-5];
+    let quat = |q: &[f64]| nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[4], q[5], q[6]));
+    // the chart's inverse about the reference at time h: (Aᵀ (p − p*), log(q*⁻¹ q))
+    let chart = |h: f64| -> Vec<f64> {
+        let (mut qr, mut qp, mut q1) = (vec![0.0; 7], vec![0.0; 7], vec![0.0; 7]);
+        m.integrate(&qs, &us, h, &mut qr);
+        m.integrate(&qs, &d, 1.0, &mut q1);
+        let up: Vec<f64> = us.iter().zip(&du).map(|(a, b)| a + b).collect();
+        m.integrate(&q1, &up, h, &mut qp);
+        let a: Mat3 = quat(&qr).to_rotation_matrix().into_inner();
+        let dp = a.transpose() * (Vec3::new(qp[0], qp[1], qp[2]) - Vec3::new(qr[0], qr[1], qr[2]));
+        let rot = (quat(&qr).inverse() * quat(&qp)).scaled_axis();
+        vec![dp[0], dp[1], dp[2], rot[0], rot[1], rot[2]]
+    };
+    let h = 1e-4;
+    let (cp, cm) = (chart(h), chart(-h));
+    let rate: Vec<f64> = (0..6).map(|i| (cp[i] - cm[i]) / (2.0 * h)).collect();
+    let om = super::motion::chart_rate(&m, &us);
+    for i in 0..6 {
+        let want: f64 = (0..6).map(|k| om[(i, k)] * d[k]).sum::<f64>() + du[i];
+        // second order in δ (1e-10) and the differences (h² |δ| ~ 1e-13)
+        assert!((rate[i] - want).abs() < 2e-9, "component {i}: {} vs {want}", rate[i]);
+    }
+    // and the rotation term is there: without Ω the rate is off by |ω × δ| ~ 3e-5
+    assert!((0..3).any(|i| (rate[3 + i] - du[3 + i]).abs() > 1e-5));
+}
+
+/// A free joint held by a point constraint (a conical pendulum) and the same on a spherical
+/// joint linearize alike, exact and by differences; the exact and differenced state matrices agree.
+#[test]
+fn constrained_free_joint_matches_the_spherical_joint() {
+    let (alpha, l, g) = (0.5f64, 0.8f64, 9.81f64);
+    let omega = (g / (l * alpha.cos())).sqrt();
+    let (c, s) = ((alpha / 2.0).cos(), (alpha / 2.0).sin());
+    // body rotated by alpha about x; body-frame angular velocity Rᵀ Ω e_z
+    let w = [0.0, omega * alpha.sin(), omega * alpha.cos()];
+    let body = r#"{"name": "bob", "mass": 1.0, "inertia": [0.02, 0.02, 0.01], "com": [0, 0, -0.8]}"#;
+    let sph = model(&format!(
+        r#"{{"name": "s", "gravity": [0, 0, -9.81], "bodies": [{body}],
+             "joints": [{{"name": "j", "type": "spherical", "parent": "ground", "child": "bob", "q0": [{c}, {s}, 0, 0], "u0": [{}, {}, {}]}}]}}"#,
+        w[0], w[1], w[2]
+    ));
+    let free = model(&format!(
+        r#"{{"name": "f", "gravity": [0, 0, -9.81], "bodies": [{body}],
+             "joints": [{{"name": "j", "type": "free", "parent": "ground", "child": "bob", "q0": [0, 0, 0, {c}, {s}, 0, 0], "u0": [0, 0, 0, {}, {}, {}]}}],
+             "constraints": [{{"type": "point", "name": "pin", "body1": "bob", "body2": "ground"}}]}}"#,
+        w[0], w[1], w[2]
+    ));
+    let spectrum = |m: &Model, how| {
+        let s = state_space(m, 0.0, &m.q0(), &m.u0(), &NoCallbacks, how, &Basis::Orthonormal).unwrap();
+        let mut im: Vec<f64> = eigenvalues(&s).iter().map(|z| z.im.abs()).collect();
+        im.sort_by(|a, b| b.total_cmp(a));
+        (im[0], s)
+    };
+    let (ref_freq, ref_s) = spectrum(&sph, Derivatives::Exact);
+    assert!(ref_freq > 1.0);
+    for (m, how, tol) in [
+        (&sph, Derivatives::CentralDifferences, 1e-8),
+        (&free, Derivatives::Exact, 1e-9),
+        (&free, Derivatives::CentralDifferences, 1e-7),
+    ] {
+        let (f, s) = spectrum(m, how);
+        assert!((f - ref_freq).abs() < tol * ref_freq, "{how:?}: {f} vs {ref_freq}");
+        assert_eq!((s.nq, s.nu), (ref_s.nq, ref_s.nu));
+    }
+    let (_, ex) = spectrum(&free, Derivatives::Exact);
+    let (_, fd) = spectrum(&free, Derivatives::CentralDifferences);
+    let diff = ex.a.iter().zip(&fd.a).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    let big = ex.a.iter().map(|a| a.abs()).fold(0.0, f64::max);
+    assert!(diff < 1e-7 * big, "exact vs fd state matrices: {diff:e} of {big:e}");
+}
