@@ -231,3 +231,94 @@ def test_exact_derivatives_refused_for_callbacks():
     m.add_force(ms.forces.PythonForce("push", lambda t, q, u: np.array([-q[0]])))
     with pytest.raises(ms.SettingsError, match="exact derivatives do not cover force element 'push'"):
         ms.linear.linearize(m, method="exact", operating_point=True)
+
+
+# ---- steady motions against independent derivations (tests/steady_refs.py, SymPy) ---------------
+
+import steady_models as sm  # noqa: E402
+
+CASES = [
+    ("upright_disc", dict(carrier="chain")),
+    ("upright_disc", dict(carrier="free")),
+    ("circular_disc", dict(carrier="chain")),
+    ("circular_disc", dict(carrier="free")),
+    ("chaplygin_sleigh", dict(joint="planar")),
+    ("chaplygin_sleigh", dict(joint="free")),
+    ("chaplygin_sleigh_unstable", dict(joint="planar")),
+    ("heavy_top", {}),
+    ("conical_pendulum", dict(joint="spherical")),
+    ("conical_pendulum", dict(joint="free")),
+]
+
+
+def steady_case(key, kw):
+    m = sm.BUILDERS[key.replace("_unstable", "")](**sm.PARAMS[key], **kw)
+    return m, m.steady_info["reference"]
+
+
+def nontrivial(lam):
+    lam = np.asarray(lam, dtype=complex)
+    lam = lam[np.abs(lam) > 1e-6 * max(np.abs(lam).max(initial=0.0), 1e-300)]
+    scale = max(np.abs(lam).max(initial=0.0), 1e-300)
+    return lam[np.lexsort((lam.imag, np.round(lam.real / scale, 6)))]
+
+
+@pytest.mark.parametrize("key,kw", CASES, ids=[f"{k}-{'-'.join(map(str, v.values()))}" for k, v in CASES])
+def test_steady_motion_eigenvalues_match_the_independent_derivation(key, kw):
+    m, ref = steady_case(key, kw)
+    lin = ms.linear.linearize(m)
+    assert lin.steady
+    got = nontrivial(np.linalg.eigvals(lin.A))
+    # the turning disc in a chain keeps its heading-frame position: the shifted circle at +-i Omega;
+    # where the cyclic world positions are dropped (free carrier) that pair is not a state
+    want = nontrivial(ref.all_eigenvalues if key == "circular_disc" and kw["carrier"] == "chain" else ref.eigenvalues)
+    np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-9 * np.abs(want).max())
+    # the self-check of each non-trivial eigenvalue against simulate
+    c = ms.linear.check(lin)
+    assert c.eigenvalues.size == (want.imag >= 0).sum() and c.worst < 1e-4, c.table()
+
+
+def test_chaplygin_sleigh_is_stable_with_the_blade_behind():
+    for key, sign in (("chaplygin_sleigh", -1), ("chaplygin_sleigh_unstable", 1)):
+        m, _ = steady_case(key, dict(joint="planar"))
+        p = sm.PARAMS[key]
+        lin = ms.linear.linearize(m)
+        lam = nontrivial(np.linalg.eigvals(lin.A))
+        assert lam.size == 1 and lam[0].real == pytest.approx(p["m"] * p["a"] * p["v"] / (p["I"] + p["m"] * p["a"] ** 2), rel=1e-9)
+        assert lin.modes().stable == (sign < 0)
+
+
+def test_cyclic_coordinates_of_the_steady_motions():
+    m, _ = steady_case("heavy_top", {})
+    assert ms.linear.linearize(m).cyclic == ["precession", "spin"]
+    m, _ = steady_case("upright_disc", dict(carrier="chain"))
+    lin = ms.linear.linearize(m)
+    assert lin.cyclic == ["x", "y", "heading", "spin"] and lin.M is None  # the heading rate feeds the lean
+    m, _ = steady_case("conical_pendulum", dict(joint="spherical"))
+    (text,) = ms.linear.linearize(m).cyclic
+    assert text.startswith("turn of 'pivot' about")  # the vertical, seen from the body
+
+
+def test_heavy_top_second_order_form_and_gyroscopic_matrix():
+    m, ref = steady_case("heavy_top", {})
+    lin = ms.linear.linearize(m)
+    # holonomic: all Euler angles kept; the precession-spin coupling is gyroscopic (skew G)
+    assert lin.M.shape == (3, 3) and np.abs(lin.G).max() > 1e-3 and np.allclose(lin.G, -lin.G.T)
+    w = nontrivial(lin.modes().eigenvalues)
+    assert w[-1].imag == pytest.approx(np.abs(ref.eigenvalues).max(), rel=1e-8)
+
+
+def test_steady_motion_solver_finds_the_top_precession():
+    # start from the right nutation angle and precession rate but a wrong spin: the spin is solved
+    p = sm.PARAMS["heavy_top"]
+    m, ref = steady_case("heavy_top", {})
+    u = m.state_vector(None, "u").copy()
+    names = [j["name"] for j in m.joint_info()]
+    k = names.index("spin")
+    exact = u[k]
+    u[k] *= 1.3
+    st = ms.linear.steady_motion(m, u=u, free=["spin'"])
+    assert st.u[k] == pytest.approx(exact, rel=1e-9) and st.residual < 1e-9
+    lin = ms.linear.linearize(m, at=st)
+    assert nontrivial(lin.modes().eigenvalues)[-1].imag == pytest.approx(np.abs(ref.eigenvalues).max(), rel=1e-7)
+    assert p["theta"] == pytest.approx(m.q0()[names.index("nutation")], rel=1e-12) if "nutation" in names else True

@@ -406,6 +406,11 @@ def _modes(lam: np.ndarray, vec: np.ndarray, n: int, to_u: np.ndarray) -> Modes:
     order = np.lexsort((lam.real, wn))
     lam, vec, wn = lam[order], vec[:, order], wn[order]
     shapes = vec[:n, :]
+    if n == 0:
+        # every configuration state cyclic (a sledge): the modes live in the velocities only
+        with np.errstate(invalid="ignore", divide="ignore"):
+            zeta = np.where(wn > 0, -lam.real / np.where(wn > 0, wn, 1.0), 0.0)
+        return Modes(lam, wn / (2 * np.pi), np.abs(lam.imag) / (2 * np.pi), zeta, shapes, to_u @ shapes)
     big = np.abs(shapes).max(axis=0)
     big[big == 0] = 1.0
     k = np.abs(shapes).argmax(axis=0)
@@ -815,13 +820,31 @@ def _state_form(model: Model, q, u, t: float, method: str, prefer) -> tuple[Stat
                     np.linalg.norm(xi - null @ (null.T @ xi)) <= 1e-6 * np.linalg.norm(xi):
                 cyclic.append(coords[c])
         if not cyclic:
-            cyclic = [f"{k} combination{'s' if k > 1 else ''} of the coordinates"]
+            cyclic = [_describe_direction(model, raw["Vh"] @ null[:, i]) for i in range(k)]
         keep = np.linalg.svd(null.T)[2][k:].T
         keep_names = [f"z{i}" for i in range(keep.shape[1])]
     else:
         keep, keep_names = np.eye(nq), names[:nq]
     return StateForm(a, raw["B"], names, nq, nu, raw["Vh"], raw["P"], raw["V"], raw["Lh"], raw["Lu"], coords,
                      raw["rate"], float(raw["defect"]), cyclic, null, keep, keep_names, raw["method"]), raw
+
+
+def _describe_direction(model: Model, d: np.ndarray) -> str:
+    """A chart direction in words: a joint's turn about an axis of its child frame, or its
+    components."""
+    big = float(np.abs(d).max(initial=0.0))
+    parts = []
+    for j in model.joint_info():
+        seg = d[j["iu"]:j["iu"] + j["nu"]]
+        if np.abs(seg).max(initial=0.0) > 1e-6 * big:
+            parts.append((j, seg))
+    if len(parts) == 1:
+        j, seg = parts[0]
+        rot = {"spherical": slice(0, 3), "free": slice(3, 6)}.get(j["type"])
+        if rot is not None and np.abs(np.delete(seg, np.arange(seg.size)[rot])).max(initial=0.0) <= 1e-6 * big:
+            ax = seg[rot] / np.linalg.norm(seg[rot])
+            return f"turn of '{j['name']}' about ({ax[0]:.4g}, {ax[1]:.4g}, {ax[2]:.4g}) of its child frame"
+    return "combination " + " + ".join(f"{c:.3g} {n}" for n, c in zip(_names(model, model.nu), d / big) if abs(c) > 1e-6)
 
 
 def _second_order_form(a: np.ndarray, n_cfg: int, cfg_names: list, v: np.ndarray, mass: np.ndarray, select):
@@ -1088,6 +1111,8 @@ def check(lin: LinearModel, modes=None, amplitude: float = 1e-6, cycles: float =
                   integrator=DOPRI5(rtol=rtol, atol=rtol * 1e-2))
         ref = simulate(model, q0=q0, u0=u0, **kw)
         run = simulate(model, q0=qp, u0=up, **kw)
+        # all joint velocities (a mode may live in dependent ones, as a rolling disc's shifted
+        # circle); a cyclic heading's offset is a constant per channel in the fit
         s = np.asarray(run["u"]) - np.asarray(ref["u"])
         dt = float(np.diff(np.asarray(run["t"])).mean())
         out.append((li, _fit_rate(s, dt, li.imag != 0), span))
@@ -1099,16 +1124,20 @@ def check(lin: LinearModel, modes=None, amplitude: float = 1e-6, cycles: float =
 
 def _fit_rate(s: np.ndarray, dt: float, oscillating: bool) -> complex:
     """Growth rate (and frequency) of a sampled multi-channel signal s (samples x channels) of
-    one real exponential or one damped oscillation, by least-squares linear prediction."""
+    one real exponential or one damped oscillation over constant offsets (a zero mode touched by
+    the perturbation), by least-squares linear prediction with one constant per channel."""
+    n, c = s.shape
+    order = 2 if oscillating else 1
+    rows = n - order
+    lhs = s[order:].T.reshape(-1)
+    cols = [s[order - 1 - i:n - 1 - i].T.reshape(-1) for i in range(order)]
+    offsets = np.kron(np.eye(c), np.ones((rows, 1)))
+    coef = np.linalg.lstsq(np.column_stack(cols + [offsets]), lhs, rcond=None)[0]
     if oscillating:
-        lhs = s[2:].reshape(-1)
-        m = np.column_stack([s[1:-1].reshape(-1), s[:-2].reshape(-1)])
-        a1, a2 = np.linalg.lstsq(m, lhs, rcond=None)[0]
-        z = np.roots([1.0, -a1, -a2]).astype(complex)
+        z = np.roots([1.0, -coef[0], -coef[1]]).astype(complex)
         z = z[np.argmax(z.imag)]
     else:
-        a1 = np.linalg.lstsq(s[:-1].reshape(-1, 1), s[1:].reshape(-1), rcond=None)[0][0]
-        z = complex(a1)
+        z = complex(coef[0])
     return complex(np.log(z) / dt)
 
 
