@@ -88,8 +88,6 @@ class LinearModel:
     model: Model | None = field(default=None, repr=False, compare=False)
     #: the first-order form about the point (:class:`StateForm`; None when built by hand)
     state: "StateForm | None" = field(default=None, repr=False, compare=False)
-    #: cyclic coordinates: joint coordinates the linearized motion does not depend on
-    cyclic: list = field(default_factory=list)
     #: whether the point is an equilibrium or a steady motion (see :attr:`StateForm.steady`)
     steady: bool = True
 
@@ -118,9 +116,20 @@ class LinearModel:
         """Names of the entries of the first-order state x (rates end in a prime)."""
         return self._state().reduced()[2]
 
+    @property
+    def cyclic(self) -> list[str]:
+        """Cyclic coordinates: joint coordinates the linearized motion does not depend on
+        (positions on the plane, heading, wheel and spin angles); built with the first-order form."""
+        return list(self._state().cyclic)
+
     def _state(self) -> "StateForm":
         if self.state is None:
-            raise SettingsError("this LinearModel has no first-order form (built by hand); use ms.linear.linearize")
+            if self.model is None:
+                raise SettingsError("this LinearModel has no first-order form (built by hand); use ms.linear.linearize")
+            # at rest it is built on demand, with the same kind of derivatives
+            prefer = [] if _nonholonomic(self.model) else None
+            sf, _ = _state_form(self.model, self.q, self.u, self.t, "fd" if self.method == "fd" else "exact", prefer)
+            object.__setattr__(self, "state", sf)
         return self.state
 
     def state_space(self, inputs=None, outputs=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -530,60 +539,62 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
         prefer = idx
     else:
         prefer = [] if nonholonomic else None
-    sf, raw = _state_form(model, q, u, float(t), method, prefer)
-    _check_constraints(model, raw, q, u)
     moving = bool(np.any(u != 0.0))
-    steady, why = _steadiness(sf, u)
-    form, names, v_basis, residual = None, [], None, None
-    if coordinates is not None:
-        sel = []
-        for k in idx:
-            name = coords[k]
-            if name in sf.cyclic:
-                raise SettingsError(f"linearize: coordinates: '{name}' is cyclic (the linearized motion does not depend on "
-                                    f"it; cyclic: {', '.join(sf.cyclic)}); name non-cyclic coordinates")
-            if name not in sf.keep_names:
-                raise SettingsError(f"linearize: coordinates: '{name}' is not an independent coordinate here (the "
-                                    f"constraints determine it from the others); independent: {', '.join(sf.keep_names)}")
-            sel.append(sf.keep_names.index(name))
-        a_r = sf.reduced()[0]
-        form = _second_order_form(a_r, sf.n_config, sf.keep_names, sf.V, raw["mass"], sel)
-        if isinstance(form, str):
-            raise SettingsError(f"linearize: coordinates {', '.join(coords[k] for k in idx)}: {form}")
-        names = [coords[k] for k in idx]
-        v_basis = (sf.Vh @ sf.keep)[:, sel]
-    elif not moving:
-        # at rest: the second-order form in minimal coordinates (unchanged)
+    _check_constraints(model, q, u, float(t))
+    old = None
+    if coordinates is None and not moving:
+        # at rest: the second-order form in minimal coordinates (as always); the first-order form
+        # is built when asked for (lin.A, lin.cyclic, ...)
         core, cbs = model.engine()
         old = _core.linearize(core, q, u, float(t), cbs, method)
         n_u = old["V"].shape[0]
         names = _names(model, n_u)
         if old["V"].shape[1] != n_u or not np.allclose(old["V"], np.eye(n_u)):
             names = [f"y{k}" for k in range(old["V"].shape[1])]
-        form = (old["M"], old["D"] + old["G"], old["K"] + old["N"])
-        v_basis, residual = old["V"], old["residual"]
-        steady = steady and float(np.abs(residual).max(initial=0.0)) <= \
-            1e-8 * (1.0 + np.abs(old["K"]).max(initial=0.0) + np.abs(old["M"]).max(initial=0.0))
-    elif not nonholonomic:
-        # moving, holonomic: y = all configuration states (cyclic ones kept: a Campbell diagram
-        # follows the same coordinates at every speed)
-        form = _second_order_form(sf.A, sf.nq, sf.names[: sf.nq], sf.V, raw["mass"], None)
-        names, v_basis = sf.names[: sf.nq], sf.Vh
+        c, s_ = old["D"] + old["G"], old["K"] + old["N"]
+        mats = (old["M"], old["D"], old["G"], old["K"], old["N"])
+        v_basis, residual, sf = old["V"], old["residual"], None
+        res = float(np.abs(residual).max(initial=0.0))
+        steady = res <= 1e-8 * (1.0 + np.abs(old["K"]).max(initial=0.0) + np.abs(old["M"]).max(initial=0.0))
+        why = "" if steady else f"residual {res:.3g} on coordinate '{names[int(np.abs(residual).argmax())]}'"
+        method_used = old["method"]
     else:
-        form = _second_order_form(sf.reduced()[0], sf.n_config, sf.keep_names, sf.V, raw["mass"], None)
-        names, v_basis = list(sf.keep_names), sf.Vh @ sf.keep
-    if isinstance(form, str):
-        sf = replace(sf, why_first_order=form)
-        mats = (None,) * 5
-    else:
-        mm, c, s = form
-        mats = (mm, 0.5 * (c + c.T), 0.5 * (c - c.T), 0.5 * (s + s.T), 0.5 * (s - s.T))
-    if residual is None:
-        a_r, _, _ = sf.reduced()
+        sf, raw = _state_form(model, q, u, float(t), method, prefer)
+        steady, why = _steadiness(sf, u)
+        method_used = raw["method"]
+        if coordinates is not None:
+            sel = []
+            for k in idx:
+                name = coords[k]
+                if name in sf.cyclic:
+                    raise SettingsError(f"linearize: coordinates: '{name}' is cyclic (the linearized motion does not depend "
+                                        f"on it; cyclic: {', '.join(sf.cyclic)}); name non-cyclic coordinates")
+                if name not in sf.keep_names:
+                    raise SettingsError(f"linearize: coordinates: '{name}' is not an independent coordinate here (the "
+                                        f"constraints determine it from the others); independent: {', '.join(sf.keep_names)}")
+                sel.append(sf.keep_names.index(name))
+            form = _second_order_form(sf.reduced()[0], sf.n_config, sf.keep_names, sf.V, raw["mass"], sel)
+            if isinstance(form, str):
+                raise SettingsError(f"linearize: coordinates {', '.join(coords[k] for k in idx)}: {form}")
+            names = [coords[k] for k in idx]
+            v_basis = (sf.Vh @ sf.keep)[:, sel]
+        elif not nonholonomic:
+            # moving, holonomic: y = all configuration states (cyclic ones kept: a Campbell diagram
+            # follows the same coordinates at every speed)
+            form = _second_order_form(sf.A, sf.nq, sf.names[: sf.nq], sf.V, raw["mass"], None)
+            names, v_basis = sf.names[: sf.nq], sf.Vh
+        else:
+            form = _second_order_form(sf.reduced()[0], sf.n_config, sf.keep_names, sf.V, raw["mass"], None)
+            names, v_basis = list(sf.keep_names), sf.Vh @ sf.keep
+        if isinstance(form, str):
+            sf = replace(sf, why_first_order=form)
+            mats = (None,) * 5
+        else:
+            mm, c, s_ = form
+            mats = (mm, 0.5 * (c + c.T), 0.5 * (c - c.T), 0.5 * (s_ + s_.T), 0.5 * (s_ - s_.T))
         residual = np.concatenate([sf.keep.T @ sf.rate[: sf.nq], sf.rate[sf.nq:]])
-    lin = LinearModel(*mats, v_basis, np.asarray(residual, dtype=float), q, u, float(t), names,
-                      raw["method"] if mats[0] is None or moving or coordinates is not None else old["method"],
-                      model, sf, list(sf.cyclic), steady)
+    lin = LinearModel(*mats, v_basis, np.asarray(residual, dtype=float), q, u, float(t), names, method_used,
+                      model, sf, steady)
     if lin.M is not None:
         _check_mass(lin, model.name)
     if not steady and not operating_point:
@@ -610,18 +621,24 @@ def _steadiness(sf: StateForm, u: np.ndarray) -> tuple[bool, str]:
     return True, ""
 
 
-def _check_constraints(model: Model, raw: dict, q: np.ndarray, u: np.ndarray) -> None:
+def _check_constraints(model: Model, q: np.ndarray, u: np.ndarray, t: float) -> None:
     """A ModelError naming the first constraint the point violates (position or velocity)."""
+    cons = model.engine()[0].constraints()
+    if not cons:
+        return
+    core, cbs = model.engine()
+    phi, g, b = _core.constraint_jacobian(core, q, t, cbs)
+    vel_res = g @ u - b
     tol_q = 1e-6 * (1.0 + float(np.abs(q).max(initial=0.0)))
     tol_u = 1e-6 * (1.0 + float(np.abs(u).max(initial=0.0)))
-    for c in model.engine()[0].constraints():
+    for c in cons:
         r0, n, nh = c["row"], c["rows"], c["holonomic_rows"]
-        phi = np.abs(raw["phi"][r0:r0 + nh])
-        if phi.size and phi.max() > tol_q:
+        ph = np.abs(phi[r0:r0 + nh])
+        if ph.size and ph.max() > tol_q:
             raise ModelError(f"linearize: the point violates constraint '{c['name']}' (position residual "
-                             f"{phi.max():.3g} {c.get('violation_unit', '')}); give a consistent q (e.g. from the "
+                             f"{ph.max():.3g} {c.get('violation_unit', '')}); give a consistent q (e.g. from the "
                              "start of a simulation or ms.analysis.assemble)")
-        vel = np.abs(raw["velocity_residual"][r0:r0 + n])
+        vel = np.abs(vel_res[r0:r0 + n])
         if vel.size and vel.max() > tol_u:
             raise ModelError(f"linearize: the point violates constraint '{c['name']}' (velocity residual "
                              f"{vel.max():.3g}); give velocities the constraint admits")
