@@ -144,7 +144,7 @@ def test_linear_about_a_motion_on_the_command_line(runner, tmp_path):
                             "--sweep", "rear_hub':-12:-22:11", "--out-dir", str(tmp_path)])
     assert r.exit_code == 0, r.output
     assert "motion    steady; cyclic: free[0], free[1], free[5], rear_hub, front_hub" in r.output
-    rows = re.findall(r"^\s+\d+\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s*$", r.output.split("check against")[0], flags=re.M)
+    rows = re.findall(r"^\s+\d+\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s*$", r.output.split("mode shapes")[0], flags=re.M)
     re_parts = np.sort(np.array([float(x[3]) for x in rows]))
     want = np.sort(np.unique(np.round(bref.eigenvalues(5.0).real, 9)))
     np.testing.assert_allclose(re_parts, want, rtol=1e-5)
@@ -164,3 +164,13 @@ def test_linear_about_a_motion_bad_options(runner, tmp_path):
     assert r.exit_code != 0 and "--free: needs --at steady" in r.output
     r = runner.invoke(cli, ["linear", str(BICYCLE), "--sweep", "rear_hub':0:1", "--out-dir", str(tmp_path)])
     assert r.exit_code != 0 and "--sweep: expected SPEED:START:STOP:N" in r.output
+
+
+def test_linear_prints_the_mode_shapes(runner, tmp_path):
+    # the quarter car: the body mode is mostly body_y, the wheel hop mostly wheel_y (newcomer 15)
+    r = runner.invoke(cli, ["linear", str(QUARTER_CAR), "--at", "equilibrium", "--out-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    m1 = re.search(r"^\s+1\s+body_y 1, wheel_y (\S+) at", r.output, flags=re.M)
+    m2 = re.search(r"^\s+2\s+wheel_y 1, body_y (\S+) at", r.output, flags=re.M)
+    assert m1 and m2, r.output
+    assert 0.01 < float(m1.group(1)) < 0.5 and 0.01 < float(m2.group(1)) < 0.5

@@ -459,6 +459,10 @@ def linear(model_file: Path, at: str, free: str | None, coordinates: str | None,
     click.echo("")
     click.echo(modes.table())
     click.echo("stable" if modes.stable else f"unstable: modes {', '.join(str(k + 1) for k in modes.unstable)}")
+    if modes.shapes.shape[0]:
+        shape_names = lin.names if lin.M is not None else lin.state.keep_names
+        click.echo("mode shapes (largest coordinate 1):")
+        click.echo(modes.shapes_table(shape_names))
     click.echo("")
     stem = _safe_name(model.name)
     failed = False

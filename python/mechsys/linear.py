@@ -64,6 +64,17 @@ class Modes:
                         f"{self.damping_ratio[k]:10.4g}  {lam.real:16.6g}{flag}")
         return "\n".join(rows)
 
+    def shapes_table(self, names, modes: int = 8, cut: float = 1e-3) -> str:
+        """Mode shapes as text: per mode (the first ``modes``), each coordinate whose share is
+        above ``cut`` of the largest, with its magnitude and phase (degrees)."""
+        rows = []
+        for k in range(min(modes, self.shapes.shape[1])):
+            s = self.shapes[:, k]
+            parts = [f"{names[i]} {abs(s[i]):.3g}" + (f" at {np.degrees(np.angle(s[i])):+.0f} deg" if abs(s[i].imag) > 1e-9 else "")
+                     for i in np.argsort(-np.abs(s)) if abs(s[i]) > cut]
+            rows.append(f"{k + 1:>4}  " + (", ".join(parts) or "-"))
+        return "\n".join(rows)
+
 
 @dataclass(frozen=True)
 class LinearModel:
