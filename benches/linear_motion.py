@@ -135,20 +135,26 @@ def main(argv=None) -> int:
     tr.build()
     lins = {}
     peer_rows = []
+    tcore, tcb = tr.engine()
+    tq, tu = tr.q0(), tr.state_vector(None, "u")
+    best = {}
     for meth in ("exact", "fd"):
         tmin, tmed, lins[meth] = timed(lambda: ms.linear.linearize(tr, method=meth, operating_point=True), repeat)
+        cmin, cmed, _ = timed(lambda: _core.state_space(tcore, tq, tu, 0.0, tcb, meth, None), repeat)
         rows.append((f"{NB}-body tree, moving: `linearize` {meth}", tmin, tmed, ""))
-        print(f"tree linearize {meth}: {fmt_time(tmin)} ({fmt_time(tmed)})")
+        rows.append((f"{NB}-body tree: core state form alone ({meth})", cmin, cmed, ""))
+        best[meth] = cmin
+        print(f"tree linearize {meth}: {fmt_time(tmin)} ({fmt_time(tmed)}), core {fmt_time(cmin)}")
     da = float(np.abs(lins["exact"].A - lins["fd"].A).max() / np.abs(lins["exact"].A).max())
-    rows[-1] = (rows[-1][0], rows[-1][1], rows[-1][2], f"max |A_fd - A_exact| / max |A_exact| = {da:.1e}")
-    ours = min(r[1] for r in rows if r[0].startswith(f"{NB}-body tree") and "exact" in r[0])
+    rows[-2] = (rows[-2][0], rows[-2][1], rows[-2][2], f"largest difference of the fd state matrix to the exact one: {da:.1e} of its largest entry")
+    ours = min(best.values())
     for name, make in (("MuJoCo `mjd_transitionFD` (30-link chain)", mujoco_chain), ("Pinocchio `computeABADerivatives` (30-link chain)", pinocchio_chain)):
         fn = make()
         if fn is None:
             peer_rows.append((name, None, None, "not installed"))
             continue
         pmin, pmed, _ = timed(fn, repeat)
-        peer_rows.append((name, pmin, pmed, f"mechsys exact linearize: {ratio(ours, pmin)}"))
+        peer_rows.append((name, pmin, pmed, f"mechsys core state form (faster of exact, fd): {ratio(ours, pmin)}"))
         print(f"{name}: {fmt_time(pmin)} ({fmt_time(pmed)})")
 
     if a.out:
@@ -164,8 +170,11 @@ def main(argv=None) -> int:
             L.append(f"| {name} | {t} | {note} |")
         L.append("")
         L.append("The peers compute other quantities (MuJoCo: discrete-time transition matrices by finite differences; "
-                 "Pinocchio: the analytic derivatives of the unconstrained forward dynamics); mechsys's figure includes "
-                 "the constraint reduction, the cyclic-coordinate analysis and the second-order form.")
+                 "Pinocchio: the analytic derivatives of the unconstrained forward dynamics); the ratios set them beside "
+                 "mechsys's core state form (derivatives, constraint reduction, admissibility correction), the Python "
+                 "`linearize` adds the cyclic-coordinate analysis and the second-order form. mechsys's exact path differentiates "
+                 "the inverse dynamics by dual numbers, one pass per eight directions (O(n^2)); Pinocchio's recursive "
+                 "analytic derivatives are far faster on a tree, and an analytic pass is the way to close that gap.")
         write_doc(a.out, "\n".join(L), "<!-- linear_motion.py:begin -->", "<!-- linear_motion.py:end -->")
         print(f"wrote {a.out}")
     return 0

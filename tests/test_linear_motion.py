@@ -322,3 +322,20 @@ def test_steady_motion_solver_finds_the_top_precession():
     lin = ms.linear.linearize(m, at=st)
     assert nontrivial(lin.modes().eigenvalues)[-1].imag == pytest.approx(np.abs(ref.eigenvalues).max(), rel=1e-7)
     assert p["theta"] == pytest.approx(m.q0()[names.index("nutation")], rel=1e-12) if "nutation" in names else True
+
+
+def test_upright_disc_critical_speed_and_lean_frequency():
+    import steady_refs as sr
+
+    p = sm.PARAMS["upright_disc"]
+    vc = sr.upright_disc_critical_speed(p["R"], m=p["m"])
+    assert vc == pytest.approx(np.sqrt(9.81 * p["R"] / 3), rel=1e-12)
+    sw = ms.linear.sweep(lambda v: sm.upright_disc_model(p["m"], p["R"], v), np.linspace(0.5 * vc, 1.5 * vc, 21), parameter="v")
+    (lo, hi), = sw.stable_ranges()
+    assert vc <= lo <= vc + 0.05 * vc and hi == pytest.approx(1.5 * vc)  # the first stable value of the grid
+    # on either side: a capsizing real pair below, a lean oscillation at the reference's frequency above
+    for v in (0.9 * vc, 1.2 * vc, 3.0):
+        lam = nontrivial(np.linalg.eigvals(ms.linear.linearize(sm.upright_disc_model(p["m"], p["R"], v)).A))
+        want = nontrivial(sr.upright_disc(p["m"], p["R"], v).eigenvalues)
+        np.testing.assert_allclose(lam, want, rtol=1e-7, atol=1e-9)
+        assert (np.abs(lam.imag).max() > 0) == (v > vc)
