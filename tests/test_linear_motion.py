@@ -339,3 +339,21 @@ def test_upright_disc_critical_speed_and_lean_frequency():
         want = nontrivial(sr.upright_disc(p["m"], p["R"], v).eigenvalues)
         np.testing.assert_allclose(lam, want, rtol=1e-7, atol=1e-9)
         assert (np.abs(lam.imag).max() > 0) == (v > vc)
+
+
+def test_steady_motion_bad_names_and_values():
+    m = bicycle.build(v=5.0)
+    with pytest.raises(ms.SettingsError, match="no joint coordinate named 'rear'"):
+        ms.linear.steady_motion(m, free=["rear'"])
+    with pytest.raises(ms.SettingsError, match="fixed\\['steer'\\] must be finite"):
+        ms.linear.steady_motion(m, fixed={"steer": float("nan")})
+    with pytest.raises(ms.SettingsError, match="quaternion coordinates"):
+        ms.linear.steady_motion(m, fixed={"free[3]": 0.1})
+    with pytest.raises(ms.SettingsError, match="expected a mechsys.Model"):
+        ms.linear.steady_motion("bicycle")
+    with pytest.raises(ms.SettingsError, match="values must be finite"):
+        ms.linear.sweep(lambda v: bicycle.build(v=v), [1.0, float("inf")])
+    with pytest.raises(ms.SettingsError, match="returned str"):
+        ms.linear.sweep(lambda v: "no model", [1.0])
+    with pytest.raises(ms.SettingsError, match="modes .* out of range"):
+        ms.linear.check(ms.linear.linearize(m), modes=[7])

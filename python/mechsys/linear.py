@@ -1036,6 +1036,10 @@ def steady_motion(model: Model, q=None, u=None, t: float = 0.0, free=(), fixed=N
             lam *= 0.5
         x = x + lam * step
         r = residual(x)
+    if not np.all(np.isfinite(r)):
+        bad = int(np.nonzero(~np.isfinite(r))[0][0])
+        raise SolverError(f"steady_motion: model '{model.name}': the residual is not finite on {labels[bad]} after {it} "
+                          "iterations (the guess or a step left the model's valid range)")
     worst = float(np.abs(r).max(initial=0.0))
     if not worst <= tol * scale:
         k = int(np.nanargmax(np.abs(r)))
