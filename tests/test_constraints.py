@@ -198,9 +198,15 @@ def test_singular_configuration_met_during_a_run_is_reported_with_time_and_const
     t_warn = float(msg[0].split("t = ")[1].split(" s")[0])
     assert abs(t_warn - np.pi / 2 / omega) < 2e-3
     np.testing.assert_allclose(res["joint/guide/q"], 2 * r * np.cos(omega * res.t), atol=1e-12)
-    # a step that lands on theta = pi/2 exactly (omega t = pi/2 at t = 0.5 s)
+    # a step that lands on theta = pi/2 exactly (omega t = pi/2 at t = 0.5 s): by default the run
+    # goes on (minimum-norm multipliers, a warning with the time), or stops when asked
+    with pytest.warns(UserWarning, match=r"singular configuration at t = 0\.500000 s: constraint 'wrist'"):
+        res = ms.simulate(slider_crank(r=r, l=r, omega=np.pi), 1.0, ms.RK4(1e-3), output_dt=1e-2)
+    np.testing.assert_allclose(res["joint/guide/q"], 2 * r * np.cos(np.pi * res.t), atol=1e-9)
     with pytest.raises(ms.SolverError, match=r"singular configuration at t = 0\.500000 s: constraint 'wrist'"):
-        ms.simulate(slider_crank(r=r, l=r, omega=np.pi), 1.0, ms.RK4(1e-3), output_dt=1e-2)
+        ms.simulate(slider_crank(r=r, l=r, omega=np.pi), 1.0, ms.RK4(1e-3), output_dt=1e-2, on_singular="stop")
+    with pytest.raises(ms.SettingsError, match="on_singular: must be 'continue' or 'stop'"):
+        ms.simulate(slider_crank(r=r, l=r, omega=np.pi), 1.0, ms.RK4(1e-3), output_dt=1e-2, on_singular="warn")
 
 
 def test_velocity_violation_signal_is_recorded_for_every_row():

@@ -142,6 +142,8 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.option("--rtol", type=float, help="Relative tolerance of dopri5 and event_driven.")
 @click.option("--atol", type=float, help="Absolute tolerance of dopri5 and event_driven.")
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
+@click.option("--on-singular", "on_singular", type=click.Choice(["continue", "stop"]), default=None,
+              help="At a singular configuration (the constraints lose rank): go on with a warning [default] or stop.")
 @click.option("--out", "out", type=click.Path(path_type=Path, dir_okay=False), help="HDF5 results file [default: results/<model name>.h5].")
 @click.option("--plot", "plot_out", type=click.Path(path_type=Path, dir_okay=False), help="Write a plot (.png, .svg or .pdf).")
 @click.option(
@@ -163,6 +165,7 @@ def run(
     rtol: float | None,
     atol: float | None,
     output_dt: float | None,
+    on_singular: str | None,
     out: Path | None,
     plot_out: Path | None,
     signals: tuple[str, ...],
@@ -188,6 +191,8 @@ def run(
         rtol=rtol,
         atol=atol,
     )
+    if on_singular is not None:
+        kwargs["on_singular"] = on_singular
     start = time.perf_counter()
     res = simulate(model, **kwargs)
     wall = time.perf_counter() - start
@@ -302,7 +307,7 @@ def info(model_file: Path) -> None:
         click.echo(_table(["name", "type", "equations"], [(c["name"], c["type"], str(c["rows"])) for c in constraints]))
         if mob["redundant"]:
             names = ", ".join(f"{n}[{k}]" for n, k in mob["redundant"])
-            click.echo(f"warning: {len(mob['redundant'])} redundant equation(s) at q0: {names} (their multipliers are set to zero)")
+            click.echo(f"warning: {len(mob['redundant'])} redundant equation(s) at q0: {names} (they share the load with the rows they repeat: minimum-norm multipliers)")
     contacts = core.contacts()
     if contacts:
         click.echo("")

@@ -16,7 +16,7 @@ from .model import Model
 from .results import Results
 
 
-def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilization=None) -> dict:
+def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilization=None, on_singular="continue") -> dict:
     if integrator is None:
         integrator = DOPRI5()
     if not hasattr(integrator, "describe"):
@@ -48,6 +48,8 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
         raise SettingsError(f"output_dt: must be > 0, got {output_dt}")
     if not (np.isfinite(t_end) and np.isfinite(t0) and t_end > t0):
         raise SettingsError(f"t_end: must be finite and > t0 = {t0}, got {t_end}")
+    if on_singular not in ("continue", "stop"):
+        raise SettingsError(f"on_singular: must be 'continue' or 'stop', got {on_singular!r}")
     return {
         "t0": t0,
         "t_end": t_end,
@@ -56,6 +58,7 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
         "q0": model.state_vector(q0, "q").tolist(),
         "u0": model.state_vector(u0, "u").tolist(),
         "stabilization": _stabilization(stabilization),
+        "on_singular": on_singular,
     }
 
 
@@ -70,6 +73,7 @@ def simulate(
     progress: bool | None = None,
     keep: Sequence[str] = (),
     stabilization: Any = None,
+    on_singular: str = "continue",
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
@@ -84,6 +88,10 @@ def simulate(
     q0 and u0 stay as given when a constrained model is assembled to a consistent start (the
     others move by minimum-norm corrections). ``stabilization``: constraint drift control,
     ``"projection"`` (default), ``"none"`` or :class:`mechsys.constraints.Baumgarte`.
+    ``on_singular``: at a singular configuration (the constraint equations lose rank: a dead
+    point, a parallelogram linkage passing its flat position) ``"continue"`` (default) goes on
+    with minimum-norm multipliers and notes the passage as a warning with its time and
+    constraint; ``"stop"`` raises a SolverError there.
     """
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
@@ -96,7 +104,7 @@ def simulate(
         from .analysis import assemble
 
         q0, u0 = assemble(model, q0, u0, float(t0), keep=keep)
-    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization)
+    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization, on_singular)
     text = json.dumps(settings)
     callbacks = model.callbacks or None
     prog = _core.Progress()
@@ -166,7 +174,7 @@ def _warn_redundant(model: Model, q0, t0) -> None:
         names = ", ".join(f"{n}[{k}]" for n, k in mob["redundant"])
         warnings.warn(
             f"model '{model.name}': {len(mob['redundant'])} redundant constraint equation(s) at t0: {names}; "
-            "their multipliers are set to zero (minimum-norm)",
+            "they share the load with the rows they repeat (minimum-norm multipliers)",
             stacklevel=3,
         )
 

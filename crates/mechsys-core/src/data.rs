@@ -113,6 +113,10 @@ pub struct Data {
     pub null_scratch: Vec<f64>,
     /// constraints: rows found dependent at the last solve (nc).
     pub dependent: Vec<bool>,
+    /// constraints: rows the projections leave out (nc): near a singular configuration their
+    /// Jacobian row nearly vanishes, and a correction through it would amplify round-off (set by
+    /// the smooth integrators' system, `simulate::MultibodySystem`).
+    pub skip_rows: Vec<bool>,
     /// forces: committed positions of the Jenkins sliders, the history of the dry friction (n_sliders).
     pub slider: Vec<f64>,
     /// forces: slider positions solved at the last force evaluation (n_sliders).
@@ -175,6 +179,7 @@ impl Data {
             perm_null: vec![0; model.nc],
             null_scratch: vec![0.0; model.nc],
             dependent: vec![false; model.nc],
+            skip_rows: vec![false; model.nc],
             slider: vec![0.0; model.n_sliders],
             slider_trial: vec![0.0; model.n_sliders],
             slider_force: vec![0.0; model.n_sliders],

@@ -40,6 +40,21 @@ pub struct Settings {
     /// Drift control of the constraints.
     #[serde(default)]
     pub stabilization: Stabilization,
+    /// What a singular configuration (the constraint rows lose rank) does to the run.
+    #[serde(default)]
+    pub on_singular: OnSingular,
+}
+
+/// What a run does where the constraint equations lose rank (a dead point, a change point of a
+/// mechanism such as a parallelogram four-bar passing its flat position).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OnSingular {
+    /// Go on with minimum-norm multipliers and note the passage as a warning (time and rows).
+    #[default]
+    Continue,
+    /// Stop with a `SolverError` naming the constraint.
+    Stop,
 }
 
 /// How the constraint drift of a simulation is controlled.
@@ -264,6 +279,18 @@ pub struct MultibodySystem<'a> {
     start: Option<(Vec<bool>, Vec<f64>)>,
     /// Whether the last evaluation was near a singular configuration (one warning per passage).
     near_singular: bool,
+    /// Whether the last evaluation had lost rank (one warning per passage).
+    rank_lost: bool,
+    /// Stop at a rank drop instead of going on.
+    stop_at_singular: bool,
+    /// The last time shift that reached well-conditioned neighbours in [`Self::passage`] (s).
+    passage_tau: f64,
+    /// Workspace of the neighbouring states in [`Self::passage`] (made at the first passage).
+    neighbour: Option<Data>,
+    /// Each constraint row's squared Jacobian norm at the last evaluation relative to the start.
+    ratio: Vec<f64>,
+    /// Squared norms of the constraint Jacobian's rows at the first evaluation.
+    row0: Vec<f64>,
     /// Near-singular passages met so far.
     pub warnings: Vec<String>,
 }
@@ -279,8 +306,20 @@ impl<'a> MultibodySystem<'a> {
             stabilization: Stabilization::Projection,
             start: None,
             near_singular: false,
+            rank_lost: false,
+            stop_at_singular: false,
+            passage_tau: 0.0,
+            neighbour: None,
+            ratio: Vec::new(),
+            row0: Vec::new(),
             warnings: Vec::new(),
         }
+    }
+
+    /// Stops the run at a rank drop of the constraints instead of going on.
+    pub fn with_on_singular(mut self, policy: OnSingular) -> Self {
+        self.stop_at_singular = policy == OnSingular::Stop;
+        self
     }
 
     /// Chooses the constraint drift control.
@@ -296,13 +335,22 @@ impl<'a> MultibodySystem<'a> {
 
 /// A pivot of the constraint factorization that fell below this fraction of its value at the
 /// start marks a near-singular configuration (its row vanishes or turns dependent, and its
-/// multiplier may grow without bound). A warning, since the motion may pass it smoothly; an
-/// actual rank drop stops the run.
+/// multiplier may grow without bound): a warning, since the motion passes it.
 const NEAR_SINGULAR: f64 = 1e-6;
 
+/// Below this fraction of its start value (squared norms) a constraint row is near a singular
+/// configuration (its Jacobian row below about 3 % of its start size near a change point such as
+/// a parallelogram four-bar's flat position): the projections leave it out, and the dynamics take its multiplier
+/// from states on the constraint manifold on either side ([`MultibodySystem::passage`]) instead
+/// of from the ill-conditioned quotient at the (slightly off-manifold) state being evaluated,
+/// which would turn the state's distance from the manifold, amplified by the inverse cube of the
+/// distance to the singular point, into a motion along the other branch.
+const SINGULAR_WINDOW: f64 = 1e-3;
+
 impl MultibodySystem<'_> {
-    /// Stops the run when the constraint equations lost rank since the start (a dead point or a
-    /// change point of the mechanism), and notes passages near such a configuration.
+    /// Notes (or, with [`OnSingular::Stop`], stops at) a rank drop of the constraint equations
+    /// since the start (a dead point or a change point of the mechanism) and passages near such
+    /// a configuration; marks the rows the projections leave out there.
     fn check_singular(&mut self, t: f64) -> Result<()> {
         let dep = &self.data.dependent;
         let (pivots, rows) = self.ws.saddle.pivots();
@@ -316,28 +364,151 @@ impl MultibodySystem<'_> {
         };
         // which rows of a redundant set count as the dependent ones may change: only a rank drop counts
         let (r0, r1) = (d0.iter().filter(|d| !**d).count(), dep.iter().filter(|d| !**d).count());
-        if r1 < r0 {
+        let lost = r1 < r0;
+        if lost {
             let row = (0..dep.len()).find(|&r| dep[r] && !d0[r]).unwrap_or(0);
             let (name, k) = name_of(row);
-            return Err(Error::Solver(format!(
-                "singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) became dependent on the others (rank {r0} → {r1})"
-            )));
+            if self.stop_at_singular {
+                return Err(Error::Solver(format!(
+                    "singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) became dependent on the others (rank {r0} → {r1})"
+                )));
+            }
+            if !self.rank_lost {
+                self.warnings.push(format!(
+                    "singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) became dependent on the others (rank {r0} → {r1}); continued with minimum-norm multipliers"
+                ));
+            }
         }
-        let weakest = (0..pivots.len())
-            .filter(|&j| p0[j] > 0.0)
-            .map(|j| (pivots[j] / p0[j], rows[j]))
-            .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
+        self.rank_lost = lost;
+        let mut weakest = (f64::INFINITY, 0);
+        for j in 0..pivots.len() {
+            if p0[j] > 0.0 && pivots[j] / p0[j] < weakest.0 {
+                weakest = (pivots[j] / p0[j], rows[j]);
+            }
+        }
+        // a row whose Jacobian shrank to a fraction of its start size (squared norms): the row of
+        // a loop that vanishes at a change point
+        let norms = row_norms(&self.data);
+        if self.row0.is_empty() {
+            self.row0 = norms.clone();
+        }
+        let skip = &mut self.data.skip_rows;
+        skip.fill(false);
+        self.ratio.resize(dep.len(), 1.0);
+        for r in 0..dep.len() {
+            self.ratio[r] = if self.row0[r] > 0.0 { norms[r] / self.row0[r] } else { 1.0 };
+            if self.ratio[r] < SINGULAR_WINDOW {
+                skip[r] = true;
+            }
+        }
+        for r in 0..dep.len() {
+            if dep[r] && !d0[r] {
+                skip[r] = true;
+                self.ratio[r] = 0.0;
+            }
+        }
         let near = weakest.0 < NEAR_SINGULAR;
-        if near && !self.near_singular {
+        if near && !self.near_singular && !lost {
             let (name, k) = name_of(weakest.1);
             self.warnings.push(format!(
                 "near-singular configuration at t = {t:.6} s: constraint '{name}' (row {k}) nearly vanishes or depends on the others (its pivot fell to {:.1e} of its start value); its multipliers may be large",
                 weakest.0
             ));
         }
-        self.near_singular = near;
+        self.near_singular = near || lost;
         Ok(())
     }
+}
+
+impl MultibodySystem<'_> {
+    /// The accelerations near a singular configuration. There the multiplier of a row whose
+    /// Jacobian row nearly vanished is the quotient of two vanishing numbers (λ = r / S with r,
+    /// S of order s² at a distance s from the singular point), and the state's distance from the
+    /// constraint manifold, divided by S, pushes the motion onto the other branch (a
+    /// parallelogram four-bar flipping to its crossed form). The accelerations along the motion
+    /// are smooth through the point, so they are taken from the neighbouring states
+    /// `q ⊕ ±kτ u`, k = 1, 2, 3 (projected onto the constraints, outside the window of every such
+    /// row) by a Richardson combination exact to O(τ⁶) ([`RICHARDSON`]). The rows' multipliers are reported the same way (of a redundant set near the point
+    /// only their forces are determined). Falls back to the direct solve when no neighbour
+    /// within reach is well conditioned (the motion stops at the singular point: a dead point).
+    fn passage(&mut self, t: f64, q: &[f64], u: &[f64]) -> Result<crate::forces::Powers> {
+        let model = self.model;
+        let (nq, nu, nc) = (model.nq, model.nu, model.nc);
+        let rows: Vec<usize> = (0..nc).filter(|&r| self.data.skip_rows[r]).collect();
+        let speed = u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let p = dynamics::forward_dynamics(model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
+        if speed == 0.0 {
+            return Ok(p);
+        }
+        let (mut qs, mut us) = (vec![0.0; nq], vec![0.0; nu]);
+        let (mut udot, mut lam) = (vec![0.0; nu], vec![0.0; rows.len()]);
+        // the time shift: from a small fraction of the motion upwards until every neighbour lies
+        // outside the window
+        let mut tau = self.passage_tau.max(1e-9 / speed);
+        let mut found = false;
+        let mut data = self.neighbour.take().unwrap_or_else(|| Data::new(model));
+        for _ in 0..48 {
+            let mut ok = true;
+            udot.fill(0.0);
+            lam.fill(0.0);
+            for (shift, weight) in RICHARDSON {
+                model.integrate(q, u, shift * tau, &mut qs);
+                model.normalize(&mut qs);
+                us.copy_from_slice(u);
+                data.skip_rows.fill(false);
+                if dynamics::constrained::project(model, &mut data, &mut self.ws, t, &mut qs, &mut us, self.cb).is_err() {
+                    ok = false;
+                    break;
+                }
+                dynamics::forward_dynamics(model, &mut data, &mut self.ws, t, &qs, &us, None, self.cb)?;
+                let norms = row_norms(&data);
+                if rows.iter().any(|&r| norms[r] < 4.0 * SINGULAR_WINDOW * self.row0[r]) {
+                    ok = false;
+                    break;
+                }
+                for i in 0..nu {
+                    udot[i] += weight * data.udot[i];
+                }
+                for (k, &r) in rows.iter().enumerate() {
+                    lam[k] += weight * data.lambda[r];
+                }
+            }
+            if ok {
+                found = true;
+                break;
+            }
+            tau *= 2.0;
+            if tau * speed > 1.0 {
+                break;
+            }
+        }
+        self.neighbour = Some(data);
+        if !found {
+            return Ok(p);
+        }
+        self.passage_tau = 0.5 * tau;
+        self.data.udot.copy_from_slice(&udot);
+        for (k, &r) in rows.iter().enumerate() {
+            self.data.lambda[r] = lam[k];
+        }
+        // body accelerations of these accelerations (without gravity), for records and reactions
+        self.data.a[0] = crate::spatial::Motion::ZERO;
+        let ud = std::mem::take(&mut self.data.udot);
+        crate::kinematics::accelerations(model, &mut self.data, &ud);
+        self.data.udot = ud;
+        Ok(p)
+    }
+}
+
+/// Shifts (in units of τ) and weights of the neighbours in [`MultibodySystem::passage`]: the
+/// symmetric means m(k) = (f(kτ) + f(−kτ)) / 2 combined as (15 m(1) − 6 m(2) + m(3)) / 10, which
+/// cancels the τ² and τ⁴ terms of their expansions (exact to O(τ⁶)).
+const RICHARDSON: [(f64, f64); 6] =
+    [(1.0, 0.75), (-1.0, 0.75), (2.0, -0.3), (-2.0, -0.3), (3.0, 0.05), (-3.0, 0.05)];
+
+/// Squared norms of the rows of the constraint Jacobian in `data.g`.
+fn row_norms(data: &Data) -> Vec<f64> {
+    (0..data.g.nrows()).map(|r| data.g.row(r).norm_squared()).collect()
 }
 
 impl OdeSystem for MultibodySystem<'_> {
@@ -348,9 +519,12 @@ impl OdeSystem for MultibodySystem<'_> {
         let (nq, nu) = (self.model.nq, self.model.nu);
         let (q, rest) = y.split_at(nq);
         let u = &rest[..nu];
-        let p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
+        let mut p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
         if self.model.nc > 0 {
             self.check_singular(t)?;
+            if self.data.skip_rows.iter().any(|s| *s) {
+                p = self.passage(t, q, u)?;
+            }
         }
         self.model.qdot(q, u, &mut dy[..nq]);
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
@@ -562,7 +736,7 @@ pub fn simulate(
         "integrator: the model has unilateral contacts ('{}'); use MoreauJean (time-stepping) or EventDriven",
         model.contacts[0].name
     );
-    let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization);
+    let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization).with_on_singular(settings.on_singular);
     // a consistent initial state: on the constraint manifolds (assembly from the given q0, u0)
     // (always by projection, whatever the drift control during the run)
     let mut y0 = y0;

@@ -238,6 +238,7 @@ fn drift_control_choices() {
             q0: None,
             u0: None,
             stabilization: s,
+            on_singular: Default::default(),
         };
         let rec = simulate(&model, &settings, &NoCallbacks, None).unwrap();
         rec.constraint_violation.iter().fold(0.0f64, |m, v| m.max(v.abs()))

@@ -254,6 +254,12 @@ fn min_norm_correction(model: &Model, data: &mut Data, sp: &mut Saddle, holonomi
             sp.clear_rows(rows);
         }
     }
+    for r in 0..nc {
+        if data.skip_rows[r] {
+            data.work2[r] = 0.0;
+            sp.clear_rows(r..r + 1);
+        }
+    }
     let sparse = reuse || {
         sp.assemble_schur(false);
         sp.factor_schur(RANK_TOL) || {
@@ -309,6 +315,14 @@ fn dense_gram_factor(model: &Model, data: &mut Data, holonomic_only: bool) {
             }
         }
     }
+    for r in 0..nc {
+        if data.skip_rows[r] {
+            for c in 0..nc {
+                data.schur[r * nc + c] = 0.0;
+                data.schur[c * nc + r] = 0.0;
+            }
+        }
+    }
     data.constraint_rank = cholesky_semidefinite(&mut data.schur, nc, &mut data.perm_c, RANK_TOL);
 }
 
@@ -336,10 +350,19 @@ pub fn project(
     let mut factor_far = false;
     let mut converged = false;
     let mut worst = (0.0, 0usize);
+    // rows near a singular configuration are left out (`data.skip_rows`): the frozen factor would
+    // not know about them
+    let skipping = data.skip_rows.iter().any(|s| *s);
     for _ in 0..20 {
         crate::kinematics::positions(model, data, q);
         constraints::positions(model, data, t, q, cb)?;
-        worst = data.phi.iter().enumerate().fold((0.0, 0), |w, (k, v)| if v.abs() > w.0 { (v.abs(), k) } else { w });
+        let skip = &data.skip_rows;
+        worst = data
+            .phi
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| !skip[*k])
+            .fold((0.0, 0), |w, (k, v)| if v.abs() > w.0 { (v.abs(), k) } else { w });
         if worst.0 <= 1e-13 {
             converged = true;
             break;
@@ -348,7 +371,7 @@ pub fn project(
         sp.gather_g(&data.g);
         // a frozen factor only for the small corrections after a step; full Newton from afar
         let small = worst.0 < 1e-8;
-        let used = min_norm_correction(model, data, sp, true, small && factor);
+        let used = min_norm_correction(model, data, sp, true, small && factor && !skipping);
         // keep only a well-conditioned sparse factor: with nearly dependent rows (a redundancy that
         // is exact only on the manifold) a frozen factor amplifies the change of G
         factor = used && sp.well_conditioned(1e-8);
@@ -376,7 +399,7 @@ pub fn project(
         r[k] -= data.b[k];
     }
     data.work2 = r;
-    min_norm_correction(model, data, sp, false, all_holonomic && !factor_far && factor);
+    min_norm_correction(model, data, sp, false, all_holonomic && !factor_far && factor && !skipping);
     for (v, d) in u.iter_mut().zip(&data.scratch_u) {
         *v -= d;
     }
