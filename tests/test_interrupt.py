@@ -24,8 +24,11 @@ for i in range(10):
     b = m.add_body(f"b{i}", 1.0, ms.inertia.rod(1.0, 0.1), com=(0.05, 0, 0))
     m.add_joint(ms.joints.Revolute(f"j{i}", parent, b, axis=(0, 0, 1), parent_frame=(0.1, 0, 0) if i else None))
     parent = b
+if sys.argv[1] == "callback":
+    # a Python force law: Ctrl-C arrives while the interpreter runs it
+    m.add_force(ms.forces.PythonForce("drag", lambda t, q, u: -0.01 * u))
 print("start", flush=True)
-if sys.argv[1] == "catch":
+if sys.argv[1] in ("catch", "callback"):
     try:
         ms.simulate(m, 1000.0, ms.RK4(dt=1e-5), output_dt=0.01)
     except KeyboardInterrupt:
@@ -68,3 +71,35 @@ def test_uncaught_ctrl_c_ends_the_process_as_an_interrupt():
     assert "KeyboardInterrupt" in out and "after" not in out
     # Python ends an uncaught KeyboardInterrupt by re-raising SIGINT (exit status -2 / 130)
     assert rc in (-signal.SIGINT, 128 + signal.SIGINT), (rc, out)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_ctrl_c_inside_a_python_force_is_a_keyboard_interrupt():
+    # it used to arrive as CallbackError (newcomer finding 10): `except KeyboardInterrupt` missed it
+    rc, out, waited = interrupted("callback")
+    assert "CallbackError" not in out and "FATAL" not in out, out
+    assert rc == 0 and "caught KeyboardInterrupt" in out and "after" in out, out
+    assert waited < 10.0
+
+
+def test_keyboard_interrupt_raised_by_a_callback_passes_through_unchanged():
+    import mechsys as ms
+
+    def law(t, q, u):
+        if t > 0.01:
+            raise KeyboardInterrupt
+        return -u
+
+    m = ms.Model("k", gravity=(0, 0, 0))
+    b = m.add_body("b", 1.0, [1, 1, 1])
+    m.add_joint(ms.joints.Prismatic("x", m.ground, b, axis=(1, 0, 0), u0=1.0))
+    m.add_force(ms.forces.PythonForce("law", law))
+    with pytest.raises(KeyboardInterrupt):
+        ms.simulate(m, 1.0, ms.RK4(dt=1e-3))
+    # any other exception stays a CallbackError naming the element
+    m2 = ms.Model("k2", gravity=(0, 0, 0))
+    b2 = m2.add_body("b", 1.0, [1, 1, 1])
+    m2.add_joint(ms.joints.Prismatic("x", m2.ground, b2, axis=(1, 0, 0), u0=1.0))
+    m2.add_force(ms.forces.PythonForce("bad", lambda t, q, u: 1 / 0))
+    with pytest.raises(ms.CallbackError, match="bad"):
+        ms.simulate(m2, 1.0, ms.RK4(dt=1e-3))

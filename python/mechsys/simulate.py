@@ -16,7 +16,8 @@ from .model import Model
 from .results import Results
 
 
-def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilization=None, on_singular="continue") -> dict:
+def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilization=None, on_singular="continue",
+              max_steps=None, max_wall=None) -> dict:
     if integrator is None:
         integrator = DOPRI5()
     if not hasattr(integrator, "describe"):
@@ -50,6 +51,16 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
         raise SettingsError(f"t_end: must be finite and > t0 = {t0}, got {t_end}")
     if on_singular not in ("continue", "stop"):
         raise SettingsError(f"on_singular: must be 'continue' or 'stop', got {on_singular!r}")
+    if max_steps is not None and not (isinstance(max_steps, (int, np.integer)) and not isinstance(max_steps, bool)
+                                      and max_steps >= 1):
+        raise SettingsError(f"max_steps: must be a whole number >= 1, got {max_steps!r}")
+    if max_wall is not None:
+        try:
+            max_wall = float(max_wall)
+        except (TypeError, ValueError):
+            raise SettingsError(f"max_wall: must be a number of seconds > 0, got {max_wall!r}") from None
+        if not (np.isfinite(max_wall) and max_wall > 0):
+            raise SettingsError(f"max_wall: must be a number of seconds > 0, got {max_wall!r}")
     return {
         "t0": t0,
         "t_end": t_end,
@@ -59,6 +70,8 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
         "u0": model.state_vector(u0, "u").tolist(),
         "stabilization": _stabilization(stabilization),
         "on_singular": on_singular,
+        "max_steps": None if max_steps is None else int(max_steps),
+        "max_wall": max_wall,
     }
 
 
@@ -74,6 +87,8 @@ def simulate(
     keep: Sequence[str] = (),
     stabilization: Any = None,
     on_singular: str = "continue",
+    max_steps: int | None = None,
+    max_wall: float | None = None,
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
@@ -91,7 +106,11 @@ def simulate(
     ``on_singular``: at a singular configuration (the constraint equations lose rank: a dead
     point, a parallelogram linkage passing its flat position) ``"continue"`` (default) goes on
     with minimum-norm multipliers and notes the passage as a warning with its time and
-    constraint; ``"stop"`` raises a SolverError there.
+    constraint; ``"stop"`` raises a SolverError there. ``max_steps`` (accepted steps of RK4,
+    DOPRI5, Radau5) and ``max_wall`` (seconds, any scheme) are budgets: the run stops with a
+    SolverError saying which was spent and at what time. An RK4 run whose energy grows
+    geometrically (a step above the stability limit) stops with a SolverError naming the stiffest
+    spring and the step that would be stable.
     """
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
@@ -104,7 +123,7 @@ def simulate(
         from .analysis import assemble
 
         q0, u0 = assemble(model, q0, u0, float(t0), keep=keep)
-    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization, on_singular)
+    settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization, on_singular, max_steps, max_wall)
     text = json.dumps(settings)
     callbacks = model.callbacks or None
     prog = _core.Progress()

@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::integrator::{self, IntegratorKind, OdeSystem, Stats};
 use crate::kinematics::{point_acceleration, point_velocity};
-use crate::model::Model;
+use crate::model::{ForceElement, Model};
 
 /// Settings of one simulation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -43,6 +43,58 @@ pub struct Settings {
     /// What a singular configuration (the constraint rows lose rank) does to the run.
     #[serde(default)]
     pub on_singular: OnSingular,
+    /// Most accepted steps of a smooth scheme (RK4, DOPRI5, Radau5) before the run stops.
+    #[serde(default)]
+    pub max_steps: Option<u64>,
+    /// Most wall-clock seconds before the run stops (checked at every sample and every 256 steps).
+    #[serde(default)]
+    pub max_wall: Option<f64>,
+}
+
+/// The run's budgets ([`Settings::max_steps`], [`Settings::max_wall`]) and the clock.
+#[derive(Debug, Clone)]
+pub struct Budget {
+    start: std::time::Instant,
+    max_steps: Option<u64>,
+    max_wall: Option<f64>,
+    steps: u64,
+}
+
+impl Budget {
+    /// Starts the clock.
+    pub fn new(settings: &Settings) -> Self {
+        Budget { start: std::time::Instant::now(), max_steps: settings.max_steps, max_wall: settings.max_wall, steps: 0 }
+    }
+
+    /// An error once the wall-time budget is spent.
+    pub fn wall(&self, t: f64) -> Result<()> {
+        if let Some(w) = self.max_wall {
+            let used = self.start.elapsed().as_secs_f64();
+            if used > w {
+                return Err(Error::Solver(format!(
+                    "wall-time budget of {w} s spent at t = {t:.6} s ({used:.3} s): raise max_wall, or shorten the run"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Counts an accepted step; an error once the step budget is spent.
+    pub fn step(&mut self, t: f64) -> Result<()> {
+        self.steps += 1;
+        if let Some(n) = self.max_steps {
+            if self.steps > n {
+                return Err(Error::Solver(format!(
+                    "step budget of {n} accepted steps spent at t = {t:.6} s: raise max_steps, or look for what makes the \
+                     steps small (a stiff element, a near-singular configuration, a tolerance too tight)"
+                )));
+            }
+        }
+        if self.steps % 256 == 0 {
+            self.wall(t)?;
+        }
+        Ok(())
+    }
 }
 
 /// What a run does where the constraint equations lose rank (a dead point, a change point of a
@@ -291,6 +343,8 @@ pub struct MultibodySystem<'a> {
     ratio: Vec<f64>,
     /// Squared norms of the constraint Jacobian's rows at the first evaluation.
     row0: Vec<f64>,
+    /// Step and wall-time budgets.
+    pub budget: Option<Budget>,
     /// Near-singular passages met so far.
     pub warnings: Vec<String>,
 }
@@ -312,6 +366,7 @@ impl<'a> MultibodySystem<'a> {
             neighbour: None,
             ratio: Vec::new(),
             row0: Vec::new(),
+            budget: None,
             warnings: Vec::new(),
         }
     }
@@ -533,6 +588,9 @@ impl OdeSystem for MultibodySystem<'_> {
         Ok(())
     }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        if let Some(b) = self.budget.as_mut() {
+            b.step(t)?;
+        }
         let (nq, nu) = (self.model.nq, self.model.nu);
         if self.model.n_sliders > 0 {
             let chains = &mut self.ws.forces.jenkins;
@@ -600,6 +658,31 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         s.output_dt
     );
     let span = s.t_end - s.t0;
+    if let IntegratorKind::Rk4 { dt } | IntegratorKind::Radau5 { dt, .. } | IntegratorKind::MoreauJean { dt, .. } =
+        s.integrator
+    {
+        crate::ensure!(
+            !(dt > span * (1.0 + 1e-12)),
+            Settings,
+            "integrator.dt: the step ({dt} s) is longer than the run ({span} s from t0 to t_end)"
+        );
+    }
+    crate::ensure!(
+        s.output_dt <= span * (1.0 + 1e-12),
+        Settings,
+        "output_dt: {} s is longer than the run ({span} s from t0 to t_end): the results would hold the start only",
+        s.output_dt
+    );
+    if let IntegratorKind::Dopri5 { rtol, atol, .. } = s.integrator {
+        // below ~100 ε the error estimate is round-off: the step size collapses instead of converging
+        crate::ensure!(
+            rtol.is_finite() && (1e-14..1.0).contains(&rtol),
+            Settings,
+            "integrator.rtol: must be in [1e-14, 1) (below 1e-14 double precision cannot meet it; 1 and above \
+             control nothing), got {rtol:e}"
+        );
+        crate::ensure!(atol.is_finite() && atol >= 0.0, Settings, "integrator.atol: must be >= 0, got {atol}");
+    }
     let n_out = ((span / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() as usize + 1;
     let width = 1 + 2 * model.nq + 3 * model.nu + 17 * model.nbodies() + 10;
     crate::ensure!(
@@ -754,17 +837,106 @@ pub fn simulate(
         )?;
     }
     let mut scratch = vec![0.0; sys.dim()];
+    // an explicit fixed step above its stability limit grows the energy geometrically: watched
+    // for RK4 (the adaptive and implicit schemes control or damp it); variable-mass bodies carry
+    // energy away with the ejected mass, so their balance is not checked
+    let guard = matches!(settings.integrator, IntegratorKind::Rk4 { .. }) && model.bodies.iter().all(|b| b.mass_rate == 0.0);
+    let mut divergence = Divergence::default();
+    sys.budget = Some(Budget::new(settings));
     let mut observer = |sys: &mut MultibodySystem, t: f64, y: &[f64], fresh: bool| -> Result<()> {
         if !fresh {
             sys.rhs(t, y, &mut scratch)?;
         }
         record(model, &sys.data, &sys.ws.saddle, t, y, &mut rec);
+        if guard {
+            if let Some(msg) = divergence.check(&rec, t) {
+                return Err(divergence_error(model, settings, &mut sys.data, t, y, msg));
+            }
+        }
+        if let Some(b) = &sys.budget {
+            b.wall(t)?;
+        }
         report_progress(progress, rec.t.len(), t)
     };
     let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
     rec.stats = stats;
     rec.warnings = std::mem::take(&mut sys.warnings);
     Ok(rec)
+}
+
+/// Watches the energy balance of a fixed-step explicit run: the kinetic plus potential energy
+/// minus the external work plus the dissipated energy is constant for a stable run (to the
+/// integration error); above the step's stability limit it grows geometrically.
+#[derive(Debug, Default)]
+struct Divergence {
+    /// |T| + |V| + |W| + |D| of the first sample.
+    start: f64,
+    /// The energy balance T + V − W + D of the first sample.
+    balance0: f64,
+}
+
+impl Divergence {
+    /// What grew when the energy balance grew beyond half of all the energies present and to a
+    /// thousand times the energies at the start (and well above round-off: a millijoule per
+    /// tonne), else None.
+    fn check(&mut self, rec: &Recording, t: f64) -> Option<String> {
+        let k = rec.t.len() - 1;
+        let (tk, v, w, d) = (rec.kinetic[k], rec.potential[k], rec.external_work[k], rec.dissipated[k]);
+        let balance = tk + v - w + d;
+        let size = tk.abs() + v.abs() + w.abs() + d.abs();
+        if k == 0 {
+            (self.start, self.balance0) = (size, balance);
+            return None;
+        }
+        let grown = (balance - self.balance0).abs();
+        let floor = 1e-6 * rec.body_mass.iter().take(rec.n_bodies).sum::<f64>();
+        if grown > 0.5 * size && size > 1e3 * self.start.max(floor) {
+            Some(format!(
+                "the run diverged at t = {t:.6} s: the energy grew from {:.4e} J to {balance:.4e} J with nothing doing that work",
+                self.balance0
+            ))
+        } else {
+            None
+        }
+    }
+}
+
+/// The divergence error: the step, the stiffest spring (point-to-point `k (1/m1 + 1/m2)`, or a
+/// joint spring's `k / M_ii` with the mass matrix at the state) and the step that would be stable.
+fn divergence_error(model: &Model, settings: &Settings, data: &mut Data, t: f64, y: &[f64], msg: String) -> Error {
+    let IntegratorKind::Rk4 { dt } = settings.integrator else { return Error::Solver(msg) };
+    let mut msg = msg + &format!("; the fixed step dt = {dt} s is above the scheme's stability limit");
+    let inv_mass = |b: usize| if b == 0 { 0.0 } else { 1.0 / model.bodies[b].mass };
+    let mut stiffest: Option<(String, f64)> = None;
+    let mut consider = |name: String, w2: f64| {
+        if w2.is_finite() && w2 > 0.0 && stiffest.as_ref().is_none_or(|s| w2.sqrt() > s.1) {
+            stiffest = Some((name, w2.sqrt()));
+        }
+    };
+    for f in &model.forces {
+        if let ForceElement::SpringDamper { name, body1, body2, k, .. } = f {
+            consider(format!("force element '{name}'"), k.abs() * (inv_mass(*body1) + inv_mass(*body2)));
+        }
+    }
+    let q = &y[..model.nq];
+    if q.iter().all(|v| v.is_finite()) && model.joints.iter().any(|j| j.spring.is_some()) {
+        crate::dynamics::crba::mass_matrix(model, data, t, q);
+        for j in &model.joints {
+            if let Some(sp) = &j.spring {
+                for (i, k) in sp.k.iter().enumerate() {
+                    let m = data.mass_matrix[(j.iu + i, j.iu + i)];
+                    consider(format!("the spring of joint '{}'", j.name), k.abs() / m);
+                }
+            }
+        }
+    }
+    if let Some((name, omega)) = stiffest {
+        msg += &format!(
+            " ({name}, the stiffest spring, oscillates at about {omega:.4e} rad/s: RK4 is stable for dt < 2.8 / omega = {:.3e} s)",
+            2.8 / omega
+        );
+    }
+    Error::Solver(msg + "; reduce dt, or use DOPRI5 (adaptive) or Radau5 (implicit, for stiff models)")
 }
 
 /// The Moreau–Jean run: steps of `dt`, a sample after every `output_dt / dt` steps.
@@ -779,6 +951,7 @@ fn time_stepping(
     (dt, solver, continue_on_painleve): (f64, crate::solver::Method, bool),
     mut rec: Recording,
 ) -> Result<Recording> {
+    let budget = Budget::new(settings);
     use crate::integrator::moreau_jean::MoreauJean;
     let (nq, nu, np) = (model.nq, model.nu, model.n_contact_points);
     // (prepare() checked that output_dt is a whole multiple of dt)
@@ -911,6 +1084,7 @@ fn time_stepping(
             rec.group_pairs.push(g.pairs as f64);
             rec.group_impulse_against.extend_from_slice(&g.impulse_against);
         }
+        budget.wall(t_rec)?;
         report_progress(progress, rec.t.len(), t_rec)?;
     }
     rec.events = EventRecord::from_log(model, &log);
@@ -939,6 +1113,7 @@ fn event_driven(
     opts: crate::integrator::event_driven::Options,
     mut rec: Recording,
 ) -> Result<Recording> {
+    let budget = Budget::new(settings);
     use crate::integrator::event_driven::{self, Phase};
     let (nq, nu, np) = (model.nq, model.nu, model.n_contact_points);
     let mut phase = Phase::new(model, cb, opts)?;
@@ -976,6 +1151,7 @@ fn event_driven(
         }
         rec.dissipated_impact.push(e_impact);
         rec.dissipated_friction.push(y[e + 2] + e_impulsive_friction);
+        budget.wall(t)?;
         report_progress(progress, rec.t.len(), t)
     };
     let stats = event_driven::integrate(&mut phase, settings.t0, &y, t_out, &mut warnings, &mut sample)?;

@@ -28,6 +28,9 @@ fn raise(class: &str, msg: String) -> PyErr {
 impl From<PyMechsysError> for PyErr {
     fn from(e: PyMechsysError) -> PyErr {
         let msg = e.0.to_string();
+        if matches!(e.0, Error::Callback(_)) && msg.contains(crate::simulate::INTERRUPTED) {
+            return pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted inside a Python callback");
+        }
         let class = match e.0 {
             Error::Model(_) | Error::Description { .. } => "ModelError",
             Error::Settings(_) => "SettingsError",

@@ -48,8 +48,15 @@ fn shape_str(shape: &[usize]) -> String {
     }
 }
 
+/// Marks a callback error that is a KeyboardInterrupt (Ctrl-C inside a Python force law), so that
+/// it reaches the script as KeyboardInterrupt again instead of as a CallbackError.
+pub const INTERRUPTED: &str = "\u{1}KeyboardInterrupt in a callback";
+
 fn py_err(e: PyErr) -> Error {
     Python::with_gil(|py| {
+        if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+            return Error::Callback(INTERRUPTED.into());
+        }
         let tb = e.traceback(py).and_then(|t| t.format().ok()).unwrap_or_default();
         Error::Callback(format!("{e}{}", if tb.is_empty() { String::new() } else { format!("\n{tb}") }))
     })

@@ -239,6 +239,8 @@ fn drift_control_choices() {
             u0: None,
             stabilization: s,
             on_singular: Default::default(),
+            max_steps: None,
+            max_wall: None,
         };
         let rec = simulate(&model, &settings, &NoCallbacks, None).unwrap();
         rec.constraint_violation.iter().fold(0.0f64, |m, v| m.max(v.abs()))
