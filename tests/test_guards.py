@@ -65,3 +65,37 @@ def test_step_and_wall_budgets():
 def test_settings_that_cannot_give_a_meaningful_run_are_refused(kwargs, message):
     with pytest.raises(ms.SettingsError, match=message):
         ms.simulate(spring(1.0), 0.5, **kwargs)
+
+
+# ---- point masses (issue 13, part 4) ---------------------------------------------------------------
+
+
+def test_point_mass_pendulum_period_is_the_elliptic_integral():
+    from scipy.special import ellipk
+
+    g, l, th0 = 9.81, 0.8, 2.0  # large amplitude: far from the small-angle period
+    m = ms.Model("point-pendulum", gravity=(0, 0, -g))
+    bob = m.add_body("bob", 0.5, [0, 0, 0], com=(0, 0, -l))  # a point mass: zero inertia
+    m.add_joint(ms.joints.Revolute("hinge", m.ground, bob, axis=(1, 0, 0), q0=th0))
+    period = 4 * np.sqrt(l / g) * ellipk(np.sin(th0 / 2) ** 2)
+    res = ms.simulate(m, period, ms.DOPRI5(rtol=1e-12, atol=1e-14), output_dt=period / 400)
+    q = res["joint/hinge/q"]
+    assert q[-1] == pytest.approx(th0, abs=1e-8) and q[200] == pytest.approx(-th0, abs=1e-8)
+    assert np.ptp(res["energy/total"]) < 1e-10
+
+
+def test_a_point_mass_turning_about_its_own_centre_is_named():
+    m = ms.Model("pm")
+    b = m.add_body("bob", 1.0, [0, 0, 0])
+    m.add_joint(ms.joints.Spherical("ball", m.ground, b))
+    with pytest.raises(ms.ModelError, match=r"'ball' \(velocity 0\).*move no inertia"):
+        ms.simulate(m, 1.0)
+    with pytest.raises(ms.ModelError, match="negative principal moment"):
+        ms.Model("neg").add_body("b", 1.0, [-1, 1, 1]).model.build() if False else _negative()
+
+
+def _negative():
+    m = ms.Model("neg")
+    b = m.add_body("b", 1.0, [-1.0, 1.0, 1.0])
+    m.add_joint(ms.joints.Revolute("r", m.ground, b))
+    m.build()

@@ -641,6 +641,36 @@ pub fn matrix_to_quaternion(a: &crate::math::Mat3) -> [f64; 4] {
     }
 }
 
+/// A `ModelError` naming the joint coordinates that move no inertia at the start (bodies of zero
+/// inertia are allowed: a point mass turning about its own centre is not): the equations of
+/// motion have no solution for their accelerations.
+pub fn check_inertia(model: &Model, t: f64, q: &[f64]) -> Result<()> {
+    let nu = model.nu;
+    if nu == 0 || model.bodies.iter().skip(1).all(|b| b.principal_axes && b.inertia.diagonal().min() > 0.0) {
+        return Ok(());
+    }
+    let mut data = Data::new(model);
+    crate::kinematics::positions(model, &mut data, q);
+    crate::dynamics::crba::mass_matrix(model, &mut data, t, q);
+    let m = &data.mass_matrix;
+    let big = (0..nu).map(|i| m[(i, i)].abs()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let name = |i: usize| {
+        let j = model.joints.iter().find(|j| j.iu <= i && i < j.iu + j.nu()).expect("every velocity has a joint");
+        if j.nu() == 1 { format!("'{}'", j.name) } else { format!("'{}' (velocity {})", j.name, i - j.iu) }
+    };
+    let light: Vec<String> = (0..nu).filter(|&i| !(m[(i, i)] > 1e-12 * big)).map(name).collect();
+    let singular = !light.is_empty() || m.clone().cholesky().is_none();
+    crate::ensure!(
+        !singular,
+        Model,
+        "the joint coordinate(s) {} move no inertia at t = {t} s (a body of zero inertia turning about its own centre, \
+         or massless bodies alone on a joint): their accelerations are undetermined; give those bodies inertia, \
+         offset the centre of mass from the joint, or remove the coordinate",
+        if light.is_empty() { "of a combination".to_string() } else { light.join(", ") }
+    );
+    Ok(())
+}
+
 /// Checks settings and returns the output times and the initial state.
 pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
     crate::ensure!(s.t0.is_finite(), Settings, "t0: must be finite, got {}", s.t0);
@@ -743,6 +773,7 @@ pub fn simulate(
     progress: Option<&Progress>,
 ) -> Result<Recording> {
     let (t_out, y0) = prepare(model, settings)?;
+    check_inertia(model, settings.t0, &y0[..model.nq])?;
     let n_out = t_out.len();
     let nb = model.nbodies() - 1;
     let (nq, nu) = (model.nq, model.nu);

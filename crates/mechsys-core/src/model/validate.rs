@@ -129,10 +129,13 @@ pub(crate) fn inertia(desc: &InertiaDescription, what: &str) -> Result<Mat3> {
     let mut eig: Vec<f64> = SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
     eig.sort_by(|x, y| x.total_cmp(y));
     let (a, b, c) = (eig[0], eig[1], eig[2]);
+    // zero moments are allowed (a point mass, a thin rod about its axis): a coordinate that then
+    // moves nothing with inertia is reported by name when a run starts
+    let floor = -1e-12 * scale;
     crate::ensure!(
-        a > 0.0 && b > 0.0 && c > 0.0,
+        a >= floor && b >= floor && c >= floor,
         Model,
-        "{what}: inertia tensor is not positive definite (principal moments {a:.6e}, {b:.6e}, {c:.6e})"
+        "{what}: inertia tensor has a negative principal moment (principal moments {a:.6e}, {b:.6e}, {c:.6e})"
     );
     // triangle inequalities of the principal moments: each ≤ sum of the other two
     let tol = 1e-9 * (a + b + c);
