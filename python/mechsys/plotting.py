@@ -119,7 +119,9 @@ def plot(
         if a.shape[1] == 1:
             ax.plot(t, a[:, 0], lw=1.2)
         else:
-            for label, col in zip(component_labels(n, unit, a.shape[1]), a.T):
+            named = getattr(results, "_columns", {}).get(n, ([],))[0]
+            labels = named if len(named) == a.shape[1] else component_labels(n, unit, a.shape[1])
+            for label, col in zip(labels, a.T):
                 ax.plot(t, col, lw=1.2, label=label)
             ax.legend(loc="upper right", fontsize="small", ncols=min(a.shape[1], 7), framealpha=0.7)
         ax.set_title(n, fontsize="medium")

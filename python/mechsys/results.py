@@ -31,11 +31,17 @@ joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint ori
 Models with contacts (Moreau-Jean) add, per contact (shape (n,) for one candidate point, (n, k)
 for k points; tangential ones (n, [k,] 2) in 3-D): ``contact/<c>/g_n`` (m), ``gd_n``, ``gd_t``
 (m/s), ``lambda_n``, ``lambda_t`` (N, the step's impulse over the step), ``impulse_n``,
-``impulse_t`` (N s), ``state`` (0 open, 1 stick, 2 slip), ``friction_reserve`` (mu0 lambda_N -
+``impulse_t`` (N s), ``state`` (int8 levels open 0, stick 1, slip 2: ``res.levels(name)``; an
+HDF5 enum in files), ``friction_reserve`` (mu0 lambda_N -
 |lambda_T|, N), and ``energy/dissipated_impact``, ``energy/dissipated_friction`` (J).
 
 ``constraint/<c>/velocity_violation`` (the violation's unit per second, same shape as
 ``violation``) is ``G u - b`` for every row, the velocity-only (non-holonomic) rows included.
+
+Vector signals name their columns and give each its unit: ``res.columns("q")`` ->
+``["hinge.angle", "float.x", ..., "float.qw", ...]``, ``res.column_units("q")`` -> ``["rad",
+"m", ..., "1", ...]``. Arrays are read-only views (``np.array(res[name])`` for a copy to change).
+``res.to_pandas()`` and ``res.to_xarray()`` give labelled tables (with pandas / xarray installed).
 """
 
 from __future__ import annotations
@@ -47,6 +53,22 @@ from typing import Callable, Iterable
 import numpy as np
 
 from .errors import ResultsError
+
+# per joint type: (q columns, q units, u columns, u units); udot has u's columns and units per s
+_JOINT_COLUMNS = {
+    "revolute": (["angle"], ["rad"], ["rate"], ["rad/s"]),
+    "prismatic": (["position"], ["m"], ["rate"], ["m/s"]),
+    "cylindrical": (["angle", "position"], ["rad", "m"], ["angle rate", "rate"], ["rad/s", "m/s"]),
+    "universal": (["angle1", "angle2"], ["rad", "rad"], ["rate1", "rate2"], ["rad/s", "rad/s"]),
+    "spherical": (["qw", "qx", "qy", "qz"], ["1"] * 4, ["wx", "wy", "wz"], ["rad/s"] * 3),
+    "planar": (["x", "y", "angle"], ["m", "m", "rad"], ["vx", "vy", "rate"], ["m/s", "m/s", "rad/s"]),
+    "free": (["x", "y", "z", "qw", "qx", "qy", "qz"], ["m"] * 3 + ["1"] * 4, ["vx", "vy", "vz", "wx", "wy", "wz"],
+             ["m/s"] * 3 + ["rad/s"] * 3),
+    "fixed": ([], [], [], []),
+}
+
+#: the levels of the contact state signals (an HDF5 enum in files)
+CONTACT_STATES = {"open": 0, "stick": 1, "slip": 2}
 
 _JOINT_UNITS = {
     "revolute": ("rad", "rad/s", "rad/s^2"),
@@ -76,6 +98,8 @@ class Results:
         self.attrs = dict(attrs or {})
         # signals derived from the recorded state on first access: name -> (unit, group computer)
         self._lazy = dict(lazy or {})
+        # per-column names and units of vector signals: name -> (columns, units)
+        self._columns: dict[str, tuple[list, list]] = {}
 
     # ---- construction from a simulation --------------------------------------------------------
     @classmethod
@@ -84,15 +108,27 @@ class Results:
     ) -> "Results":
         s: dict[str, np.ndarray] = {}
         u: dict[str, str] = {}
+        cols: dict[str, tuple[list, list]] = {}
+        xyz = ["x", "y", "z"]
 
-        def put(name, arr, unit):
+        def put(name, arr, unit, columns=None, column_units=None):
             s[name] = arr
             u[name] = unit
+            if columns is not None:
+                cols[name] = (list(columns), list(column_units) if column_units is not None else [unit] * len(columns))
 
+        qc, qu, uc, uu_ = [], [], [], []
+        for j in joints:
+            a, b, c, d = _JOINT_COLUMNS.get(j["type"], ([f"q{i}" for i in range(j["nq"])], [""] * j["nq"],
+                                                         [f"u{i}" for i in range(j["nu"])], [""] * j["nu"]))
+            qc += [f"{j['name']}.{x}" for x in a]
+            qu += b
+            uc += [f"{j['name']}.{x}" for x in c]
+            uu_ += d
         put("t", raw["t"], "s")
-        put("q", raw["q"], "mixed")
-        put("u", raw["u"], "mixed")
-        put("udot", raw["udot"], "mixed")
+        put("q", raw["q"], "mixed", qc, qu)
+        put("u", raw["u"], "mixed", uc, uu_)
+        put("udot", raw["udot"], "mixed", uc, [_rate_unit(x) for x in uu_])
         for j in joints:
             uq, uu, ua = _JOINT_UNITS.get(j["type"], ("", "", ""))
             if j["nq"] == 0:
@@ -100,15 +136,17 @@ class Results:
             sq = slice(j["iq"], j["iq"] + j["nq"])
             su = slice(j["iu"], j["iu"] + j["nu"])
             one = j["nq"] == 1
-            put(f"joint/{j['name']}/q", raw["q"][:, j["iq"]] if one else raw["q"][:, sq], uq)
-            put(f"joint/{j['name']}/u", raw["u"][:, j["iu"]] if one else raw["u"][:, su], uu)
-            put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua)
+            a, b, c, d = _JOINT_COLUMNS.get(j["type"], (None, None, None, None))
+            put(f"joint/{j['name']}/q", raw["q"][:, j["iq"]] if one else raw["q"][:, sq], uq, None if one else a, b)
+            put(f"joint/{j['name']}/u", raw["u"][:, j["iu"]] if one else raw["u"][:, su], uu, None if one else c, d)
+            put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua, None if one else c,
+                None if one or d is None else [_rate_unit(x) for x in d])
         for k, b in enumerate(body_names):
-            put(f"body/{b}/position", raw["body_position"][:, k, :], "m")
-            put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1")
-            put(f"body/{b}/velocity", raw["body_velocity"][:, k, :], "m/s")
-            put(f"body/{b}/angular_velocity", raw["body_angular_velocity"][:, k, :], "rad/s")
-            put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2")
+            put(f"body/{b}/position", raw["body_position"][:, k, :], "m", xyz)
+            put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1", ["w", "x", "y", "z"])
+            put(f"body/{b}/velocity", raw["body_velocity"][:, k, :], "m/s", xyz)
+            put(f"body/{b}/angular_velocity", raw["body_angular_velocity"][:, k, :], "rad/s", xyz)
+            put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2", xyz)
             put(f"body/{b}/mass", raw["body_mass"][:, k], "kg")
             put(f"body/{b}/kinetic_energy", raw["body_kinetic"][:, k], "J")
         put("energy/kinetic", raw["kinetic"], "J")
@@ -118,8 +156,8 @@ class Results:
         contact_loss = raw["dissipated_impact"] + raw["dissipated_friction"] if "dissipated_impact" in raw else 0.0
         put("energy/dissipated", raw["dissipated"] + contact_loss, "J")
         put("energy/external_work", raw["external_work"], "J")
-        put("momentum/linear", raw["momentum_linear"], "N s")
-        put("momentum/angular", raw["momentum_angular"], "N m s")
+        put("momentum/linear", raw["momentum_linear"], "N s", xyz)
+        put("momentum/angular", raw["momentum_angular"], "N m s", xyz)
         if engine is not None:
             for c in engine.constraints():
                 sl = slice(c["row"], c["row"] + c["rows"])
@@ -151,7 +189,7 @@ class Results:
                 put(f"{pre}/lambda_t", raw["contact_lambda_t"][:, sl, :nt] if nt > 1 else raw["contact_lambda_t"][:, sl, 0], "N")
                 put(f"{pre}/impulse_n", raw["contact_impulse_n"][:, sl], "N s")
                 put(f"{pre}/impulse_t", raw["contact_impulse_t"][:, sl, :nt] if nt > 1 else raw["contact_impulse_t"][:, sl, 0], "N s")
-                put(f"{pre}/state", raw["contact_state"][:, sl], "0 open, 1 stick, 2 slip")
+                put(f"{pre}/state", np.asarray(raw["contact_state"][:, sl]).astype(np.int8), "1")
                 put(f"{pre}/friction_reserve", raw["contact_reserve"][:, sl], "N")
         if engine is not None and "group_closed" in raw:
             # contact groups (mechsys.ContactGroup): one column per group
@@ -166,13 +204,17 @@ class Results:
                 put(f"{pre}/pairs", raw["group_pairs"][:, k], "1")
                 put(f"{pre}/impulse_against", raw["group_impulse_against"][:, k, :], "N s")
                 put(f"{pre}/force_against", raw["group_impulse_against"][:, k, :] / span[:, None], "N")
+        for a in s.values():
+            a.setflags(write=False)
         lazy = {}
         if engine is not None and joints:
             group = _reaction_group(engine, callbacks, joints, raw)
             for j in joints:
                 lazy[f"joint/{j['name']}/reaction_force"] = ("N", group)
                 lazy[f"joint/{j['name']}/reaction_torque"] = ("N m", group)
-        return cls(s, u, attrs, lazy)
+        out = cls(s, u, attrs, lazy)
+        out._columns = cols
+        return out
 
     # ---- access --------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> np.ndarray:
@@ -191,8 +233,85 @@ class Results:
     def _materialize(self, name: str) -> None:
         unit, compute = self._lazy[name]
         for n, arr in compute().items():
+            arr.setflags(write=False)
             self._signals[n] = arr
             self._units[n] = self._lazy.pop(n, (unit, None))[0]
+            if arr.ndim == 2 and arr.shape[1] == 3:
+                self._columns[n] = (["x", "y", "z"], [self._units[n]] * 3)
+
+    def columns(self, name: str) -> list[str]:
+        """Names of a signal's columns (joint coordinates as ``joint.x``, ``joint.qw``, ...;
+        components ``x``, ``y``, ``z``; ``[k]`` where nothing better is known); one name for a
+        scalar signal."""
+        a = self[name]
+        if name in self._columns:
+            return list(self._columns[name][0])
+        if a.ndim == 1:
+            return [name.rsplit("/", 1)[-1]]
+        return [f"[{k}]" for k in range(int(np.prod(a.shape[1:])))]
+
+    def column_units(self, name: str) -> list[str]:
+        """The unit of each column (``q``: m for positions, 1 for quaternion entries, rad for
+        angles, ...)."""
+        if name in self._columns:
+            self[name]
+            return list(self._columns[name][1])
+        return [self.unit(name)] * len(self.columns(name))
+
+    def levels(self, name: str) -> dict[str, int] | None:
+        """The named levels of an integer signal (a contact's ``state``: open 0, stick 1, slip 2),
+        else None."""
+        self[name]
+        return dict(CONTACT_STATES) if name.startswith("contact/") and name.endswith("/state") else None
+
+    def to_pandas(self, signals: Iterable[str] | None = None):
+        """A pandas DataFrame indexed by time (s): one column per scalar signal, ``name.column``
+        for each column of a vector signal (all signals with one row per sample by default);
+        ``df.attrs["units"]`` maps every column to its unit. Needs pandas."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ResultsError("to_pandas needs pandas (pip install pandas)") from None
+        data, units = {}, {}
+        for n, a2, cols, cu in self._tables(signals):
+            for k, (c, un) in enumerate(zip(cols, cu)):
+                key = n if a2.shape[1] == 1 else f"{n}.{c}"
+                data[key] = a2[:, k]
+                units[key] = un
+        df = pd.DataFrame(data, index=pd.Index(np.asarray(self.t), name="t"))
+        df.attrs["units"] = units
+        return df
+
+    def to_xarray(self, signals: Iterable[str] | None = None):
+        """An xarray Dataset over the time coordinate ``t`` (s): one variable per signal, vector
+        signals with a second dimension ``<name>/column`` labelled by the column names; each
+        variable's ``units`` attribute (and ``column_units`` for vectors). Needs xarray."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise ResultsError("to_xarray needs xarray (pip install xarray)") from None
+        data = {}
+        for n, a2, cols, cu in self._tables(signals):
+            if a2.shape[1] == 1:
+                data[n] = xr.DataArray(a2[:, 0], dims=("t",), attrs={"units": cu[0]})
+            else:
+                dim = f"{n}/column"
+                data[n] = xr.DataArray(a2, dims=("t", dim), coords={dim: cols},
+                                       attrs={"units": self.unit(n), "column_units": list(cu)})
+        return xr.Dataset(data, coords={"t": ("t", np.asarray(self.t), {"units": "s"})})
+
+    def _tables(self, signals):
+        names = list(signals) if signals is not None else [n for n in self.names() if n != "t"]
+        out = []
+        for n in names:
+            a = np.asarray(self[n])
+            if a.shape[0] != len(self.t) or a.ndim > 2:
+                if signals is not None:
+                    raise ResultsError(f"signal '{n}' is not a table of one row per sample (shape {a.shape})")
+                continue
+            a2 = a.reshape(len(self.t), -1)
+            out.append((n, a2, self.columns(n), self.column_units(n)))
+        return out
 
     def __contains__(self, name: str) -> bool:
         return name in self._signals or name in self._lazy
@@ -275,8 +394,16 @@ class Results:
                     f.attrs[k] = v
             f.attrs["signal_order"] = json.dumps(list(self._signals))
             for name, arr in self._signals.items():
-                ds = f.create_dataset(name, data=np.ascontiguousarray(arr))
+                data = np.ascontiguousarray(arr)
+                if self.levels(name) is not None:
+                    ds = f.create_dataset(name, data=data.astype(np.int8),
+                                          dtype=h5py.enum_dtype(CONTACT_STATES, basetype="i1"))
+                else:
+                    ds = f.create_dataset(name, data=data)
                 ds.attrs["unit"] = self._units.get(name, "")
+                if name in self._columns:
+                    ds.attrs["columns"] = json.dumps(self._columns[name][0])
+                    ds.attrs["column_units"] = json.dumps(self._columns[name][1])
         return path
 
     @classmethod
@@ -296,17 +423,27 @@ class Results:
                 raise ResultsError(f"'{path}' is an HDF5 file but not mechsys results (no 'format' attribute)")
             signals: dict[str, np.ndarray] = {}
             units: dict[str, str] = {}
+            columns: dict[str, tuple[list, list]] = {}
 
             def visit(name, obj):
                 if isinstance(obj, h5py.Dataset):
-                    signals[name] = obj[()]
+                    arr = np.asarray(obj[()])
+                    arr.setflags(write=False)
+                    signals[name] = arr
                     units[name] = str(obj.attrs.get("unit", ""))
+                    if "columns" in obj.attrs:
+                        try:
+                            columns[name] = (json.loads(obj.attrs["columns"]), json.loads(obj.attrs["column_units"]))
+                        except (KeyError, ValueError, TypeError):
+                            raise ResultsError(f"'{path}': signal '{name}': unreadable column names") from None
 
             f.visititems(visit)
             attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
         order = json.loads(attrs.pop("signal_order", "[]"))
         order = [n for n in order if n in signals] + [n for n in signals if n not in order]
-        return cls({n: signals[n] for n in order}, units, attrs)
+        out = cls({n: signals[n] for n in order}, units, attrs)
+        out._columns = columns
+        return out
 
     def to_csv(self, path: str | Path, signals: Iterable[str] | None = None) -> Path:
         """Writes chosen signals (all scalar and vector ones if None) as CSV with a header row
@@ -324,7 +461,7 @@ class Results:
             if a2.shape[1] == 1:
                 header.append(f"{n} [{unit}]")
             else:
-                header.extend(f"{n}[{i}] [{unit}]" for i in range(a2.shape[1]))
+                header.extend(f"{n}[{i}] [{cu}]" for i, cu in enumerate(self.column_units(n)))
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
@@ -363,4 +500,9 @@ def _rate_unit(unit: str) -> str:
     """The unit of the time rate of a quantity in ``unit`` ("m" -> "m/s", "N, N m" style lists per part)."""
     if not unit:
         return "1/s"
-    return ", ".join(f"{part.strip()}/s" for part in unit.split(","))
+    return ", ".join(_per_second(part.strip()) for part in unit.split(","))
+
+
+def _per_second(unit: str) -> str:
+    """"m/s" -> "m/s^2", "m" -> "m/s"."""
+    return unit[:-2] + "/s^2" if unit.endswith("/s") else f"{unit}/s"
