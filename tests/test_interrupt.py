@@ -103,3 +103,33 @@ def test_keyboard_interrupt_raised_by_a_callback_passes_through_unchanged():
     m2.add_force(ms.forces.PythonForce("bad", lambda t, q, u: 1 / 0))
     with pytest.raises(ms.CallbackError, match="bad"):
         ms.simulate(m2, 1.0, ms.RK4(dt=1e-3))
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_ctrl_c_in_mechsys_run_exits_130(tmp_path):
+    model = tmp_path / "chain.py"
+    model.write_text(
+        "import signal\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "import mechsys as ms\n"
+        "model = ms.Model('chain', gravity=(0, -9.81, 0))\n"
+        "parent = model.ground\n"
+        "for i in range(10):\n"
+        "    b = model.add_body(f'b{i}', 1.0, ms.inertia.rod(1.0, 0.1), com=(0.05, 0, 0))\n"
+        "    model.add_joint(ms.joints.Revolute(f'j{i}', parent, b, axis=(0, 0, 1), parent_frame=(0.1, 0, 0) if i else None))\n"
+        "    parent = b\n"
+        "simulation = dict(t_end=1000.0, integrator=ms.RK4(dt=1e-5), output_dt=0.01)\n"
+    )
+    p = subprocess.Popen([sys.executable, "-m", "mechsys", "run", str(model), "--out", str(tmp_path / "r.h5")],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(4.0)  # the model is loaded and the engine steps
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert p.returncode == 130, (p.returncode, out, err)
+    assert "interrupted" in err and "Traceback" not in err and "FATAL" not in err
+    assert not (tmp_path / "r.h5").exists()  # nothing half-written

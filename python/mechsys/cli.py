@@ -55,6 +55,10 @@ class _Group(click.Group):
             return super().invoke(ctx)
         except (MechsysError, OSError) as e:
             raise CliError(_message(e)) from e
+        except KeyboardInterrupt:
+            # Ctrl-C: the run was cancelled cleanly; the shell's convention for SIGINT is 130
+            click.echo("interrupted", err=True)
+            raise SystemExit(130) from None
 
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
@@ -144,6 +148,8 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
 @click.option("--on-singular", "on_singular", type=click.Choice(["continue", "stop"]), default=None,
               help="At a singular configuration (the constraints lose rank): go on with a warning [default] or stop.")
+@click.option("--max-steps", "max_steps", type=int, help="Stop after this many accepted steps (rk4, dopri5, radau5).")
+@click.option("--max-wall", "max_wall", type=float, help="Stop after this many seconds of wall-clock time.")
 @click.option("--out", "out", type=click.Path(path_type=Path, dir_okay=False), help="HDF5 results file [default: results/<model name>.h5].")
 @click.option("--plot", "plot_out", type=click.Path(path_type=Path, dir_okay=False), help="Write a plot (.png, .svg or .pdf).")
 @click.option(
@@ -166,6 +172,8 @@ def run(
     atol: float | None,
     output_dt: float | None,
     on_singular: str | None,
+    max_steps: int | None,
+    max_wall: float | None,
     out: Path | None,
     plot_out: Path | None,
     signals: tuple[str, ...],
@@ -193,6 +201,10 @@ def run(
     )
     if on_singular is not None:
         kwargs["on_singular"] = on_singular
+    if max_steps is not None:
+        kwargs["max_steps"] = max_steps
+    if max_wall is not None:
+        kwargs["max_wall"] = max_wall
     start = time.perf_counter()
     res = simulate(model, **kwargs)
     wall = time.perf_counter() - start
