@@ -22,6 +22,12 @@ momentum/linear                 N s          (n, 3)
 momentum/angular                N m s        (n, 3)  about the inertial origin
 constraint/<c>/lambda           N, N m, ...  (n,) or (n, 3)  Lagrange multipliers
 constraint/<c>/violation        m, rad, ...  (n,) or (n, 3)  Phi(q, t)
+body/<b>/angular_acceleration   rad/s^2      (n, 3)  inertial components
+body/<b>/com_position, ...      m, m/s, ...  (n, 3)  centre of mass: _position, _velocity, _acceleration
+com/position, velocity,         m, m/s, ...  (n, 3)  the system's centre of mass
+  acceleration
+marker/<b>/<m>/position, ...    m, m/s, ...  (n, 3)  a marker's origin: position, velocity, acceleration
+marker/<b>/<m>/orientation      1            (n, 4)  its frame as a quaternion [w, x, y, z] of A_IM
 joint/<j>/reaction_force        N            (n, 3)  wrench of the parent on the child through
 joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint origin, child
                                                      joint frame components (computed on first
@@ -147,6 +153,8 @@ class Results:
             put(f"body/{b}/velocity", raw["body_velocity"][:, k, :], "m/s", xyz)
             put(f"body/{b}/angular_velocity", raw["body_angular_velocity"][:, k, :], "rad/s", xyz)
             put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2", xyz)
+            if "body_angular_acceleration" in raw:
+                put(f"body/{b}/angular_acceleration", raw["body_angular_acceleration"][:, k, :], "rad/s^2", xyz)
             put(f"body/{b}/mass", raw["body_mass"][:, k], "kg")
             put(f"body/{b}/kinetic_energy", raw["body_kinetic"][:, k], "J")
         put("energy/kinetic", raw["kinetic"], "J")
@@ -207,6 +215,10 @@ class Results:
         for a in s.values():
             a.setflags(write=False)
         lazy = {}
+        if engine is not None and "body_angular_acceleration" in raw:
+            group, sensors = _sensor_group(engine, body_names, raw)
+            for name, unit in sensors.items():
+                lazy[name] = (unit, group)
         if engine is not None and joints:
             group = _reaction_group(engine, callbacks, joints, raw)
             for j in joints:
@@ -238,6 +250,8 @@ class Results:
             self._units[n] = self._lazy.pop(n, (unit, None))[0]
             if arr.ndim == 2 and arr.shape[1] == 3:
                 self._columns[n] = (["x", "y", "z"], [self._units[n]] * 3)
+            elif arr.ndim == 2 and arr.shape[1] == 4 and n.endswith("/orientation"):
+                self._columns[n] = (["w", "x", "y", "z"], ["1"] * 4)
 
     def columns(self, name: str) -> list[str]:
         """Names of a signal's columns (joint coordinates as ``joint.x``, ``joint.qw``, ...;
@@ -466,6 +480,73 @@ class Results:
         path.parent.mkdir(parents=True, exist_ok=True)
         np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
         return path
+
+
+def _sensor_group(engine, body_names: list[str], raw: dict):
+    """Marker and centre-of-mass signals from the recorded body states (computed on first access):
+    a point r fixed in a body (A_IB from the orientation) moves as p + A r, v + w x (A r),
+    a + al x (A r) + w x (w x (A r)); a marker's orientation is q_body * q_marker."""
+    from .kinematics import matrix_to_quat
+
+    info = {b["name"]: b for b in engine.bodies()}
+    names: dict[str, str] = {}
+    for b in body_names:
+        for mk in info[b].get("marker_frames", []):
+            pre = f"marker/{b}/{mk[0]}"
+            names.update({f"{pre}/position": "m", f"{pre}/velocity": "m/s", f"{pre}/acceleration": "m/s^2",
+                          f"{pre}/orientation": "1"})
+        names.update({f"body/{b}/com_position": "m", f"body/{b}/com_velocity": "m/s", f"body/{b}/com_acceleration": "m/s^2"})
+    if body_names:
+        names.update({"com/position": "m", "com/velocity": "m/s", "com/acceleration": "m/s^2"})
+
+    def compute() -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        qb = raw["body_orientation"]  # (n, nb, 4) [w, x, y, z]
+        m_tot = 0.0
+        sums = [0.0, 0.0, 0.0]
+        for k, b in enumerate(body_names):
+            a_ib = _quat_matrices(qb[:, k, :])
+            p, v, a = raw["body_position"][:, k, :], raw["body_velocity"][:, k, :], raw["body_acceleration"][:, k, :]
+            w, al = raw["body_angular_velocity"][:, k, :], raw["body_angular_acceleration"][:, k, :]
+
+            def point(r):
+                rr = a_ib @ np.asarray(r, dtype=float)  # (n, 3)
+                return p + rr, v + np.cross(w, rr), a + np.cross(al, rr) + np.cross(w, np.cross(w, rr))
+
+            for name, pos, rot in info[b].get("marker_frames", []):
+                pre = f"marker/{b}/{name}"
+                x, xd, xdd = point(pos)
+                qm = matrix_to_quat(np.asarray(rot, dtype=float).reshape(3, 3))
+                out[f"{pre}/position"], out[f"{pre}/velocity"], out[f"{pre}/acceleration"] = x, xd, xdd
+                out[f"{pre}/orientation"] = _quat_products(qb[:, k, :], qm)
+            c, cd, cdd = point(info[b]["com"])
+            out[f"body/{b}/com_position"], out[f"body/{b}/com_velocity"], out[f"body/{b}/com_acceleration"] = c, cd, cdd
+            mass = raw["body_mass"][:, k][:, None]
+            m_tot = m_tot + mass
+            sums = [s_ + mass * x for s_, x in zip(sums, (c, cd, cdd))]
+        if body_names:
+            out["com/position"], out["com/velocity"], out["com/acceleration"] = (x / m_tot for x in sums)
+        return out
+
+    return compute, names
+
+
+def _quat_matrices(q: np.ndarray) -> np.ndarray:
+    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) [w, x, y, z]."""
+    w, x, y, z = q.T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
+
+
+def _quat_products(q: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """q * r for quaternions q (n, 4) and one r (4,), [w, x, y, z]."""
+    w1, x1, y1, z1 = q.T
+    w2, x2, y2, z2 = r
+    return np.stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], -1)
 
 
 def _reaction_group(engine, callbacks, joints: list[dict], raw: dict):

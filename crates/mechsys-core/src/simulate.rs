@@ -154,6 +154,8 @@ pub struct Recording {
     pub body_angular_velocity: Vec<f64>,
     /// Accelerations of body-frame origins, I components (n_out × n_bodies × 3), m/s².
     pub body_acceleration: Vec<f64>,
+    /// Angular accelerations, I components (n_out × n_bodies × 3), rad/s².
+    pub body_angular_acceleration: Vec<f64>,
     /// Body masses (n_out × n_bodies), kg.
     pub body_mass: Vec<f64>,
     /// Kinetic energy (n_out), J.
@@ -789,6 +791,7 @@ pub fn simulate(
         body_velocity: Vec::with_capacity(n_out * nb * 3),
         body_angular_velocity: Vec::with_capacity(n_out * nb * 3),
         body_acceleration: Vec::with_capacity(n_out * nb * 3),
+        body_angular_acceleration: Vec::with_capacity(n_out * nb * 3),
         body_mass: Vec::with_capacity(n_out * nb),
         kinetic: Vec::with_capacity(n_out),
         body_kinetic: Vec::with_capacity(n_out * nb),
@@ -1332,6 +1335,7 @@ fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &
         rec.body_velocity.extend_from_slice(point_velocity(data, i, &origin).as_slice());
         rec.body_angular_velocity.extend_from_slice(data.v[i].w.as_slice());
         rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
+        rec.body_angular_acceleration.extend_from_slice(data.a[i].w.as_slice());
         rec.body_mass.push(data.inertia[i].m);
     }
     // one product I v per body gives its kinetic energy and both momenta (world convention)

@@ -70,6 +70,16 @@ impl PyModel {
             let markers: Vec<(String, Vec<f64>)> =
                 b.markers.iter().map(|m| (m.name.clone(), m.pose.r.as_slice().to_vec())).collect();
             d.set_item("markers", markers)?;
+            // the markers' rotations too (A_BM, row-major 3x3), for marker sensors
+            let frames: Vec<(String, Vec<f64>, Vec<f64>)> = b
+                .markers
+                .iter()
+                .map(|m| {
+                    let a = m.pose.a;
+                    (m.name.clone(), m.pose.r.as_slice().to_vec(), (0..9).map(|k| a[(k / 3, k % 3)]).collect())
+                })
+                .collect();
+            d.set_item("marker_frames", frames)?;
             out.push(d);
         }
         Ok(out)

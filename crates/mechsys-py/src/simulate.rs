@@ -229,6 +229,7 @@ fn simulate<'py>(
     put("body_velocity", rec.body_velocity, &[n, nb, 3])?;
     put("body_angular_velocity", rec.body_angular_velocity, &[n, nb, 3])?;
     put("body_acceleration", rec.body_acceleration, &[n, nb, 3])?;
+    put("body_angular_acceleration", rec.body_angular_acceleration, &[n, nb, 3])?;
     put("body_mass", rec.body_mass, &[n, nb])?;
     put("kinetic", rec.kinetic, &[n])?;
     put("body_kinetic", rec.body_kinetic, &[n, nb])?;
