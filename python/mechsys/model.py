@@ -124,10 +124,24 @@ class Model:
                 raise ModelError(f"add_marker: unknown body '{bname}'")
         self._invalidate()
 
+    def _own_bodies(self, element, what: str) -> None:
+        """ModelError when an element refers to a body handle of another model (joined by name it
+        would silently take this model's body of the same name)."""
+        items = vars(element).items() if hasattr(element, "__dict__") else ()
+        for key, value in items:
+            for v in (value if isinstance(value, (list, tuple)) else [value]):
+                body = v if isinstance(v, Body) else getattr(v, "body", None) if hasattr(v, "contour") else None
+                owner = getattr(body, "model", self) if isinstance(body, Body) else self
+                if owner is not self:
+                    name = getattr(element, "name", "?")
+                    raise ModelError(f"{what} '{name}'.{key}: the body handle '{body.name}' belongs to model "
+                                     f"'{owner.name}', not to '{self.name}' (use this model's add_body handle, or its name)")
+
     def add_joint(self, joint: Joint | dict) -> Joint | dict:
         """Adds a joint (see :mod:`mechsys.joints`)."""
         if not isinstance(joint, (Joint, dict)):
             raise ModelError(f"add_joint: expected a mechsys.joints joint, got {type(joint).__name__}")
+        self._own_bodies(joint, "joint")
         self._joints.append(joint)
         self._invalidate()
         return joint
@@ -136,6 +150,7 @@ class Model:
         """Adds a force element (see :mod:`mechsys.forces`)."""
         if not (hasattr(force, "describe") or isinstance(force, dict)):
             raise ModelError(f"add_force: expected a mechsys.forces element, got {type(force).__name__}")
+        self._own_bodies(force, "force")
         self._forces.append(force)
         self._invalidate()
         return force
@@ -144,6 +159,7 @@ class Model:
         """Adds a bilateral constraint (see :mod:`mechsys.constraints`)."""
         if not (hasattr(constraint, "describe") or isinstance(constraint, dict)):
             raise ModelError(f"add_constraint: expected a mechsys.constraints element, got {type(constraint).__name__}")
+        self._own_bodies(constraint, "constraint")
         self._constraints.append(constraint)
         self._invalidate()
         return constraint
@@ -175,8 +191,20 @@ class Model:
     def describe(self) -> tuple[dict, list]:
         """The plain-data description (as in a model file) and the Python callbacks it refers to."""
         callbacks: list = list(self._extra_callbacks)
-        forces = [f if isinstance(f, dict) else f.describe(callbacks) for f in self._forces]
-        constraints = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._constraints]
+
+        def described(element, what):
+            if isinstance(element, dict):
+                return element
+            try:
+                return element.describe(callbacks)
+            except (TypeError, ValueError) as e:
+                if isinstance(e, ModelError):
+                    raise
+                raise ModelError(f"{what} '{getattr(element, 'name', '?')}': a value is not what it should be ({e}); "
+                                 "numbers must be numbers (not strings)") from None
+
+        forces = [described(f, "force") for f in self._forces]
+        constraints = [described(c, "constraint") for c in self._constraints]
         desc = {
             "name": self.name,
             "gravity": list(self.gravity),

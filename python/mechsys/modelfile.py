@@ -212,6 +212,16 @@ def _load_python(path: Path) -> tuple[Model, Any]:
     sys.path.insert(0, folder)
     try:
         namespace = runpy.run_path(str(path), run_name="__mechsys_model__")
+    except SyntaxError as e:
+        raise ModelError(f"line {e.lineno}: syntax error: {e.msg}" + (f": {e.text.strip()}" if e.text else "")) from None
+    except MechsysError:
+        raise
+    except Exception as e:  # noqa: BLE001 - the model file's own errors, reported briefly
+        import traceback
+
+        frames = [f for f in traceback.extract_tb(e.__traceback__) if Path(f.filename).resolve() == path.resolve()]
+        where = f"line {frames[-1].lineno}: " if frames else ""
+        raise ModelError(f"{where}running the model file raised {type(e).__name__}: {e}") from None
     finally:
         try:
             sys.path.remove(folder)

@@ -61,13 +61,22 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
             raise SettingsError(f"max_wall: must be a number of seconds > 0, got {max_wall!r}") from None
         if not (np.isfinite(max_wall) and max_wall > 0):
             raise SettingsError(f"max_wall: must be a number of seconds > 0, got {max_wall!r}")
+    qv, uv = model.state_vector(q0, "q"), model.state_vector(u0, "u")
+    for which, vec in (("q0", qv), ("u0", uv)):
+        bad = np.nonzero(~np.isfinite(np.asarray(vec, dtype=float)))[0]
+        if bad.size:
+            k = int(bad[0])
+            key = "iq" if which == "q0" else "iu"
+            width = "nq" if which == "q0" else "nu"
+            joint = next((j["name"] for j in model.joint_info() if j[key] <= k < j[key] + j[width]), "?")
+            raise SettingsError(f"{which}[{k}]: joint '{joint}' gets a value that is not finite ({vec[k]}); give numbers")
     return {
         "t0": t0,
         "t_end": t_end,
         "output_dt": float(output_dt),
         "integrator": integrator.describe(),
-        "q0": model.state_vector(q0, "q").tolist(),
-        "u0": model.state_vector(u0, "u").tolist(),
+        "q0": qv.tolist(),
+        "u0": uv.tolist(),
         "stabilization": _stabilization(stabilization),
         "on_singular": on_singular,
         "max_steps": None if max_steps is None else int(max_steps),
