@@ -76,3 +76,29 @@ def test_sensor_signals_are_saved(tmp_path):
     back = ms.Results.load(res.save(tmp_path / "s.h5"))
     np.testing.assert_array_equal(back["marker/plate/edge/position"], res["marker/plate/edge/position"])
     assert back.columns("com/velocity") == ["x", "y", "z"]
+
+
+def test_loads_are_recorded_as_they_are_applied():
+    # a motor torque (JointForce), a controller (PythonForce) and a body force, each as a signal
+    m = ms.Model("loads", gravity=(0, 0, 0))
+    wheel = m.add_body("wheel", 2.0, [0.1, 0.1, 0.2])
+    cart = m.add_body("cart", 3.0, [1, 1, 1])
+    m.add_joint(ms.joints.Revolute("spin", m.ground, wheel, axis=(0, 0, 1)))
+    m.add_joint(ms.joints.Prismatic("slide", m.ground, cart, axis=(1, 0, 0)))
+    m.add_force(ms.forces.JointForce("motor", "spin", 0.5, function=ms.functions.Ramp(slope=2.0)))
+    m.add_force(ms.forces.PythonForce("pd", lambda t, q, u: np.array([0.0, -4.0 * q[1] - 1.0 * u[1]])))
+    m.add_force(ms.forces.BodyForce("push", "cart", force=(1.5, 0.0, 0.0), torque=(0.0, 0.0, 0.2)))
+    res = ms.simulate(m, 1.0, ms.DOPRI5(rtol=1e-11, atol=1e-13), output_dt=0.01)
+    np.testing.assert_allclose(res["force/motor/force"], 0.5 * 2.0 * res.t, atol=1e-12)
+    assert res.unit("force/motor/force") == "N m"
+    pd = res["force/pd/force"]
+    assert res.columns("force/pd/force") == ["spin.rate", "slide.rate"]
+    assert res.column_units("force/pd/force") == ["N m", "N"]
+    x, v = res["joint/slide/q"], res["joint/slide/u"]
+    np.testing.assert_allclose(pd[:, 1], -4.0 * x - v, atol=1e-10)
+    np.testing.assert_allclose(pd[:, 0], 0.0, atol=0)
+    np.testing.assert_allclose(res["force/push/force"], np.tile([1.5, 0, 0], (len(res.t), 1)), atol=0)
+    np.testing.assert_allclose(res["force/push/torque"], np.tile([0, 0, 0.2], (len(res.t), 1)), atol=0)
+    # and they are what moves the bodies: m x'' = 1.5 + pd (the cart), I w' = t (the wheel, 0.5 * 2 t)
+    np.testing.assert_allclose(3.0 * res["joint/slide/udot"], 1.5 + pd[:, 1], atol=1e-8)
+    np.testing.assert_allclose(0.2 * res["joint/spin/udot"], res["force/motor/force"], atol=1e-9)

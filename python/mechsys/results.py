@@ -20,6 +20,12 @@ energy/kinetic, potential,      J            (n,)
   external_work
 momentum/linear                 N s          (n, 3)
 momentum/angular                N m s        (n, 3)  about the inertial origin
+force/<e>/force, /deflection    N, m, ...    (n,) or (n, k)  a force element's force (resisting its
+                                                     deflection) and deflection; the loads record
+                                                     what they apply: a joint force its value, a
+                                                     Python force its generalized forces (columns
+                                                     named by joint coordinate), a body force its
+                                                     force and force/<e>/torque (about its point)
 constraint/<c>/lambda           N, N m, ...  (n,) or (n, 3)  Lagrange multipliers
 constraint/<c>/violation        m, rad, ...  (n,) or (n, 3)  Phi(q, t)
 body/<b>/angular_acceleration   rad/s^2      (n, 3)  inertial components
@@ -178,11 +184,28 @@ class Results:
                         _rate_unit(c["violation_unit"]))
         if engine is not None and "force_value" in raw:
             # each force element's force along its deflection (resisting it) and the deflection
+            joint_of = {}
+            for j in joints:
+                a, b, c, d = _JOINT_COLUMNS.get(j["type"], (None, None, [f"u{i}" for i in range(j["nu"])], [""] * j["nu"]))
+                for i in range(j["nu"]):
+                    joint_of[j["iu"] + i] = (f"{j['name']}.{c[i]}", _force_unit(d[i]))
             for f in engine.force_outputs():
                 k, w = f["first"], f["width"]
                 sl = slice(k, k + w) if w > 1 else k
-                put(f"force/{f['name']}/force", raw["force_value"][:, sl], f["force_unit"])
-                put(f"force/{f['name']}/deflection", raw["force_deflection"][:, sl], f["deflection_unit"])
+                name, kind = f["name"], f["type"]
+                if kind == "body_force":
+                    # the applied force and its torque about the point, inertial components
+                    put(f"force/{name}/force", raw["force_value"][:, k:k + 3], "N", xyz)
+                    put(f"force/{name}/torque", raw["force_value"][:, k + 3:k + 6], "N m", xyz)
+                elif kind == "joint_force":
+                    put(f"force/{name}/force", raw["force_value"][:, sl], f["force_unit"])
+                elif kind == "python_force":
+                    labels = [joint_of.get(i, (f"u{i}", ""))[0] for i in range(w)]
+                    put(f"force/{name}/force", raw["force_value"][:, sl], "mixed", labels,
+                        [joint_of.get(i, ("", ""))[1] for i in range(w)])
+                else:
+                    put(f"force/{name}/force", raw["force_value"][:, sl], f["force_unit"])
+                    put(f"force/{name}/deflection", raw["force_deflection"][:, sl], f["deflection_unit"])
         if engine is not None and "contact_gap" in raw:
             put("energy/dissipated_impact", raw["dissipated_impact"], "J")
             put("energy/dissipated_friction", raw["dissipated_friction"], "J")
@@ -582,6 +605,11 @@ def _rate_unit(unit: str) -> str:
     if not unit:
         return "1/s"
     return ", ".join(_per_second(part.strip()) for part in unit.split(","))
+
+
+def _force_unit(rate_unit: str) -> str:
+    """The generalized force that goes with a velocity: m/s -> N, rad/s -> N m."""
+    return {"m/s": "N", "rad/s": "N m"}.get(rate_unit, "")
 
 
 def _per_second(unit: str) -> str:

@@ -247,7 +247,7 @@ pub fn evaluate(
     for fe in &model.forces {
         // this element's recorded values (taken first: an arm may `continue`)
         let o = next;
-        next += fe.outputs();
+        next += fe.outputs(model.nu);
         match fe {
             ForceElement::SpringDamper { name, body1, point1, body2, point2, k, k3, d, l0, table, travel } => {
                 let p1 = point_position(data, *body1, point1);
@@ -390,6 +390,11 @@ pub fn evaluate(
                 let w = Force::new(n + x.point_to_parent(point).cross(&f), f);
                 p_ext += wrench_power(data, *body, &w);
                 data.f_ext[*body] += w;
+                // recorded: the applied force and the torque (about its point), inertial components
+                for k in 0..3 {
+                    data.element_force[o + k] = f[k];
+                    data.element_force[o + 3 + k] = n[k];
+                }
             }
             ForceElement::JointForce { joint, value, function, .. } => {
                 let s = function.eval(t, cb)?;
@@ -397,14 +402,21 @@ pub fn evaluate(
                 for (k, v) in value.iter().enumerate() {
                     data.tau_applied[j.iu + k] += v * s;
                     p_ext += v * s * u[j.iu + k];
+                    data.element_force[o + k] = v * s;
                 }
             }
             ForceElement::Callback { name, id } => {
                 let before: f64 = data.tau_applied.iter().zip(u).map(|(a, b)| a * b).sum();
+                let nu = model.nu;
+                data.element_force[o..o + nu].copy_from_slice(&data.tau_applied[..nu]);
                 cb.generalized_force(*id, t, q, u, &mut data.tau_applied)
                     .map_err(|e| Error::Callback(format!("force element '{name}': {e}")))?;
                 let after: f64 = data.tau_applied.iter().zip(u).map(|(a, b)| a * b).sum();
                 p_ext += after - before;
+                // recorded: the generalized forces the callback added
+                for i in 0..nu {
+                    data.element_force[o + i] = data.tau_applied[i] - data.element_force[o + i];
+                }
             }
         }
     }

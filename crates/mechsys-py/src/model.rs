@@ -237,7 +237,7 @@ impl PyModel {
         let mut out = Vec::new();
         let mut first = 0usize;
         for f in &self.model.forces {
-            let width = f.outputs();
+            let width = f.outputs(self.model.nu);
             let joint_units = |j: usize| match self.model.joints[j].kind {
                 JointKind::Revolute { .. } => ("N m", "rad"),
                 JointKind::Prismatic { .. } => ("N", "m"),
@@ -252,7 +252,9 @@ impl PyModel {
                     let (a, b) = joint_units(j.joint);
                     ("jenkins", a, b)
                 }
-                _ => ("", "", ""),
+                F::BodyForce { .. } => ("body_force", "N, N m", ""),
+                F::JointForce { joint, .. } => ("joint_force", joint_units(*joint).0, ""),
+                F::Callback { .. } => ("python_force", "mixed", ""),
             };
             if width > 0 {
                 let d = PyDict::new(py);

@@ -324,15 +324,18 @@ impl ForceElement {
     }
 
     /// How many values the element records as its force (and as its deflection): 6 for a
-    /// bushing, 1 for the elements acting along one coordinate, 0 for loads.
-    pub fn outputs(&self) -> usize {
+    /// bushing, 1 for the elements acting along one coordinate; the loads record what they apply
+    /// (a body force its force and torque, 6; a joint force one value per joint velocity; a Python
+    /// force its generalized forces, `nu` of a model of `nu` velocities) and no deflection.
+    pub fn outputs(&self, nu: usize) -> usize {
         match self {
-            ForceElement::Bushing { .. } => 6,
+            ForceElement::Bushing { .. } | ForceElement::BodyForce { .. } => 6,
             ForceElement::SpringDamper { .. }
             | ForceElement::SqueezeFilm { .. }
             | ForceElement::JournalBearing { .. }
             | ForceElement::Jenkins(_) => 1,
-            ForceElement::BodyForce { .. } | ForceElement::JointForce { .. } | ForceElement::Callback { .. } => 0,
+            ForceElement::JointForce { value, .. } => value.len(),
+            ForceElement::Callback { .. } => nu,
         }
     }
 }

@@ -946,7 +946,7 @@ impl Model {
 
         let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
-        let n_force_outputs = forces.iter().map(|f| f.outputs()).sum();
+        let n_force_outputs = forces.iter().map(|f| f.outputs(iu)).sum();
         Ok(Model {
             name: desc.name.clone(),
             gravity: g,
