@@ -305,6 +305,48 @@ class JointForce:
 
 
 @dataclass
+class Servo:
+    """A servo actuator on a joint (velocity ``index`` of it): ``mode="position"`` drives the joint
+    coordinate to ``reference`` r(t) with the motor torque ``kp n (r - q) + kd n (r' - q')``;
+    ``mode="velocity"`` drives the joint velocity to r(t) with ``kd n (r - q')``. ``gear`` n is the
+    ratio of motor to joint turns (the joint gets n times the motor torque); ``max_torque`` clamps
+    the motor torque. ``reference``: a number, a mechsys.functions object or a callable f(t)
+    (position servos use its derivative as the reference rate). Recorded as
+    ``force/<name>/force`` (the torque or force on the joint) and ``force/<name>/deflection`` (the
+    tracking error r - q, or r - q')."""
+
+    name: str
+    joint: Any
+    reference: Any
+    kp: float = 0.0
+    kd: float = 0.0
+    mode: str = "position"
+    max_torque: float | None = None
+    gear: float = 1.0
+    index: int = 0
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"force '{self.name}'"
+        ref = functions.describe(self.reference, callbacks, f"{w}.reference")
+        if ref is None:
+            raise ModelError(f"{w}.reference: give the reference (a number, a mechsys.functions object or f(t))")
+        d = {
+            "type": "servo",
+            "name": self.name,
+            "joint": _name(self.joint),
+            "index": int(self.index),
+            "mode": str(self.mode),
+            "kp": float(self.kp),
+            "kd": float(self.kd),
+            "reference": ref,
+            "gear": float(self.gear),
+        }
+        if self.max_torque is not None:
+            d["max_torque"] = float(self.max_torque)
+        return d
+
+
+@dataclass
 class PythonForce:
     """A force law written in Python: ``func(t, q, u) -> array of nu generalized forces``.
 
@@ -323,6 +365,7 @@ class PythonForce:
 
 
 __all__ = [
+    "Servo",
     "SpringDamper",
     "Bushing",
     "SqueezeFilm",

@@ -396,6 +396,23 @@ pub fn evaluate(
                     data.element_force[o + 3 + k] = n[k];
                 }
             }
+            ForceElement::Servo { name, joint, index, position, kp, kd, reference, max_torque, gear } => {
+                let j = &model.joints[*joint];
+                let (x, v) = (q[j.iq + index], u[j.iu + index]);
+                let (r, rd, _) = crate::constraints::function_derivatives(reference, t, cb)
+                    .map_err(|e| Error::Callback(format!("servo '{name}'.reference: {e}")))?;
+                // the tracking error (recorded as the element's deflection) and the motor torque
+                let (err, tm) = if *position {
+                    (r - x, kp * gear * (r - x) + kd * gear * (rd - v))
+                } else {
+                    (r - v, kd * gear * (r - v))
+                };
+                let tau = gear * tm.clamp(-max_torque, *max_torque);
+                data.tau_applied[j.iu + index] += tau;
+                p_ext += tau * v;
+                data.element_force[o] = tau;
+                data.element_deflection[o] = err;
+            }
             ForceElement::JointForce { joint, value, function, .. } => {
                 let s = function.eval(t, cb)?;
                 let j = &model.joints[*joint];

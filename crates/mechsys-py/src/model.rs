@@ -220,6 +220,7 @@ impl PyModel {
                     F::SpringDamper { .. } => "spring_damper",
                     F::BodyForce { .. } => "body_force",
                     F::JointForce { .. } => "joint_force",
+                    F::Servo { .. } => "servo",
                     F::Callback { .. } => "callback",
                     F::Bushing { .. } => "bushing",
                     F::SqueezeFilm { .. } => "squeeze_film",
@@ -254,6 +255,10 @@ impl PyModel {
                 }
                 F::BodyForce { .. } => ("body_force", "N, N m", ""),
                 F::JointForce { joint, .. } => ("joint_force", joint_units(*joint).0, ""),
+                F::Servo { joint, position, .. } => {
+                    let (a, b) = joint_units(*joint);
+                    ("servo", a, if *position { b } else if b == "rad" { "rad/s" } else { "m/s" })
+                }
                 F::Callback { .. } => ("python_force", "mixed", ""),
             };
             if width > 0 {

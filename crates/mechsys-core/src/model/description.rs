@@ -656,6 +656,35 @@ pub enum ForceDescription {
         #[serde(default)]
         function: Option<TimeFunctionDescription>,
     },
+    /// A servo actuator on one joint velocity: a position servo `τ_m = kp n (r − q) + kd n (ṙ − q̇)`
+    /// or a velocity servo `τ_m = kd n (r − q̇)` on the motor side of a gear of ratio n (motor
+    /// angle n q), the motor torque clamped to ±`max_torque`, `n τ_m` on the joint.
+    Servo {
+        /// Element name.
+        name: String,
+        /// Joint acted upon.
+        joint: String,
+        /// Which of the joint's velocities (0 for 1-DOF joints).
+        #[serde(default)]
+        index: usize,
+        /// "position" or "velocity".
+        #[serde(default = "default_servo_mode")]
+        mode: String,
+        /// Proportional gain (N m/rad or N/m, motor side).
+        #[serde(default)]
+        kp: f64,
+        /// Derivative (position servo) or velocity (velocity servo) gain (N m s/rad or N s/m).
+        #[serde(default)]
+        kd: f64,
+        /// The reference r(t): joint coordinate (position servo) or joint velocity (velocity servo).
+        reference: TimeFunctionDescription,
+        /// Motor torque limit (absent: none).
+        #[serde(default)]
+        max_torque: Option<f64>,
+        /// Gear ratio n (motor turns per joint turn).
+        #[serde(default = "default_gear")]
+        gear: f64,
+    },
     /// A user callback computing generalized forces from (t, q, u): slow, it calls back into Python.
     Callback {
         /// Element name.
@@ -667,6 +696,14 @@ pub enum ForceDescription {
 
 fn default_frame() -> String {
     "inertial".to_string()
+}
+
+fn default_servo_mode() -> String {
+    "position".to_string()
+}
+
+fn default_gear() -> f64 {
+    1.0
 }
 
 impl ModelDescription {

@@ -288,6 +288,27 @@ pub enum ForceElement {
         /// Time scaling.
         function: TimeFunction,
     },
+    /// A position or velocity servo on one joint velocity (see `ForceDescription::Servo`).
+    Servo {
+        /// Name.
+        name: String,
+        /// Joint index.
+        joint: usize,
+        /// Velocity index within the joint.
+        index: usize,
+        /// Position (true) or velocity servo.
+        position: bool,
+        /// Gains (motor side).
+        kp: f64,
+        /// Derivative or velocity gain (motor side).
+        kd: f64,
+        /// Reference of time.
+        reference: TimeFunction,
+        /// Motor torque limit (infinite: none).
+        max_torque: f64,
+        /// Gear ratio.
+        gear: f64,
+    },
     /// Generalized force on a joint.
     JointForce {
         /// Name.
@@ -315,6 +336,7 @@ impl ForceElement {
             ForceElement::SpringDamper { name, .. }
             | ForceElement::BodyForce { name, .. }
             | ForceElement::JointForce { name, .. }
+            | ForceElement::Servo { name, .. }
             | ForceElement::Bushing { name, .. }
             | ForceElement::SqueezeFilm { name, .. }
             | ForceElement::JournalBearing { name, .. }
@@ -333,6 +355,7 @@ impl ForceElement {
             ForceElement::SpringDamper { .. }
             | ForceElement::SqueezeFilm { .. }
             | ForceElement::JournalBearing { .. }
+            | ForceElement::Servo { .. }
             | ForceElement::Jenkins(_) => 1,
             ForceElement::JointForce { value, .. } => value.len(),
             ForceElement::Callback { .. } => nu,

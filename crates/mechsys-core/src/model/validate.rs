@@ -479,6 +479,7 @@ impl Model {
                 ForceDescription::SpringDamper { name, .. }
                 | ForceDescription::BodyForce { name, .. }
                 | ForceDescription::JointForce { name, .. }
+                | ForceDescription::Servo { name, .. }
                 | ForceDescription::Bushing { name, .. }
                 | ForceDescription::SqueezeFilm { name, .. }
                 | ForceDescription::JournalBearing { name, .. }
@@ -690,6 +691,43 @@ impl Model {
                         joint: ji,
                         value: per_dof(value, n, &format!("{what}.value"))?,
                         function: time_function(function, &format!("{what}.function"), &mut n_callbacks)?,
+                    }
+                }
+                ForceDescription::Servo { joint, index, mode, kp, kd, reference, max_torque, gear, .. } => {
+                    let ji =
+                        *joint_index.get(joint).ok_or_else(|| err(format!("{what}.joint: unknown joint '{joint}'")))?;
+                    let n = joints[ji].nu();
+                    crate::ensure!(
+                        *index < n && joints[ji].kind.nq() == n,
+                        Model,
+                        "{what}.index: joint '{joint}' has {n} velocities whose coordinates are their integrals; got index {index}"
+                    );
+                    let position = match mode.as_str() {
+                        "position" => true,
+                        "velocity" => false,
+                        m => return Err(err(format!("{what}.mode: must be \"position\" or \"velocity\", got \"{m}\""))),
+                    };
+                    for (k, v) in [("kp", kp), ("kd", kd)] {
+                        crate::ensure!(v.is_finite() && *v >= 0.0, Model, "{what}.{k}: must be a finite gain >= 0, got {v}");
+                    }
+                    crate::ensure!(*kp > 0.0 || *kd > 0.0, Model, "{what}: give kp or kd (both are 0: the servo does nothing)");
+                    crate::ensure!(
+                        gear.is_finite() && *gear != 0.0,
+                        Model,
+                        "{what}.gear: must be a finite, nonzero ratio, got {gear}"
+                    );
+                    let limit = max_torque.unwrap_or(f64::INFINITY);
+                    crate::ensure!(limit > 0.0 && !limit.is_nan(), Model, "{what}.max_torque: must be > 0, got {limit}");
+                    ForceElement::Servo {
+                        name,
+                        joint: ji,
+                        index: *index,
+                        position,
+                        kp: *kp,
+                        kd: *kd,
+                        reference: time_function(&Some(reference.clone()), &format!("{what}.reference"), &mut n_callbacks)?,
+                        max_torque: limit,
+                        gear: *gear,
                     }
                 }
                 ForceDescription::Callback { id, .. } => {
