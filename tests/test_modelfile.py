@@ -346,3 +346,43 @@ def test_simulation_kwargs_overrides_an_integrator_object():
         simulation_kwargs(defaults, dt=-1.0)
     with pytest.raises(SettingsError, match=r"--solver\.type: expected nsgs, newton or lemke, got 'gauss'"):
         simulation_kwargs(defaults, solver="gauss")
+
+
+def test_scalars_for_one_dof_values_in_toml(tmp_path):
+    # q0, u0 of a 1-DOF joint and a joint force's value may be plain numbers (newcomer finding 18)
+    text = """
+name = "pend"
+gravity = [0, 0, -9.81]
+[[bodies]]
+name = "bob"
+mass = 1.0
+inertia = [0.01, 0.01, 0.01]
+com = [0, 0, -0.5]
+[[joints]]
+name = "hinge"
+type = "revolute"
+parent = "ground"
+child = "bob"
+axis = [1, 0, 0]
+q0 = 0.3
+u0 = -0.2
+[[forces]]
+type = "joint_force"
+name = "push"
+joint = "hinge"
+value = 2.0
+"""
+    path = tmp_path / "pend.toml"
+    path.write_text(text)
+    from mechsys.modelfile import load_model
+
+    model, _ = load_model(path)
+    assert model.q0()[0] == 0.3 and model.state_vector(None, "u")[0] == -0.2
+    res = ms.simulate(model, 0.01, ms.RK4(dt=1e-3))
+    np.testing.assert_allclose(res["force/push/force"], 2.0)
+    path.write_text(text.replace("value = 2.0", 'value = "lots"'))
+    with pytest.raises(ms.ModelError, match=r"forces\[0\].*value: expected a finite number or a list of finite numbers"):
+        load_model(path)
+    path.write_text(text.replace("q0 = 0.3", 'q0 = "up"'))
+    with pytest.raises(ms.ModelError, match=r"joints\[0\]\.q0: expected a finite number or a list of finite numbers"):
+        load_model(path)

@@ -425,11 +425,11 @@ pub struct JointDescription {
     /// Joint frame on the child body.
     #[serde(default)]
     pub child_frame: FrameDescription,
-    /// Initial joint coordinates (length nq of the joint).
-    #[serde(default)]
+    /// Initial joint coordinates (length nq of the joint; a plain number for a 1-DOF joint).
+    #[serde(default, deserialize_with = "one_or_many_opt")]
     pub q0: Option<Vec<f64>>,
-    /// Initial joint velocities (length nu of the joint).
-    #[serde(default)]
+    /// Initial joint velocities (length nu of the joint; a plain number for a 1-DOF joint).
+    #[serde(default, deserialize_with = "one_or_many_opt")]
     pub u0: Option<Vec<f64>>,
     /// Joint spring.
     #[serde(default)]
@@ -650,7 +650,8 @@ pub enum ForceDescription {
         name: String,
         /// Joint acted upon.
         joint: String,
-        /// One value per joint velocity (N or N m).
+        /// One value per joint velocity (N or N m; a plain number for a 1-DOF joint).
+        #[serde(deserialize_with = "one_or_many_value")]
         value: Vec<f64>,
         /// Scalar time function multiplying `value` (constant 1 if absent).
         #[serde(default)]
@@ -696,6 +697,31 @@ pub enum ForceDescription {
 
 fn default_frame() -> String {
     "inertial".to_string()
+}
+
+/// A list of numbers, or one number standing for a list of one (the 1-DOF case in model files).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum OneOrMany {
+    One(f64),
+    Many(Vec<f64>),
+}
+
+fn one_or_many<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Vec<f64>, D::Error> {
+    let v = OneOrMany::deserialize(d).map_err(|_| serde::de::Error::custom("expected a finite number or a list of finite numbers"))?;
+    Ok(match v {
+        OneOrMany::One(x) => vec![x],
+        OneOrMany::Many(v) => v,
+    })
+}
+
+/// As [`one_or_many`] for a force's `value` (an internally tagged enum's errors carry no key path).
+fn one_or_many_value<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Vec<f64>, D::Error> {
+    one_or_many(d).map_err(|_| serde::de::Error::custom("value: expected a finite number or a list of finite numbers"))
+}
+
+fn one_or_many_opt<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<f64>>, D::Error> {
+    one_or_many(d).map(Some)
 }
 
 fn default_servo_mode() -> String {
