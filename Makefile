@@ -42,6 +42,7 @@ bench: $(BUILD)
 	$(PY) benches/event_driven.py --baseline benches/baselines/event_driven_50c2cb9.json --out docs/benchmarks.md
 	$(PY) benches/linear.py --out docs/benchmarks.md
 	$(PY) benches/linear_motion.py --out docs/benchmarks.md
+	$(PY) benches/sensors.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results
