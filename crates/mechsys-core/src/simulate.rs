@@ -882,6 +882,15 @@ pub fn simulate(
             sys.rhs(t, y, &mut scratch)?;
         }
         record(model, &sys.data, &sys.ws.saddle, t, y, &mut rec);
+        if model.n_sliders > 0 {
+            // the Jenkins sliders book their work when a step is committed; a sample inside or at
+            // the end of a step (before the commit) adds the work they did since the last one
+            let d = &sys.data;
+            let pending: f64 = (0..model.n_sliders).map(|i| d.slider_force[i] * (d.slider_trial[i] - d.slider[i])).sum();
+            if let Some(last) = rec.dissipated.last_mut() {
+                *last += pending;
+            }
+        }
         if guard {
             if let Some(msg) = divergence.check(&rec, t) {
                 return Err(divergence_error(model, settings, &mut sys.data, t, y, msg));
