@@ -102,3 +102,31 @@ def test_loads_are_recorded_as_they_are_applied():
     # and they are what moves the bodies: m x'' = 1.5 + pd (the cart), I w' = t (the wheel, 0.5 * 2 t)
     np.testing.assert_allclose(3.0 * res["joint/slide/udot"], 1.5 + pd[:, 1], atol=1e-8)
     np.testing.assert_allclose(0.2 * res["joint/spin/udot"], res["force/motor/force"], atol=1e-9)
+
+
+@pytest.mark.parametrize("integrator", [ms.MoreauJean(dt=1e-3), ms.EventDriven()], ids=["moreau_jean", "event_driven"])
+def test_contact_point_and_normal(integrator):
+    # a ball dropped on a tilted plane (normal (0, sin a, cos a), friction holding it): the contact
+    # point lies one radius from the centre, on the plane, and the normal is the plane's
+    a, r = 0.3, 0.1
+    m = ms.Model("ball", gravity=(0, 0, -9.81))
+    ball = m.add_body("ball", 1.0, [4e-3] * 3)
+    n = np.array([0.0, np.sin(a), np.cos(a)])
+    m.add_joint(ms.joints.Free("float", m.ground, ball, q0=[*(n * (r + 0.02)), 1, 0, 0, 0]))
+    plane = ms.contours.Plane(normal=tuple(n))
+    m.add_contact(ms.contacts.Contact("floor", m.ground.contour(plane), ball.contour(ms.contours.Sphere(radius=r)),
+                                      friction=ms.laws.Coulomb(mu=0.8)))
+    res = ms.simulate(m, 0.5, integrator, output_dt=0.01)
+    centre = res["body/ball/position"]
+    normal = res["contact/floor/normal"]
+    # from the ball (the second contour) towards the plane (the first): against the plane's normal
+    np.testing.assert_allclose(normal, np.tile(-n, (len(res.t), 1)), atol=1e-12)
+    after = res.t > 0.2
+    point = res["contact/floor/point"]
+    # on the plane's surface, one radius plus the gap (a velocity-level scheme's small drift) from
+    # the centre
+    gap = res["contact/floor/g_n"][after]
+    np.testing.assert_allclose(np.linalg.norm(point[after] - centre[after], axis=1), r + gap, atol=1e-12)
+    np.testing.assert_allclose(point[after] @ n, 0.0, atol=1e-12)
+    assert np.abs(gap).max() < 2e-4
+    assert res.unit("contact/floor/point") == "m" and res.columns("contact/floor/point") == ["x", "y", "z"]

@@ -43,7 +43,8 @@ joint/<j>/reaction_torque       N m          (n, 3)  the joint, at the joint ori
 Models with contacts (Moreau-Jean) add, per contact (shape (n,) for one candidate point, (n, k)
 for k points; tangential ones (n, [k,] 2) in 3-D): ``contact/<c>/g_n`` (m), ``gd_n``, ``gd_t``
 (m/s), ``lambda_n``, ``lambda_t`` (N, the step's impulse over the step), ``impulse_n``,
-``impulse_t`` (N s), ``state`` (int8 levels open 0, stick 1, slip 2: ``res.levels(name)``; an
+``impulse_t`` (N s), ``point`` (m, where the contact is on the first contour's surface, inertial
+components, (n, [k,] 3)), ``normal`` (from the second contour towards the first), ``state`` (int8 levels open 0, stick 1, slip 2: ``res.levels(name)``; an
 HDF5 enum in files), ``friction_reserve`` (mu0 lambda_N -
 |lambda_T|, N), and ``energy/dissipated_impact``, ``energy/dissipated_friction`` (J).
 
@@ -214,6 +215,11 @@ class Results:
                 sl = slice(k, k + n) if n > 1 else k
                 pre = f"contact/{c['name']}"
                 put(f"{pre}/g_n", raw["contact_gap"][:, sl], "m")
+                if "contact_point" in raw:
+                    # where the contact is (on the first contour's surface) and its normal (from the
+                    # second contour towards the first), inertial components
+                    put(f"{pre}/point", raw["contact_point"][:, sl, :], "m", xyz if n == 1 else None)
+                    put(f"{pre}/normal", raw["contact_normal"][:, sl, :], "1", xyz if n == 1 else None)
                 put(f"{pre}/gd_n", raw["contact_gd_n"][:, sl], "m/s")
                 put(f"{pre}/gd_t", raw["contact_gd_t"][:, sl, :nt] if nt > 1 else raw["contact_gd_t"][:, sl, 0], "m/s")
                 put(f"{pre}/lambda_n", raw["contact_lambda_n"][:, sl], "N")

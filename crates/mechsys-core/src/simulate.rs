@@ -186,6 +186,10 @@ pub struct Recording {
     pub warnings: Vec<String>,
     /// Contact gaps g_N per candidate point (n_out × n_points), m.
     pub contact_gap: Vec<f64>,
+    /// Contact points on contour 1's surface, I components (n_out × points × 3), m.
+    pub contact_point: Vec<f64>,
+    /// Contact normals from contour 2 towards contour 1, I components (n_out × points × 3).
+    pub contact_normal: Vec<f64>,
     /// Relative normal velocities ġ_N (n_out × n_points), m/s.
     pub contact_gd_n: Vec<f64>,
     /// Relative tangential velocities ġ_T (n_out × n_points × 2), m/s.
@@ -1102,6 +1106,8 @@ fn time_stepping(
             let span = if k == 0 { dt } else { settings.output_dt };
             let (in_, it) = (acc_n[pt], acc_t[pt]);
             rec.contact_gap.push(kk.point.g_n);
+            rec.contact_point.extend_from_slice(kk.point.p1.as_slice());
+            rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
             rec.contact_gd_n.push(kk.gd_n);
             rec.contact_gd_t.extend_from_slice(&kk.gd_t);
             rec.contact_impulse_n.push(in_);
@@ -1181,6 +1187,8 @@ fn event_driven(
             prev[3 * pt + 1] = now_t[0];
             prev[3 * pt + 2] = now_t[1];
             rec.contact_gap.push(kk.point.g_n);
+            rec.contact_point.extend_from_slice(kk.point.p1.as_slice());
+            rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
             rec.contact_gd_n.push(kk.gd_n);
             rec.contact_gd_t.extend_from_slice(&kk.gd_t);
             rec.contact_impulse_n.push(i_n);

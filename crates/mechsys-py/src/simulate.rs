@@ -274,6 +274,8 @@ fn simulate<'py>(
     let np = m.n_contact_points;
     if !m.contacts.is_empty() || !m.contact_groups.is_empty() {
         put("contact_gap", rec.contact_gap, &[n, np])?;
+        put("contact_point", rec.contact_point, &[n, np, 3])?;
+        put("contact_normal", rec.contact_normal, &[n, np, 3])?;
         put("contact_gd_n", rec.contact_gd_n, &[n, np])?;
         put("contact_gd_t", rec.contact_gd_t, &[n, np, 2])?;
         put("contact_lambda_n", rec.contact_lambda_n, &[n, np])?;
