@@ -31,8 +31,10 @@ print("start", flush=True)
 if sys.argv[1] in ("catch", "callback"):
     try:
         ms.simulate(m, 1000.0, ms.RK4(dt=1e-5), output_dt=0.01)
-    except KeyboardInterrupt:
-        print("caught KeyboardInterrupt", flush=True)
+    except KeyboardInterrupt as e:
+        res = getattr(e, "results", None)
+        kept = "no results" if res is None else f"{len(res.t)} samples up to t = {res.t[-1]:.2f} s"
+        print(f"caught KeyboardInterrupt ({kept})", flush=True)
 else:
     ms.simulate(m, 1000.0, ms.RK4(dt=1e-5), output_dt=0.01)
 print("after", flush=True)
@@ -62,6 +64,11 @@ def test_ctrl_c_cancels_the_run_and_the_script_goes_on():
     assert rc == 0, out
     assert "caught KeyboardInterrupt" in out and "after" in out
     assert waited < 10.0  # the engine stops at its next sample (0.01 s of model time)
+    # what was computed is kept on the interrupt: samples up to where it stopped
+    import re
+
+    n, t_stop = re.search(r"\((\d+) samples up to t = ([0-9.]+) s\)", out).groups()
+    assert int(n) > 1 and abs(float(t_stop) - (int(n) - 1) * 0.01) < 1e-6, out
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")

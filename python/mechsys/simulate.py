@@ -158,8 +158,11 @@ def simulate(
         # thread stopped at exit inside the engine aborts the process)
         worker = threading.Thread(target=run, name="mechsys-simulate")
         worker.start()
-        _wait(done, prog, n_expected, progress)
+        interrupted = _wait(done, prog, n_expected, progress)
         worker.join()
+        if interrupted and (error or "cancelled" not in raw):
+            # stopped otherwise (an error, or it ended on its own just then): the interrupt wins
+            raise KeyboardInterrupt
     if error:
         raise error[0]
     import warnings
@@ -174,7 +177,15 @@ def simulate(
         "mechsys_version": _core.__version__,
     }
     body_names = core.body_names[1:]
-    return Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
+    cancelled = raw.pop("cancelled", None)
+    res = Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
+    if cancelled is not None:
+        # Ctrl-C: the samples before it are kept on the interrupt (`except KeyboardInterrupt as e:
+        # e.results`)
+        interrupt = KeyboardInterrupt(f"{cancelled}; the results so far are in .results")
+        interrupt.results = res
+        raise interrupt
+    return res
 
 
 def _stabilization(value) -> dict:
@@ -207,11 +218,12 @@ def _warn_redundant(model: Model, q0, t0) -> None:
         )
 
 
-def _wait(done: threading.Event, prog, n_expected: int, progress: bool | None) -> None:
-    """Waits for the simulation thread to set ``done``, showing a bar after ~1 s. Ctrl-C cancels
-    the run: the engine stops at its next sample, and the KeyboardInterrupt is raised once it has
-    (further Ctrl-C meanwhile only repeat the request). The wait is on an Event, not on
-    ``Thread.join``, whose state an interrupt can leave claiming the thread ended."""
+def _wait(done: threading.Event, prog, n_expected: int, progress: bool | None) -> bool:
+    """Waits for the simulation thread to set ``done``, showing a bar after ~1 s; returns whether
+    Ctrl-C cancelled the run. Ctrl-C cancels: the engine stops at its next sample and returns the
+    samples so far, raised by the caller on a KeyboardInterrupt (further Ctrl-C meanwhile only
+    repeat the request). The wait is on an Event, not on ``Thread.join``, whose state an
+    interrupt can leave claiming the thread ended."""
     import sys
 
     start = time.perf_counter()
@@ -235,7 +247,7 @@ def _wait(done: threading.Event, prog, n_expected: int, progress: bool | None) -
                     break
             except KeyboardInterrupt:
                 prog.cancel()
-        raise
+        return True
     finally:
         if bar is not None:
             bar.n = prog.samples

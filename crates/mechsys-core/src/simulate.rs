@@ -182,6 +182,8 @@ pub struct Recording {
     pub force_value: Vec<f64>,
     /// Deflection of each force element (n_out × n_force_outputs).
     pub force_deflection: Vec<f64>,
+    /// Set when the run was cancelled from outside: the message; the samples before it are kept.
+    pub cancelled: Option<String>,
     /// Notes on the run that did not stop it (near-singular configurations), in time order.
     pub warnings: Vec<String>,
     /// Contact gaps g_N per candidate point (n_out × n_points), m.
@@ -905,11 +907,23 @@ pub fn simulate(
         }
         report_progress(progress, rec.t.len(), t)
     };
-    let stats = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer)?;
-    rec.stats = stats;
+    let outcome = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer);
+    drop(observer);
+    match outcome {
+        Ok(stats) => rec.stats = stats,
+        // cancelled (Ctrl-C): the samples recorded so far are kept, each one complete
+        Err(Error::Solver(msg)) if msg.starts_with(CANCELLED) => {
+            rec.n_out = rec.t.len();
+            rec.cancelled = Some(msg);
+        }
+        Err(e) => return Err(e),
+    }
     rec.warnings = std::mem::take(&mut sys.warnings);
     Ok(rec)
 }
+
+/// The start of the message of a run cancelled from outside ([`Progress::cancel`]).
+pub const CANCELLED: &str = "simulation cancelled";
 
 /// Watches the energy balance of a fixed-step explicit run: the kinetic plus potential energy
 /// minus the external work plus the dissipated energy is constant for a stable run (to the
@@ -1319,7 +1333,7 @@ fn report_progress(progress: Option<&Progress>, samples: usize, t: f64) -> Resul
     if let Some(p) = progress {
         p.samples.store(samples as u64, Ordering::Relaxed);
         if p.cancel.load(Ordering::Relaxed) {
-            return Err(Error::Solver(format!("simulation cancelled at t = {t:.6} s")));
+            return Err(Error::Solver(format!("{CANCELLED} at t = {t:.6} s")));
         }
     }
     Ok(())

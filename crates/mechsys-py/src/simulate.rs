@@ -246,6 +246,9 @@ fn simulate<'py>(
         put("force_deflection", rec.force_deflection, &[n, m.n_force_outputs])?;
     }
     d.set_item("warnings", rec.warnings)?;
+    if let Some(msg) = &rec.cancelled {
+        d.set_item("cancelled", msg)?;
+    }
     let events = pyo3::types::PyList::empty(py);
     for e in &rec.events {
         let ev = PyDict::new(py);
