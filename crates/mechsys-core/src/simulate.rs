@@ -908,7 +908,6 @@ pub fn simulate(
         report_progress(progress, rec.t.len(), t)
     };
     let outcome = integrator::integrate(&settings.integrator, &mut sys, settings.t0, &y0, &t_out, &mut observer);
-    drop(observer);
     match outcome {
         Ok(stats) => rec.stats = stats,
         // cancelled (Ctrl-C): the samples recorded so far are kept, each one complete
