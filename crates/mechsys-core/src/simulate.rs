@@ -353,6 +353,10 @@ pub struct MultibodySystem<'a> {
     row0: Vec<f64>,
     /// Step and wall-time budgets.
     pub budget: Option<Budget>,
+    /// The velocities of the last evaluation (models with Jenkins sliders), for `switched`.
+    last_u: Vec<f64>,
+    /// Per Jenkins slider: whether it slipped at an evaluation since the last `switched` call.
+    slipped: Vec<bool>,
     /// Near-singular passages met so far.
     pub warnings: Vec<String>,
 }
@@ -375,6 +379,8 @@ impl<'a> MultibodySystem<'a> {
             ratio: Vec::new(),
             row0: Vec::new(),
             budget: None,
+            last_u: Vec::with_capacity(model.nu),
+            slipped: vec![false; model.n_sliders],
             warnings: Vec::new(),
         }
     }
@@ -589,11 +595,37 @@ impl OdeSystem for MultibodySystem<'_> {
                 p = self.passage(t, q, u)?;
             }
         }
+        if self.model.n_sliders > 0 {
+            // the velocities of the last evaluation and which sliders slipped, for `switched`
+            self.last_u.clear();
+            self.last_u.extend_from_slice(u);
+            for i in 0..self.slipped.len() {
+                self.slipped[i] |= self.data.slider_trial[i] != self.data.slider[i];
+            }
+        }
         self.model.qdot(q, u, &mut dy[..nq]);
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
         dy[nq + nu] = p.dissipated;
         dy[nq + nu + 1] = p.external;
         Ok(())
+    }
+    fn switched(&mut self) -> bool {
+        // a slider that slipped since its commit while its joint now moves back (the deflection
+        // rate against the slip) reversed inside the step: the return mapping from the commit
+        // misses how far it went before it stuck
+        let mut reversed = false;
+        for f in &self.model.forces {
+            if let ForceElement::Jenkins(j) = f {
+                let v = self.last_u.get(j.iu).copied().unwrap_or(0.0);
+                for i in j.slot..j.slot + j.len() {
+                    let d = self.data.slider_trial[i] - self.data.slider[i];
+                    // still slipping but moving back, or slipped at an earlier stage and stuck now
+                    reversed |= d * v < 0.0 || (self.slipped[i] && d == 0.0);
+                }
+            }
+        }
+        self.slipped.fill(false);
+        reversed
     }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         if let Some(b) = self.budget.as_mut() {

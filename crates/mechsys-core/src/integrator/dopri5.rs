@@ -239,6 +239,14 @@ pub fn integrate<S: OdeSystem>(
         }
         let err = st.attempt(sys, t, &y, h, rtol, atol)?;
         stats.evaluations += 6;
+        // a switch the error estimate cannot see (a slider's reversal inside the step): shrink the
+        // step around it until it is below the tolerance's share of the span
+        if sys.switched() && err <= 1.0 && h > rtol * (t_end - t0) {
+            stats.rejected += 1;
+            h *= 0.25;
+            reject = true;
+            continue;
+        }
         if !err.is_finite() {
             // a stage produced inf/NaN: shrink hard and retry
             stats.rejected += 1;

@@ -37,6 +37,12 @@ pub trait OdeSystem {
     fn accepted(&mut self, _t: f64, _y: &mut [f64]) -> Result<()> {
         Ok(())
     }
+    /// Whether a force law switched in a way the step's error estimate cannot see since the last
+    /// call (a dry-friction slider that slipped and then stuck again: its history within the step
+    /// is lost); resets. An adaptive scheme shrinks such a step until it is below its tolerance.
+    fn switched(&mut self) -> bool {
+        false
+    }
 }
 
 /// Called at each output time with the system and the state; `fresh` says the system's last `rhs`
