@@ -4,6 +4,7 @@ thread cut off at exit. Tested the way it fails: a real SIGINT to a subprocess."
 
 from __future__ import annotations
 
+import re
 import signal
 import subprocess
 import sys
@@ -27,10 +28,19 @@ for i in range(10):
 if sys.argv[1] == "callback":
     # a Python force law: Ctrl-C arrives while the interpreter runs it
     m.add_force(ms.forces.PythonForce("drag", lambda t, q, u: -0.01 * u))
+scheme = ms.RK4(dt=1e-5)
+if sys.argv[1] in ("moreau_jean", "event_driven"):
+    # a pendulum with a contact far below it (never closing): the contact schemes step it
+    m = ms.Model("pendulum", gravity=(0, -9.81, 0))
+    bob = m.add_body("bob", 1.0, ms.inertia.rod(1.0, 0.1), com=(0.05, 0, 0))
+    m.add_joint(ms.joints.Revolute("j", m.ground, bob, axis=(0, 0, 1), q0=1.0))
+    m.add_contact(ms.Contact("floor", m.ground.contour(ms.contours.Plane(normal=(0, 1, 0), point=(0, -100, 0))),
+                             bob.contour(ms.contours.Sphere(radius=0.01))))
+    scheme = ms.MoreauJean(dt=1e-5) if sys.argv[1] == "moreau_jean" else ms.EventDriven(rtol=1e-9, atol=1e-11)
 print("start", flush=True)
-if sys.argv[1] in ("catch", "callback"):
+if sys.argv[1] in ("catch", "callback", "moreau_jean", "event_driven"):
     try:
-        ms.simulate(m, 1000.0, ms.RK4(dt=1e-5), output_dt=0.01)
+        ms.simulate(m, 1000.0, scheme, output_dt=0.01)
     except KeyboardInterrupt as e:
         res = getattr(e, "results", None)
         kept = "no results" if res is None else f"{len(res.t)} samples up to t = {res.t[-1]:.2f} s"
@@ -140,3 +150,13 @@ def test_ctrl_c_in_mechsys_run_exits_130(tmp_path):
     assert p.returncode == 130, (p.returncode, out, err)
     assert "interrupted" in err and "Traceback" not in err and "FATAL" not in err
     assert not (tmp_path / "r.h5").exists()  # nothing half-written
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize("scheme", ["moreau_jean"])
+def test_ctrl_c_keeps_the_samples_of_the_contact_schemes(scheme):
+    rc, out, waited = interrupted(scheme)
+    assert rc == 0 and "FATAL" not in out, out
+    n, t_stop = re.search(r"\((\d+) samples up to t = ([0-9.]+) s\)", out).groups()
+    assert int(n) > 1 and abs(float(t_stop) - (int(n) - 1) * 0.01) < 1e-6, out
+    assert waited < 10.0

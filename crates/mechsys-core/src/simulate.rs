@@ -1179,7 +1179,16 @@ fn time_stepping(
             rec.group_impulse_against.extend_from_slice(&g.impulse_against);
         }
         budget.wall(t_rec)?;
-        report_progress(progress, rec.t.len(), t_rec)?;
+        match report_progress(progress, rec.t.len(), t_rec) {
+            Ok(()) => {}
+            // cancelled (Ctrl-C): the samples recorded so far are kept, each one complete
+            Err(Error::Solver(msg)) if msg.starts_with(CANCELLED) => {
+                rec.n_out = rec.t.len();
+                rec.cancelled = Some(msg);
+                break;
+            }
+            Err(e) => return Err(e),
+        }
     }
     rec.events = EventRecord::from_log(model, &log);
     if stepper.unconverged.0 > 0 {
@@ -1250,8 +1259,15 @@ fn event_driven(
         budget.wall(t)?;
         report_progress(progress, rec.t.len(), t)
     };
-    let stats = event_driven::integrate(&mut phase, settings.t0, &y, t_out, &mut warnings, &mut sample)?;
-    rec.stats = stats;
+    match event_driven::integrate(&mut phase, settings.t0, &y, t_out, &mut warnings, &mut sample) {
+        Ok(stats) => rec.stats = stats,
+        // cancelled (Ctrl-C): the samples recorded so far are kept, each one complete
+        Err(Error::Solver(msg)) if msg.starts_with(CANCELLED) => {
+            rec.n_out = rec.t.len();
+            rec.cancelled = Some(msg);
+        }
+        Err(e) => return Err(e),
+    }
     rec.warnings.extend(warnings);
     rec.events = EventRecord::from_log(model, &phase.log);
     Ok(rec)
