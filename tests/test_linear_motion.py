@@ -321,7 +321,8 @@ def test_steady_motion_solver_finds_the_top_precession():
     assert st.u[k] == pytest.approx(exact, rel=1e-9) and st.residual < 1e-9
     lin = ms.linear.linearize(m, at=st)
     assert nontrivial(lin.modes().eigenvalues)[-1].imag == pytest.approx(np.abs(ref.eigenvalues).max(), rel=1e-7)
-    assert p["theta"] == pytest.approx(m.q0()[names.index("nutation")], rel=1e-12) if "nutation" in names else True
+    # only the spin was free: the nutation angle stays the given one
+    assert st.q[names.index("nutation")] == pytest.approx(p["theta"], rel=1e-12)
 
 
 def test_upright_disc_critical_speed_and_lean_frequency():
@@ -357,3 +358,11 @@ def test_steady_motion_bad_names_and_values():
         ms.linear.sweep(lambda v: "no model", [1.0])
     with pytest.raises(ms.SettingsError, match="modes .* out of range"):
         ms.linear.check(ms.linear.linearize(m), modes=[7])
+
+
+def test_check_refuses_settings_that_would_fit_nothing():
+    lin = ms.linear.linearize(bicycle.build(v=5.0))
+    for kw, name in ((dict(amplitude=0.0), "amplitude"), (dict(amplitude=float("nan")), "amplitude"),
+                     (dict(cycles=-1.0), "cycles"), (dict(samples=3), "samples")):
+        with pytest.raises(ms.SettingsError, match=f"check: {name}"):
+            ms.linear.check(lin, **kw)

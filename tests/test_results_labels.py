@@ -13,7 +13,7 @@ import mechsys as ms
 def mixed_model() -> ms.Model:
     m = ms.Model("mixed", gravity=(0, 0, -9.81))
     arm = m.add_body("arm", 1.0, [0.01, 0.01, 0.01], com=(0.2, 0, 0))
-    ball = m.add_body("ball", 0.5, ms.inertia.sphere(0.5, 0.05) if hasattr(ms.inertia, "sphere") else [5e-4] * 3)
+    ball = m.add_body("ball", 0.5, ms.inertia.sphere(0.5, 0.05))
     m.add_joint(ms.joints.Revolute("hinge", m.ground, arm, axis=(0, 1, 0), q0=0.2))
     m.add_joint(ms.joints.Free("float", m.ground, ball, q0=[0, 0, 1, 1, 0, 0, 0], u0=[0.1, 0, 0, 0, 0, 2.0]))
     return m

@@ -6,32 +6,30 @@ integrator; and the stop-instead option."""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 import mechsys as ms
 
-A, B, R = 0.1, 0.3, 0.005  # crank / rocker length, coupler length, link radius
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import parallelogram  # noqa: E402
+
+A, B, R = 0.1, 0.3, 0.005  # crank / rocker length, coupler length, link radius (as the example's)
 M_LINK, M_COUPLER, G = 0.2, 0.4, 9.81
+assert (parallelogram.A, parallelogram.B, parallelogram.R, parallelogram.M_LINK, parallelogram.M_COUPLER) == \
+    (A, B, R, M_LINK, M_COUPLER)
 
 
 def parallelograms(n: int, theta0: float = 0.3, omega0: float = 12.0) -> ms.Model:
-    """n parallelogram loops in a row: a crank and n rockers (length A, pivots B apart), n couplers
-    (length B), each coupler hinged to the previous rocker's tip (the crank's for the first) and
-    closed on the next rocker's tip by a Point constraint (3 rows, one redundant in the plane)."""
-    m = ms.Model(f"parallelograms{n}", gravity=(0.0, -G, 0.0))
-    link = ms.inertia.cylinder(M_LINK, R, A)
-    prev = m.add_body("crank", M_LINK, link, com=(A / 2, 0, 0))
-    m.add_joint(ms.joints.Revolute("crank", m.ground, prev, q0=theta0, u0=omega0))
-    for k in range(n):
-        coupler = m.add_body(f"coupler{k}", M_COUPLER, ms.inertia.cylinder(M_COUPLER, R, B), com=(B / 2, 0, 0))
-        rocker = m.add_body(f"rocker{k}", M_LINK, link, com=(A / 2, 0, 0))
-        m.add_joint(ms.joints.Revolute(f"a{k}", prev, coupler, parent_frame=(A, 0, 0), q0=-theta0, u0=-omega0))
-        m.add_joint(ms.joints.Revolute(f"r{k}", m.ground, rocker, parent_frame=((k + 1) * B, 0, 0), q0=theta0, u0=omega0))
-        m.add_constraint(ms.constraints.Point(f"loop{k}", body1=coupler, point1=(B, 0, 0), body2=rocker, point2=(A, 0, 0)))
-        prev = rocker
-    return m
+    """n parallelogram loops in a row (examples/parallelogram.py): a crank and n rockers (length A,
+    pivots B apart), n couplers (length B), each coupler hinged to the previous rocker's tip (the
+    crank's for the first) and closed on the next rocker's tip by a Point constraint (3 rows, one
+    redundant in the plane)."""
+    return parallelogram.build(n, theta0, omega0)
 
 
 def reduction(n: int, t, theta0: float = 0.3, omega0: float = 12.0):

@@ -1110,6 +1110,12 @@ def check(lin: LinearModel, modes=None, amplitude: float = 1e-6, cycles: float =
     model = lin.model
     if model is None:
         raise SettingsError("check: this LinearModel has no model (built by hand)")
+    # (a zero or non-finite amplitude would fit a zero signal: log(0), a silent NaN)
+    for name, v in (("amplitude", amplitude), ("cycles", cycles), ("rtol", rtol)):
+        if not (isinstance(v, (int, float, np.floating)) and np.isfinite(v) and v > 0):
+            raise SettingsError(f"check: {name} must be a finite number > 0, got {v!r}")
+    if not (isinstance(samples, (int, np.integer)) and samples >= 8):
+        raise SettingsError(f"check: samples must be a whole number >= 8, got {samples!r}")
     a, _, _ = sf.reduced()
     lam, vec = np.linalg.eig(a)
     big = float(np.abs(lam).max(initial=0.0))

@@ -351,6 +351,8 @@ pub struct MultibodySystem<'a> {
     ratio: Vec<f64>,
     /// Squared norms of the constraint Jacobian's rows at the first evaluation.
     row0: Vec<f64>,
+    /// The same at the last evaluation (a buffer).
+    norms: Vec<f64>,
     /// Step and wall-time budgets.
     pub budget: Option<Budget>,
     /// The velocities of the last evaluation (models with Jenkins sliders), for `switched`.
@@ -378,6 +380,7 @@ impl<'a> MultibodySystem<'a> {
             neighbour: None,
             ratio: Vec::new(),
             row0: Vec::new(),
+            norms: Vec::with_capacity(model.nc),
             budget: None,
             last_u: Vec::with_capacity(model.nu),
             slipped: vec![false; model.n_sliders],
@@ -457,7 +460,9 @@ impl MultibodySystem<'_> {
         }
         // a row whose Jacobian shrank to a fraction of its start size (squared norms): the row of
         // a loop that vanishes at a change point
-        let norms = row_norms(&self.data);
+        // (into a buffer sized once: this runs at every evaluation of a constrained model)
+        let mut norms = std::mem::take(&mut self.norms);
+        row_norms(&self.data, &mut norms);
         if self.row0.is_empty() {
             self.row0 = norms.clone();
         }
@@ -485,6 +490,7 @@ impl MultibodySystem<'_> {
             ));
         }
         self.near_singular = near || lost;
+        self.norms = norms;
         Ok(())
     }
 }
@@ -530,8 +536,8 @@ impl MultibodySystem<'_> {
                     break;
                 }
                 dynamics::forward_dynamics(model, &mut data, &mut self.ws, t, &qs, &us, None, self.cb)?;
-                let norms = row_norms(&data);
-                if rows.iter().any(|&r| norms[r] < 4.0 * SINGULAR_WINDOW * self.row0[r]) {
+                row_norms(&data, &mut self.norms);
+                if rows.iter().any(|&r| self.norms[r] < 4.0 * SINGULAR_WINDOW * self.row0[r]) {
                     ok = false;
                     break;
                 }
@@ -576,8 +582,12 @@ const RICHARDSON: [(f64, f64); 6] =
     [(1.0, 0.75), (-1.0, 0.75), (2.0, -0.3), (-2.0, -0.3), (3.0, 0.05), (-3.0, 0.05)];
 
 /// Squared norms of the rows of the constraint Jacobian in `data.g`.
-fn row_norms(data: &Data) -> Vec<f64> {
-    (0..data.g.nrows()).map(|r| data.g.row(r).norm_squared()).collect()
+fn row_norms(data: &Data, out: &mut Vec<f64>) {
+    // over each row's planned pattern only (the rest of G is zero)
+    out.clear();
+    out.extend((0..data.g.nrows()).map(|r| {
+        (data.g_row_ptr[r]..data.g_row_ptr[r + 1]).map(|p| data.g[(r, data.g_row_idx[p])].powi(2)).sum::<f64>()
+    }));
 }
 
 impl OdeSystem for MultibodySystem<'_> {

@@ -138,11 +138,7 @@ fn linearize<'py>(
     callbacks: Option<Vec<PyObject>>,
     method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use mechsys_core::linear::Derivatives;
-    let how = Derivatives::from_name(method).ok_or_else(|| {
-        let allowed = Derivatives::NAMES.map(|n| format!("'{n}'")).join(", ");
-        settings(format!("linearize: method must be one of {allowed}, got '{method}'"))
-    })?;
+    let how = derivatives(method)?;
     let m = &model.model;
     let q = q_checked(model, &q)?;
     let u = check_len(&u, m.nu, "u")?;
@@ -157,6 +153,15 @@ fn linearize<'py>(
     d.set_item("method", lin.method.as_str())?;
     d.set_item("residual", PyArray1::from_slice(py, &lin.residual))?;
     Ok(d)
+}
+
+/// The derivatives `linearize` and `state_space` take, from their `method` name.
+fn derivatives(method: &str) -> PyResult<mechsys_core::linear::Derivatives> {
+    use mechsys_core::linear::Derivatives;
+    Derivatives::from_name(method).ok_or_else(|| {
+        let allowed = Derivatives::NAMES.map(|n| format!("'{n}'")).join(", ");
+        settings(format!("linearize: method must be one of {allowed}, got '{method}'"))
+    })
 }
 
 /// The state form `x' = A x + B tau` about a (moving) state (see `mechsys_core::linear::motion`):
@@ -176,11 +181,8 @@ fn state_space<'py>(
     method: &str,
     prefer: Option<Vec<usize>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use mechsys_core::linear::{Basis, Derivatives};
-    let how = Derivatives::from_name(method).ok_or_else(|| {
-        let allowed = Derivatives::NAMES.map(|n| format!("'{n}'")).join(", ");
-        settings(format!("linearize: method must be one of {allowed}, got '{method}'"))
-    })?;
+    use mechsys_core::linear::Basis;
+    let how = derivatives(method)?;
     let m = &model.model;
     let q = q_checked(model, &q)?;
     let u = check_len(&u, m.nu, "u")?;

@@ -120,7 +120,7 @@ pub fn state_space(
     how: Derivatives,
     basis: &Basis,
 ) -> Result<StateSpace> {
-    let (nq, nu, nc) = (model.nq, model.nu, model.nc);
+    let (nu, nc) = (model.nu, model.nc);
     let exact = super::check_point(model, q, u, how, "state_space")?;
     let (mut data, mut ws) = (Data::new(model), crate::dynamics::Workspace::new(model));
     crate::dynamics::forward_dynamics(model, &mut data, &mut ws, t, q, u, None, cb)?;
@@ -157,12 +157,13 @@ pub fn state_space(
     // P: the velocity change that keeps a configuration perturbation admissible, G δu = −J δ
     // with J = ∂(G u* − b)/∂q
     let p = if nc > 0 && n1 > 0 {
-        let j = differentiate(model, t, q, &vh, |data, qp| {
-            crate::kinematics::positions(model, data, qp);
-            crate::constraints::positions(model, data, t, qp, cb)?;
-            let mut r = &data.g * DVector::from_column_slice(u);
+        let mut data_j = Data::new(model);
+        let j = differentiate_state(model, q, u, &vh, true, &mut |qp, _| {
+            crate::kinematics::positions(model, &mut data_j, qp);
+            crate::constraints::positions(model, &mut data_j, t, qp, cb)?;
+            let mut r = &data_j.g * DVector::from_column_slice(u);
             for k in 0..nc {
-                r[k] -= data.b[k];
+                r[k] -= data_j.b[k];
             }
             Ok(r)
         })?;
@@ -234,7 +235,6 @@ pub fn state_space(
     if let Some(x) = a.iter().chain(b.iter()).find(|x| !x.is_finite()) {
         return Err(Error::Solver(format!("linearize: a state-matrix entry is not finite ({x})")));
     }
-    let _ = nq;
     Ok(StateSpace {
         nq: n1,
         nu: n2,
@@ -411,36 +411,6 @@ fn saddle_solve(
     let s = g * &y;
     let mu = pinv(&s) * (r2 - g * &free);
     free + y * mu
-}
-
-/// Five-point differences of `f(q* ⊕ s d_j)` along the columns `d_j` of `dirs` (nu × n).
-fn differentiate(
-    model: &Model,
-    _t: f64,
-    q: &[f64],
-    dirs: &DMatrix<f64>,
-    mut f: impl FnMut(&mut Data, &[f64]) -> Result<DVector<f64>>,
-) -> Result<DMatrix<f64>> {
-    let mut data = Data::new(model);
-    let mut qp = vec![0.0; model.nq];
-    let mut out: Option<DMatrix<f64>> = None;
-    for j in 0..dirs.ncols() {
-        let dir: Vec<f64> = dirs.column(j).iter().copied().collect();
-        let mut acc: Option<DVector<f64>> = None;
-        for (s, w) in [(2.0, -1.0), (1.0, 8.0), (-1.0, -8.0), (-2.0, 1.0)] {
-            model.integrate(q, &dir, s * STEP, &mut qp);
-            model.normalize(&mut qp);
-            let val = f(&mut data, &qp)? * w;
-            acc = Some(match acc {
-                Some(a) => a + val,
-                None => val,
-            });
-        }
-        let col = acc.expect("four points") / (12.0 * STEP);
-        let o = out.get_or_insert_with(|| DMatrix::zeros(col.len(), dirs.ncols()));
-        o.set_column(j, &col);
-    }
-    Ok(out.unwrap_or_else(|| DMatrix::zeros(0, dirs.ncols())))
 }
 
 /// Five-point differences of `f(q, u)` along the columns of `dirs`, in q (chart, `config`) or in
