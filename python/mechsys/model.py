@@ -48,11 +48,19 @@ class Model:
 
     >>> m = Model("pendulum", gravity=(0, -9.81, 0))
     >>> rod = m.add_body("rod", mass=1.0, inertia=[1e-4, 0.0833, 0.0833], com=(0.5, 0, 0))
+
+    ``planar=True`` makes a planar model: every body moves in the world x-y plane (revolute joints
+    about z, prismatic joints in the plane, :class:`mechsys.joints.Planar` for free bodies, fixed
+    joints), gravity lies in the plane, and loop closures hold only their in-plane equations (a
+    point coincidence 2, a revolute loop 2, a fixed loop 3), so a planar loop is never redundant.
     """
 
-    def __init__(self, name: str = "model", gravity: Sequence[float] = (0.0, 0.0, 0.0)):
+    def __init__(self, name: str = "model", gravity: Sequence[float] = (0.0, 0.0, 0.0), *, planar: bool = False):
         self.name = name
         self.gravity = _vec3(gravity, "gravity")
+        if not isinstance(planar, (bool, np.bool_)):
+            raise ModelError(f"model '{name}'.planar: expected true or false, got {planar!r}")
+        self.planar = bool(planar)
         self._bodies: list[dict] = []
         self._joints: list[Joint | dict] = []
         self._forces: list[Any] = []
@@ -213,6 +221,8 @@ class Model:
             "forces": forces,
             "ground_markers": copy.deepcopy(self._ground_markers),
         }
+        if self.planar:
+            desc["planar"] = True
         if constraints:
             desc["constraints"] = constraints
         contacts = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._contacts]
@@ -259,7 +269,10 @@ class Model:
         """A model from a plain-data description (e.g. a parsed TOML model file)."""
         if not isinstance(desc, dict):
             raise ModelError(f"model: expected a table/dict, got {type(desc).__name__}")
-        m = cls(desc.get("name", "model"), desc.get("gravity", (0.0, 0.0, 0.0)))
+        planar = desc.get("planar", False)
+        if not isinstance(planar, bool):
+            raise ModelError(f"model.planar: expected true or false, got {planar!r}")
+        m = cls(desc.get("name", "model"), desc.get("gravity", (0.0, 0.0, 0.0)), planar=planar)
         # non-list values are passed on unchanged so the engine reports "expected a sequence"
         def seq(key):
             v = desc.get(key, [])
@@ -272,7 +285,7 @@ class Model:
         m._constraints = seq("constraints")
         m._contacts = seq("contacts")
         m._contact_groups = seq("contact_groups")
-        known = {"name", "gravity", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts", "contact_groups"}
+        known = {"name", "gravity", "planar", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts", "contact_groups"}
         extra = set(desc) - known
         if extra:
             # let the engine produce the canonical message for a misspelt top-level key

@@ -177,12 +177,21 @@ class Results:
             for c in engine.constraints():
                 sl = slice(c["row"], c["row"] + c["rows"])
                 unit = c["unit"]
-                put(f"constraint/{c['name']}/lambda", raw["constraint_lambda"][:, sl] if c["rows"] > 1 else raw["constraint_lambda"][:, c["row"]], unit)
-                put(f"constraint/{c['name']}/violation", raw["constraint_violation"][:, sl] if c["rows"] > 1 else raw["constraint_violation"][:, c["row"]], c["violation_unit"])
+                # a planar model's constraints name their in-plane rows (x, y, rz, normal)
+                ccols = c.get("columns") if c["rows"] > 1 else None
+                cu, cv = c.get("column_units"), c.get("column_violation_units")
+                if ccols is not None:
+                    unit, vunit = ", ".join(dict.fromkeys(cu)), ", ".join(dict.fromkeys(cv))
+                else:
+                    vunit = c["violation_unit"]
+                put(f"constraint/{c['name']}/lambda", raw["constraint_lambda"][:, sl] if c["rows"] > 1 else raw["constraint_lambda"][:, c["row"]], unit,
+                    ccols, cu)
+                put(f"constraint/{c['name']}/violation", raw["constraint_violation"][:, sl] if c["rows"] > 1 else raw["constraint_violation"][:, c["row"]], vunit,
+                    ccols, cv)
                 if "constraint_velocity_violation" in raw:
                     vv = raw["constraint_velocity_violation"]
                     put(f"constraint/{c['name']}/velocity_violation", vv[:, sl] if c["rows"] > 1 else vv[:, c["row"]],
-                        _rate_unit(c["violation_unit"]))
+                        _rate_unit(vunit), ccols, [_rate_unit(u) for u in cv] if ccols is not None else None)
         if engine is not None and "force_value" in raw:
             # each force element's force along its deflection (resisting it) and the deflection
             joint_of = {}

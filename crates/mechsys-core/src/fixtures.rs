@@ -57,6 +57,7 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        planar: false,
         constraints: vec![],
     }
 }

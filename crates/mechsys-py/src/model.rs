@@ -201,8 +201,16 @@ impl PyModel {
             d.set_item("name", &c.name)?;
             d.set_item("type", t)?;
             d.set_item("row", c.row)?;
-            d.set_item("rows", c.kind.rows())?;
-            d.set_item("holonomic_rows", c.kind.holonomic_rows())?;
+            d.set_item("rows", c.rows())?;
+            d.set_item("holonomic_rows", c.holonomic_rows())?;
+            if let Some(sel) = &c.select {
+                // a planar model's in-plane rows: name them (the units then follow the rows)
+                d.set_item("columns", sel.names[..sel.n].to_vec())?;
+                let units: Vec<(&str, &str)> =
+                    sel.names[..sel.n].iter().map(|n| if *n == "rz" { ("N m", "rad") } else { ("N", "m") }).collect();
+                d.set_item("column_units", units.iter().map(|u| u.0).collect::<Vec<_>>())?;
+                d.set_item("column_violation_units", units.iter().map(|u| u.1).collect::<Vec<_>>())?;
+            }
             d.set_item("unit", unit)?;
             d.set_item("violation_unit", vunit)?;
             out.push(d);

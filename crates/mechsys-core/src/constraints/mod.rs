@@ -84,13 +84,23 @@ struct BodyRows {
     body2: usize,
     n: usize,
     phi: [f64; MAX_ROWS],
+    /// Velocity right-hand sides (non-zero for rheonomic rows).
+    b: [f64; MAX_ROWS],
     w1: [Force; MAX_ROWS],
     w2: [Force; MAX_ROWS],
 }
 
 impl BodyRows {
     fn new(body1: usize, body2: usize) -> Self {
-        BodyRows { body1, body2, n: 0, phi: [0.0; MAX_ROWS], w1: [Force::ZERO; MAX_ROWS], w2: [Force::ZERO; MAX_ROWS] }
+        BodyRows {
+            body1,
+            body2,
+            n: 0,
+            phi: [0.0; MAX_ROWS],
+            b: [0.0; MAX_ROWS],
+            w1: [Force::ZERO; MAX_ROWS],
+            w2: [Force::ZERO; MAX_ROWS],
+        }
     }
     /// A row with violation `phi`, wrench `w1` on body1 and `w2` on body2.
     fn push(&mut self, phi: f64, w1: Force, w2: Force) {
@@ -233,10 +243,44 @@ fn disc_contact(
     Ok((a, kh, kn, p))
 }
 
-/// Position-level rows of the body kinds handled through wrenches (None for the others).
-fn body_rows(c: &Constraint, data: &Data, t: f64) -> Result<Option<BodyRows>> {
+/// Position-level rows of the body kinds handled through wrenches (None for the others). A
+/// point coincidence comes here only when a planar selection combines its rows (its own path is
+/// faster); a prescribed body motion needs `t` and the callbacks.
+fn body_rows(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks) -> Result<Option<BodyRows>> {
     let (ex, ey, ez) = (Vec3::x(), Vec3::y(), Vec3::z());
     Ok(Some(match &c.kind {
+        ConstraintKind::Point { body1, p1, body2, p2 } => {
+            let mut r = BodyRows::new(*body1, *body2);
+            let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
+            for e in [ex, ey, ez] {
+                r.push(e.dot(&(w1 - w2)), force_at(&w1, &e), force_at(&w2, &e));
+            }
+            r
+        }
+        ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
+            let mut r = BodyRows::new(*body, 0);
+            let x = data.x_abs[*body].compose(frame);
+            // Φ = r_f - p(t): Φ̇ = v_f - ṗ, a force at the frame origin along each world axis
+            let [p, pd, _] = prescribed_point(position, t, cb, c, "position")?;
+            for (k, e) in [ex, ey, ez].iter().enumerate() {
+                r.push(x.r[k] - p[k], force_at(&x.r, e), Force::ZERO);
+                r.b[k] = pd[k];
+            }
+            if let Some(angles) = orientation {
+                // Q = A_f A_pᵀ, Q̇ = (ω_f - Q ω_p)~ Q: Φ̇ = E(Q) ω_f - E(Q) Q ω_p; the row k
+                // of E(Q) is a moment
+                let (a_p, w_p, _) = prescribed_rotation(angles, t, cb, c)?;
+                let qm = x.a * a_p.transpose();
+                let phi = skew_vee(&qm);
+                let e = vee_rate_matrix(&qm);
+                let b = e * (qm * w_p);
+                for k in 0..3 {
+                    r.push(phi[k], moment(&e.row(k).transpose()), Force::ZERO);
+                    r.b[3 + k] = b[k];
+                }
+            }
+            r
+        }
         ConstraintKind::PointOnLine { body1, p1, body2, p2, n } => {
             let mut r = BodyRows::new(*body1, *body2);
             let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
@@ -320,8 +364,33 @@ fn body_rows(c: &Constraint, data: &Data, t: f64) -> Result<Option<BodyRows>> {
 
 /// Velocity-product part of the time derivative of the velocity rows of the body kinds, i.e.
 /// `-γ` (`Ġ u`), into `out`; false for the other kinds.
-fn body_rows_rate(c: &Constraint, data: &Data, t: f64, out: &mut [f64; MAX_ROWS]) -> Result<bool> {
+fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: &mut [f64; MAX_ROWS]) -> Result<bool> {
     match &c.kind {
+        ConstraintKind::Point { body1, p1, body2, p2 } => {
+            let a = point_acceleration(data, *body1, p1) - point_acceleration(data, *body2, p2);
+            out[..3].copy_from_slice(a.as_slice());
+        }
+        ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
+            let x = data.x_abs[*body].compose(frame);
+            // Φ̈ = a_f - p̈
+            let [_, _, pdd] = prescribed_point(position, t, cb, c, "position")?;
+            let acc = acceleration_at(data, *body, &x.r);
+            for k in 0..3 {
+                out[k] = acc[k] - pdd[k];
+            }
+            if let Some(angles) = orientation {
+                // Φ̇ = E(Q) w, w = ω_f - Q ω_p, Q̇ = w̃ Q: Φ̈ = E(Q̇) w + E(Q) ẇ with
+                // ẇ = ω̇_f - w × (Q ω_p) - Q ω̇_p
+                let (a_p, w_p, wd_p) = prescribed_rotation(angles, t, cb, c)?;
+                let qm = x.a * a_p.transpose();
+                let qw = qm * w_p;
+                let w = data.v[*body].w - qw;
+                let qm_d = w.cross_matrix() * qm;
+                let wd = data.a[*body].w - w.cross(&qw) - qm * wd_p;
+                let phidd = vee_rate_matrix(&qm_d) * w + vee_rate_matrix(&qm) * wd;
+                out[3..6].copy_from_slice(phidd.as_slice());
+            }
+        }
         ConstraintKind::PointOnLine { body1, p1, body2, p2, .. }
         | ConstraintKind::PointOnPlane { body1, p1, body2, p2, .. } => {
             // Φ = n·d with n fixed in body2: Φ̈ = n̈·d + 2 ṅ·ḋ + n·d̈
@@ -568,6 +637,24 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
     }
     for c in &model.constraints {
         let r = c.row;
+        if let Some(sel) = &c.select {
+            // planar: constant combinations of the kind's spatial rows
+            let rows = body_rows(c, data, t, cb)?.expect("a selected constraint has body rows");
+            for (k, s) in sel.s.iter().enumerate().take(sel.n) {
+                let (mut phi, mut b, mut w1, mut w2) = (0.0, 0.0, Force::ZERO, Force::ZERO);
+                for j in 0..rows.n {
+                    phi += s[j] * rows.phi[j];
+                    b += s[j] * rows.b[j];
+                    w1 += rows.w1[j] * s[j];
+                    w2 += rows.w2[j] * s[j];
+                }
+                data.phi[r + k] = phi;
+                data.b[r + k] = b;
+                add_wrench_row(model, &data.s, rows.body1, &w1, 1.0, &mut data.g, r + k);
+                add_wrench_row(model, &data.s, rows.body2, &w2, -1.0, &mut data.g, r + k);
+            }
+            continue;
+        }
         match &c.kind {
             ConstraintKind::Point { body1, p1, body2, p2 } => {
                 let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
@@ -607,31 +694,6 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 data.b[r] = fd;
                 data.g[(r, *iu)] += 1.0;
             }
-            ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
-                let x = data.x_abs[*body].compose(frame);
-                // Φ = r_f - p(t): Φ̇ = v_f - ṗ, a force at the frame origin along each world axis
-                let [p, pd, _] = prescribed_point(position, t, cb, c, "position")?;
-                for (k, e) in [Vec3::x(), Vec3::y(), Vec3::z()].iter().enumerate() {
-                    data.phi[r + k] = x.r[k] - p[k];
-                    data.b[r + k] = pd[k];
-                    add_wrench_row(model, &data.s, *body, &force_at(&x.r, e), 1.0, &mut data.g, r + k);
-                }
-                if let Some(angles) = orientation {
-                    // Q = A_f A_pᵀ, Q̇ = (ω_f - Q ω_p)~ Q: Φ̇ = E(Q) ω_f - E(Q) Q ω_p; the row k
-                    // of E(Q) is a moment
-                    let (a_p, w_p, _) = prescribed_rotation(angles, t, cb, c)?;
-                    let qm = x.a * a_p.transpose();
-                    let phi = skew_vee(&qm);
-                    let e = vee_rate_matrix(&qm);
-                    let b = e * (qm * w_p);
-                    for k in 0..3 {
-                        data.phi[r + 3 + k] = phi[k];
-                        data.b[r + 3 + k] = b[k];
-                        let m = moment(&e.row(k).transpose());
-                        add_wrench_row(model, &data.s, *body, &m, 1.0, &mut data.g, r + 3 + k);
-                    }
-                }
-            }
             ConstraintKind::Velocity { rows, w_matrix, w_offset, .. } => {
                 let (rows, nu) = (*rows, model.nu);
                 let mut w = vec![0.0; rows * nu];
@@ -655,10 +717,10 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 }
             }
             _ => {
-                let rows = body_rows(c, data, t)?.expect("a body constraint kind");
+                let rows = body_rows(c, data, t, cb)?.expect("a body constraint kind");
                 for k in 0..rows.n {
                     data.phi[r + k] = rows.phi[k];
-                    data.b[r + k] = 0.0;
+                    data.b[r + k] = rows.b[k];
                     add_wrench_row(model, &data.s, rows.body1, &rows.w1[k], 1.0, &mut data.g, r + k);
                     add_wrench_row(model, &data.s, rows.body2, &rows.w2[k], -1.0, &mut data.g, r + k);
                 }
@@ -674,6 +736,14 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
 pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
     for c in &model.constraints {
         let r = c.row;
+        if let Some(sel) = &c.select {
+            let mut rate = [0.0; MAX_ROWS];
+            body_rows_rate(c, data, t, cb, &mut rate)?;
+            for (k, s) in sel.s.iter().enumerate().take(sel.n) {
+                data.gamma[r + k] = -s.iter().zip(&rate).map(|(a, b)| a * b).sum::<f64>();
+            }
+            continue;
+        }
         match &c.kind {
             ConstraintKind::Velocity { rows, w_matrix, w_offset, w_rate } => {
                 let gamma = &mut data.gamma[r..r + rows];
@@ -705,32 +775,9 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64
             ConstraintKind::Prescribed { function, .. } => {
                 data.gamma[r] = function_derivatives(function, t, cb).map_err(in_constraint(c, "function"))?.2;
             }
-            ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
-                let x = data.x_abs[*body].compose(frame);
-                // Φ̈ = a_f - p̈
-                let [_, _, pdd] = prescribed_point(position, t, cb, c, "position")?;
-                let acc = acceleration_at(data, *body, &x.r);
-                for k in 0..3 {
-                    data.gamma[r + k] = pdd[k] - acc[k];
-                }
-                if let Some(angles) = orientation {
-                    // Φ̇ = E(Q) w, w = ω_f - Q ω_p, Q̇ = w̃ Q: Φ̈ = E(Q̇) w + E(Q) ẇ with
-                    // ẇ = ω̇_f - w × (Q ω_p) - Q ω̇_p
-                    let (a_p, w_p, wd_p) = prescribed_rotation(angles, t, cb, c)?;
-                    let qm = x.a * a_p.transpose();
-                    let qw = qm * w_p;
-                    let w = data.v[*body].w - qw;
-                    let qm_d = w.cross_matrix() * qm;
-                    let wd = data.a[*body].w - w.cross(&qw) - qm * wd_p;
-                    let phidd = vee_rate_matrix(&qm_d) * w + vee_rate_matrix(&qm) * wd;
-                    for k in 0..3 {
-                        data.gamma[r + 3 + k] = -phidd[k];
-                    }
-                }
-            }
             _ => {
                 let mut rate = [0.0; MAX_ROWS];
-                body_rows_rate(c, data, t, &mut rate)?;
+                body_rows_rate(c, data, t, cb, &mut rate)?;
                 for k in 0..c.kind.rows() {
                     data.gamma[r + k] = -rate[k];
                 }
@@ -750,6 +797,33 @@ pub fn apply_forces(model: &Model, data: &mut Data) {
 fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
     for c in &model.constraints {
         let r = c.row;
+        if let Some(sel) = &c.select {
+            // the multipliers of the kind's spatial rows: λ_full = Sᵀ λ (likewise Φ)
+            let (mut lam, mut phi) = ([0.0; MAX_ROWS], [0.0; MAX_ROWS]);
+            for (k, s) in sel.s.iter().enumerate().take(sel.n) {
+                for j in 0..MAX_ROWS {
+                    lam[j] += s[j] * data.lambda[r + k];
+                    phi[j] += s[j] * data.phi[r + k];
+                }
+            }
+            if let ConstraintKind::PrescribedBody { body, frame, .. } = &c.kind {
+                let x = data.x_abs[*body].compose(frame);
+                let f = Vec3::new(lam[0], lam[1], lam[2]);
+                let e = vee_rate_matrix(&rotation_from_vee(&Vec3::new(phi[3], phi[4], phi[5])));
+                data.f_ext[*body] += Force::new(x.r.cross(&f) + e.transpose() * Vec3::new(lam[3], lam[4], lam[5]), f);
+            } else {
+                let rows = body_rows(c, data, f64::NAN, &crate::forces::NoCallbacks)?.expect("a body constraint kind");
+                for (k, l) in lam.iter().enumerate().take(rows.n) {
+                    if rows.body1 != 0 {
+                        data.f_ext[rows.body1] += rows.w1[k] * *l;
+                    }
+                    if rows.body2 != 0 {
+                        data.f_ext[rows.body2] += rows.w2[k] * (-*l);
+                    }
+                }
+            }
+            continue;
+        }
         match &c.kind {
             ConstraintKind::Point { body1, p1, body2, p2 } => {
                 let l = Vec3::new(data.lambda[r], data.lambda[r + 1], data.lambda[r + 2]);
@@ -790,7 +864,7 @@ fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
                 data.f_ext[*body] += w;
             }
             _ => {
-                let rows = body_rows(c, data, f64::NAN)?.expect("a body constraint kind");
+                let rows = body_rows(c, data, f64::NAN, &crate::forces::NoCallbacks)?.expect("a body constraint kind");
                 for k in 0..rows.n {
                     let l = data.lambda[r + k];
                     if rows.body1 != 0 {

@@ -68,6 +68,7 @@ pub(super) fn model_with_all_kinds() -> Model {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        planar: false,
         constraints: vec![
             ConstraintDescription::Point {
                 name: "pin".into(),
@@ -219,6 +220,7 @@ fn drift_control_choices() {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        planar: false,
         constraints: vec![ConstraintDescription::Distance {
             name: "rod".into(),
             body1: "b".into(),

@@ -249,7 +249,7 @@ fn min_norm_correction(model: &Model, data: &mut Data, sp: &mut Saddle, holonomi
     let (nu, nc) = (model.nu, model.nc);
     if holonomic_only {
         for con in &model.constraints {
-            let rows = con.row + con.kind.holonomic_rows()..con.row + con.kind.rows();
+            let rows = con.row + con.holonomic_rows()..con.row + con.rows();
             data.work2[rows.clone()].fill(0.0);
             sp.clear_rows(rows);
         }
@@ -306,7 +306,7 @@ fn dense_gram_factor(model: &Model, data: &mut Data, holonomic_only: bool) {
     }
     if holonomic_only {
         for con in &model.constraints {
-            for k in con.kind.holonomic_rows()..con.kind.rows() {
+            for k in con.holonomic_rows()..con.rows() {
                 let r = con.row + k;
                 for c in 0..nc {
                     data.schur[r * nc + c] = 0.0;
@@ -345,7 +345,7 @@ pub fn project(
     }
     // one factor of G Gᵀ serves every Newton step and, when every row is holonomic, the velocity
     // correction too: G changes between them only by the O(|Φ|) position corrections
-    let all_holonomic = model.constraints.iter().all(|c| c.kind.holonomic_rows() == c.kind.rows());
+    let all_holonomic = model.constraints.iter().all(|c| c.holonomic_rows() == c.rows());
     let mut factor = false;
     let mut factor_far = false;
     let mut converged = false;

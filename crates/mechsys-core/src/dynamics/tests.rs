@@ -81,6 +81,7 @@ fn mixed_tree() -> Model {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        planar: false,
         constraints: vec![],
     })
     .unwrap()

@@ -142,7 +142,7 @@ pub fn state_space(
     // the holonomic rows
     let mut holonomic = Vec::with_capacity(nc);
     for c in &model.constraints {
-        let (rows, h) = (c.kind.rows(), c.kind.holonomic_rows());
+        let (rows, h) = (c.rows(), c.holonomic_rows());
         holonomic.extend((0..rows).map(|k| k < h));
     }
     let hrows: Vec<usize> = (0..nc).filter(|&r| holonomic[r]).collect();

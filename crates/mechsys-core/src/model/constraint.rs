@@ -196,6 +196,21 @@ pub enum Reach {
     All,
 }
 
+/// The rows a constraint keeps in a planar model: row `k` is `Σ_j s[k][j] · (full row j)`, a
+/// constant combination of the kind's spatial rows. In a planar model the out-of-plane rows of a
+/// loop closure vanish identically (they would only be redundant), and the in-plane ones are
+/// fixed combinations because rotations about the world z-axis keep the z-components of
+/// body-fixed vectors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Selection {
+    /// Number of rows kept (≤ 3).
+    pub n: usize,
+    /// Combination coefficients over the kind's rows (≤ 6).
+    pub s: [[f64; 6]; 3],
+    /// Column names of the kept rows.
+    pub names: [&'static str; 3],
+}
+
 /// A named constraint with its row offset in the stacked constraint vector.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Constraint {
@@ -205,6 +220,19 @@ pub struct Constraint {
     pub kind: ConstraintKind,
     /// Offset of its rows.
     pub row: usize,
+    /// The rows kept in a planar model (None: all of the kind's rows).
+    pub select: Option<Selection>,
+}
+
+impl Constraint {
+    /// Number of scalar equations (after the planar selection).
+    pub fn rows(&self) -> usize {
+        self.select.map_or_else(|| self.kind.rows(), |s| s.n)
+    }
+    /// Number of holonomic rows (the selected kinds are all holonomic).
+    pub fn holonomic_rows(&self) -> usize {
+        self.select.map_or_else(|| self.kind.holonomic_rows(), |s| s.n)
+    }
 }
 
 impl ConstraintKind {
@@ -289,7 +317,7 @@ pub fn row_pattern(model: &Model) -> (Vec<usize>, Vec<usize>) {
         }
         buf.sort_unstable();
         buf.dedup();
-        for k in 0..c.kind.rows() {
+        for k in 0..c.rows() {
             row_idx.extend_from_slice(&buf);
             row_ptr[c.row + k + 1] = row_idx.len();
         }

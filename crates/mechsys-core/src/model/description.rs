@@ -42,6 +42,10 @@ pub struct ModelDescription {
     /// other contours, with one friction and one impact law (pairs found by a broad phase).
     #[serde(default)]
     pub contact_groups: Vec<ContactGroupDescription>,
+    /// A planar model: every body moves in the world x-y plane (revolute joints about z,
+    /// prismatic and planar joints in the plane), loop closures keep only their in-plane rows.
+    #[serde(default)]
+    pub planar: bool,
 }
 
 /// A bilateral constraint. Read through a JSON value so that a malformed entry's error names the

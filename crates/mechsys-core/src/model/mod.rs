@@ -16,6 +16,7 @@ pub mod description;
 pub mod jenkins;
 pub mod joint;
 pub mod rotation_description;
+mod planar;
 mod validate;
 
 use std::collections::HashMap;
@@ -386,6 +387,8 @@ pub struct Model {
     pub n_contact_points: usize,
     /// Total number of constraint equations.
     pub nc: usize,
+    /// A planar model (see [`planar`]): constraints keep their in-plane rows.
+    pub planar: bool,
     /// Total number of coordinates.
     pub nq: usize,
     /// Total number of velocities (degrees of freedom).

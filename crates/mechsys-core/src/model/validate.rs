@@ -951,7 +951,7 @@ impl Model {
                 }
             };
             let rows = kind.rows();
-            constraints.push(Constraint { name, kind, row });
+            constraints.push(Constraint { name, kind, row, select: None });
             row += rows;
         }
 
@@ -985,7 +985,8 @@ impl Model {
         let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
         let n_force_outputs = forces.iter().map(|f| f.outputs(iu)).sum();
-        Ok(Model {
+        let planar = desc.planar;
+        let mut model = Model {
             name: desc.name.clone(),
             gravity: g,
             bodies,
@@ -996,6 +997,7 @@ impl Model {
             contact_groups,
             n_contact_points,
             nc: row,
+            planar,
             nq: iq,
             nu: iu,
             variable_mass,
@@ -1006,7 +1008,11 @@ impl Model {
             description: desc,
             body_index,
             joint_index,
-        })
+        };
+        if planar {
+            super::planar::planarize(&mut model)?;
+        }
+        Ok(model)
     }
 }
 
