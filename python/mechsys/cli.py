@@ -205,11 +205,22 @@ def run(
         kwargs["max_steps"] = max_steps
     if max_wall is not None:
         kwargs["max_wall"] = max_wall
+    out_path = out if out is not None else Path("results") / f"{_safe_name(model.name)}.h5"
     start = time.perf_counter()
-    res = simulate(model, **kwargs)
+    try:
+        res = simulate(model, **kwargs)
+    except KeyboardInterrupt as e:
+        partial = getattr(e, "results", None)
+        if partial is None or not len(partial.t):
+            raise
+        # Ctrl-C keeps what was computed: the samples up to the stop, marked as interrupted in
+        # the file (attribute 'interrupted'), then the shell's exit status for SIGINT
+        partial.attrs["interrupted"] = f"cancelled at t = {partial.t[-1]:g} s of {kwargs.get('t_end', '?')} s"
+        partial.save(out_path)
+        click.echo(f"interrupted at t = {partial.t[-1]:g} s: the {len(partial.t)} samples so far saved to {out_path}", err=True)
+        raise SystemExit(130) from None
     wall = time.perf_counter() - start
 
-    out_path = out if out is not None else Path("results") / f"{_safe_name(model.name)}.h5"
     try:
         res.save(out_path)
     except OSError as e:
