@@ -125,7 +125,7 @@ def test_unknown_simulation_key(tmp_path):
     with pytest.raises(ModelError) as e:
         load_model(p)
     assert str(e.value) == (
-        f"{p}: simulation.t_ned: unknown key; expected one of t_end, t0, output_dt, integrator, q0, u0"
+        f"{p}: simulation.t_ned: unknown key; expected one of t_end, t0, output_dt, integrator, q0, u0, sensors"
     )
 
 

@@ -128,8 +128,10 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
         if j["nq"] > 0 and n in results:
             names.append(n)
             break
-    names.append("energy/total")
-    return names
+    if "energy/total" in results:
+        names.append("energy/total")
+    # a selective recording (--sensors) may hold neither: its first signals then
+    return names or [n for n in results.names() if n != "t"][:2]
 
 
 # ---- commands ------------------------------------------------------------------------------------
@@ -150,6 +152,8 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
               help="At a singular configuration (the constraints lose rank): go on with a warning [default] or stop.")
 @click.option("--max-steps", "max_steps", type=int, help="Stop after this many accepted steps (rk4, dopri5, radau5).")
 @click.option("--max-wall", "max_wall", type=float, help="Stop after this many seconds of wall-clock time.")
+@click.option("--sensors", "sensors", multiple=True, metavar="PATTERN[,PATTERN...]",
+              help="Record only these signals (names or patterns such as 'joint/*/q', 'marker/arm/tip/*'); repeat or separate by commas [default: everything].")
 @click.option("--out", "out", type=click.Path(path_type=Path, dir_okay=False), help="HDF5 results file [default: results/<model name>.h5].")
 @click.option("--plot", "plot_out", type=click.Path(path_type=Path, dir_okay=False), help="Write a plot (.png, .svg or .pdf).")
 @click.option(
@@ -174,6 +178,7 @@ def run(
     on_singular: str | None,
     max_steps: int | None,
     max_wall: float | None,
+    sensors: tuple[str, ...],
     out: Path | None,
     plot_out: Path | None,
     signals: tuple[str, ...],
@@ -198,6 +203,7 @@ def run(
         dt=dt,
         rtol=rtol,
         atol=atol,
+        sensors=_split_signals(sensors) or None,
     )
     if on_singular is not None:
         kwargs["on_singular"] = on_singular

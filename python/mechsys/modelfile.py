@@ -55,7 +55,7 @@ from .integrators import DOPRI5, NSGS, RK4, EventDriven, Lemke, MoreauJean, Newt
 from .model import Model
 
 #: Keys of the ``[simulation]`` table.
-SIMULATION_KEYS: tuple[str, ...] = ("t_end", "t0", "output_dt", "integrator", "q0", "u0")
+SIMULATION_KEYS: tuple[str, ...] = ("t_end", "t0", "output_dt", "integrator", "q0", "u0", "sensors")
 
 #: Keys allowed in an integrator table, per integrator type (besides ``type``).
 INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
@@ -344,6 +344,11 @@ def _check_simulation(sim: dict, model: Model, allow_objects: bool) -> dict:
             out[key] = x
         elif key == "integrator":
             out[key] = _check_integrator(value, allow_objects)
+        elif key == "sensors":
+            items = [value] if isinstance(value, str) else value
+            if not isinstance(items, (list, tuple)) or not all(isinstance(x, str) for x in items):
+                raise ModelError(f"simulation.sensors: expected a list of signal names or patterns, got {value!r}")
+            out[key] = list(items)
         else:
             out[key] = _check_state(value, key, model)
     if "t_end" in out and out["t_end"] <= out.get("t0", 0.0):
@@ -403,7 +408,7 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
         raise SettingsError(f"simulation.{unknown[0]}: unknown key; expected one of {', '.join(SIMULATION_KEYS)}")
 
     kwargs: dict[str, Any] = {}
-    for key in ("t_end", "t0", "output_dt", "q0", "u0"):
+    for key in ("t_end", "t0", "output_dt", "q0", "u0", "sensors"):
         value = over.get(key, defaults.get(key))
         if value is not None:
             kwargs[key] = value

@@ -138,10 +138,20 @@ class Results:
             qu += b
             uc += [f"{j['name']}.{x}" for x in c]
             uu_ += d
+        # a selective recording (simulate(sensors=...)) holds some bodies only, maybe no
+        # accelerations, constraint or force values
+        if "body_index" in raw:
+            all_bodies = body_names
+            body_names = [all_bodies[i - 1] for i in raw["body_index"]]
+            complete = len(body_names) == len(all_bodies)
+        else:
+            complete = True
+        acc = "udot" in raw
         put("t", raw["t"], "s")
         put("q", raw["q"], "mixed", qc, qu)
         put("u", raw["u"], "mixed", uc, uu_)
-        put("udot", raw["udot"], "mixed", uc, [_rate_unit(x) for x in uu_])
+        if acc:
+            put("udot", raw["udot"], "mixed", uc, [_rate_unit(x) for x in uu_])
         for j in joints:
             uq, uu, ua = _JOINT_UNITS.get(j["type"], ("", "", ""))
             if j["nq"] == 0:
@@ -152,14 +162,16 @@ class Results:
             a, b, c, d = _JOINT_COLUMNS.get(j["type"], (None, None, None, None))
             put(f"joint/{j['name']}/q", raw["q"][:, j["iq"]] if one else raw["q"][:, sq], uq, None if one else a, b)
             put(f"joint/{j['name']}/u", raw["u"][:, j["iu"]] if one else raw["u"][:, su], uu, None if one else c, d)
-            put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua, None if one else c,
-                None if one or d is None else [_rate_unit(x) for x in d])
+            if acc:
+                put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua, None if one else c,
+                    None if one or d is None else [_rate_unit(x) for x in d])
         for k, b in enumerate(body_names):
             put(f"body/{b}/position", raw["body_position"][:, k, :], "m", xyz)
             put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1", ["w", "x", "y", "z"])
             put(f"body/{b}/velocity", raw["body_velocity"][:, k, :], "m/s", xyz)
             put(f"body/{b}/angular_velocity", raw["body_angular_velocity"][:, k, :], "rad/s", xyz)
-            put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2", xyz)
+            if acc:
+                put(f"body/{b}/acceleration", raw["body_acceleration"][:, k, :], "m/s^2", xyz)
             if "body_angular_acceleration" in raw:
                 put(f"body/{b}/angular_acceleration", raw["body_angular_acceleration"][:, k, :], "rad/s^2", xyz)
             put(f"body/{b}/mass", raw["body_mass"][:, k], "kg")
@@ -173,7 +185,7 @@ class Results:
         put("energy/external_work", raw["external_work"], "J")
         put("momentum/linear", raw["momentum_linear"], "N s", xyz)
         put("momentum/angular", raw["momentum_angular"], "N m s", xyz)
-        if engine is not None:
+        if engine is not None and "constraint_lambda" in raw:
             for c in engine.constraints():
                 sl = slice(c["row"], c["row"] + c["rows"])
                 unit = c["unit"]
@@ -253,11 +265,11 @@ class Results:
         for a in s.values():
             a.setflags(write=False)
         lazy = {}
-        if engine is not None and "body_angular_acceleration" in raw:
-            group, sensors = _sensor_group(engine, body_names, raw)
+        if engine is not None and "body_orientation" in raw and "body_mass" in raw:
+            group, sensors = _sensor_group(engine, body_names, raw, complete)
             for name, unit in sensors.items():
                 lazy[name] = (unit, group)
-        if engine is not None and joints:
+        if engine is not None and joints and acc:
             group = _reaction_group(engine, callbacks, joints, raw)
             for j in joints:
                 lazy[f"joint/{j['name']}/reaction_force"] = ("N", group)
@@ -265,6 +277,15 @@ class Results:
         out = cls(s, u, attrs, lazy)
         out._columns = cols
         return out
+
+    def _keep_only(self, names) -> None:
+        """Drops every signal but ``t`` and ``names`` (a selective recording; names the run
+        cannot give, e.g. contact signals of another scheme, are left out)."""
+        keep = set(names) | {"t"}
+        self._signals = {n: a for n, a in self._signals.items() if n in keep}
+        self._units = {n: u for n, u in self._units.items() if n in keep or n in self._lazy}
+        self._lazy = {n: v for n, v in self._lazy.items() if n in keep}
+        self._columns = {n: c for n, c in self._columns.items() if n in keep}
 
     # ---- access --------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> np.ndarray:
@@ -283,6 +304,8 @@ class Results:
     def _materialize(self, name: str) -> None:
         unit, compute = self._lazy[name]
         for n, arr in compute().items():
+            if n not in self._lazy:
+                continue  # left out by a selective recording (or already there)
             arr.setflags(write=False)
             self._signals[n] = arr
             self._units[n] = self._lazy.pop(n, (unit, None))[0]
@@ -520,22 +543,31 @@ class Results:
         return path
 
 
-def _sensor_group(engine, body_names: list[str], raw: dict):
+def _sensor_group(engine, body_names: list[str], raw: dict, complete: bool = True):
     """Marker and centre-of-mass signals from the recorded body states (computed on first access):
     a point r fixed in a body (A_IB from the orientation) moves as p + A r, v + w x (A r),
-    a + al x (A r) + w x (w x (A r)); a marker's orientation is q_body * q_marker."""
+    a + al x (A r) + w x (w x (A r)); a marker's orientation is q_body * q_marker. Without
+    recorded accelerations there are no acceleration signals; the model's centre of mass needs
+    every body recorded (``complete``)."""
     from .kinematics import matrix_to_quat
 
+    acc = "body_angular_acceleration" in raw
     info = {b["name"]: b for b in engine.bodies()}
     names: dict[str, str] = {}
     for b in body_names:
         for mk in info[b].get("marker_frames", []):
             pre = f"marker/{b}/{mk[0]}"
-            names.update({f"{pre}/position": "m", f"{pre}/velocity": "m/s", f"{pre}/acceleration": "m/s^2",
-                          f"{pre}/orientation": "1"})
-        names.update({f"body/{b}/com_position": "m", f"body/{b}/com_velocity": "m/s", f"body/{b}/com_acceleration": "m/s^2"})
-    if body_names:
-        names.update({"com/position": "m", "com/velocity": "m/s", "com/acceleration": "m/s^2"})
+            names.update({f"{pre}/position": "m", f"{pre}/velocity": "m/s", f"{pre}/orientation": "1"})
+            if acc:
+                names[f"{pre}/acceleration"] = "m/s^2"
+        names.update({f"body/{b}/com_position": "m", f"body/{b}/com_velocity": "m/s"})
+        if acc:
+            names[f"body/{b}/com_acceleration"] = "m/s^2"
+    whole = bool(body_names) and complete
+    if whole:
+        names.update({"com/position": "m", "com/velocity": "m/s"})
+        if acc:
+            names["com/acceleration"] = "m/s^2"
 
     def compute() -> dict[str, np.ndarray]:
         out: dict[str, np.ndarray] = {}
@@ -544,26 +576,35 @@ def _sensor_group(engine, body_names: list[str], raw: dict):
         sums = [0.0, 0.0, 0.0]
         for k, b in enumerate(body_names):
             a_ib = _quat_matrices(qb[:, k, :])
-            p, v, a = raw["body_position"][:, k, :], raw["body_velocity"][:, k, :], raw["body_acceleration"][:, k, :]
-            w, al = raw["body_angular_velocity"][:, k, :], raw["body_angular_acceleration"][:, k, :]
+            p, v, w = raw["body_position"][:, k, :], raw["body_velocity"][:, k, :], raw["body_angular_velocity"][:, k, :]
+            a = raw["body_acceleration"][:, k, :] if acc else None
+            al = raw["body_angular_acceleration"][:, k, :] if acc else None
 
             def point(r):
                 rr = a_ib @ np.asarray(r, dtype=float)  # (n, 3)
+                if not acc:
+                    return p + rr, v + np.cross(w, rr), None
                 return p + rr, v + np.cross(w, rr), a + np.cross(al, rr) + np.cross(w, np.cross(w, rr))
 
             for name, pos, rot in info[b].get("marker_frames", []):
                 pre = f"marker/{b}/{name}"
                 x, xd, xdd = point(pos)
                 qm = matrix_to_quat(np.asarray(rot, dtype=float).reshape(3, 3))
-                out[f"{pre}/position"], out[f"{pre}/velocity"], out[f"{pre}/acceleration"] = x, xd, xdd
+                out[f"{pre}/position"], out[f"{pre}/velocity"] = x, xd
+                if acc:
+                    out[f"{pre}/acceleration"] = xdd
                 out[f"{pre}/orientation"] = _quat_products(qb[:, k, :], qm)
             c, cd, cdd = point(info[b]["com"])
-            out[f"body/{b}/com_position"], out[f"body/{b}/com_velocity"], out[f"body/{b}/com_acceleration"] = c, cd, cdd
+            out[f"body/{b}/com_position"], out[f"body/{b}/com_velocity"] = c, cd
+            if acc:
+                out[f"body/{b}/com_acceleration"] = cdd
             mass = raw["body_mass"][:, k][:, None]
             m_tot = m_tot + mass
-            sums = [s_ + mass * x for s_, x in zip(sums, (c, cd, cdd))]
-        if body_names:
-            out["com/position"], out["com/velocity"], out["com/acceleration"] = (x / m_tot for x in sums)
+            sums = [s_ + mass * x if x is not None else s_ for s_, x in zip(sums, (c, cd, cdd))]
+        if whole:
+            out["com/position"], out["com/velocity"] = sums[0] / m_tot, sums[1] / m_tot
+            if acc:
+                out["com/acceleration"] = sums[2] / m_tot
         return out
 
     return compute, names
@@ -630,3 +671,83 @@ def _force_unit(rate_unit: str) -> str:
 def _per_second(unit: str) -> str:
     """"m/s" -> "m/s^2", "m" -> "m/s"."""
     return unit[:-2] + "/s^2" if unit.endswith("/s") else f"{unit}/s"
+
+
+# ---- selective recording (simulate(sensors=...)) ---------------------------------------------------
+_ACCELERATION_SUFFIXES = ("udot", "/acceleration", "/angular_acceleration", "/com_acceleration", "/reaction_force",
+                          "/reaction_torque")
+_CONTACT_SUFFIXES = ("g_n", "point", "normal", "gd_n", "gd_t", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
+                     "friction_reserve")
+_GROUP_SUFFIXES = ("closed", "max_penetration", "impulse_n", "lambda_n", "pairs", "impulse_against", "force_against")
+
+
+def signal_universe(engine) -> list[str]:
+    """Every signal name a run of the engine model can give (some only with contacts or the
+    matching scheme): what ``sensors=`` patterns are checked against."""
+    names = ["t", "q", "u", "udot"]
+    for j in engine.joints():
+        if j["nq"]:
+            names += [f"joint/{j['name']}/{x}" for x in ("q", "u", "udot")]
+        names += [f"joint/{j['name']}/reaction_force", f"joint/{j['name']}/reaction_torque"]
+    for b in engine.bodies():
+        n = b["name"]
+        names += [f"body/{n}/{x}" for x in ("position", "orientation", "velocity", "angular_velocity", "acceleration",
+                                             "angular_acceleration", "mass", "kinetic_energy", "com_position",
+                                             "com_velocity", "com_acceleration")]
+        for mk in b.get("marker_frames", []):
+            names += [f"marker/{n}/{mk[0]}/{x}" for x in ("position", "velocity", "acceleration", "orientation")]
+    names += ["com/position", "com/velocity", "com/acceleration"]
+    names += [f"energy/{x}" for x in ("kinetic", "potential", "total", "dissipated", "external_work", "dissipated_impact",
+                                      "dissipated_friction")]
+    names += ["momentum/linear", "momentum/angular"]
+    for c in engine.constraints():
+        names += [f"constraint/{c['name']}/{x}" for x in ("lambda", "violation", "velocity_violation")]
+    for name, _ in engine.forces():
+        names += [f"force/{name}/{x}" for x in ("force", "torque", "deflection")]
+    for c in engine.contacts():
+        names += [f"contact/{c['name']}/{x}" for x in _CONTACT_SUFFIXES]
+    for g in engine.contact_groups():
+        names += [f"contact/{g['name']}/{x}" for x in _GROUP_SUFFIXES]
+    return names
+
+
+def record_selection(engine, patterns) -> tuple[dict, list[str]]:
+    """The engine's recording selection for signal-name patterns (``fnmatch``: ``*``, ``?``,
+    ``[..]``) and the names they match; a pattern matching nothing is a SettingsError naming it."""
+    import difflib
+    import fnmatch
+
+    from .errors import SettingsError
+
+    if isinstance(patterns, str):
+        patterns = [patterns]
+    try:
+        patterns = list(patterns)
+    except TypeError:
+        raise SettingsError(f"sensors: expected a list of signal names or patterns, got {patterns!r}") from None
+    if not patterns:
+        raise SettingsError("sensors: empty list (None records everything)")
+    universe = signal_universe(engine)
+    chosen: list[str] = []
+    for p in patterns:
+        if not isinstance(p, str) or not p:
+            raise SettingsError(f"sensors: expected signal names or patterns (strings), got {p!r}")
+        hits = fnmatch.filter(universe, p)
+        if not hits:
+            close = difflib.get_close_matches(p, universe, n=5, cutoff=0.6)
+            hint = f"; similar: {', '.join(close)}" if close else ""
+            raise SettingsError(f"sensors: '{p}' matches no signal of model '{engine.name}'{hint}")
+        chosen += [h for h in hits if h not in chosen]
+    body_names = [b["name"] for b in engine.bodies()]
+    if any(n.startswith("com/") for n in chosen):
+        bodies = body_names
+    else:
+        wanted = {n.split("/")[1] for n in chosen if n.startswith(("body/", "marker/"))}
+        bodies = [b for b in body_names if b in wanted]
+    selection = {
+        "bodies": bodies,
+        "accelerations": any(n.endswith(_ACCELERATION_SUFFIXES) for n in chosen),
+        "constraints": any(n.startswith("constraint/") for n in chosen),
+        "forces": any(n.startswith("force/") for n in chosen),
+    }
+    return selection, chosen

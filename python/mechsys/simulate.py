@@ -98,6 +98,7 @@ def simulate(
     on_singular: str = "continue",
     max_steps: int | None = None,
     max_wall: float | None = None,
+    sensors: Sequence[str] | None = None,
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
@@ -120,6 +121,10 @@ def simulate(
     SolverError saying which was spent and at what time. An RK4 run whose energy grows
     geometrically (a step above the stability limit) stops with a SolverError naming the stiffest
     spring and the step that would be stable.
+    ``sensors``: record only these signals — names or patterns (``"joint/*/q"``,
+    ``"marker/arm/tip/*"``, ``"energy/total"``); the engine then skips the bodies, accelerations,
+    constraint and force values nothing asked for (default None: everything). A pattern that
+    matches no signal of the model is a SettingsError naming it.
     """
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
@@ -133,6 +138,11 @@ def simulate(
 
         q0, u0 = assemble(model, q0, u0, float(t0), keep=keep)
     settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization, on_singular, max_steps, max_wall)
+    chosen = None
+    if sensors is not None:
+        from .results import record_selection
+
+        settings["record"], chosen = record_selection(core, sensors)
     text = json.dumps(settings)
     callbacks = model.callbacks or None
     prog = _core.Progress()
@@ -178,7 +188,11 @@ def simulate(
     }
     body_names = core.body_names[1:]
     cancelled = raw.pop("cancelled", None)
+    if chosen is not None:
+        attrs["sensors"] = json.dumps(list(sensors) if not isinstance(sensors, str) else [sensors])
     res = Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
+    if chosen is not None:
+        res._keep_only(chosen)
     if cancelled is not None:
         # Ctrl-C: the samples before it are kept on the interrupt (`except KeyboardInterrupt as e:
         # e.results`)

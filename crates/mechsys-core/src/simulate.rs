@@ -49,6 +49,40 @@ pub struct Settings {
     /// Most wall-clock seconds before the run stops (checked at every sample and every 256 steps).
     #[serde(default)]
     pub max_wall: Option<f64>,
+    /// What is recorded beyond the state, energies and momenta (default: everything).
+    #[serde(default)]
+    pub record: RecordSelection,
+}
+
+/// Which groups of signals a run records. The state (t, q, u), energies, momenta and contact
+/// signals are always recorded; a large model asked for a few signals skips the rest (a body's
+/// states are 23 values per sample).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordSelection {
+    /// Bodies whose states (position, orientation, velocities, accelerations, mass, kinetic
+    /// energy) are recorded, by name; None: all.
+    #[serde(default)]
+    pub bodies: Option<Vec<String>>,
+    /// Generalized and body accelerations.
+    #[serde(default = "yes")]
+    pub accelerations: bool,
+    /// Constraint multipliers and violations.
+    #[serde(default = "yes")]
+    pub constraints: bool,
+    /// Force elements' forces and deflections.
+    #[serde(default = "yes")]
+    pub forces: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for RecordSelection {
+    fn default() -> Self {
+        RecordSelection { bodies: None, accelerations: true, constraints: true, forces: true }
+    }
 }
 
 /// The run's budgets ([`Settings::max_steps`], [`Settings::max_wall`]) and the clock.
@@ -134,8 +168,12 @@ pub enum Stabilization {
 pub struct Recording {
     /// Number of samples.
     pub n_out: usize,
-    /// Number of bodies recorded (the model's bodies without the ground).
+    /// Number of bodies recorded (the model's bodies without the ground, or the selected ones).
     pub n_bodies: usize,
+    /// Model indices of the recorded bodies (1-based: 0 is the ground), in recording order.
+    pub body_index: Vec<usize>,
+    /// What was recorded.
+    pub selection: RecordSelection,
     /// Sample times (n_out), s.
     pub t: Vec<f64>,
     /// Coordinates (n_out × nq).
@@ -825,21 +863,30 @@ pub fn simulate(
     let (t_out, y0) = prepare(model, settings)?;
     check_inertia(model, settings.t0, &y0[..model.nq])?;
     let n_out = t_out.len();
-    let nb = model.nbodies() - 1;
+    let body_index = recorded_bodies(model, &settings.record)?;
+    let nb = body_index.len();
+    let sel = settings.record.clone();
+    let (na, nc, nf) = (
+        if sel.accelerations { 1 } else { 0 },
+        if sel.constraints { model.nc } else { 0 },
+        if sel.forces { model.n_force_outputs } else { 0 },
+    );
     let (nq, nu) = (model.nq, model.nu);
     let mut rec = Recording {
         n_out,
         n_bodies: nb,
+        body_index,
+        selection: sel,
         t: Vec::with_capacity(n_out),
         q: Vec::with_capacity(n_out * nq),
         u: Vec::with_capacity(n_out * nu),
-        udot: Vec::with_capacity(n_out * nu),
+        udot: Vec::with_capacity(n_out * nu * na),
         body_position: Vec::with_capacity(n_out * nb * 3),
         body_orientation: Vec::with_capacity(n_out * nb * 4),
         body_velocity: Vec::with_capacity(n_out * nb * 3),
         body_angular_velocity: Vec::with_capacity(n_out * nb * 3),
-        body_acceleration: Vec::with_capacity(n_out * nb * 3),
-        body_angular_acceleration: Vec::with_capacity(n_out * nb * 3),
+        body_acceleration: Vec::with_capacity(n_out * nb * 3 * na),
+        body_angular_acceleration: Vec::with_capacity(n_out * nb * 3 * na),
         body_mass: Vec::with_capacity(n_out * nb),
         kinetic: Vec::with_capacity(n_out),
         body_kinetic: Vec::with_capacity(n_out * nb),
@@ -848,11 +895,11 @@ pub fn simulate(
         external_work: Vec::with_capacity(n_out),
         momentum_linear: Vec::with_capacity(n_out * 3),
         momentum_angular: Vec::with_capacity(n_out * 3),
-        constraint_lambda: Vec::with_capacity(n_out * model.nc),
-        constraint_violation: Vec::with_capacity(n_out * model.nc),
-        constraint_velocity_violation: Vec::with_capacity(n_out * model.nc),
-        force_value: Vec::with_capacity(n_out * model.n_force_outputs),
-        force_deflection: Vec::with_capacity(n_out * model.n_force_outputs),
+        constraint_lambda: Vec::with_capacity(n_out * nc),
+        constraint_violation: Vec::with_capacity(n_out * nc),
+        constraint_velocity_violation: Vec::with_capacity(n_out * nc),
+        force_value: Vec::with_capacity(n_out * nf),
+        force_deflection: Vec::with_capacity(n_out * nf),
         warnings: Vec::new(),
         stats: Stats::default(),
         ..Default::default()
@@ -923,7 +970,8 @@ pub fn simulate(
     // for RK4 (the adaptive and implicit schemes control or damp it); variable-mass bodies carry
     // energy away with the ejected mass, so their balance is not checked
     let guard = matches!(settings.integrator, IntegratorKind::Rk4 { .. }) && model.bodies.iter().all(|b| b.mass_rate == 0.0);
-    let mut divergence = Divergence::default();
+    let mut divergence =
+        Divergence { floor: 1e-6 * model.bodies.iter().skip(1).map(|b| b.mass).sum::<f64>(), ..Default::default() };
     sys.budget = Some(Budget::new(settings));
     let mut observer = |sys: &mut MultibodySystem, t: f64, y: &[f64], fresh: bool| -> Result<()> {
         if !fresh {
@@ -975,6 +1023,8 @@ struct Divergence {
     start: f64,
     /// The energy balance T + V − W + D of the first sample.
     balance0: f64,
+    /// Round-off floor of the energies: a millijoule per tonne of the model's mass.
+    floor: f64,
 }
 
 impl Divergence {
@@ -991,8 +1041,7 @@ impl Divergence {
             return None;
         }
         let grown = (balance - self.balance0).abs();
-        let floor = 1e-6 * rec.body_mass.iter().take(rec.n_bodies).sum::<f64>();
-        if grown > 0.5 * size && size > 1e3 * self.start.max(floor) {
+        if grown > 0.5 * size && size > 1e3 * self.start.max(self.floor) {
             Some(format!(
                 "the run diverged at t = {t:.6} s: the energy grew from {:.4e} J to {balance:.4e} J with nothing doing that work",
                 self.balance0
@@ -1396,16 +1445,39 @@ fn report_progress(progress: Option<&Progress>, samples: usize, t: f64) -> Resul
     Ok(())
 }
 
+/// Model indices of the bodies a run records (ascending), from the selection's names.
+fn recorded_bodies(model: &Model, sel: &RecordSelection) -> Result<Vec<usize>> {
+    let Some(names) = &sel.bodies else {
+        return Ok((1..model.nbodies()).collect());
+    };
+    let mut out = Vec::with_capacity(names.len());
+    for n in names {
+        match model.body_id(n) {
+            Some(0) => return Err(Error::Settings(format!("record.bodies: 'ground' has no recorded states"))),
+            Some(i) => out.push(i),
+            None => return Err(Error::Settings(format!("record.bodies: unknown body '{n}'"))),
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
 /// The record stage: appends one sample of every signal from an evaluated workspace (`saddle`:
 /// the constrained solve's factorization, holding G as last gathered, for `G u - b`).
 fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &mut Recording) {
     let (nq, nu) = (model.nq, model.nu);
-    let nb_rec = model.nbodies() - 1;
+    let nb_rec = rec.n_bodies;
+    let sel = &rec.selection;
+    let (acc, cons, forces) = (sel.accelerations, sel.constraints, sel.forces);
     rec.t.push(t);
     rec.q.extend_from_slice(&y[..nq]);
     rec.u.extend_from_slice(&y[nq..nq + nu]);
-    rec.udot.extend_from_slice(&data.udot);
-    for i in 1..model.nbodies() {
+    if acc {
+        rec.udot.extend_from_slice(&data.udot);
+    }
+    for bi in 0..nb_rec {
+        let i = rec.body_index[bi];
         let x = &data.x_abs[i];
         rec.body_position.extend_from_slice(x.r.as_slice());
         let mut qb = matrix_to_quaternion(&x.a);
@@ -1422,16 +1494,23 @@ fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &
         let origin = crate::math::Vec3::zeros();
         rec.body_velocity.extend_from_slice(point_velocity(data, i, &origin).as_slice());
         rec.body_angular_velocity.extend_from_slice(data.v[i].w.as_slice());
-        rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
-        rec.body_angular_acceleration.extend_from_slice(data.a[i].w.as_slice());
+        if acc {
+            rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
+            rec.body_angular_acceleration.extend_from_slice(data.a[i].w.as_slice());
+        }
         rec.body_mass.push(data.inertia[i].m);
     }
     // one product I v per body gives its kinetic energy and both momenta (world convention)
     let (mut t_sum, mut p, mut l) = (0.0, crate::math::Vec3::zeros(), crate::math::Vec3::zeros());
+    let all = nb_rec == model.nbodies() - 1;
+    let mut next = 0;
     for i in 1..model.nbodies() {
         let h = data.inertia[i].mul_motion(&data.v[i]);
         let e = 0.5 * data.v[i].dot(&h);
-        rec.body_kinetic.push(e);
+        if all || (next < nb_rec && rec.body_index[next] == i) {
+            rec.body_kinetic.push(e);
+            next += 1;
+        }
         t_sum += e;
         p += h.f;
         l += h.n;
@@ -1442,10 +1521,15 @@ fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &
     rec.external_work.push(y[nq + nu + 1]);
     rec.momentum_linear.extend_from_slice(p.as_slice());
     rec.momentum_angular.extend_from_slice(l.as_slice());
+    if forces {
+        rec.force_value.extend_from_slice(&data.element_force);
+        rec.force_deflection.extend_from_slice(&data.element_deflection);
+    }
+    if !cons {
+        return;
+    }
     rec.constraint_lambda.extend_from_slice(&data.lambda);
     rec.constraint_violation.extend_from_slice(&data.phi);
-    rec.force_value.extend_from_slice(&data.element_force);
-    rec.force_deflection.extend_from_slice(&data.element_deflection);
     let k = rec.constraint_velocity_violation.len();
     rec.constraint_velocity_violation.resize(k + model.nc, 0.0);
     if model.nc > 0 {

@@ -223,13 +223,19 @@ fn simulate<'py>(
     put("t", rec.t, &[n])?;
     put("q", rec.q, &[n, m.nq])?;
     put("u", rec.u, &[n, m.nu])?;
-    put("udot", rec.udot, &[n, m.nu])?;
+    let sel = rec.selection.clone();
+    if sel.accelerations {
+        put("udot", rec.udot, &[n, m.nu])?;
+    }
+    d.set_item("body_index", rec.body_index.clone())?;
     put("body_position", rec.body_position, &[n, nb, 3])?;
     put("body_orientation", rec.body_orientation, &[n, nb, 4])?;
     put("body_velocity", rec.body_velocity, &[n, nb, 3])?;
     put("body_angular_velocity", rec.body_angular_velocity, &[n, nb, 3])?;
-    put("body_acceleration", rec.body_acceleration, &[n, nb, 3])?;
-    put("body_angular_acceleration", rec.body_angular_acceleration, &[n, nb, 3])?;
+    if sel.accelerations {
+        put("body_acceleration", rec.body_acceleration, &[n, nb, 3])?;
+        put("body_angular_acceleration", rec.body_angular_acceleration, &[n, nb, 3])?;
+    }
     put("body_mass", rec.body_mass, &[n, nb])?;
     put("kinetic", rec.kinetic, &[n])?;
     put("body_kinetic", rec.body_kinetic, &[n, nb])?;
@@ -238,10 +244,12 @@ fn simulate<'py>(
     put("external_work", rec.external_work, &[n])?;
     put("momentum_linear", rec.momentum_linear, &[n, 3])?;
     put("momentum_angular", rec.momentum_angular, &[n, 3])?;
-    put("constraint_lambda", rec.constraint_lambda, &[n, m.nc])?;
-    put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
-    put("constraint_velocity_violation", rec.constraint_velocity_violation, &[n, m.nc])?;
-    if m.n_force_outputs > 0 {
+    if sel.constraints {
+        put("constraint_lambda", rec.constraint_lambda, &[n, m.nc])?;
+        put("constraint_violation", rec.constraint_violation, &[n, m.nc])?;
+        put("constraint_velocity_violation", rec.constraint_velocity_violation, &[n, m.nc])?;
+    }
+    if m.n_force_outputs > 0 && sel.forces {
         put("force_value", rec.force_value, &[n, m.n_force_outputs])?;
         put("force_deflection", rec.force_deflection, &[n, m.n_force_outputs])?;
     }
