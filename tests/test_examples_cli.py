@@ -120,3 +120,21 @@ def test_command_line_options_override_an_integrator_object(tmp_path):
     proc = run_example(path, 0.02, out, tmp_path, "--rtol", "1e-8")
     assert proc.returncode == 2
     assert proc.stderr.strip() == "error: --rtol does not apply to integrator moreau_jean (it has a fixed step: use --dt)"
+
+
+def test_the_readme_model_is_the_model_of_its_toml_file(tmp_path, monkeypatch):
+    """The README's first Python model and examples/double_pendulum.toml are one model: run both
+    and compare (the README code as written, results written under a temporary directory)."""
+    readme = (EXAMPLES.parent / "README.md").read_text()
+    code = readme.split("## A first model", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(tmp_path)
+    ns: dict = {}
+    exec(compile(code, "README.md", "exec"), ns)  # noqa: S102 - the project's own README
+    model, defaults = load_model(EXAMPLES / "double_pendulum.toml")
+    from mechsys.modelfile import simulation_kwargs
+
+    toml_res = ms.simulate(model, **simulation_kwargs(defaults))
+    py_res = ns["res"]
+    assert len(py_res.t) == len(toml_res.t)
+    for name in ("joint/shoulder/q", "joint/elbow/q", "energy/total"):
+        assert np.abs(py_res[name] - toml_res[name]).max() < 1e-12, name

@@ -125,7 +125,7 @@ def test_unknown_simulation_key(tmp_path):
     with pytest.raises(ModelError) as e:
         load_model(p)
     assert str(e.value) == (
-        f"{p}: simulation.t_ned: unknown key; expected one of t_end, t0, output_dt, integrator, q0, u0, sensors"
+        f"{p}: simulation.t_ned: unknown key; expected one of t_end, t0, output_dt, integrator, q0, u0, sensors, on_singular, max_steps, max_wall"
     )
 
 
@@ -386,3 +386,22 @@ value = 2.0
     path.write_text(text.replace("q0 = 0.3", 'q0 = "up"'))
     with pytest.raises(ms.ModelError, match=r"joints\[0\]\.q0: expected a finite number or a list of finite numbers"):
         load_model(path)
+
+
+def test_run_guards_and_sensors_in_the_simulation_table(tmp_path):
+    p = write(tmp_path, PENDULUM_TOML.replace("t_end = 1.0", "t_end = 1.0\nmax_steps = 10\nsensors = [\"joint/*/q\"]"))
+    model, defaults = load_model(p)
+    assert defaults["max_steps"] == 10 and defaults["sensors"] == ["joint/*/q"]
+    with pytest.raises(ms.SolverError, match="step budget"):
+        ms.simulate(model, **simulation_kwargs(defaults))
+    p = write(tmp_path, PENDULUM_TOML.replace("t_end = 1.0", "t_end = 1.0\non_singular = \"sometimes\""))
+    model, defaults = load_model(p)
+    with pytest.raises(ms.SettingsError, match="on_singular: must be 'continue' or 'stop'"):
+        ms.simulate(model, **simulation_kwargs(defaults))
+
+
+@pytest.mark.parametrize("key", ["constraints", "contacts", "contact_groups"])
+def test_a_single_table_where_an_array_of_tables_belongs_is_named(tmp_path, key):
+    p = write(tmp_path, PENDULUM_TOML + f"\n[{key}]\nname = \"x\"\n")
+    with pytest.raises(ModelError, match=rf"{key}: expected an array of tables \(\[\[{key}\]\]\)"):
+        load_model(p)

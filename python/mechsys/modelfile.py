@@ -55,7 +55,8 @@ from .integrators import DOPRI5, NSGS, RK4, EventDriven, Lemke, MoreauJean, Newt
 from .model import Model
 
 #: Keys of the ``[simulation]`` table.
-SIMULATION_KEYS: tuple[str, ...] = ("t_end", "t0", "output_dt", "integrator", "q0", "u0", "sensors")
+SIMULATION_KEYS: tuple[str, ...] = ("t_end", "t0", "output_dt", "integrator", "q0", "u0", "sensors", "on_singular",
+                                     "max_steps", "max_wall")
 
 #: Keys allowed in an integrator table, per integrator type (besides ``type``).
 INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
@@ -128,7 +129,7 @@ def _parameter(value: Any, key: str, allowed: tuple[str, ...], kind: str, where:
 
 
 # top-level keys of the description that must be arrays of tables
-_LIST_KEYS = ("bodies", "joints", "forces", "ground_markers")
+_LIST_KEYS = ("bodies", "joints", "forces", "ground_markers", "constraints", "contacts", "contact_groups")
 
 
 class ModelFileNotFoundError(ModelError, FileNotFoundError):
@@ -344,6 +345,8 @@ def _check_simulation(sim: dict, model: Model, allow_objects: bool) -> dict:
             out[key] = x
         elif key == "integrator":
             out[key] = _check_integrator(value, allow_objects)
+        elif key in ("on_singular", "max_steps", "max_wall"):
+            out[key] = value  # checked by simulate, naming the key
         elif key == "sensors":
             items = [value] if isinstance(value, str) else value
             if not isinstance(items, (list, tuple)) or not all(isinstance(x, str) for x in items):
@@ -408,7 +411,7 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
         raise SettingsError(f"simulation.{unknown[0]}: unknown key; expected one of {', '.join(SIMULATION_KEYS)}")
 
     kwargs: dict[str, Any] = {}
-    for key in ("t_end", "t0", "output_dt", "q0", "u0", "sensors"):
+    for key in ("t_end", "t0", "output_dt", "q0", "u0", "sensors", "on_singular", "max_steps", "max_wall"):
         value = over.get(key, defaults.get(key))
         if value is not None:
             kwargs[key] = value

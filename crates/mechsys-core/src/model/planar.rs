@@ -166,8 +166,9 @@ fn selection(model: &Model, data: &Data, ci: usize) -> Result<Option<Selection>>
         ConstraintKind::PointOnLine { body2, n, .. } => {
             let a2 = data.x_abs[*body2].a;
             let dirs = [a2 * n[0], a2 * n[1]];
-            for a in in_plane(&dirs) {
-                push(&mut sel, &[(0, a[0]), (1, a[1])], "normal");
+            // one in-plane normal (a line in the plane), or both when the line is along z
+            for (i, a) in in_plane(&dirs).into_iter().enumerate() {
+                push(&mut sel, &[(0, a[0]), (1, a[1])], ["normal", "normal2"][i]);
             }
         }
         ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
