@@ -21,8 +21,9 @@ import mechsys as ms
 A, B, R, M_LINK, M_COUPLER = 0.1, 0.3, 0.005, 0.2, 0.4
 
 
-def build(n: int = 3, theta0: float = 0.3, omega0: float = 12.0, servo_speed: float | None = None) -> ms.Model:
-    m = ms.Model("parallelograms", gravity=(0.0, -9.81, 0.0))
+def build(n: int = 3, theta0: float = 0.3, omega0: float = 12.0, servo_speed: float | None = None,
+          planar: bool = False) -> ms.Model:
+    m = ms.Model("parallelograms", gravity=(0.0, -9.81, 0.0), planar=planar)
     link = ms.inertia.cylinder(M_LINK, R, A)
     prev = m.add_body("crank", M_LINK, link, com=(A / 2, 0, 0))
     m.add_joint(ms.joints.Revolute("crank", m.ground, prev, q0=theta0, u0=omega0))

@@ -47,8 +47,15 @@ def test_grashof_classes(lengths, kind):
 
 
 def test_mobility_counts_degrees_of_freedom_and_names_redundant_equations():
-    mob = ms.mechanisms.mobility(four_bar())
-    # three revolute joints, one planar loop closure (2 independent equations of 3)
+    # the example is a planar model: its loop closure holds the 2 in-plane equations
+    planar = four_bar()
+    mob = ms.mechanisms.mobility(planar)
+    assert (mob["nu"], mob["nc"], mob["rank"], mob["dof"]) == (3, 2, 2, 1) and mob["redundant"] == []
+    # built in 3-D: three revolute joints, one loop closure (2 independent equations of 3)
+    spatial = four_bar()
+    spatial.planar = False
+    spatial._invalidate()
+    mob = ms.mechanisms.mobility(spatial)
     assert (mob["nu"], mob["nc"], mob["rank"], mob["dof"]) == (3, 3, 2, 1)
     assert mob["redundant"] == [("b", 2)]
     m = ms.Model("tree")

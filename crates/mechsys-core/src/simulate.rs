@@ -381,8 +381,10 @@ pub struct MultibodySystem<'a> {
     rank_lost: bool,
     /// Stop at a rank drop instead of going on.
     stop_at_singular: bool,
-    /// The last time shift that reached well-conditioned neighbours in [`Self::passage`] (s).
+    /// The unit of the grid of time shifts to the neighbours in [`Self::passage`] (s), fixed at
+    /// the first passage, and the grid steps last found on either side.
     passage_tau: f64,
+    passage_k: [i32; 2],
     /// Workspace of the neighbouring states in [`Self::passage`] (made at the first passage).
     neighbour: Option<Data>,
     /// Each constraint row's squared Jacobian norm at the last evaluation relative to the start.
@@ -391,6 +393,8 @@ pub struct MultibodySystem<'a> {
     row0: Vec<f64>,
     /// The same at the last evaluation (a buffer).
     norms: Vec<f64>,
+    /// The evaluated state projected onto the constraints near a singular configuration (buffers).
+    staged: (Vec<f64>, Vec<f64>),
     /// Step and wall-time budgets.
     pub budget: Option<Budget>,
     /// The velocities of the last evaluation (models with Jenkins sliders), for `switched`.
@@ -415,9 +419,11 @@ impl<'a> MultibodySystem<'a> {
             rank_lost: false,
             stop_at_singular: false,
             passage_tau: 0.0,
+            passage_k: [20, 20],
             neighbour: None,
             ratio: Vec::new(),
             row0: Vec::new(),
+            staged: (Vec::new(), Vec::new()),
             norms: Vec::with_capacity(model.nc),
             budget: None,
             last_u: Vec::with_capacity(model.nu),
@@ -456,6 +462,18 @@ const NEAR_SINGULAR: f64 = 1e-6;
 /// which would turn the state's distance from the manifold, amplified by the inverse cube of the
 /// distance to the singular point, into a motion along the other branch.
 const SINGULAR_WINDOW: f64 = 1e-3;
+
+/// How far outside the window the nodes of [`MultibodySystem::passage`] lie (factor on the
+/// squared row norms).
+const NODE_MARGIN: f64 = 16.0;
+
+/// Interpolation nodes on each side of a singular configuration in [`MultibodySystem::passage`].
+const PASSAGE_NODES: usize = 5;
+
+/// Below this fraction of its start value (squared norms) a row is near enough to a singular
+/// configuration for the evaluated states to be projected onto the constraints first (see
+/// [`OdeSystem::rhs`] of [`MultibodySystem`]).
+const SINGULAR_CARE: f64 = 1e-1;
 
 impl MultibodySystem<'_> {
     /// Notes (or, with [`OnSingular::Stop`], stops at) a rank drop of the constraint equations
@@ -539,67 +557,92 @@ impl MultibodySystem<'_> {
     /// S of order s² at a distance s from the singular point), and the state's distance from the
     /// constraint manifold, divided by S, pushes the motion onto the other branch (a
     /// parallelogram four-bar flipping to its crossed form). The accelerations along the motion
-    /// are smooth through the point, so they are taken from the neighbouring states
-    /// `q ⊕ ±kτ u`, k = 1, 2, 3 (projected onto the constraints, outside the window of every such
-    /// row) by a Richardson combination exact to O(τ⁶) ([`RICHARDSON`]). The rows' multipliers are reported the same way (of a redundant set near the point
-    /// only their forces are determined). Falls back to the direct solve when no neighbour
-    /// within reach is well conditioned (the motion stops at the singular point: a dead point).
+    /// are smooth through the point, so they are interpolated from neighbouring states
+    /// `q ⊕ σ u` (projected onto the constraints) just outside the window of every such row:
+    /// three on each side, the nearest ones where the row leaves the window, and the Lagrange
+    /// polynomial through the six evaluated at σ = 0 (error of the order of the sixth power of
+    /// the window's width along the motion, whatever the state's place inside it). The rows'
+    /// multipliers are interpolated the same way (of a redundant set near the point only their
+    /// forces are determined). Falls back to the direct solve when no neighbour within reach is
+    /// well conditioned on one side (the motion stops at the singular point: a dead point).
     fn passage(&mut self, t: f64, q: &[f64], u: &[f64]) -> Result<crate::forces::Powers> {
         let model = self.model;
-        let (nq, nu, nc) = (model.nq, model.nu, model.nc);
-        let rows: Vec<usize> = (0..nc).filter(|&r| self.data.skip_rows[r]).collect();
+        let nu = model.nu;
+        let rows: Vec<usize> = (0..model.nc).filter(|&r| self.data.skip_rows[r]).collect();
         let speed = u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let p = dynamics::forward_dynamics(model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
         if speed == 0.0 {
             return Ok(p);
         }
-        let (mut qs, mut us) = (vec![0.0; nq], vec![0.0; nu]);
-        let (mut udot, mut lam) = (vec![0.0; nu], vec![0.0; rows.len()]);
-        // the time shift: from a small fraction of the motion upwards until every neighbour lies
-        // outside the window
-        let mut tau = self.passage_tau.max(1e-9 / speed);
-        let mut found = false;
         let mut data = self.neighbour.take().unwrap_or_else(|| Data::new(model));
-        for _ in 0..48 {
-            let mut ok = true;
-            udot.fill(0.0);
-            lam.fill(0.0);
-            for (shift, weight) in RICHARDSON {
-                model.integrate(q, u, shift * tau, &mut qs);
-                model.normalize(&mut qs);
-                us.copy_from_slice(u);
-                data.skip_rows.fill(false);
-                if dynamics::constrained::project(model, &mut data, &mut self.ws, t, &mut qs, &mut us, self.cb).is_err() {
-                    ok = false;
+        // the nearest shift on each side whose state lies outside the window, on the grid
+        // σ_k = σ₀ 2^k fixed at the first passage (the smallest such k, searched from the last
+        // one found: the result depends on the state only)
+        if self.passage_tau == 0.0 {
+            self.passage_tau = 1e-9 / speed;
+        }
+        let base = self.passage_tau;
+        let mut edge = [0.0f64; 2];
+        let mut nodes: Vec<(f64, Vec<f64>, Vec<f64>)> = Vec::with_capacity(2 * PASSAGE_NODES);
+        for (side, sign) in [(0, 1.0), (1, -1.0)] {
+            let mut k = self.passage_k[side];
+            let mut best: Option<(i32, (Vec<f64>, Vec<f64>))> = None;
+            let mut rising = false;
+            for _ in 0..64 {
+                let sigma = base * 2f64.powi(k);
+                if sigma * speed > 1.0 {
                     break;
                 }
-                dynamics::forward_dynamics(model, &mut data, &mut self.ws, t, &qs, &us, None, self.cb)?;
-                row_norms(&data, &mut self.norms);
-                if rows.iter().any(|&r| self.norms[r] < 4.0 * SINGULAR_WINDOW * self.row0[r]) {
-                    ok = false;
-                    break;
-                }
-                for i in 0..nu {
-                    udot[i] += weight * data.udot[i];
-                }
-                for (k, &r) in rows.iter().enumerate() {
-                    lam[k] += weight * data.lambda[r];
+                match self.neighbour_state(&mut data, t, q, u, sign * sigma, &rows)? {
+                    Some(v) => {
+                        best = Some((k, v));
+                        if rising || k == 0 {
+                            break; // the one below was inside
+                        }
+                        k -= 1; // a smaller one may do as well
+                    }
+                    None if best.is_some() => break,
+                    None => {
+                        rising = true;
+                        k += 1;
+                    }
                 }
             }
-            if ok {
-                found = true;
-                break;
-            }
-            tau *= 2.0;
-            if tau * speed > 1.0 {
-                break;
+            let Some((k, (ud, lam))) = best else {
+                self.neighbour = Some(data);
+                return Ok(p);
+            };
+            self.passage_k[side] = k;
+            edge[side] = base * 2f64.powi(k);
+            nodes.push((sign * edge[side], ud, lam));
+        }
+        // two more on each side, spaced by a quarter of the gap across the window
+        let d = 0.25 * (edge[0] + edge[1]);
+        for (side, sign) in [(0, 1.0), (1, -1.0)] {
+            for k in 1..PASSAGE_NODES {
+                let sigma = sign * (edge[side] + k as f64 * d);
+                match self.neighbour_state(&mut data, t, q, u, sigma, &rows)? {
+                    Some((ud, lam)) => nodes.push((sigma, ud, lam)),
+                    None => {
+                        self.neighbour = Some(data);
+                        return Ok(p);
+                    }
+                }
             }
         }
         self.neighbour = Some(data);
-        if !found {
-            return Ok(p);
+        // Lagrange weights of the nodes at σ = 0
+        let (mut udot, mut lam) = (vec![0.0; nu], vec![0.0; rows.len()]);
+        for (k, (sk, uk, lk)) in nodes.iter().enumerate() {
+            let w: f64 = nodes
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != k)
+                .map(|(_, (sj, _, _))| (0.0 - sj) / (sk - sj))
+                .product();
+            udot.iter_mut().zip(uk).for_each(|(a, b)| *a += w * b);
+            lam.iter_mut().zip(lk).for_each(|(a, b)| *a += w * b);
         }
-        self.passage_tau = 0.5 * tau;
         self.data.udot.copy_from_slice(&udot);
         for (k, &r) in rows.iter().enumerate() {
             self.data.lambda[r] = lam[k];
@@ -611,13 +654,41 @@ impl MultibodySystem<'_> {
         self.data.udot = ud;
         Ok(p)
     }
-}
 
-/// Shifts (in units of τ) and weights of the neighbours in [`MultibodySystem::passage`]: the
-/// symmetric means m(k) = (f(kτ) + f(−kτ)) / 2 combined as (15 m(1) − 6 m(2) + m(3)) / 10, which
-/// cancels the τ² and τ⁴ terms of their expansions (exact to O(τ⁶)).
-const RICHARDSON: [(f64, f64); 6] =
-    [(1.0, 0.75), (-1.0, 0.75), (2.0, -0.3), (-2.0, -0.3), (3.0, 0.05), (-3.0, 0.05)];
+    /// The accelerations and the multipliers of `rows` at the state `q ⊕ σ u` at time `t + σ`
+    /// (along the motion, also for driven constraints) projected onto the constraints, or None
+    /// when it lies inside the window of one of `rows` (or does not project).
+    fn neighbour_state(
+        &mut self,
+        data: &mut Data,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        sigma: f64,
+        rows: &[usize],
+    ) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
+        let model = self.model;
+        let ts = t + sigma;
+        let (mut qs, mut us) = (vec![0.0; model.nq], u.to_vec());
+        model.integrate(q, u, sigma, &mut qs);
+        model.normalize(&mut qs);
+        data.skip_rows.fill(false);
+        // twice: the second call finds the positions converged and projects the velocities with
+        // G factored at the projected configuration itself (the first may reuse a factor from
+        // one Newton step before, whose error near the singular point is not small)
+        for _ in 0..2 {
+            if dynamics::constrained::project(model, data, &mut self.ws, ts, &mut qs, &mut us, self.cb).is_err() {
+                return Ok(None);
+            }
+        }
+        dynamics::forward_dynamics(model, data, &mut self.ws, ts, &qs, &us, None, self.cb)?;
+        row_norms(data, &mut self.norms);
+        if rows.iter().any(|&r| self.norms[r] < NODE_MARGIN * SINGULAR_WINDOW * self.row0[r]) {
+            return Ok(None);
+        }
+        Ok(Some((data.udot.clone(), rows.iter().map(|&r| data.lambda[r]).collect())))
+    }
+}
 
 /// Squared norms of the rows of the constraint Jacobian in `data.g`.
 fn row_norms(data: &Data, out: &mut Vec<f64>) {
@@ -637,11 +708,33 @@ impl OdeSystem for MultibodySystem<'_> {
         let (q, rest) = y.split_at(nq);
         let u = &rest[..nu];
         let mut p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
+        let (mut qs, mut us) = std::mem::take(&mut self.staged);
+        let mut staged = false;
         if self.model.nc > 0 {
             self.check_singular(t)?;
-            if self.data.skip_rows.iter().any(|s| *s) {
-                p = self.passage(t, q, u)?;
+            // near a singular configuration the accelerations of a state off the constraint
+            // manifold (a Runge–Kutta stage) carry its distance from it, amplified by inverse
+            // powers of the distance to the singular point, into the other branch's direction:
+            // such a state is evaluated at its projection (a smooth map that changes nothing on
+            // the manifold, so the scheme keeps its order there); decided on the state's own
+            // row norms, so that the motion does not depend on the evaluations before it
+            if self.ratio.iter().any(|&r| r < SINGULAR_CARE) {
+                qs.clear();
+                qs.extend_from_slice(q);
+                us.clear();
+                us.extend_from_slice(u);
+                if dynamics::constrained::project(self.model, &mut self.data, &mut self.ws, t, &mut qs, &mut us, self.cb)
+                    .is_ok()
+                {
+                    staged = true;
+                    p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, &qs, &us, None, self.cb)?;
+                    self.check_singular(t)?;
+                }
             }
+        }
+        let (q, u) = if staged { (&qs[..], &us[..]) } else { (q, u) };
+        if self.data.skip_rows.iter().any(|s| *s) {
+            p = self.passage(t, q, u)?;
         }
         if self.model.n_sliders > 0 {
             // the velocities of the last evaluation and which sliders slipped, for `switched`
@@ -655,6 +748,7 @@ impl OdeSystem for MultibodySystem<'_> {
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
         dy[nq + nu] = p.dissipated;
         dy[nq + nu + 1] = p.external;
+        self.staged = (qs, us);
         Ok(())
     }
     fn switched(&mut self) -> bool {

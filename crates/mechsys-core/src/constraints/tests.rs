@@ -243,6 +243,7 @@ fn drift_control_choices() {
             on_singular: Default::default(),
             max_steps: None,
             max_wall: None,
+            record: Default::default(),
         };
         let rec = simulate(&model, &settings, &NoCallbacks, None).unwrap();
         rec.constraint_violation.iter().fold(0.0f64, |m, v| m.max(v.abs()))
