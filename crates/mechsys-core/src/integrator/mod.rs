@@ -119,7 +119,7 @@ impl IntegratorKind {
     pub fn fixed_step(&self) -> Option<f64> {
         match *self {
             IntegratorKind::Rk4 { dt } | IntegratorKind::MoreauJean { dt, .. } => Some(dt),
-            IntegratorKind::Radau5 { dt, rtol, .. } if rtol == 0.0 => Some(dt),
+            IntegratorKind::Radau5 { dt, rtol: 0.0, .. } => Some(dt),
             _ => None,
         }
     }

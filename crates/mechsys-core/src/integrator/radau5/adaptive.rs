@@ -23,7 +23,6 @@ const KEEP_BELOW: f64 = 1.2;
 /// The method's constants, derived once from its Butcher matrix (not tabulated, so that the unit
 /// tests check the derivation against the literature's values).
 pub(crate) struct Tableau {
-    pub a: [[f64; 3]; 3],
     pub c: [f64; 3],
     /// Real eigenvalue γ of A⁻¹ and its complex pair α ± iβ.
     pub gamma: f64,
@@ -119,7 +118,7 @@ impl Tableau {
         for j in 0..3 {
             dd[j] = gamma * (0..3).map(|i| (bh[i] - a[2][i]) * m[i][j]).sum::<f64>();
         }
-        Tableau { a, c, gamma, alpha, beta, t, ti, dd }
+        Tableau { c, gamma, alpha, beta, t, ti, dd }
     }
 
     /// Weights w_i(θ) of the collocation polynomial u(t₀ + θh) = y₀ + Σ w_i(θ) Z_i (Lagrange on
@@ -330,6 +329,7 @@ impl Adaptive {
     }
 
     /// The scaled norm of the error estimate (eq. 8.20), refined once more if `refine` and > 1.
+    #[allow(clippy::too_many_arguments)]
     fn error<S: OdeSystem>(
         &mut self,
         sys: &mut S,

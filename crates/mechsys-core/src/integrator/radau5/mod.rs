@@ -30,6 +30,7 @@
 mod adaptive;
 
 pub use adaptive::integrate_adaptive;
+#[cfg(test)]
 pub(crate) use adaptive::Tableau;
 
 use super::{check_finite, IntegratorKind, Observer, OdeSystem, Stats};
@@ -50,7 +51,7 @@ struct Work {
     backup: Vec<f64>,
 }
 
-fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
+pub(crate) fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
     let s6 = 6f64.sqrt();
     let a = [
         [(88.0 - 7.0 * s6) / 360.0, (296.0 - 169.0 * s6) / 1800.0, (-2.0 + 3.0 * s6) / 225.0],
