@@ -494,7 +494,16 @@ pub fn integrate_adaptive<S: OdeSystem>(
                 continue;
             }
         };
-        let err = wk.error(sys, t, &y, h, rtol, atol, first || reject, &mut stats)?.max(1e-10);
+        let err = wk.error(sys, t, &y, h, rtol, atol, first || reject, &mut stats)?;
+        if !err.is_finite() {
+            // an evaluation produced inf/NaN: shrink hard and retry (max() below would hide it)
+            stats.rejected += 1;
+            h *= 0.1;
+            reject = true;
+            need_jac = !jac_here;
+            continue;
+        }
+        let err = err.max(1e-10);
         // eq. 8.25 with a safety factor that shrinks with the Newton iterations spent
         let fac = SAFE.min(SAFE * (1 + 2 * NIT) as f64 / (iters + 2 * NIT) as f64);
         let mut quot = (err.powf(0.25) / fac).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
