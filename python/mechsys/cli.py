@@ -118,6 +118,11 @@ def _describe_integrator(settings: dict) -> str:
         elif isinstance(v, dict) and "type" in v:  # moreau_jean's contact solver
             parts.append(f"{k}={v['type']}")
     params = ", ".join(parts)
+    if kind == "radau5":
+        # its two modes read differently: say which one ran
+        mode = "adaptive" if integ.get("rtol") else "fixed step"
+        keep = ("rtol", "atol", "max_step", "first_step") if mode == "adaptive" else ("dt", "newton_tol")
+        return f"radau5 ({', '.join([mode] + [p for p in parts if p.split('=')[0] in keep])})"
     return f"{kind}({params})" if params else str(kind)
 
 
@@ -141,12 +146,12 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.argument("model_file", metavar="MODEL", type=click.Path(path_type=Path, dir_okay=False))
 @click.option("--t-end", type=float, help="End time (s); overrides simulation.t_end.")
 @click.option("--t0", type=float, help="Start time (s); overrides simulation.t0.")
-@click.option("--dt", type=float, help="Step of rk4/radau5/moreau_jean (s); alone it selects rk4.")
+@click.option("--dt", type=float, help="Step of rk4/radau5/moreau_jean (s); alone it selects rk4; radau5 with --dt takes fixed steps.")
 @click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5", "moreau_jean", "event_driven"], case_sensitive=False),
               help="Integration scheme (moreau_jean: time-stepping for models with contacts; event_driven: located contact events).")
 @click.option("--solver", type=click.Choice(["nsgs", "newton", "lemke"], case_sensitive=False), help="Contact solver of moreau_jean; overrides the model file's.")
-@click.option("--rtol", type=float, help="Relative tolerance of dopri5 and event_driven.")
-@click.option("--atol", type=float, help="Absolute tolerance of dopri5 and event_driven.")
+@click.option("--rtol", type=float, help="Relative tolerance of dopri5, event_driven and radau5 (radau5 with --rtol: adaptive steps).")
+@click.option("--atol", type=float, help="Absolute tolerance of dopri5, event_driven and adaptive radau5.")
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")
 @click.option("--on-singular", "on_singular", type=click.Choice(["continue", "stop"]), default=None,
               help="At a singular configuration (the constraints lose rank): go on with a warning [default] or stop.")

@@ -5,15 +5,16 @@ contacts, Moreau-Jean time-stepping (:class:`MoreauJean`) with a choice of conta
 
 - :class:`RK4` — classical Runge-Kutta, fixed step: cheap, predictable, 4th order.
 - :class:`DOPRI5` — Dormand-Prince 5(4), adaptive with error control and dense output (the default).
-- :class:`Radau5` — Radau IIA (3 stages, order 5, L-stable), fixed step, implicit: for stiff
-  spring-damper systems where explicit schemes need tiny steps. L-stability damps parasitic stiff
-  modes instead of letting them ring, and as a collocation method on the first-order form it
-  needs no special handling of quaternion kinematics (generalized-alpha would).
+- :class:`Radau5` — Radau IIA (3 stages, order 5, L-stable), implicit: for stiff spring-damper
+  systems where explicit schemes need tiny steps; a fixed step ``dt`` or adaptive steps under
+  ``rtol``/``atol`` with dense output. L-stability damps parasitic stiff modes instead of letting
+  them ring, and as a collocation method on the first-order form it needs no special handling of
+  quaternion kinematics (generalized-alpha would).
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import KW_ONLY, asdict, dataclass
 
 
 @dataclass(frozen=True)
@@ -41,13 +42,43 @@ class DOPRI5:
 
 @dataclass(frozen=True)
 class Radau5:
-    """Implicit Radau IIA (order 5) with fixed step ``dt``; Newton tolerance ``newton_tol``."""
+    """Implicit Radau IIA (order 5, L-stable): a fixed step ``dt`` (s), or adaptive steps under
+    the tolerances ``rtol``/``atol`` -- give exactly one of ``dt`` and ``rtol``.
 
-    dt: float
+    Fixed: every step is ``dt``; Newton stops at ``newton_tol`` (relative). Adaptive: error control
+    by the embedded estimate of Hairer & Wanner (Solving ODEs II, IV.8), steps limited by
+    ``max_step`` (0: none), starting at ``first_step`` (0: automatic), Newton's tolerance derived
+    from ``rtol``; outputs between steps come from the collocation polynomial. For example
+    ``Radau5(1e-3)`` (fixed) or ``Radau5(rtol=1e-6, atol=1e-9)`` (adaptive).
+    """
+
+    dt: float | None = None
+    _: KW_ONLY
+    rtol: float | None = None
+    atol: float = 1e-10
     newton_tol: float = 1e-10
+    max_step: float = 0.0
+    first_step: float = 0.0
+
+    def __post_init__(self):
+        from .errors import SettingsError
+
+        if self.dt is not None and self.rtol is not None:
+            raise SettingsError("integrator: give radau5 a step dt (fixed) or a tolerance rtol (adaptive), not both")
+        if self.dt is None and self.rtol is None:
+            raise SettingsError("integrator: give radau5 a step dt (fixed) or a tolerance rtol (adaptive), one of them")
+
+    @property
+    def adaptive(self) -> bool:
+        """Whether the steps are chosen by error control (an ``rtol`` was given)."""
+        return self.rtol is not None
 
     def describe(self) -> dict:
-        return {"type": "radau5", "dt": float(self.dt), "newton_tol": float(self.newton_tol)}
+        if not self.adaptive:
+            return {"type": "radau5", "dt": float(self.dt), "newton_tol": float(self.newton_tol)}
+        return {"type": "radau5", "rtol": float(self.rtol), "atol": float(self.atol),
+                "newton_tol": float(self.newton_tol), "max_step": float(self.max_step),
+                "first_step": float(self.first_step)}
 
 
 @dataclass(frozen=True)
@@ -129,7 +160,7 @@ class EventDriven:
 
 
 def from_name(name: str, dt: float | None = None, rtol: float | None = None, atol: float | None = None):
-    """An integrator from its name (command line): rk4, dopri5, radau5."""
+    """An integrator from its name (command line): rk4, dopri5, radau5 (``dt``: fixed, ``rtol``: adaptive)."""
     from .errors import SettingsError
 
     n = name.lower()
@@ -140,8 +171,10 @@ def from_name(name: str, dt: float | None = None, rtol: float | None = None, ato
     if n == "dopri5":
         return DOPRI5(rtol=1e-8 if rtol is None else rtol, atol=1e-10 if atol is None else atol)
     if n == "radau5":
-        if dt is None:
-            raise SettingsError("integrator radau5 needs a step: give --dt")
+        if dt is None and rtol is None:
+            raise SettingsError("integrator radau5 needs a step or a tolerance: give --dt (fixed) or --rtol (adaptive)")
+        if rtol is not None:
+            return Radau5(dt, rtol=rtol, atol=1e-10 if atol is None else atol)
         return Radau5(dt)
     if n in ("moreau_jean", "moreaujean", "mj"):
         if dt is None:

@@ -62,7 +62,7 @@ SIMULATION_KEYS: tuple[str, ...] = ("t_end", "t0", "output_dt", "integrator", "q
 INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
     "rk4": ("dt",),
     "dopri5": ("rtol", "atol", "max_step", "first_step"),
-    "radau5": ("dt", "newton_tol"),
+    "radau5": ("dt", "rtol", "atol", "newton_tol", "max_step", "first_step"),
     "moreau_jean": ("dt", "solver", "continue_on_painleve"),
     "event_driven": ("rtol", "atol", "max_step", "gap_tol", "velocity_tol", "max_events", "continue_on_painleve"),
 }
@@ -265,8 +265,10 @@ def _check_integrator(spec: Any, allow_objects: bool) -> Any:
         solver = getattr(spec, "solver", None)
         if isinstance(spec, MoreauJean) and not isinstance(solver, tuple(_SOLVER_CLASSES.values())):
             raise ModelError(f"{where}.solver: expected mechsys.NSGS, Newton or Lemke, got {_tname(solver)} {solver!r}")
-        # the fields as given (describe() would convert them and hide, e.g., a string dt)
-        table = _check_integrator_table(_fields(spec, _INTEGRATOR_CLASSES), where)
+        # the fields as given (describe() would convert them and hide, e.g., a string dt); None
+        # is "not given" (Radau5's dt or rtol)
+        given = {k: v for k, v in _fields(spec, _INTEGRATOR_CLASSES).items() if v is not None}
+        table = _check_integrator_table(given, where)
         table.pop("type")
         if "solver" in table:
             table["solver"] = _solver(table["solver"], f"{where}.solver", ModelError)
@@ -298,6 +300,8 @@ def _check_integrator_table(spec: dict, where: str) -> dict:
             continue
         x = _parameter(value, key, allowed, kind, f"{where}.{key}", ModelError)
         out[key] = x.describe() if key == "solver" else x
+    if kind == "radau5" and "dt" in out and "rtol" in out:
+        raise ModelError(f"{where}: give radau5 a step dt (fixed) or a tolerance rtol (adaptive), not both")
     return out
 
 
@@ -390,7 +394,8 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
     integrator object), the integrator parameters ``dt``, ``rtol``, ``atol`` and ``solver``
     (moreau_jean's contact solver: a name, a table or a solver object; naming the file's own
     solver keeps its settings). Changing the integrator type keeps the parameters that still
-    apply (a file's ``dt`` carries over from rk4 to radau5). Without any integrator the engine's
+    apply (a file's ``dt`` carries over from rk4 to radau5; for radau5 a ``dt`` or ``rtol`` override
+    replaces the file's other, choosing fixed or adaptive steps). Without any integrator the engine's
     default (DOPRI5) is used, or RK4 when only ``dt`` is given. Every parameter is checked, with
     the option or key in the message (``--dt: must be > 0, got -1``).
 
@@ -452,7 +457,18 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
             hint = " (it is adaptive: use --rtol/--atol)" if kind in ("dopri5", "event_driven") else " (it has a fixed step: use --dt)"
             raise SettingsError(f"--{key} does not apply to integrator {kind}{hint}")
         spec[key] = value
-    if "dt" in allowed and spec.get("dt") is None:
+    if kind == "radau5":
+        # a step or a tolerance: the one given on the command line replaces the file's other
+        if "rtol" in params and "dt" not in params:
+            spec.pop("dt", None)
+        if "dt" in params and "rtol" not in params:
+            spec.pop("rtol", None)
+        if spec.get("dt") is None and spec.get("rtol") is None:
+            raise SettingsError("integrator radau5 needs a step or a tolerance: set simulation.integrator.dt or rtol, "
+                                "or pass --dt (fixed steps) or --rtol (adaptive)")
+        if spec.get("rtol") is None and "atol" in params:
+            raise SettingsError("--atol does not apply to integrator radau5 with a fixed step (give --rtol for adaptive steps)")
+    elif "dt" in allowed and spec.get("dt") is None:
         raise SettingsError(f"integrator {kind} needs a step: set simulation.integrator.dt or pass --dt")
     solver = over.get("solver")
     if solver is not None:
@@ -470,6 +486,8 @@ def simulation_kwargs(defaults: dict | None = None, **overrides: Any) -> dict:
             args[key] = _parameter(value, key, allowed, kind, where, SettingsError)
     try:
         kwargs["integrator"] = _INTEGRATOR_CLASSES[kind](**args)
+    except SettingsError:
+        raise  # already names the setting (radau5's dt and rtol both given)
     except (TypeError, ValueError) as e:
         raise SettingsError(f"integrator {kind}: {e}") from None
     return kwargs

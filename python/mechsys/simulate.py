@@ -33,8 +33,15 @@ def _settings(model: Model, t_end, integrator, output_dt, q0, u0, t0, stabilizat
     step = getattr(integrator, "dt", None)
     if step is not None and not (isinstance(step, (int, float)) and np.isfinite(step) and step > 0):
         raise SettingsError(f"integrator.dt: must be > 0, got {step}")
+    if isinstance(integrator, Radau5) and integrator.rtol is not None:
+        r = integrator.rtol
+        # checked here too: 0 is how the engine spells "fixed step" (it could not say which was
+        # meant), and the value is shown as given (the engine's JSON reading may round it)
+        if isinstance(r, bool) or not isinstance(r, (int, float)) or not 1e-14 <= r < 1:
+            raise SettingsError(f"integrator.rtol: must be in [1e-14, 1) for adaptive steps (below 1e-14 double "
+                                f"precision cannot meet it; 1 and above control nothing), got {r!r}")
     if output_dt is None:
-        if isinstance(integrator, (RK4, Radau5)):
+        if isinstance(integrator, RK4) or (isinstance(integrator, Radau5) and integrator.dt is not None):
             output_dt = integrator.dt
         elif isinstance(integrator, MoreauJean):
             # samples fall on steps: the whole multiple of dt nearest to 1/1000 of the span
@@ -105,7 +112,7 @@ def simulate(
     ``integrator``: :class:`mechsys.RK4`, :class:`mechsys.DOPRI5` (default) or
     :class:`mechsys.Radau5` for smooth models; :class:`mechsys.MoreauJean` (time-stepping) or
     :class:`mechsys.EventDriven` for models with contacts (their events in ``res.events``).
-    ``output_dt``: sampling interval of the results (default: the step of RK4 and Radau5, the
+    ``output_dt``: sampling interval of the results (default: the step of RK4 and fixed Radau5, the
     whole multiple of the step nearest to 1/1000 of the span for MoreauJean, else 1/1000 of the
     span). ``q0``/``u0``: full vectors or ``{joint name: value}`` dicts
     (the joints' own q0/u0 elsewhere). ``progress``: show a progress bar (default: only when

@@ -870,9 +870,10 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         s.output_dt
     );
     let span = s.t_end - s.t0;
-    if let IntegratorKind::Rk4 { dt } | IntegratorKind::Radau5 { dt, .. } | IntegratorKind::MoreauJean { dt, .. } =
-        s.integrator
-    {
+    if matches!(s.integrator, IntegratorKind::Radau5 { .. }) {
+        crate::integrator::radau5::check(&s.integrator)?;
+    }
+    if let Some(dt) = s.integrator.fixed_step() {
         crate::ensure!(
             !(dt > span * (1.0 + 1e-12)),
             Settings,
@@ -904,9 +905,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         s.output_dt,
         span
     );
-    if let IntegratorKind::Rk4 { dt } | IntegratorKind::Radau5 { dt, .. } | IntegratorKind::MoreauJean { dt, .. } =
-        s.integrator
-    {
+    if let Some(dt) = s.integrator.fixed_step() {
         crate::ensure!(dt.is_finite() && dt > 0.0, Settings, "integrator.dt: must be > 0, got {dt}");
         let ratio = s.output_dt / dt;
         crate::ensure!(

@@ -4,7 +4,8 @@
 //! (unit quaternions); a scheme advances it and calls an observer at each requested output time.
 //! - [`rk4`]: classical fixed-step Runge–Kutta of order 4;
 //! - [`dopri5`]: Dormand–Prince 5(4) with step-size control and dense output;
-//! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable), fixed step, for stiff systems;
+//! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable) for stiff systems, at a fixed
+//!   step or adaptive with error control and dense output;
 //! - [`moreau_jean`]: time-stepping at velocity/impulse level for models with unilateral contacts
 //!   (not an [`OdeSystem`] scheme: [`crate::simulate`] runs it directly);
 //! - [`event_driven`]: smooth phases between located contact events, impacts and transition
@@ -73,13 +74,28 @@ pub enum IntegratorKind {
         #[serde(default)]
         first_step: f64,
     },
-    /// Fixed-step Radau IIA (3 stages, order 5), implicit, for stiff systems.
+    /// Radau IIA (3 stages, order 5), implicit, for stiff systems: a fixed step `dt`, or
+    /// adaptive steps under the tolerances `rtol`, `atol` (exactly one of `dt`, `rtol` is > 0).
     Radau5 {
-        /// Step size (s).
+        /// Fixed step size (s); 0 with an `rtol` (adaptive).
+        #[serde(default)]
         dt: f64,
-        /// Newton tolerance on the stage increments (relative).
+        /// Newton tolerance on the stage increments (relative) of the fixed-step mode; the
+        /// adaptive mode derives its own from `rtol`.
         #[serde(default = "default_newton_tol")]
         newton_tol: f64,
+        /// Relative tolerance of the adaptive mode; 0 means fixed steps.
+        #[serde(default)]
+        rtol: f64,
+        /// Absolute tolerance of the adaptive mode.
+        #[serde(default = "default_atol")]
+        atol: f64,
+        /// Largest adaptive step (s); 0 means unlimited.
+        #[serde(default)]
+        max_step: f64,
+        /// Initial adaptive step (s); 0 means automatic.
+        #[serde(default)]
+        first_step: f64,
     },
     /// Moreau–Jean time-stepping for unilateral contacts, impacts and friction ([`moreau_jean`]).
     MoreauJean {
@@ -96,6 +112,17 @@ pub enum IntegratorKind {
     },
     /// Event-driven integration of contact models ([`event_driven`]).
     EventDriven(event_driven::Options),
+}
+
+impl IntegratorKind {
+    /// The step of a fixed-step scheme (RK4, Moreau–Jean, Radau5 without `rtol`), else None.
+    pub fn fixed_step(&self) -> Option<f64> {
+        match *self {
+            IntegratorKind::Rk4 { dt } | IntegratorKind::MoreauJean { dt, .. } => Some(dt),
+            IntegratorKind::Radau5 { dt, rtol: 0.0, .. } => Some(dt),
+            _ => None,
+        }
+    }
 }
 
 fn default_true() -> bool {
@@ -149,7 +176,7 @@ pub fn integrate<S: OdeSystem>(
         IntegratorKind::Dopri5 { rtol, atol, max_step, first_step } => {
             dopri5::integrate(sys, t0, y0, t_out, *rtol, *atol, *max_step, *first_step, obs)
         }
-        IntegratorKind::Radau5 { dt, newton_tol } => radau5::integrate(sys, t0, y0, *dt, *newton_tol, t_out, obs),
+        IntegratorKind::Radau5 { .. } => radau5::integrate(kind, sys, t0, y0, t_out, obs),
         IntegratorKind::MoreauJean { .. } | IntegratorKind::EventDriven(_) => Err(crate::error::Error::Settings(
             "integrator: Moreau–Jean and the event-driven scheme are for contact models; simulate() runs them".into(),
         )),

@@ -59,6 +59,79 @@ pub fn lu_solve(a: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
     }
 }
 
+/// Factors the complex row-major `n × n` matrix `re + i·im` in place, its real and imaginary
+/// parts in two arrays laid out as for [`lu_factor`]; pivots (largest modulus) into `piv`.
+pub fn lu_factor_complex(re: &mut [f64], im: &mut [f64], n: usize, piv: &mut [usize]) -> Result<()> {
+    for k in 0..n {
+        let mut p = k;
+        let mut best = re[k * n + k].hypot(im[k * n + k]);
+        for r in k + 1..n {
+            let v = re[r * n + k].hypot(im[r * n + k]);
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        piv[k] = p;
+        if best == 0.0 || !best.is_finite() {
+            return Err(Error::Solver(format!("singular matrix in complex LU factorization (column {k})")));
+        }
+        if p != k {
+            for c in 0..n {
+                re.swap(k * n + c, p * n + c);
+                im.swap(k * n + c, p * n + c);
+            }
+        }
+        let (dr, di) = (re[k * n + k], im[k * n + k]);
+        let d2 = dr * dr + di * di;
+        for r in k + 1..n {
+            // l = a_rk / d = a_rk · conj(d) / |d|²
+            let (ar, ai) = (re[r * n + k], im[r * n + k]);
+            let (lr, li) = ((ar * dr + ai * di) / d2, (ai * dr - ar * di) / d2);
+            re[r * n + k] = lr;
+            im[r * n + k] = li;
+            if lr != 0.0 || li != 0.0 {
+                for c in k + 1..n {
+                    let (ur, ui) = (re[k * n + c], im[k * n + c]);
+                    re[r * n + c] -= lr * ur - li * ui;
+                    im[r * n + c] -= lr * ui + li * ur;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves `A x = b` in place with the factors of [`lu_factor_complex`] (`b = br + i·bi`).
+pub fn lu_solve_complex(re: &[f64], im: &[f64], n: usize, piv: &[usize], br: &mut [f64], bi: &mut [f64]) {
+    for k in 0..n {
+        br.swap(k, piv[k]);
+        bi.swap(k, piv[k]);
+    }
+    for r in 0..n {
+        let (mut sr, mut si) = (br[r], bi[r]);
+        for c in 0..r {
+            let (lr, li) = (re[r * n + c], im[r * n + c]);
+            sr -= lr * br[c] - li * bi[c];
+            si -= lr * bi[c] + li * br[c];
+        }
+        br[r] = sr;
+        bi[r] = si;
+    }
+    for r in (0..n).rev() {
+        let (mut sr, mut si) = (br[r], bi[r]);
+        for c in r + 1..n {
+            let (ur, ui) = (re[r * n + c], im[r * n + c]);
+            sr -= ur * br[c] - ui * bi[c];
+            si -= ur * bi[c] + ui * br[c];
+        }
+        let (dr, di) = (re[r * n + r], im[r * n + r]);
+        let d2 = dr * dr + di * di;
+        br[r] = (sr * dr + si * di) / d2;
+        bi[r] = (si * dr - sr * di) / d2;
+    }
+}
+
 /// Cholesky factorization with diagonal pivoting of the symmetric positive semidefinite row-major
 /// `n × n` matrix `a`, in place (lower factor). Pivots smaller than `tol` times the largest are
 /// treated as zero: their rows are dependent on the others (redundant constraints). Returns the rank;
@@ -195,6 +268,39 @@ mod tests {
         }
         let mut s = [1.0, 2.0, 2.0, 4.0];
         assert!(lu_factor(&mut s, 2, &mut [0; 2]).is_err());
+    }
+
+    #[test]
+    fn complex_lu_agrees_with_the_real_form_of_the_system() {
+        // (P + iQ)(x + iy) = b + ic  ⇔  [P -Q; Q P] [x; y] = [b; c], solved by the real LU
+        let n = 3;
+        let p0 = [0.0, 2.0, 1.0, 1.0, -1.0, 0.5, 3.0, 0.0, 1.0]; // a zero leading real part: pivoting
+        let q0 = [0.0, 0.3, -1.0, 2.0, 0.0, 0.1, -0.5, 1.0, 0.2];
+        let (b, c) = ([1.0, -2.0, 0.5], [0.0, 4.0, -1.0]);
+        let m = 2 * n;
+        let mut big = vec![0.0; m * m];
+        for r in 0..n {
+            for k in 0..n {
+                big[r * m + k] = p0[r * n + k];
+                big[r * m + n + k] = -q0[r * n + k];
+                big[(n + r) * m + k] = q0[r * n + k];
+                big[(n + r) * m + n + k] = p0[r * n + k];
+            }
+        }
+        let mut rhs = [b[0], b[1], b[2], c[0], c[1], c[2]];
+        let mut piv = [0; 6];
+        lu_factor(&mut big, m, &mut piv).unwrap();
+        lu_solve(&big, m, &piv, &mut rhs);
+        let (mut re, mut im) = (p0, q0);
+        let mut cp = [0; 3];
+        lu_factor_complex(&mut re, &mut im, n, &mut cp).unwrap();
+        let (mut x, mut y) = (b, c);
+        lu_solve_complex(&re, &im, n, &cp, &mut x, &mut y);
+        for i in 0..n {
+            assert!((x[i] - rhs[i]).abs() < 1e-13 && (y[i] - rhs[n + i]).abs() < 1e-13, "{i}");
+        }
+        let (mut sr, mut si) = ([1.0, 2.0, 2.0, 4.0], [1.0, 0.0, 2.0, 0.0]);
+        assert!(lu_factor_complex(&mut sr, &mut si, 2, &mut [0; 2]).is_err());
     }
 
     #[test]

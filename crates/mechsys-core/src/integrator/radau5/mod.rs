@@ -1,13 +1,39 @@
-//! Radau IIA with three stages (order 5, stiffly accurate, L-stable), at fixed step size.
+//! Radau IIA with three stages (order 5, stiffly accurate, L-stable), at a fixed step or with
+//! adaptive steps under error control.
 //!
 //! Why this scheme for stiff spring–damper systems: L-stability damps the parasitic fast modes of
 //! stiff springs completely instead of letting them ring (as the trapezoidal rule would), order 5
 //! keeps the slow motion accurate at large steps, and being a collocation method on the first-order
 //! form it needs no special treatment of the q̇ = H*(q) u kinematics, unlike generalized-α.
-//! The stage equations are solved by simplified Newton with a finite-difference Jacobian at the
-//! step start; if Newton does not converge the step is split in halves (up to 2⁸ pieces).
+//!
+//! **Fixed step** (`dt`): the stage equations are solved by simplified Newton on the 3n × 3n
+//! iteration matrix I − h A ⊗ J with a finite-difference Jacobian at the step start; if Newton
+//! does not converge the step is split in halves (up to 2⁸ pieces).
+//!
+//! **Adaptive** (`rtol`, `atol`; Hairer & Wanner, *Solving ODEs II*, section IV.8):
+//! - the iteration matrix is brought to block-diagonal form by the eigen-decomposition
+//!   A⁻¹ = T Λ T⁻¹ (one real eigenvalue γ, one complex pair α ± iβ), so each Newton iteration
+//!   solves one real n × n system (γ/h − J) and one complex one ((α + iβ)/h − J) (eq. 8.16);
+//! - Newton is watched through its contraction rate θ_k = ‖ΔZ_k‖ / ‖ΔZ_{k−1}‖ in the norm scaled
+//!   by sc_i = atol + rtol |y_i|; it stops when η_k ‖ΔZ_k‖ ≤ κ · fnewt with η_k = θ_k / (1 − θ_k)
+//!   (eq. 8.10–8.12) and gives up (smaller step) when θ ≥ 1 or when the rate predicts no
+//!   convergence within the allowed iterations;
+//! - its starting values extrapolate the previous step's collocation polynomial;
+//! - the error estimate is the embedded order-3 solution filtered through (I − h γ₀ J)⁻¹ with
+//!   γ₀ = 1/γ (eq. 8.19–8.20), evaluated once more at y₀ + err on the first step and after
+//!   rejections (where stiff components would spoil the plain estimate);
+//! - the step size follows h · err^(−1/4) with a safety factor that shrinks with the Newton
+//!   iterations spent and Gustafsson's predictive controller (eq. 8.25);
+//! - the Jacobian is kept while Newton converges fast (θ small), and recomputed after rejections;
+//! - dense output: the collocation polynomial through (0, y₀), (c_i, y₀ + Z_i).
 
-use super::{check_finite, Observer, OdeSystem, Stats};
+mod adaptive;
+
+pub use adaptive::integrate_adaptive;
+#[cfg(test)]
+pub(crate) use adaptive::Tableau;
+
+use super::{check_finite, IntegratorKind, Observer, OdeSystem, Stats};
 use crate::error::{Error, Result};
 use crate::math::linalg::{lu_factor, lu_solve};
 
@@ -25,7 +51,7 @@ struct Work {
     backup: Vec<f64>,
 }
 
-fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
+pub(crate) fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
     let s6 = 6f64.sqrt();
     let a = [
         [(88.0 - 7.0 * s6) / 360.0, (296.0 - 169.0 * s6) / 1800.0, (-2.0 + 3.0 * s6) / 225.0],
@@ -149,7 +175,7 @@ fn advance<S: OdeSystem>(
 }
 
 /// Fixed-step integration with observations at `t_out` (multiples of `dt` from t0).
-pub fn integrate<S: OdeSystem>(
+pub fn integrate_fixed<S: OdeSystem>(
     sys: &mut S,
     t0: f64,
     y0: &[f64],
@@ -198,4 +224,72 @@ pub fn integrate<S: OdeSystem>(
         step_no += 1;
     }
     Ok(stats)
+}
+
+/// Checks the settings of [`IntegratorKind::Radau5`]; returns whether they ask for adaptive
+/// steps (an `rtol`) rather than a fixed step (a `dt`).
+pub(crate) fn check(kind: &IntegratorKind) -> Result<bool> {
+    let IntegratorKind::Radau5 { dt, newton_tol, rtol, atol, max_step, first_step } = *kind else {
+        return Err(Error::Settings("integrator: not radau5".into()));
+    };
+    let (fixed, adaptive) = (dt != 0.0, rtol != 0.0);
+    if fixed && adaptive {
+        return Err(Error::Settings(
+            "integrator: give radau5 a step dt (fixed) or a tolerance rtol (adaptive), not both".into(),
+        ));
+    }
+    if !fixed && !adaptive {
+        return Err(Error::Settings(
+            "integrator: give radau5 a step dt (fixed) or a tolerance rtol (adaptive), one of them (dt > 0 or rtol > 0)"
+                .into(),
+        ));
+    }
+    crate::ensure!(
+        newton_tol.is_finite() && newton_tol > 0.0,
+        Settings,
+        "integrator.newton_tol: must be > 0, got {newton_tol}"
+    );
+    if fixed {
+        crate::ensure!(dt.is_finite() && dt > 0.0, Settings, "integrator.dt: must be > 0, got {dt}");
+        return Ok(false);
+    }
+    // below ~100 ε the error estimate is round-off: the step size collapses instead of converging
+    crate::ensure!(
+        rtol.is_finite() && (1e-14..1.0).contains(&rtol),
+        Settings,
+        "integrator.rtol: must be in [1e-14, 1) (below 1e-14 double precision cannot meet it; 1 and above \
+         control nothing), got {rtol:e}"
+    );
+    crate::ensure!(atol.is_finite() && atol > 0.0, Settings, "integrator.atol: must be > 0, got {atol}");
+    crate::ensure!(
+        max_step.is_finite() && max_step >= 0.0,
+        Settings,
+        "integrator.max_step: must be >= 0, got {max_step}"
+    );
+    crate::ensure!(
+        first_step.is_finite() && first_step >= 0.0,
+        Settings,
+        "integrator.first_step: must be >= 0, got {first_step}"
+    );
+    Ok(true)
+}
+
+/// Runs [`IntegratorKind::Radau5`]: fixed steps of `dt`, or adaptive steps under `rtol`, `atol`.
+pub fn integrate<S: OdeSystem>(
+    kind: &IntegratorKind,
+    sys: &mut S,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    obs: &mut Observer<'_, S>,
+) -> Result<Stats> {
+    let adaptive = check(kind)?;
+    let IntegratorKind::Radau5 { dt, newton_tol, rtol, atol, max_step, first_step } = *kind else {
+        unreachable!("checked above")
+    };
+    if adaptive {
+        integrate_adaptive(sys, t0, y0, t_out, rtol, atol, max_step, first_step, obs)
+    } else {
+        integrate_fixed(sys, t0, y0, dt, newton_tol, t_out, obs)
+    }
 }
