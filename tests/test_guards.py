@@ -99,3 +99,21 @@ def _negative():
     b = m.add_body("b", 1.0, [-1.0, 1.0, 1.0])
     m.add_joint(ms.joints.Revolute("r", m.ground, b))
     m.build()
+
+
+def test_a_long_run_is_not_stopped_by_a_step_floor_relative_to_its_span():
+    """The adaptive schemes' smallest step was 1e-14 of the span: a 10-link chain run to
+    t_end = 1000 s stopped with 'step size underflow' at t = 1.9157 s (where its steps are ~1e-11
+    s), while the same run to 3 s went through. Now only the round-off of t bounds the step."""
+    m = ms.Model("chain", gravity=(0, -9.81, 0))
+    parent = m.ground
+    for i in range(10):
+        b = m.add_body(f"b{i}", 1.0, ms.inertia.rod(1.0, 0.1), com=(0.05, 0, 0))
+        m.add_joint(ms.joints.Revolute(f"j{i}", parent, b, parent_frame=(0.1, 0, 0) if i else None))
+        parent = b
+    for integ in (ms.DOPRI5(), ms.Radau5(rtol=1e-6)):
+        with pytest.raises(ms.SolverError) as e:
+            ms.simulate(m, 1000.0, integ, output_dt=0.01, max_steps=3000)
+        msg = str(e.value)
+        assert "step budget of 3000 accepted steps spent at t = " in msg, msg
+        assert float(msg.split("spent at t = ")[1].split(" s")[0]) > 2.0, msg

@@ -228,8 +228,7 @@ pub fn integrate<S: OdeSystem>(
             }
             break;
         }
-        // relative to the time and to the span, so that fast systems on short spans still start
-        if h < 1e-14 * t.abs().max(t_end - t0) {
+        if h < super::step_floor(t, t0, t_end) {
             return Err(Error::Solver(format!(
                 "step size underflow at t = {t:.6} s (h = {h:.3e}); the system may be stiff (use radau5) or singular"
             )));

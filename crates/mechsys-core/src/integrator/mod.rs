@@ -183,6 +183,14 @@ pub fn integrate<S: OdeSystem>(
     }
 }
 
+/// The smallest step an adaptive scheme may take at time `t` of a run over `[t0, t_end]`: a few
+/// units of round-off of t (a step below it no longer advances the time). Not relative to the
+/// span: a floor of 1e-14 (t_end − t0) stopped long runs of fast systems (a 1000 s run at
+/// t = 1.9 s); near t = 0 a millionth of the span keeps it above zero.
+pub(crate) fn step_floor(t: f64, t0: f64, t_end: f64) -> f64 {
+    10.0 * f64::EPSILON * t.abs().max(1e-6 * (t_end - t0).abs()).max(f64::MIN_POSITIVE)
+}
+
 /// Fails with a solver error if y holds a NaN or inf, naming the time.
 pub(crate) fn check_finite(t: f64, y: &[f64]) -> Result<()> {
     if y.iter().all(|v| v.is_finite()) {

@@ -298,7 +298,7 @@ pub fn integrate<'a>(
         if cap.is_finite() {
             h = h.min(cap.max(1e-14 * t.abs().max(1.0)));
         }
-        if h < 1e-15 * t.abs().max(t_end - t0) {
+        if h < crate::integrator::step_floor(t, t0, t_end) {
             return Err(Error::Solver(format!("step size underflow at t = {t:.9} s (h = {h:.3e})")));
         }
         let err = st.attempt(phase, t, &y, h, opts.rtol, opts.atol)?;

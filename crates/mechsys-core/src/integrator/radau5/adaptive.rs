@@ -443,8 +443,7 @@ pub fn integrate_adaptive<S: OdeSystem>(
             }
             break;
         }
-        // relative to the time only: a floor relative to the whole span fails long runs
-        if !(h >= 10.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE)) {
+        if !(h >= crate::integrator::step_floor(t, t0, t_end)) {
             return Err(Error::Solver(format!(
                 "step size underflow at t = {t:.6} s (h = {h:.3e}) in radau5: Newton does not converge or the error \
                  estimate cannot be met; the model may be singular or discontinuous there"
