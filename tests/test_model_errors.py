@@ -128,7 +128,21 @@ def build_inertia(value):
     return lambda: with_joint(ms.joints.Revolute("hinge", parent="ground", child="arm"), inertia=value).build()
 
 
+def build_unnamed_force():
+    m = with_joint(ms.joints.Revolute("hinge", parent="ground", child="arm"))
+    m.add_force(ms.forces.JointForce("", "hinge", 1.0))
+    m.build()
+
+
+def build_unnamed_marker():
+    m = with_joint(ms.joints.Revolute("hinge", parent="ground", child="arm"))
+    m.add_marker("arm", " ")
+    m.build()
+
+
 MODEL_ERRORS = {
+    "unnamed force": (build_unnamed_force, ["forces[0]", "name must not be empty"]),
+    "unnamed marker": (build_unnamed_marker, ["markers[0]", "name must not be empty"]),
     "unknown parent": (build_unknown_parent, ["hinge", "parent", "nowhere"]),
     "unknown child": (build_unknown_child, ["hinge", "child", "nobody"]),
     "duplicate body": (build_duplicate_body, ["duplicate", "arm"]),

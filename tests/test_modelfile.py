@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -405,3 +406,14 @@ def test_a_single_table_where_an_array_of_tables_belongs_is_named(tmp_path, key)
     p = write(tmp_path, PENDULUM_TOML + f"\n[{key}]\nname = \"x\"\n")
     with pytest.raises(ModelError, match=rf"{key}: expected an array of tables \(\[\[{key}\]\]\)"):
         load_model(p)
+
+
+@pytest.mark.parametrize("extra, where", [
+    ('[[forces]]\ntype = "callback"\nname = "law"\nid = 0\n', "forces[0] 'law'"),
+    ('[[forces]]\ntype = "joint_force"\nname = "drive"\njoint = "hinge"\nvalue = { type = "callback", id = 0 }\n',
+     "forces[0] 'drive'.value"),
+])
+def test_a_callback_in_a_toml_file_is_refused_at_load_naming_the_element(tmp_path, extra, where):
+    text = PENDULUM_TOML.replace("[simulation]", extra + "\n[simulation]")
+    with pytest.raises(ModelError, match=re.escape(f"{where}: a callback needs a Python callable")):
+        load_model(write(tmp_path, text))

@@ -204,7 +204,33 @@ def _load_toml(path: Path) -> tuple[Model, Any]:
                 f"constraints[{i}] '{c.get('name', '?')}': a velocity constraint needs Python callables (W, w, Wdot); "
                 "define it with mechsys.constraints.Velocity in a .py model file"
             )
+    where = _callback_in(data)
+    if where is not None:
+        # a callback id refers to a Python callable, which a TOML file cannot hold: say so at
+        # load instead of at the run ("the model refers to 1 callbacks, 0 given")
+        raise ModelError(f"{where}: a callback needs a Python callable, which a TOML file cannot hold; "
+                         "use a function given by values (constant, ramp, harmonic, table) or a .py model file")
     return Model.from_dict(data), sim
+
+
+def _callback_in(node, path: str = "") -> str | None:
+    """Where a model description refers to a Python callback ({type = "callback"}), as
+    ``forces[0] 'drive'.value``, or None."""
+    if isinstance(node, dict):
+        if node.get("type") == "callback":
+            return path or "model"
+        for k, v in node.items():
+            if isinstance(v, (dict, list)):
+                found = _callback_in(v, f"{path}.{k}" if path else k)
+                if found:
+                    return found
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            name = v.get("name") if isinstance(v, dict) else None
+            found = _callback_in(v, f"{path}[{i}]" + (f" '{name}'" if isinstance(name, str) else ""))
+            if found:
+                return found
+    return None
 
 
 def _load_python(path: Path) -> tuple[Model, Any]:

@@ -487,6 +487,8 @@ impl Model {
                 | ForceDescription::Callback { name, .. } => name.clone(),
             };
             let what = format!("forces[{i}] '{name}'");
+            // a name is how its signals are found (force/<name>/...)
+            crate::ensure!(!name.trim().is_empty(), Model, "forces[{i}]: name must not be empty");
             crate::ensure!(force_names.insert(name.clone()), Model, "{what}: duplicate force element name");
             forces.push(match f {
                 ForceDescription::SpringDamper {
@@ -1022,6 +1024,7 @@ fn markers(list: &[MarkerDescription], what: &str) -> Result<Vec<Marker>> {
         .enumerate()
         .map(|(i, m)| {
             let w = format!("{what}[{i}] '{}'", m.name);
+            crate::ensure!(!m.name.trim().is_empty(), Model, "{what}[{i}]: name must not be empty");
             crate::ensure!(seen.insert(m.name.clone()), Model, "{w}: duplicate marker name");
             Ok(Marker {
                 name: m.name.clone(),
