@@ -1014,7 +1014,7 @@ pub fn simulate(
             |law: &crate::model::contact::ImpactLaw| matches!(law, crate::model::contact::ImpactLaw::Poisson { .. });
         if let Some(c) = model.contacts.iter().find(|c| poisson(&c.impact)) {
             return Err(Error::Settings(format!(
-                "contact '{}': Poisson's impact law needs the event-driven scheme (integrator EventDriven); MoreauJean applies restitution at velocity level, as Newton's law: give this contact laws.Newton(eps) (impact = { type = \"newton\", eps = ... } in a model file) to use it",
+                "contact '{}': Poisson's impact law needs the event-driven scheme (integrator EventDriven); MoreauJean applies restitution at velocity level, as Newton's law: give this contact laws.Newton(eps) (impact = {{ type = \"newton\", eps = ... }} in a model file) to use it",
                 c.name
             )));
         }
