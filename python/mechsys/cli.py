@@ -217,6 +217,10 @@ def run(
     if max_wall is not None:
         kwargs["max_wall"] = max_wall
     out_path = out if out is not None else Path("results") / f"{_safe_name(model.name)}.h5"
+    # a bad output path is found before the run, not after it
+    from .files import check_outputs
+
+    check_outputs({"model file": model_file}, {"--out": out_path, "--plot": plot_out, "--csv": csv_out})
     start = time.perf_counter()
     try:
         res = simulate(model, **kwargs)
@@ -288,6 +292,9 @@ def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, tit
 
     res = load(results_file)
     out_path = out if out is not None else results_file.with_suffix(".png")
+    from .files import check_outputs
+
+    check_outputs({"results file": results_file}, {"--out": out_path})
     plot(res, _split_signals(signals), out=out_path, title=title)
     click.echo(f"plot  {out_path}")
 

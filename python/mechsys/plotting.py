@@ -153,8 +153,9 @@ def plot(
     )
 
     if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=dpi, format=path.suffix.lower()[1:])
+        from .files import write_atomically
+
+        write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=path.suffix.lower()[1:]))
     return fig
 
 

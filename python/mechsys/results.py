@@ -459,9 +459,12 @@ class Results:
         for name in list(self._lazy):
             if name in self._lazy:
                 self._materialize(name)
+        from .files import atomic_path
+
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with h5py.File(path, "w", track_order=True) as f:
+        # to a temporary file renamed over the target: a failed or interrupted save leaves the
+        # previous results as they were
+        with atomic_path(path) as tmp, h5py.File(tmp, "w", track_order=True) as f:
             f.attrs["format"] = "mechsys-results"
             f.attrs["format_version"] = 1
             for k, v in self.attrs.items():
@@ -537,10 +540,10 @@ class Results:
                 header.append(f"{n} [{unit}]")
             else:
                 header.extend(f"{n}[{i}] [{cu}]" for i, cu in enumerate(self.column_units(n)))
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
-        return path
+        from .files import write_atomically
+
+        table = np.hstack(cols)
+        return write_atomically(path, lambda tmp: np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments=""))
 
 
 def _sensor_group(engine, body_names: list[str], raw: dict, complete: bool = True):

@@ -1,0 +1,121 @@
+"""Outputs never destroy what was there (issue 13's bad inputs; ../shared/reviews/file-safety.md):
+every writer goes through a temporary file renamed over its target, so a save that fails or is
+interrupted part-way leaves the previous file intact and no debris; the command line refuses, before
+it simulates, an output that is its own input or another output, or that cannot be written."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mechsys as ms
+from mechsys.files import check_outputs, write_atomically
+
+ROOT = Path(__file__).resolve().parents[1]
+PENDULUM = ROOT / "examples" / "pendulum.toml"
+
+
+def mechsys(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "mechsys", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd or ROOT)
+
+
+@pytest.fixture
+def model(tmp_path):
+    p = tmp_path / "pendulum.toml"
+    p.write_bytes(PENDULUM.read_bytes())
+    return p
+
+
+@pytest.mark.parametrize("option", ["--out", "--csv", "--plot"])
+def test_an_output_naming_the_model_file_is_refused_and_the_model_survives(model, tmp_path, option):
+    before = model.read_bytes()
+    extra = [] if option == "--out" else ["--out", tmp_path / "r.h5"]
+    p = mechsys("run", model, option, model, *extra, "--t-end", "0.1")
+    assert p.returncode != 0
+    assert f"{option} {model}: that is the model file" in p.stderr and "Traceback" not in p.stderr
+    assert model.read_bytes() == before
+    assert not (tmp_path / "r.h5").exists()  # refused before the run: nothing written
+
+
+def test_two_outputs_naming_one_file_and_unwritable_places_are_refused_before_the_run(model, tmp_path):
+    p = mechsys("run", model, "--out", tmp_path / "r.png", "--plot", tmp_path / "r.png", "--t-end", "0.1")
+    assert p.returncode != 0 and "--out and --plot name the same file" in p.stderr
+    assert not (tmp_path / "r.png").exists()
+    p = mechsys("run", model, "--out", tmp_path, "--t-end", "0.1")
+    assert p.returncode != 0 and "is a directory" in p.stderr
+    if os.geteuid() != 0:  # root writes anywhere
+        ro = tmp_path / "ro"
+        ro.mkdir()
+        ro.chmod(0o555)
+        try:
+            p = mechsys("run", model, "--out", ro / "r.h5", "--t-end", "0.1")
+            assert p.returncode != 0 and "cannot write in" in p.stderr
+        finally:
+            ro.chmod(0o755)
+
+
+def test_plot_refuses_to_overwrite_its_results_file(model, tmp_path):
+    res_path = tmp_path / "res.h5"
+    assert mechsys("run", model, "--out", res_path, "--t-end", "0.1", "-q").returncode == 0
+    before = res_path.read_bytes()
+    p = mechsys("plot", res_path, "joint/hinge/q", "--out", res_path)
+    assert p.returncode != 0 and "that is the results file" in p.stderr
+    assert res_path.read_bytes() == before
+    assert ms.Results.load(res_path)["joint/hinge/q"].shape == (11,)
+
+
+def test_a_save_that_fails_part_way_keeps_the_previous_results_and_leaves_no_debris(model, tmp_path, monkeypatch):
+    from mechsys.modelfile import load_model
+
+    m, sim = load_model(model)
+    res = ms.simulate(m, 0.1, ms.RK4(dt=1e-3))
+    path = tmp_path / "r.h5"
+    res.save(path)
+    before = path.read_bytes()
+    import h5py
+
+    real = h5py.Group.create_dataset
+    calls = {"n": 0}
+
+    def failing(self, name, *a, **k):
+        calls["n"] += 1
+        if calls["n"] > 3:
+            raise OSError(28, "No space left on device")
+        return real(self, name, *a, **k)
+
+    monkeypatch.setattr(h5py.Group, "create_dataset", failing)
+    with pytest.raises(OSError, match="No space left"):
+        res.save(path)
+    monkeypatch.setattr(h5py.Group, "create_dataset", real)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pendulum.toml", "r.h5"]
+    # an interrupt during a write: the same
+    csv = tmp_path / "r.csv"
+    res.to_csv(csv, ["joint/hinge/q"])
+    good = csv.read_text()
+
+    def interrupted(tmp):
+        Path(tmp).write_text("half")
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        write_atomically(csv, interrupted)
+    assert csv.read_text() == good
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pendulum.toml", "r.csv", "r.h5"]
+
+
+def test_check_outputs_names_each_problem(tmp_path):
+    a = tmp_path / "a.h5"
+    a.write_text("x")
+    with pytest.raises(ms.SettingsError, match=r"--out .*a.h5: that is the model file"):
+        check_outputs({"model file": a}, {"--out": a})
+    # the same file through a different spelling of its path
+    with pytest.raises(ms.SettingsError, match="--out and --csv name the same file"):
+        check_outputs({}, {"--out": tmp_path / "b.h5", "--csv": tmp_path / "sub" / ".." / "b.h5"})
+    check_outputs({"model file": a}, {"--out": tmp_path / "new" / "deeper" / "r.h5", "--plot": None})
