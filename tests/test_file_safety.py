@@ -119,3 +119,25 @@ def test_check_outputs_names_each_problem(tmp_path):
     with pytest.raises(ms.SettingsError, match="--out and --csv name the same file"):
         check_outputs({}, {"--out": tmp_path / "b.h5", "--csv": tmp_path / "sub" / ".." / "b.h5"})
     check_outputs({"model file": a}, {"--out": tmp_path / "new" / "deeper" / "r.h5", "--plot": None})
+
+
+@pytest.mark.parametrize("name, fragment", [
+    ("a/position", "must not contain '/'"),
+    ("a\x00b", "control character"),
+    ("line\nbreak", "control character"),
+    ("..", "is not a usable name"),
+    ("x" * 201, "too long"),
+])
+def test_names_that_would_break_signal_names_or_the_results_file_are_refused(name, fragment):
+    m = ms.Model("names")
+    b = m.add_body(name, 1.0, [1, 1, 1])
+    m.add_joint(ms.joints.Revolute("j", m.ground, b))
+    with pytest.raises(ms.ModelError, match=r"bodies\[0\]"):
+        m.build()
+    with pytest.raises(ms.ModelError, match=fragment):
+        m.build()
+    m2 = ms.Model("names")
+    b2 = m2.add_body("b", 1.0, [1, 1, 1])
+    m2.add_joint(ms.joints.Revolute(name, m2.ground, b2))
+    with pytest.raises(ms.ModelError, match=r"joints\[0\]"):
+        m2.build()

@@ -95,7 +95,8 @@ def _fmt_vec(v: Sequence[float]) -> str:
 
 
 def _safe_name(name: str) -> str:
-    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "model"
+    # a file-name stem: portable characters, at most 100 of them (file systems stop at 255 bytes)
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:100] or "model"
 
 
 def _split_signals(values: Sequence[str]) -> list[str]:

@@ -288,7 +288,7 @@ pub(super) fn validate(
     rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
 ) -> Result<Contact> {
     let what = format!("contacts[{index}] '{}'", d.name);
-    crate::ensure!(!d.name.trim().is_empty(), Model, "contacts[{index}]: name must not be empty");
+    super::validate::check_name(&d.name, &format!("contacts[{index}]"))?;
     let b1 = body(&d.body1, &format!("{what}.body1"))?;
     let b2 = body(&d.body2, &format!("{what}.body2"))?;
     crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{}'", d.body1);
@@ -309,7 +309,7 @@ pub(super) fn validate_group(
     rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
 ) -> Result<ContactGroup> {
     let what = format!("contact_groups[{index}] '{}'", d.name);
-    crate::ensure!(!d.name.trim().is_empty(), Model, "contact_groups[{index}]: name must not be empty");
+    super::validate::check_name(&d.name, &format!("contact_groups[{index}]"))?;
     crate::ensure!(!d.members.is_empty(), Model, "{what}.members: a group needs at least one member");
     let any_planar = d.members.iter().chain(&d.against).any(|m| planar(&m.contour));
     let any_spatial = d

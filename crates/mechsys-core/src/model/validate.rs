@@ -13,6 +13,26 @@ fn err(msg: String) -> Error {
     Error::Model(msg)
 }
 
+/// A name is part of its signals' names (`body/<name>/position`) and of the results file's
+/// paths: not empty, no '/', no control characters, not "." or "..", at most 200 bytes.
+pub(crate) fn check_name(name: &str, what: &str) -> Result<()> {
+    crate::ensure!(!name.trim().is_empty(), Model, "{what}: name must not be empty");
+    let bad = name.chars().find(|c| *c == '/' || c.is_control());
+    crate::ensure!(
+        bad.is_none(),
+        Model,
+        "{what} {name:?}: a name must not contain {} (names are parts of signal names such as body/<name>/position)",
+        match bad {
+            Some('/') => "'/'".to_string(),
+            Some(c) => format!("the control character {:?}", c),
+            None => String::new(),
+        }
+    );
+    crate::ensure!(name != "." && name != "..", Model, "{what}: '{name}' is not a usable name");
+    crate::ensure!(name.len() <= 200, Model, "{what}: a name of {} bytes is too long (at most 200)", name.len());
+    Ok(())
+}
+
 fn finite3(v: &[f64; 3], what: &str) -> Result<Vec3> {
     crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: must be finite, got {v:?}");
     Ok(Vec3::new(v[0], v[1], v[2]))
@@ -218,7 +238,7 @@ impl Model {
         names.insert("ground".to_string(), 0);
         for (i, b) in desc.bodies.iter().enumerate() {
             let what = format!("bodies[{i}] '{}'", b.name);
-            crate::ensure!(!b.name.trim().is_empty(), Model, "bodies[{i}]: name must not be empty");
+            check_name(&b.name, &format!("bodies[{i}]"))?;
             crate::ensure!(b.name != "ground", Model, "{what}: the name 'ground' is reserved for the inertial frame");
             crate::ensure!(
                 names.insert(b.name.clone(), i + 1).is_none(),
@@ -233,7 +253,7 @@ impl Model {
         let mut parent_joint: HashMap<usize, usize> = HashMap::new(); // desc body idx -> desc joint idx
         for (i, j) in desc.joints.iter().enumerate() {
             let what = format!("joints[{i}] '{}'", j.name);
-            crate::ensure!(!j.name.trim().is_empty(), Model, "joints[{i}]: name must not be empty");
+            check_name(&j.name, &format!("joints[{i}]"))?;
             crate::ensure!(joint_names.insert(j.name.clone()), Model, "{what}: duplicate joint name '{}'", j.name);
             let p = *names.get(&j.parent).ok_or_else(|| err(format!("{what}.parent: unknown body '{}'", j.parent)))?;
             let c = *names.get(&j.child).ok_or_else(|| err(format!("{what}.child: unknown body '{}'", j.child)))?;
@@ -488,7 +508,7 @@ impl Model {
             };
             let what = format!("forces[{i}] '{name}'");
             // a name is how its signals are found (force/<name>/...)
-            crate::ensure!(!name.trim().is_empty(), Model, "forces[{i}]: name must not be empty");
+            check_name(&name, &format!("forces[{i}]"))?;
             crate::ensure!(force_names.insert(name.clone()), Model, "{what}: duplicate force element name");
             forces.push(match f {
                 ForceDescription::SpringDamper {
@@ -752,7 +772,7 @@ impl Model {
         for (ci, c) in desc.constraints.iter().enumerate() {
             let name = c.name().to_string();
             let what = format!("constraints[{ci}] '{name}'");
-            crate::ensure!(!name.trim().is_empty(), Model, "constraints[{ci}]: name must not be empty");
+            check_name(&name, &format!("constraints[{ci}]"))?;
             crate::ensure!(constraint_names.insert(name.clone()), Model, "{what}: duplicate constraint name");
             let kind = match c {
                 ConstraintDescription::Point { body1, point1, body2, point2, .. } => {
@@ -1024,7 +1044,7 @@ fn markers(list: &[MarkerDescription], what: &str) -> Result<Vec<Marker>> {
         .enumerate()
         .map(|(i, m)| {
             let w = format!("{what}[{i}] '{}'", m.name);
-            crate::ensure!(!m.name.trim().is_empty(), Model, "{what}[{i}]: name must not be empty");
+            check_name(&m.name, &format!("{what}[{i}]"))?;
             crate::ensure!(seen.insert(m.name.clone()), Model, "{w}: duplicate marker name");
             Ok(Marker {
                 name: m.name.clone(),
