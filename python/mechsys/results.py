@@ -420,17 +420,17 @@ class Results:
     @property
     def model(self) -> dict:
         """The model description the results came from."""
-        return json.loads(self.attrs.get("model", "{}"))
+        return _json_attr(self.attrs, "model", "{}")
 
     @property
     def settings(self) -> dict:
         """The simulation settings."""
-        return json.loads(self.attrs.get("settings", "{}"))
+        return _json_attr(self.attrs, "settings", "{}")
 
     @property
     def stats(self) -> dict:
         """Integrator statistics (steps, rejected, evaluations, jacobians)."""
-        return json.loads(self.attrs.get("stats", "{}"))
+        return _json_attr(self.attrs, "stats", "{}")
 
     @property
     def events(self) -> list[dict]:
@@ -443,7 +443,7 @@ class Results:
         add ``mu``, ``mu_critical``, ``situation`` (``inconsistent`` or ``non-unique``),
         ``solutions`` (the points closed in each solution of a non-unique state, as
         ``"contact[k]"``) and ``resolved_by_impulse``. Empty for the smooth integrators."""
-        return json.loads(self.attrs.get("events", "[]"))
+        return _json_attr(self.attrs, "events", "[]")
 
     def __repr__(self) -> str:
         n = len(self.t)
@@ -466,7 +466,7 @@ class Results:
         # previous results as they were
         with atomic_path(path) as tmp, h5py.File(tmp, "w", track_order=True) as f:
             f.attrs["format"] = "mechsys-results"
-            f.attrs["format_version"] = 1
+            f.attrs["format_version"] = FORMAT_VERSION
             for k, v in self.attrs.items():
                 if k != "signal_order":
                     f.attrs[k] = v
@@ -474,19 +474,26 @@ class Results:
             for name, arr in self._signals.items():
                 data = np.ascontiguousarray(arr)
                 if self.levels(name) is not None:
-                    ds = f.create_dataset(name, data=data.astype(np.int8),
-                                          dtype=h5py.enum_dtype(CONTACT_STATES, basetype="i1"))
+                    data = data.astype(np.int8)
+                    ds = f.create_dataset(name, data=data, dtype=h5py.enum_dtype(CONTACT_STATES, basetype="i1"))
                 else:
                     ds = f.create_dataset(name, data=data)
                 ds.attrs["unit"] = self._units.get(name, "")
+                ds.attrs["crc32"] = _crc32(data)
                 if name in self._columns:
                     ds.attrs["columns"] = json.dumps(self._columns[name][0])
                     ds.attrs["column_units"] = json.dumps(self._columns[name][1])
+            # written last: a file without it was not finished
+            f.attrs["signal_count"] = len(self._signals)
+            f.attrs["complete"] = True
         return path
 
     @classmethod
     def load(cls, path: str | Path) -> "Results":
-        """Reads a results file written by :meth:`save`."""
+        """Reads a results file written by :meth:`save`, as untrusted input: the file must be
+        complete (its marker written last) with every signal's checksum matching; links, external
+        storage, virtual or compressed datasets and shapes larger than the file are refused. Every
+        problem is a :class:`mechsys.ResultsError` naming the file and the signal."""
         import h5py
 
         path = Path(path)
@@ -496,28 +503,37 @@ class Results:
             f = h5py.File(path, "r")
         except OSError as e:
             raise ResultsError(f"'{path}' is not an HDF5 results file ({e})") from None
-        with f:
-            if f.attrs.get("format") != "mechsys-results":
-                raise ResultsError(f"'{path}' is an HDF5 file but not mechsys results (no 'format' attribute)")
-            signals: dict[str, np.ndarray] = {}
-            units: dict[str, str] = {}
-            columns: dict[str, tuple[list, list]] = {}
+        size = path.stat().st_size
+        try:
+            with f:
+                if f.attrs.get("format") != "mechsys-results":
+                    raise ResultsError(f"'{path}' is an HDF5 file but not mechsys results (no 'format' attribute)")
+                version = int(f.attrs.get("format_version", 0))
+                if version > FORMAT_VERSION or version < 1:
+                    raise ResultsError(f"'{path}': results format version {version} is not one this mechsys reads "
+                                       f"(1 to {FORMAT_VERSION})")
+                if version >= 2 and not bool(f.attrs.get("complete", False)):
+                    raise ResultsError(f"'{path}': incomplete results file (no completeness marker: its writing stopped "
+                                       "part-way); run the simulation again")
+                signals, units, columns = _read_signals(f, path, size, checksums=version >= 2)
+                if version >= 2 and int(f.attrs.get("signal_count", -1)) != len(signals):
+                    raise ResultsError(f"'{path}': {len(signals)} signals, the file says {int(f.attrs.get('signal_count', -1))}")
+                attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        except ResultsError:
+            raise
+        except (OSError, KeyError, ValueError, TypeError, RuntimeError) as e:
+            raise ResultsError(f"'{path}': unreadable results file ({type(e).__name__}: {e})") from None
+        if version < 2:
+            import warnings
 
-            def visit(name, obj):
-                if isinstance(obj, h5py.Dataset):
-                    arr = np.asarray(obj[()])
-                    arr.setflags(write=False)
-                    signals[name] = arr
-                    units[name] = str(obj.attrs.get("unit", ""))
-                    if "columns" in obj.attrs:
-                        try:
-                            columns[name] = (json.loads(obj.attrs["columns"]), json.loads(obj.attrs["column_units"]))
-                        except (KeyError, ValueError, TypeError):
-                            raise ResultsError(f"'{path}': signal '{name}': unreadable column names") from None
-
-            f.visititems(visit)
-            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-        order = json.loads(attrs.pop("signal_order", "[]"))
+            warnings.warn(f"'{path}' was written before results files carried checksums (format 1): not verified",
+                          UserWarning, stacklevel=2)
+        try:
+            order = json.loads(attrs.pop("signal_order", "[]"))
+            if not isinstance(order, list):
+                raise ValueError("not a list")
+        except (ValueError, TypeError):
+            raise ResultsError(f"'{path}': unreadable attribute 'signal_order'") from None
         order = [n for n in order if n in signals] + [n for n in signals if n not in order]
         out = cls({n: signals[n] for n in order}, units, attrs)
         out._columns = columns
@@ -754,3 +770,79 @@ def record_selection(engine, patterns) -> tuple[dict, list[str]]:
         "forces": any(n.startswith("force/") for n in chosen),
     }
     return selection, chosen
+
+
+#: Results file format: 2 adds the completeness marker and a CRC-32 per signal.
+FORMAT_VERSION = 2
+#: Largest results file signal the reader accepts, bytes (a guard against crafted shapes).
+MAX_SIGNAL_BYTES = 8 << 30
+
+
+def _crc32(arr) -> int:
+    import zlib
+
+    return zlib.crc32(np.ascontiguousarray(arr).tobytes()) & 0xFFFFFFFF
+
+
+def _read_signals(f, path: Path, size: int, checksums: bool):
+    """Every dataset of an open results file, checked as untrusted input (see Results.load)."""
+    import h5py
+
+    signals: dict[str, np.ndarray] = {}
+    units: dict[str, str] = {}
+    columns: dict[str, tuple[list, list]] = {}
+
+    def walk(group, prefix: str) -> None:
+        for key in group:
+            name = f"{prefix}{key}"
+            link = group.get(key, getlink=True)
+            if isinstance(link, (h5py.SoftLink, h5py.ExternalLink)):
+                raise ResultsError(f"'{path}': signal '{name}' is a {'soft' if isinstance(link, h5py.SoftLink) else 'external'} "
+                                   "link; results files hold their data themselves (refused)")
+            obj = group[key]
+            if isinstance(obj, h5py.Group):
+                walk(obj, name + "/")
+                continue
+            if not isinstance(obj, h5py.Dataset):
+                raise ResultsError(f"'{path}': '{name}' is neither a signal nor a group")
+            if obj.is_virtual or obj.external:
+                raise ResultsError(f"'{path}': signal '{name}' keeps its data in other files (external or virtual "
+                                   "dataset); refused")
+            if obj.compression is not None or obj.chunks is not None and obj.id.get_create_plist().get_nfilters():
+                raise ResultsError(f"'{path}': signal '{name}' is compressed or filtered; mechsys writes plain data (refused)")
+            if obj.dtype.kind not in "fiub" or obj.dtype.itemsize > 8 or obj.ndim > 4:
+                raise ResultsError(f"'{path}': signal '{name}' has type {obj.dtype} and {obj.ndim} dimensions; "
+                                   "expected numbers in at most 4 dimensions")
+            nbytes = int(np.prod(obj.shape, dtype=np.int64)) * obj.dtype.itemsize
+            if nbytes > size or nbytes > MAX_SIGNAL_BYTES:
+                raise ResultsError(f"'{path}': signal '{name}' declares {nbytes} bytes, more than the file holds "
+                                   f"({size} bytes); refused")
+            try:
+                arr = np.asarray(obj[()])
+            except (OSError, ValueError, TypeError) as e:
+                raise ResultsError(f"'{path}': signal '{name}' cannot be read ({e})") from None
+            if checksums:
+                stored = obj.attrs.get("crc32")
+                if stored is None:
+                    raise ResultsError(f"'{path}': signal '{name}' has no checksum")
+                if int(stored) != _crc32(arr):
+                    raise ResultsError(f"'{path}': signal '{name}' is corrupt (checksum mismatch)")
+            arr.setflags(write=False)
+            signals[name] = arr
+            units[name] = str(obj.attrs.get("unit", ""))
+            if "columns" in obj.attrs:
+                try:
+                    columns[name] = (json.loads(obj.attrs["columns"]), json.loads(obj.attrs["column_units"]))
+                except (KeyError, ValueError, TypeError):
+                    raise ResultsError(f"'{path}': signal '{name}': unreadable column names") from None
+
+    walk(f, "")
+    return signals, units, columns
+
+
+def _json_attr(attrs: dict, key: str, default: str):
+    """A JSON attribute of a results file; ResultsError (not a traceback) when it is malformed."""
+    try:
+        return json.loads(attrs.get(key, default))
+    except (ValueError, TypeError):
+        raise ResultsError(f"results attribute '{key}' is not readable JSON (the file is damaged)") from None
