@@ -141,3 +141,51 @@ def test_names_that_would_break_signal_names_or_the_results_file_are_refused(nam
     m2.add_joint(ms.joints.Revolute(name, m2.ground, b2))
     with pytest.raises(ms.ModelError, match=r"joints\[0\]"):
         m2.build()
+
+
+def test_an_output_that_is_a_symlink_is_refused_unless_followed(model, tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious data")
+    link = tmp_path / "link.h5"
+    link.symlink_to(victim)
+    p = mechsys("run", model, "--out", link, "--t-end", "0.1")
+    assert p.returncode != 0 and "is a symbolic link" in p.stderr
+    assert victim.read_text() == "precious data"
+    for opt, name in (("--csv", "link.csv"), ("--plot", "link.png")):
+        other = tmp_path / name
+        other.symlink_to(victim)
+        p = mechsys("run", model, "--out", tmp_path / "r.h5", opt, other, "--t-end", "0.1")
+        assert p.returncode != 0 and f"{opt} {other}: is a symbolic link" in p.stderr
+        assert victim.read_text() == "precious data"
+    # asked for: the link's target is written (and the link stays a link)
+    target = tmp_path / "target.h5"
+    link2 = tmp_path / "link2.h5"
+    link2.symlink_to(target)
+    p = mechsys("run", model, "--out", link2, "--t-end", "0.1", "--follow-symlinks", "-q")
+    assert p.returncode == 0, p.stderr
+    assert link2.is_symlink() and ms.Results.load(target)["joint/hinge/q"].shape == (11,)
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["--t-end", "1e300"], "gives 1.000e302 samples"),
+    (["--dt", "1e-300", "--t-end", "1"], "is 1.000e300 steps, more than 1e12"),
+    (["--t-end", "1e6", "--output-dt", "1e-6"], "bytes of results, more than the"),
+])
+def test_runs_that_could_never_finish_or_fit_are_refused_before_they_start(model, tmp_path, args, fragment):
+    """--t-end 1e300 returned 0 samples with exit 0 (the sample count wrapped to zero), --dt 1e-300
+    hung; now each is an error with the estimate, before any allocation."""
+    p = subprocess.run([sys.executable, "-m", "mechsys", "run", str(model), "--out", str(tmp_path / "r.h5"), *args],
+                       capture_output=True, text=True, cwd=ROOT, timeout=60)
+    assert p.returncode != 0 and fragment in p.stderr and "Traceback" not in p.stderr, p.stderr
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_a_model_too_big_for_memory_is_refused_with_the_estimate():
+    from mechsys.errors import ModelError
+
+    m = ms.Model("big")
+    for i in range(40_000):
+        b = m.add_body(f"b{i}", 1.0, [1, 1, 1])
+        m.add_joint(ms.joints.Free(f"j{i}", m.ground, b))
+    with pytest.raises(ModelError, match=r"40000 bodies, 240000 velocities .* need about 4.6\d\de11 bytes of workspace"):
+        m.build()

@@ -170,6 +170,8 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
     help="Signals for --plot and --csv; repeat or separate by commas [default plot: first joint's q, energy/total].",
 )
 @click.option("--csv", "csv_out", type=click.Path(path_type=Path, dir_okay=False), help="Also write signals as CSV (all if no --signals).")
+@click.option("--follow-symlinks", "follow_symlinks", is_flag=True,
+              help="Write through an output path that is a symbolic link (refused by default).")
 @click.option("-q", "--quiet", is_flag=True, help="Print nothing on success.")
 def run(
     model_file: Path,
@@ -189,6 +191,7 @@ def run(
     plot_out: Path | None,
     signals: tuple[str, ...],
     csv_out: Path | None,
+    follow_symlinks: bool,
     quiet: bool,
 ) -> None:
     """Simulate a model file (.toml or .py) and save the results to HDF5.
@@ -221,7 +224,9 @@ def run(
     # a bad output path is found before the run, not after it
     from .files import check_outputs
 
-    check_outputs({"model file": model_file}, {"--out": out_path, "--plot": plot_out, "--csv": csv_out})
+    outs = check_outputs({"model file": model_file}, {"--out": out_path, "--plot": plot_out, "--csv": csv_out},
+                         follow_symlinks)
+    out_path, plot_out, csv_out = outs["--out"], outs["--plot"], outs["--csv"]
     start = time.perf_counter()
     try:
         res = simulate(model, **kwargs)
@@ -286,7 +291,10 @@ def run(
 @click.argument("signals", metavar="SIGNAL...", nargs=-1, required=True)
 @click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False), help="Image file (.png, .svg or .pdf) [default: RESULTS.png].")
 @click.option("--title", help="Figure title [default: the model name].")
-def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, title: str | None) -> None:
+@click.option("--follow-symlinks", "follow_symlinks", is_flag=True,
+              help="Write through an output path that is a symbolic link (refused by default).")
+def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, title: str | None,
+             follow_symlinks: bool) -> None:
     """Plot signals of a results file against time, one subplot per signal."""
     from .plotting import plot
     from .results import load
@@ -295,7 +303,7 @@ def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, tit
     out_path = out if out is not None else results_file.with_suffix(".png")
     from .files import check_outputs
 
-    check_outputs({"results file": results_file}, {"--out": out_path})
+    out_path = check_outputs({"results file": results_file}, {"--out": out_path}, follow_symlinks)["--out"]
     plot(res, _split_signals(signals), out=out_path, title=title)
     click.echo(f"plot  {out_path}")
 

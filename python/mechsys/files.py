@@ -61,12 +61,19 @@ def _same(a: Path, b: Path) -> bool:
     return a.resolve() == b.resolve()
 
 
-def check_outputs(inputs: dict[str, Path], outputs: dict[str, Path | None]) -> None:
+def check_outputs(inputs: dict[str, Path], outputs: dict[str, Path | None], follow_symlinks: bool = False) -> dict:
     """Refuses, before any work, an output that is one of the command's inputs (``--out
-    model.toml``), one file named by two outputs, a directory, or a place that cannot be written;
-    the messages name the option. ``inputs``/``outputs`` map option names to paths."""
+    model.toml``), one file named by two outputs, a directory, a symbolic link (unless
+    ``follow_symlinks``: then its target is written), or a place that cannot be written; the
+    messages name the option. ``inputs``/``outputs`` map option names to paths. Returns the
+    outputs to write (links resolved when followed)."""
     given = {k: Path(v) for k, v in outputs.items() if v is not None}
-    for opt, out in given.items():
+    for opt, out in list(given.items()):
+        if out.is_symlink():
+            if not follow_symlinks:
+                raise SettingsError(f"{opt} {out}: is a symbolic link (to {os.readlink(out)}); refused, since writing "
+                                    "through it would replace another file (--follow-symlinks writes its target)")
+            given[opt] = out = out.resolve()
         for what, inp in inputs.items():
             if _same(out, Path(inp)):
                 raise SettingsError(f"{opt} {out}: that is the {what}; writing there would replace it (choose another file)")
@@ -85,6 +92,7 @@ def check_outputs(inputs: dict[str, Path], outputs: dict[str, Path | None]) -> N
         for b in names[i + 1:]:
             if _same(given[a], given[b]):
                 raise SettingsError(f"{a} and {b} name the same file {given[a]}; each output needs its own")
+    return {k: given.get(k) for k in outputs}
 
 
 __all__ = ["atomic_path", "write_atomically", "check_outputs"]

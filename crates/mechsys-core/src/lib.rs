@@ -25,6 +25,7 @@ pub mod kinematics;
 pub mod linear;
 pub mod math;
 pub mod model;
+pub mod resources;
 pub mod simulate;
 pub mod solver;
 pub mod spatial;

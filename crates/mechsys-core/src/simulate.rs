@@ -896,17 +896,41 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         );
         crate::ensure!(atol.is_finite() && atol >= 0.0, Settings, "integrator.atol: must be >= 0, got {atol}");
     }
-    let n_out = ((span / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() as usize + 1;
-    let width = 1 + 2 * model.nq + 3 * model.nu + 17 * model.nbodies() + 10;
+    // the samples' memory, estimated before anything is allocated (in f64: a huge span must not
+    // wrap the count to zero)
+    let samples = ((span / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    let bodies = s.record.bodies.as_ref().map_or(model.nbodies() - 1, |b| b.len()) as f64;
+    let width = 1.0
+        + 2.0 * model.nq as f64
+        + 3.0 * model.nu as f64
+        + 23.0 * bodies
+        + 3.0 * model.nc as f64
+        + 2.0 * model.n_force_outputs as f64
+        + 14.0 * model.n_contact_points as f64
+        + 10.0;
+    let bytes = samples * width * 8.0;
+    let budget = crate::resources::memory_budget();
     crate::ensure!(
-        (n_out as f64) * (width as f64) * 8.0 < 16e9,
+        bytes.is_finite() && bytes < budget,
         Settings,
-        "output_dt: {} s over {} s gives {n_out} samples, more than 16 GB of results; choose a larger output_dt",
+        "output_dt: {:e} s over {:e} s gives {samples:.3e} samples of {width} values, about {:.3e} bytes of results, more than \
+         the {:.3e} bytes this run may use (half the memory available); choose a larger output_dt, a shorter run or \
+         sensors= to record less",
         s.output_dt,
-        span
+        span,
+        bytes,
+        budget
     );
     if let Some(dt) = s.integrator.fixed_step() {
         crate::ensure!(dt.is_finite() && dt > 0.0, Settings, "integrator.dt: must be > 0, got {dt}");
+        // a step count that could never be run (or counted) is refused, not started
+        let steps = span / dt;
+        crate::ensure!(
+            steps < 1e12,
+            Settings,
+            "integrator.dt: {dt:e} s over {span:e} s is {steps:.3e} steps, more than 1e12 (years of computing); choose a \
+             larger step or a shorter run"
+        );
         let ratio = s.output_dt / dt;
         crate::ensure!(
             (ratio - ratio.round()).abs() < 1e-9 * ratio.max(1.0) && ratio.round() >= 1.0,
@@ -915,6 +939,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
             s.output_dt
         );
     }
+    let n_out = samples as usize;
     let t_out: Vec<f64> = (0..n_out).map(|k| (s.t0 + k as f64 * s.output_dt).min(s.t_end)).collect();
 
     let mut y = vec![0.0; model.nq + model.nu + 2];

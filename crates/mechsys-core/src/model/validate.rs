@@ -1031,6 +1031,20 @@ impl Model {
             body_index,
             joint_index,
         };
+        // the workspace's dense matrices, before anything allocates them
+        let need = crate::resources::workspace_bytes(model.nbodies(), model.nu, model.nc);
+        let budget = crate::resources::memory_budget();
+        crate::ensure!(
+            need < budget,
+            Model,
+            "model '{}': {} bodies, {} velocities and {} constraint equations need about {need:.3e} bytes of workspace \
+             (dense mass and constraint matrices), more than the {budget:.3e} bytes this process may use (half the \
+             memory available)",
+            model.name,
+            model.nbodies() - 1,
+            model.nu,
+            model.nc
+        );
         if planar {
             super::planar::planarize(&mut model)?;
         }
