@@ -189,3 +189,59 @@ def test_a_model_too_big_for_memory_is_refused_with_the_estimate():
         m.add_joint(ms.joints.Free(f"j{i}", m.ground, b))
     with pytest.raises(ModelError, match=r"40000 bodies, 240000 velocities .* need about 4.6\d\de11 bytes of workspace"):
         m.build()
+
+
+SAVER = r"""
+import sys
+import mechsys as ms
+m = ms.Model("chain", gravity=(0, -9.81, 0))
+parent = m.ground
+for i in range(20):
+    b = m.add_body(f"b{i}", 1.0, ms.inertia.rod(1.0, 0.1), com=(0.05, 0, 0))
+    m.add_joint(ms.joints.Revolute(f"j{i}", parent, b, parent_frame=(0.1, 0, 0) if i else None, q0=0.1))
+    parent = b
+res = ms.simulate(m, 0.5, ms.RK4(dt=1e-4), output_dt=1e-4)
+print("ready", flush=True)
+while True:
+    res.save(sys.argv[1])
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_killing_a_save_at_random_moments_never_damages_the_results_file(tmp_path):
+    """SIGKILL and SIGINT during saves, 20 times at random moments: the file is always a complete,
+    verified results file (the previous one or the new one)."""
+    import random
+    import signal
+    import time
+
+    path = tmp_path / "r.h5"
+    rng = random.Random(7)
+    for k in range(20):
+        p = subprocess.Popen([sys.executable, "-u", "-c", SAVER, str(path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+        try:
+            assert p.stdout.readline().strip() == "ready"
+            time.sleep(rng.uniform(0.0, 0.6))
+            p.send_signal(signal.SIGKILL if k % 2 == 0 else signal.SIGINT)
+            p.wait(timeout=30)
+        finally:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+        if path.exists():
+            res = ms.Results.load(path)  # complete marker and every checksum verified
+            assert res["joint/j19/q"].shape == (5001,)
+    assert path.exists()
+
+
+def test_two_runs_writing_one_output_at_once_leave_one_complete_file(model, tmp_path):
+    out = tmp_path / "r.h5"
+    runs = [subprocess.Popen([sys.executable, "-m", "mechsys", "run", str(model), "--out", str(out), "--t-end", t, "-q"],
+                             cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE) for t in ("2.0", "3.0")]
+    for p in runs:
+        p.wait(timeout=120)
+    assert all(p.returncode == 0 for p in runs)
+    res = ms.Results.load(out)
+    assert res.t[-1] in (2.0, 3.0) and len(res.t) in (201, 301)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pendulum.toml", "r.h5"]
