@@ -54,24 +54,27 @@ def test_short_bearing_load_capacity_and_attitude_are_the_closed_forms():
 @pytest.mark.parametrize("theory", ["short", "long"])
 def test_film_forces_are_the_integrated_pressure(theory):
     # independent quadrature: the short-bearing pressure P(theta) integrated over the pi-film; the
-    # long bearing's p' (p = 0 at both film ends) integrated twice
-    for eps, ed, ws in [(0.4, 0.0, 150.0), (0.6, 20.0, -40.0), (0.85, -5.0, 300.0)]:
-        fr, ft, m = B.film_forces(theory, R, L, C, ETA, eps, ed, ws)
+    # long bearing's p' (p = 0 at both film ends) integrated twice. The film's half follows the
+    # spin: a negative spin mirrors it (s = -1), a whirl faster than half the spin makes omega* < 0
+    # with the same half (the wedge term then pushes outwards)
+    for eps, ed, ws, spin in [(0.4, 0.0, 150.0, 150.0), (0.6, 20.0, -40.0, -40.0), (0.85, -5.0, 300.0, 300.0),
+                              (0.5, 8.0, -60.0, 100.0)]:
+        s = 1.0 if spin >= 0 else -1.0
+        fr, ft, m = B.film_forces(theory, R, L, C, ETA, eps, ed, ws, spin)
         if theory == "short":
-            P = lambda t: ETA * L**3 / (2 * C**2) * (abs(ws) * eps * np.sin(t) - 2 * ed * np.cos(t)) / (1 + eps * np.cos(t)) ** 3
+            P = lambda t: ETA * L**3 / (2 * C**2) * (s * ws * eps * np.sin(t) - 2 * ed * np.cos(t)) / (1 + eps * np.cos(t)) ** 3
             gr = R * quad(lambda t: P(t) * np.cos(t), 0, PI, epsabs=0, epsrel=1e-12)[0]
-            gt = np.sign(ws) * R * quad(lambda t: P(t) * np.sin(t), 0, PI, epsabs=0, epsrel=1e-12)[0]
+            gt = s * R * quad(lambda t: P(t) * np.sin(t), 0, PI, epsabs=0, epsrel=1e-12)[0]
         else:
-            g = lambda t, k: (eps * abs(ws) * np.cos(t) + 2 * ed * np.sin(t) + k) / (1 + eps * np.cos(t)) ** 3
+            g = lambda t, k: (eps * s * ws * np.cos(t) + 2 * ed * np.sin(t) + k) / (1 + eps * np.cos(t)) ** 3
             k = -quad(lambda t: g(t, 0), 0, PI, epsrel=1e-13)[0] / quad(lambda t: (1 + eps * np.cos(t)) ** -3, 0, PI, epsrel=1e-13)[0]
-            p = lambda t: 6 * ETA * R**2 / C**2 * quad(lambda s: g(s, k), 0, t, epsrel=1e-13)[0]
+            p = lambda t: 6 * ETA * R**2 / C**2 * quad(lambda u: g(u, k), 0, t, epsrel=1e-13)[0]
             gr = R * L * quad(lambda t: p(t) * np.cos(t), 0, PI, epsrel=1e-11)[0]
-            gt = np.sign(ws) * R * L * quad(lambda t: p(t) * np.sin(t), 0, PI, epsrel=1e-11)[0]
-        # a negative speed mirrors the film: F_r keeps its value, F_t turns with the rotation
+            gt = s * R * L * quad(lambda t: p(t) * np.sin(t), 0, PI, epsrel=1e-11)[0]
         scale = max(abs(gr), abs(gt))
-        assert abs(fr - gr) < 1e-9 * scale and abs(ft - gt) < 1e-9 * scale, (theory, eps, ed, ws)
-        # Petroff with eccentricity, opposing the spin (omega_rel = omega_star here)
-        assert m == pytest.approx(-ms.forces.journal_bearing_coefficient(R, L, C, ETA, eps) * ws, rel=1e-12)
+        assert abs(fr - gr) < 1e-9 * scale and abs(ft - gt) < 1e-9 * scale, (theory, eps, ed, ws, spin)
+        # Petroff with eccentricity, opposing the spin
+        assert m == pytest.approx(-ms.forces.journal_bearing_coefficient(R, L, C, ETA, eps) * spin, rel=1e-12)
 
 
 # ---- an independent solution of the 2-D Reynolds equation ---------------------------------------

@@ -21,7 +21,7 @@ fn law(theory: &str, radius: f64, length: f64, clearance: f64, viscosity: f64, w
             return Err(settings(format!("{what}: {k} must be > 0 ({unit}), got {v}")));
         }
     }
-    if !(clearance < radius) {
+    if clearance >= radius {
         return Err(settings(format!(
             "{what}: clearance must be smaller than the radius {radius} m, got {clearance} m"
         )));

@@ -35,9 +35,13 @@
 //!   `F_t = 6 η R³ L/c² · [π ε ω*/((2 + ε²) √q) + 4 ε ε̇/((2 + ε²) q)]`
 //!   (steady part: Sommerfeld's half-film result).
 //!
-//! Both are written for ω* ≥ 0; for ω* < 0 the converging half of the gap is the other one and the
-//! forces are the mirror image: `F_r` takes |ω*| and `F_t` changes sign. F_t thus always points
-//! along the effective rotation and F_r towards the shell centre for a steady journal.
+//! Both hold for a spin ω_rel ≥ 0. A negative spin is the mirror image (the converging half of the
+//! gap is then the other one): with `s = sgn ω_rel`, `F_r` has `s ω*` in place of ω* and the
+//! squeeze term of `F_t` takes the factor s. The film's half is fixed by the spin, not by the sign
+//! of ω*: in a half-frequency whirl ω* passes through zero and the formulas continue linearly, so
+//! the force stays smooth along the orbit (a half chosen by the sign of ω* would jump there, and
+//! an adaptive integrator would chatter on the jump). F_t points along the rotation and F_r towards
+//! the shell centre for a steady journal.
 //!
 //! The viscous friction torque on the journal is eq. 2.212 with the wall speed `R ω_rel`:
 //! `M = −2(1 + 2ε²)/(√q (1 + ε²/2)) · π R³ L η/c · ω_rel` (Petroff's law at ε = 0).
@@ -82,8 +86,8 @@ pub struct ShellLoad<T> {
     pub f_t: T,
 }
 
-/// The shape factors of a theory at ε: `F_r = −k (rr |ω*| ε² + rs ε̇)`,
-/// `F_t = k (tt ω* ε + ts sgn(ω*) ε ε̇)`.
+/// The shape factors of a theory at ε: `F_r = −k (rr s ω* ε² + rs ε̇)`,
+/// `F_t = k (tt ω* ε + ts s ε ε̇)`, `s = sgn ω_rel`.
 struct Shape<T> {
     rr: T,
     rs: T,
@@ -142,7 +146,7 @@ impl BearingLaw {
     pub fn film<T: DualNum<f64> + Copy>(&self, eps: T, eps_dot: T, omega_star: T, omega_rel: T) -> FilmLoad<T> {
         debug_assert!(eps.re() >= 0.0 && eps.re() < 1.0);
         let k = self.force_scale();
-        let s = if omega_star.re() >= 0.0 { 1.0 } else { -1.0 };
+        let s = if omega_rel.re() >= 0.0 { 1.0 } else { -1.0 };
         let sh = self.shape(eps);
         FilmLoad {
             f_r: -(sh.rr * omega_star * s * eps * eps + sh.rs * eps_dot) * k,
@@ -154,8 +158,8 @@ impl BearingLaw {
     /// The film's load on the journal from the offset `e` and its rate `e_dot` (shell x, y) and
     /// the relative spin; `Err(ε)` once the journal touches the shell (ε ≥ 1).
     ///
-    /// Assembled in Cartesian form, `F = −k [rr |ω* ε| e/c + rs ε̇ e_r] + k [tt (ω_rel ẑ × e/c −
-    /// 2 (e_t·ė/c) e_t) + ts sgn(ω*) ε ε̇ e_t]`, which is [`BearingLaw::film`]'s `F_r e_r + F_t e_t`
+    /// Assembled in Cartesian form, `F = −k [rr s ω* ε e/c + rs ε̇ e_r] + k [tt (ω_rel ẑ × e/c −
+    /// 2 (e_t·ė/c) e_t) + ts s ε ε̇ e_t]` (s = sgn ω_rel), which is [`BearingLaw::film`]'s `F_r e_r + F_t e_t`
     /// for ε > 0 and stays differentiable in `e` at the centre (where e_r is taken along x).
     pub fn shell_load<T: DualNum<f64> + Copy>(
         &self,
@@ -182,9 +186,8 @@ impl BearingLaw {
         // ε φ̇ and ω* ε: finite at the centre, unlike φ̇
         let eps_phidot = et[0] * v[0] + et[1] * v[1];
         let w_eps = omega_rel * eps - eps_phidot * 2.0;
-        // the converging half of the gap follows the sign of ω* (of ω_rel at the centre)
-        let forward = if eps.re() > 0.0 { w_eps.re() >= 0.0 } else { omega_rel.re() >= 0.0 };
-        let s = if forward { 1.0 } else { -1.0 };
+        // the converging half of the gap follows the spin
+        let s = if omega_rel.re() >= 0.0 { 1.0 } else { -1.0 };
         let k = self.force_scale();
         let sh = self.shape(eps);
         let zu = [-u[1], u[0]];

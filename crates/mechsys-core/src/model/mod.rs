@@ -6,8 +6,8 @@
 //! by joint `i - 1`, so the recursive algorithms are plain loops.
 //!
 //! Every model element is defined here (joints, bilateral constraints in [`constraint`], Jenkins
-//! elements in [`jenkins`], contacts in [`contact`]); the stages that evaluate them import the
-//! model, never the other way round.
+//! elements in [`jenkins`], hydrodynamic bearings in [`bearing`], contacts in [`contact`]); the
+//! stages that evaluate them import the model, never the other way round.
 
 pub mod bearing;
 pub mod constraint;
