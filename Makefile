@@ -43,6 +43,7 @@ bench: $(BUILD)
 	$(PY) benches/linear.py --out docs/benchmarks.md
 	$(PY) benches/linear_motion.py --out docs/benchmarks.md
 	$(PY) benches/sensors.py --out docs/benchmarks.md
+	$(PY) benches/bearing.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results

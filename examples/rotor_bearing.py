@@ -10,7 +10,8 @@ Below the threshold the journal follows the static operating point (eccentricity
 speed, `ms.bearings.static`); above it the orbit around that point grows at the rate the
 linearization predicts (half-frequency whirl) into oil whip: a limit cycle at half the spin speed
 with the journal at eps ~ 0.98-0.99, where the squeeze film is so stiff that the explicit
-integrator takes steps of about a microsecond (a million steps per simulated second).
+integrator's steps shrink to a fraction of a microsecond (millions of steps per simulated second on
+the limit cycle; docs/benchmarks.md).
 The threshold from the bearing's eight coefficients by Lund's formula (`ms.bearings.threshold`)
 is checked against the eigenvalues of the linearized multibody model.
 

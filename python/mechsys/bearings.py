@@ -226,5 +226,5 @@ def threshold(theory, radius, length, clearance, viscosity, mass, load=None, gra
             eps = 0.5 * (lo + hi)
             op = static(*g, speed_at(eps), W)
             k_eq, nu2 = _lund(op)
-            return Threshold(speed=op.speed, whirl_ratio=math.sqrt(nu2) / op.speed, k_eq=k_eq, point=op)
+            return Threshold(speed=op.speed, whirl_ratio=math.sqrt(nu2) / op.speed, k_eq=float(k_eq), point=op)
     return Threshold(speed=math.inf, whirl_ratio=None, k_eq=None, point=None)

@@ -236,7 +236,9 @@ impl BearingLaw {
         let phi = std::f64::consts::FRAC_PI_2 - f.f_t.atan2(f.f_r);
         let c = self.clearance;
         let e = [c * eps * phi.cos(), c * eps * phi.sin()];
-        let (stiffness, damping) = self.coefficients(e, speed);
+        let (stiffness, damping) = self.coefficients(e, speed).ok_or_else(|| {
+            Error::Solver(format!("bearing operating point: the journal touches the shell at ε = {eps}"))
+        })?;
         let n = speed.abs() / (2.0 * std::f64::consts::PI);
         let d = 2.0 * self.radius;
         Ok(OperatingPoint {
@@ -276,15 +278,15 @@ impl BearingLaw {
     }
 
     /// `K = −∂F/∂e` and `C = −∂F/∂ė` (shell x, y; N/m and N s/m) at the offset `e` of a journal
-    /// at rest in the shell frame spinning at `speed`, exact (dual numbers).
-    pub fn coefficients(&self, e: [f64; 2], speed: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+    /// at rest in the shell frame spinning at `speed`, exact (dual numbers); None if the offset
+    /// is not inside the clearance.
+    pub fn coefficients(&self, e: [f64; 2], speed: f64) -> Option<([[f64; 2]; 2], [[f64; 2]; 2])> {
         let (mut k, mut d) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
         for j in 0..4 {
             let seed = |i: usize, x: f64| if i == j { Dual64::new(x, 1.0) } else { Dual64::from(x) };
             let pos = [seed(0, e[0]), seed(1, e[1])];
             let vel = [seed(2, 0.0), seed(3, 0.0)];
-            // the operating point lies inside the clearance, so the load exists
-            let Ok(l) = self.shell_load(pos, vel, Dual64::from(speed)) else { continue };
+            let l = self.shell_load(pos, vel, Dual64::from(speed)).ok()?;
             for i in 0..2 {
                 let g = -l.force[i].eps;
                 if j < 2 {
@@ -294,7 +296,7 @@ impl BearingLaw {
                 }
             }
         }
-        (k, d)
+        Some((k, d))
     }
 }
 
@@ -321,8 +323,14 @@ pub struct OperatingPoint {
     pub damping: [[f64; 2]; 2],
 }
 
-/// The error of a journal touching its shell, naming the element and the time.
+/// The error of a journal touching its shell (or of an offset that is not finite), naming the
+/// element and the time.
 pub fn touch_error(name: &str, eps: f64, t: f64) -> Error {
+    if !eps.is_finite() {
+        return Error::Solver(format!(
+            "hydrodynamic bearing '{name}': the journal's offset is not finite at t = {t} s"
+        ));
+    }
     Error::Solver(format!(
         "hydrodynamic bearing '{name}': the journal touches the shell at t = {t} s (eccentricity ε = {eps:.6} ≥ 1), \
          where the film theory ends; check the initial offset, the load against the film's capacity at the speed, \
@@ -492,7 +500,7 @@ mod tests {
             let petroff = 2.0 * PI * b.radius.powi(3) * b.length * b.viscosity / c * w;
             assert!((at0.torque + petroff).abs() < 1e-12 * petroff);
             // the stiffness at the centre (exact, through the e-linear terms) is the slope of F_t
-            let (k, _) = b.coefficients([0.0, 0.0], w);
+            let (k, _) = b.coefficients([0.0, 0.0], w).unwrap();
             let d = 1e-9 * c;
             let f = b.shell_load([d, 0.0], [0.0, 0.0], w).unwrap();
             assert!((k[1][0] + f.force[1] / d).abs() < 1e-6 * k[1][0].abs(), "{k:?}");
@@ -526,6 +534,8 @@ mod tests {
         assert!(b.shell_load([0.0, -1.2 * b.clearance], [0.0, 0.0], 10.0).is_err());
         let msg = touch_error("brg", 1.01, 0.25).to_string();
         assert!(msg.contains("'brg'") && msg.contains("t = 0.25") && msg.contains("touches the shell"));
+        assert!(touch_error("brg", f64::NAN, 0.5).to_string().contains("not finite at t = 0.5 s"));
+        assert!(b.coefficients([0.0, 1.5 * b.clearance], 10.0).is_none());
     }
 
     #[test]
