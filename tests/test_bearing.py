@@ -328,7 +328,8 @@ def test_whirl_grows_in_a_simulation_as_the_linearization_says(factor):
     t = res.t
     peaks = [k for k in range(1, len(r) - 1) if r[k - 1] < r[k] >= r[k + 1] and t[k] > 0.25 * t_end]
     rate = np.polyfit(t[peaks], np.log(r[peaks]), 1)[0]
-    assert rate == pytest.approx(sigma, rel=0.03), (rate, sigma)
+    # measured: within 6e-5 (0.9 x) and 2e-4 (1.1 x) of the eigenvalue's real part
+    assert rate == pytest.approx(sigma, rel=2e-3), (rate, sigma)
     assert np.sign(rate) == np.sign(factor - 1)
 
 
