@@ -44,6 +44,8 @@ bench: $(BUILD)
 	$(PY) benches/linear_motion.py --out docs/benchmarks.md
 	$(PY) benches/sensors.py --out docs/benchmarks.md
 	$(PY) benches/stiff.py --out docs/benchmarks.md
+	$(PY) benches/bearing.py --out docs/benchmarks.md
+	$(PY) benches/planar.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results

@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms
+from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -57,6 +57,7 @@ __all__ = [
     "laws",
     "mechanisms",
     "analysis",
+    "bearings",
     "forces",
     "functions",
     "inertia",

@@ -1,7 +1,7 @@
 """Force elements: point-to-point spring-dampers (linear, cubic, tabulated, progressive), forces and
 torques on bodies, generalized forces on joints, Python force laws, and the damping elements of
 section 2.6: six-component bushings, the squeeze-film slide way (eq. 2.211), the journal bearing
-(eq. 2.212) and Jenkins dry-friction elements with press-fit chains (eq. 2.215, Fig. 2.39).
+(eq. 2.212), the hydrodynamic journal bearing (short/long-bearing film forces) and Jenkins dry-friction elements with press-fit chains (eq. 2.215, Fig. 2.39).
 Gravity is a property of the Model; joint springs and dampers are given with the joint
 (``spring=``, ``damper=``).
 
@@ -216,6 +216,67 @@ def squeeze_film_coefficient(eta: float, length: float, area: float, gap: float)
 
 
 @dataclass
+class HydrodynamicBearing:
+    """Hydrodynamic journal bearing: the oil film between a journal and its shell.
+
+    ``journal_frame`` (on ``journal``) has its origin on the journal axis at mid-length;
+    ``shell_frame`` (on ``shell``, which may be the ground) has its origin at the bearing centre and
+    its z axis along the bearing axis (rotate it with a :class:`mechsys.Frame` for another axis).
+    With e the journal centre's offset from the shell centre in the shell x-y plane, eps = |e|/c,
+    its rate seen in the shell and the journal's spin relative to the shell about the shell z axis,
+    the film pushes the journal with the short-bearing (``theory="short"``, Ocvirk, L/D <~ 1/2) or
+    long-bearing (``"long"``, Sommerfeld, L/D >~ 2) force of a pi-film, including the squeeze
+    and whirl terms, and brakes the spin with the friction torque of eq. 2.212. The shell carries
+    the opposite force and torque. See :mod:`mechsys.bearings` for the steady operating point and
+    the stiffness and damping coefficients.
+
+    ``radius`` R, ``length`` L, ``clearance`` c (m; 0 < c < R, thin film: c << R), ``viscosity``
+    eta (Pa s). A journal that reaches the shell (eps >= 1) stops a run with a SolverError naming
+    the element and the time.
+
+    Records ``force/<name>/force`` (film force on the journal, shell-frame x, y; N),
+    ``force/<name>/torque`` (N m, about the shell axis), ``force/<name>/eccentricity`` (eps),
+    ``force/<name>/position_angle`` (angle of e from the shell x axis, rad) and
+    ``force/<name>/attitude_angle`` (from the film force's load line to the line of centres, along
+    the rotation, rad).
+    """
+
+    name: str
+    journal: Any
+    shell: Any
+    radius: float
+    length: float
+    clearance: float
+    viscosity: float
+    theory: str = "short"
+    journal_frame: Any = None
+    shell_frame: Any = None
+
+    def describe(self, callbacks: list) -> dict:
+        w = f"force '{self.name}'"
+        if self.theory not in ("short", "long"):
+            raise ModelError(f"{w}.theory: expected 'short' or 'long', got {self.theory!r}")
+        d = {
+            "type": "hydrodynamic_bearing",
+            "name": self.name,
+            "journal": _name(self.journal),
+            "journal_frame": _frame(self.journal_frame, f"{w}.journal_frame"),
+            "shell": _name(self.shell),
+            "shell_frame": _frame(self.shell_frame, f"{w}.shell_frame"),
+            "theory": self.theory,
+        }
+        for key in ("radius", "length", "clearance", "viscosity"):
+            v = getattr(self, key)
+            try:
+                d[key] = float(v)
+            except (TypeError, ValueError):
+                raise ModelError(f"{w}.{key}: expected a number, got {v!r}") from None
+            if not np.isfinite(d[key]):
+                raise ModelError(f"{w}.{key}: must be a finite number, got {d[key]}")
+        return d
+
+
+@dataclass
 class Jenkins:
     """Jenkins dry-friction elements (a spring ``k`` in series with a Coulomb slider, eq. 2.215) on
     velocity ``index`` of ``joint`` (the relative displacement of shaft and hub).
@@ -370,6 +431,7 @@ __all__ = [
     "Bushing",
     "SqueezeFilm",
     "JournalBearing",
+    "HydrodynamicBearing",
     "Jenkins",
     "journal_bearing_coefficient",
     "squeeze_film_coefficient",

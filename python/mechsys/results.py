@@ -221,6 +221,15 @@ class Results:
                     put(f"force/{name}/torque", raw["force_value"][:, k + 3:k + 6], "N m", xyz)
                 elif kind == "joint_force":
                     put(f"force/{name}/force", raw["force_value"][:, sl], f["force_unit"])
+                elif kind == "hydrodynamic_bearing":
+                    # the film's force on the journal (shell-frame x, y) and its friction torque; the
+                    # eccentricity ratio, where the journal centre sits (position angle of the offset
+                    # from the shell x axis) and the attitude angle of the film force's load line
+                    put(f"force/{name}/force", raw["force_value"][:, k:k + 2], "N", ["x", "y"])
+                    put(f"force/{name}/torque", raw["force_value"][:, k + 2], "N m")
+                    put(f"force/{name}/eccentricity", raw["force_deflection"][:, k], "1")
+                    put(f"force/{name}/position_angle", raw["force_deflection"][:, k + 1], "rad")
+                    put(f"force/{name}/attitude_angle", raw["force_deflection"][:, k + 2], "rad")
                 elif kind == "python_force":
                     labels = [joint_of.get(i, (f"u{i}", ""))[0] for i in range(w)]
                     put(f"force/{name}/force", raw["force_value"][:, sl], "mixed", labels,

@@ -2,6 +2,7 @@
 //! dynamics as a base acceleration; this stage turns every other element into body wrenches
 //! (`Data::f_ext`, world components about the inertial origin) and generalized forces (`Data::tau_applied`).
 
+pub mod bearing;
 pub mod damping;
 pub mod jenkins;
 
@@ -369,6 +370,36 @@ pub fn evaluate(
                 p_diss += c * om * om;
                 data.element_force[o] = c * om;
                 data.element_deflection[o] = q[j.iq];
+            }
+            ForceElement::HydrodynamicBearing(b) => {
+                let (jb, sb) = (b.journal, b.shell);
+                let a_s = data.x_abs[sb].a * b.shell_frame.a;
+                let z_s = a_s.column(2).into_owned();
+                let p_j = point_position(data, jb, &b.journal_frame.r);
+                let p_s = point_position(data, sb, &b.shell_frame.r);
+                // the offset and its rate seen in the shell frame (the shell's material point at p_j)
+                let e = a_s.transpose() * (p_j - p_s);
+                let v_s = data.v[sb].v + data.v[sb].w.cross(&p_j);
+                let e_dot = a_s.transpose() * (point_velocity(data, jb, &b.journal_frame.r) - v_s);
+                let omega_rel = z_s.dot(&(data.v[jb].w - data.v[sb].w));
+                let load = b
+                    .law
+                    .shell_load([e.x, e.y], [e_dot.x, e_dot.y], omega_rel)
+                    .map_err(|eps| bearing::touch_error(&b.name, eps, t))?;
+                let f = a_s * Vec3::new(load.force[0], load.force[1], 0.0);
+                let n = z_s * load.torque;
+                add_wrench_at(data, jb, &p_j, &f, &n);
+                add_wrench_at(data, sb, &p_j, &(-f), &(-n));
+                // what the film takes out (negative while it feeds a whirl)
+                p_diss -= load.force[0] * e_dot.x + load.force[1] * e_dot.y + load.torque * omega_rel;
+                data.element_force[o] = load.force[0];
+                data.element_force[o + 1] = load.force[1];
+                data.element_force[o + 2] = load.torque;
+                // ε, the position angle φ of the offset, the attitude ψ of the film force's load line
+                let spin = if omega_rel >= 0.0 { 1.0 } else { -1.0 };
+                data.element_deflection[o] = load.eps;
+                data.element_deflection[o + 1] = e.y.atan2(e.x);
+                data.element_deflection[o + 2] = (spin * load.f_t).atan2(-load.f_r);
             }
             ForceElement::Jenkins(jk) => {
                 let f = jenkins::evaluate(jk, chain, data, &mut ws.jenkins, q, t)?;

@@ -1,6 +1,7 @@
 //! `mechsys._core`: thin PyO3 bindings of the engine. Type conversion and error mapping only;
 //! the GIL is released while a simulation runs.
 
+mod bearing;
 mod dynamics;
 mod errors;
 mod kinematics;
@@ -15,6 +16,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     model::register(m)?;
     dynamics::register(m)?;
+    bearing::register(m)?;
     kinematics::register(m)?;
     math::register(m)?;
     simulate::register(m)?;

@@ -234,6 +234,7 @@ impl PyModel {
                     F::SqueezeFilm { .. } => "squeeze_film",
                     F::JournalBearing { .. } => "journal_bearing",
                     F::Jenkins(_) => "jenkins",
+                    F::HydrodynamicBearing(_) => "hydrodynamic_bearing",
                 };
                 (f.name().to_string(), t.to_string())
             })
@@ -268,6 +269,8 @@ impl PyModel {
                     ("servo", a, if *position { b } else if b == "rad" { "rad/s" } else { "m/s" })
                 }
                 F::Callback { .. } => ("python_force", "mixed", ""),
+                // force: F_x, F_y (shell frame), torque; deflection: ε, position angle, attitude angle
+                F::HydrodynamicBearing(_) => ("hydrodynamic_bearing", "N, N, N m", "1, rad, rad"),
             };
             if width > 0 {
                 let d = PyDict::new(py);

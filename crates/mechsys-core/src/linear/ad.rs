@@ -322,7 +322,8 @@ fn covered(fe: &ForceElement) -> bool {
         | ForceElement::SqueezeFilm { .. }
         | ForceElement::BodyForce { .. }
         | ForceElement::JointForce { .. }
-        | ForceElement::JournalBearing { .. } => true,
+        | ForceElement::JournalBearing { .. }
+        | ForceElement::HydrodynamicBearing(_) => true,
         _ => false,
     }
 }
@@ -493,6 +494,30 @@ impl<T: Real> Tree<T> {
                     // eq. 2.212: a torque linear in the shaft speed
                     let iu = model.joints[*joint].iu;
                     self.tau[iu] -= u[iu] * *c;
+                }
+                ForceElement::HydrodynamicBearing(b) => {
+                    // forces::bearing, as in forces.rs: the film's wrench at the journal centre
+                    let (jb, sb) = (b.journal, b.shell);
+                    let a_s = self.x_abs[sb].a * lift_m::<T>(&b.shell_frame.a);
+                    let z_s: V3<T> = a_s.column(2).into_owned();
+                    let p_j = self.x_abs[jb].point(&b.journal_frame.r);
+                    let p_s = self.x_abs[sb].point(&b.shell_frame.r);
+                    let e = a_s.transpose() * (p_j - p_s);
+                    let e_dot = a_s.transpose() * (self.point_velocity(jb, &p_j) - self.point_velocity(sb, &p_j));
+                    let omega_rel = z_s.dot(&(self.v[jb].w - self.v[sb].w));
+                    let load = b
+                        .law
+                        .shell_load([e.x, e.y], [e_dot.x, e_dot.y], omega_rel)
+                        .map_err(|eps| crate::forces::bearing::touch_error(&b.name, eps, t))?;
+                    let f = a_s * V3::new(load.force[0], load.force[1], cst(0.0));
+                    let n = z_s * load.torque;
+                    let w = Wrench { n: n + p_j.cross(&f), f };
+                    if jb != 0 {
+                        self.f_ext[jb] = self.f_ext[jb].add(&w);
+                    }
+                    if sb != 0 {
+                        self.f_ext[sb] = self.f_ext[sb].sub(&w);
+                    }
                 }
                 ForceElement::JointForce { joint, value, function, .. } => {
                     let s = function.eval(t, cb)?;

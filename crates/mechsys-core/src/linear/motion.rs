@@ -183,9 +183,18 @@ pub fn state_space(
             let geo = super::geometric::constraint_load_derivative(model, t, q, &lambda, &eye, cb)?;
             let a0v = DVector::from_column_slice(&a0);
             // G u̇* − γ along q (chart) and along u
-            let (mut data2, mut ws2) = (Data::new(model), crate::dynamics::Workspace::new(model));
+            let mut data2 = Data::new(model);
+            // G and γ need only the kinematics and the constraints (as in dynamics::constrained):
+            // no force is evaluated this far (STEP) from the point, where a film or a stop law
+            // may be undefined
             let mut accel_rows = |qp: &[f64], up: &[f64]| -> Result<DVector<f64>> {
-                crate::dynamics::forward_dynamics(model, &mut data2, &mut ws2, t, qp, up, None, cb)?;
+                crate::kinematics::forward_pass(model, &mut data2, t, qp, up);
+                crate::constraints::positions(model, &mut data2, t, qp, cb)?;
+                data2.a[0] = crate::spatial::Motion::ZERO;
+                let zero = std::mem::take(&mut data2.zero_u);
+                crate::kinematics::accelerations(model, &mut data2, &zero);
+                data2.zero_u = zero;
+                crate::constraints::accelerations(model, &mut data2, t, qp, up, cb)?;
                 let mut r = &data2.g * &a0v;
                 for k in 0..nc {
                     r[k] -= data2.gamma[k];

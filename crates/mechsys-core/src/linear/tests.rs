@@ -655,3 +655,66 @@ fn constrained_free_joint_matches_the_spherical_joint() {
     let big = ex.a.iter().map(|a| a.abs()).fold(0.0, f64::max);
     assert!(diff < 1e-7 * big, "exact vs fd state matrices: {diff:e} of {big:e}");
 }
+
+// ---- hydrodynamic bearings through the exact path ----------------------------------------------
+
+/// A journal on a free joint in a shell on a turning housing, both frames tilted: the bearing's
+/// offset, its rate seen in the moving shell and the relative spin all take part. The clearance is
+/// large (4 cm) so that the differences' step (1e-5) stays small against it, the oil thick so that
+/// the film forces dominate the linearization.
+fn bearing_in_a_turning_housing(theory: &str) -> (Model, Vec<f64>, Vec<f64>) {
+    let m = model(&format!(
+        r#"{{"name": "brg", "gravity": [0, -9.81, 0],
+        "bodies": [
+            {{"name": "housing", "mass": 3.0, "com": [0.05, 0, 0], "inertia": [0.02, 0.03, 0.03]}},
+            {{"name": "rotor", "mass": 2.0, "com": [0, 0.02, 0.01], "inertia": [0.01, 0.012, 0.02]}}],
+        "joints": [
+            {{"name": "tilt", "type": "revolute", "parent": "ground", "child": "housing", "axis": [1, 0, 0], "q0": 0.3}},
+            {{"name": "float", "type": "free", "parent": "ground", "child": "rotor"}}],
+        "forces": [
+            {{"type": "hydrodynamic_bearing", "name": "brg", "journal": "rotor", "journal_frame": {{"position": [0, 0, 0.05]}},
+              "shell": "housing", "shell_frame": {{"position": [0.1, 0, 0], "rotation": {{"cardan": [0, 0, 0.2]}}}},
+              "radius": 0.05, "length": 0.1, "clearance": 0.04, "viscosity": 50.0, "theory": "{theory}"}}]}}"#
+    ));
+    // the rotor turned as the housing, its journal centre 3 and -4 mm off the shell centre (shell x, y)
+    let a = crate::model::joint::axis_rotation(&crate::math::Vec3::x(), 0.3);
+    let a_s = a * crate::model::joint::axis_rotation(&crate::math::Vec3::z(), 0.2);
+    let p_j = crate::math::Vec3::new(0.1, 0.0, 0.0) + a_s * crate::math::Vec3::new(12e-3, -16e-3, 0.0);
+    let r = p_j - a * crate::math::Vec3::new(0.0, 0.0, 0.05);
+    let mut q = m.q0();
+    q[1..4].copy_from_slice(&[r.x, r.y, r.z]);
+    q[4..8].copy_from_slice(&[0.15f64.cos(), 0.15f64.sin(), 0.0, 0.0]);
+    // housing turning, the rotor spinning about its axis and drifting in the gap
+    let u = vec![2.0, 0.01, -0.02, 0.005, 2.1, 0.3, 120.0];
+    (m, q, u)
+}
+
+#[test]
+fn hydrodynamic_bearing_generic_law_equals_the_engine_and_its_exact_derivatives_the_differences() {
+    for theory in ["short", "long"] {
+        let (model, q, u) = bearing_in_a_turning_housing(theory);
+        let udot: Vec<f64> = (0..model.nu).map(|i| 0.5 * ((i as f64) * 0.9 + 0.1).sin()).collect();
+        let mut data = crate::data::Data::new(&model);
+        let mut ws = crate::dynamics::Workspace::new(&model);
+        let mut want = vec![0.0; model.nu];
+        crate::dynamics::inverse_dynamics(&model, &mut data, &mut ws, 0.0, &q, &u, &udot, &NoCallbacks, &mut want)
+            .unwrap();
+        // the bearing is loaded: its film force is well above the dynamics' rounding
+        assert!(data.element_deflection[0] > 0.4 && data.element_force[0].hypot(data.element_force[1]) > 50.0);
+        let mut tree = super::ad::Tree::<f64>::new(&model);
+        let mut got = vec![0.0; model.nu];
+        tree.inverse_dynamics(&model, 0.0, &q, &u, &udot, &NoCallbacks, &mut got).unwrap();
+        let err = max_diff(&got, &want) / max_abs(&want);
+        assert!(err < 1e-13, "{theory}: {err:.3e}: {got:?} vs {want:?}");
+        exact_vs_fd(&format!("{theory} bearing in a turning housing"), &model, 0.0, &q, &u, &NoCallbacks, 1e-6);
+    }
+}
+
+#[test]
+fn hydrodynamic_bearing_touching_its_shell_is_a_named_solver_error() {
+    let (model, mut q, u) = bearing_in_a_turning_housing("short");
+    q[2] -= 0.06;
+    let e = linearize(&model, 0.5, &q, &u, &NoCallbacks).unwrap_err();
+    assert!(matches!(e, crate::error::Error::Solver(_)), "{e:?}");
+    assert!(e.to_string().contains("'brg'") && e.to_string().contains("touches the shell"), "{e}");
+}

@@ -604,6 +604,36 @@ pub enum ForceDescription {
         #[serde(default)]
         eccentricity: f64,
     },
+    /// Hydrodynamic journal bearing (short- or long-bearing theory over a π-film, see
+    /// `forces::bearing`): the oil film between a journal (the origin of `journal_frame` on its
+    /// axis) and a shell (the origin of `shell_frame` at the bearing centre, its z along the
+    /// bearing axis) pushes the journal with the film force of its offset, offset rate and relative
+    /// spin, and brakes the spin with the friction torque of eq. 2.212; the shell gets the opposite.
+    HydrodynamicBearing {
+        /// Element name.
+        name: String,
+        /// Body carrying the journal.
+        journal: String,
+        /// Journal frame on that body (its origin on the journal axis, mid-length).
+        #[serde(default)]
+        journal_frame: FrameDescription,
+        /// Body carrying the shell (`ground` allowed).
+        shell: String,
+        /// Shell frame on that body (origin at the bearing centre, z along the bearing axis).
+        #[serde(default)]
+        shell_frame: FrameDescription,
+        /// Journal radius R (m).
+        radius: f64,
+        /// Bearing length L (m).
+        length: f64,
+        /// Radial clearance c (m), 0 < c < R.
+        clearance: f64,
+        /// Dynamic viscosity η (Pa s).
+        viscosity: f64,
+        /// "short" (Ocvirk) or "long" (Sommerfeld).
+        #[serde(default = "default_bearing_theory")]
+        theory: String,
+    },
     /// Jenkins elements (a spring in series with a Coulomb slider, eq. 2.215) on one velocity of a
     /// joint: one element, several in parallel, or a press fit (Fig. 2.39): a chain of massless
     /// shaft segments of stiffness `shaft_stiffness`, each held to the hub by a Jenkins element.
@@ -726,6 +756,10 @@ fn one_or_many_value<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Res
 
 fn one_or_many_opt<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<f64>>, D::Error> {
     one_or_many(d).map(Some)
+}
+
+fn default_bearing_theory() -> String {
+    "short".to_string()
 }
 
 fn default_servo_mode() -> String {

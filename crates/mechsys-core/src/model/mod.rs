@@ -6,9 +6,10 @@
 //! by joint `i - 1`, so the recursive algorithms are plain loops.
 //!
 //! Every model element is defined here (joints, bilateral constraints in [`constraint`], Jenkins
-//! elements in [`jenkins`], contacts in [`contact`]); the stages that evaluate them import the
-//! model, never the other way round.
+//! elements in [`jenkins`], hydrodynamic bearings in [`bearing`], contacts in [`contact`]); the
+//! stages that evaluate them import the model, never the other way round.
 
+pub mod bearing;
 pub mod constraint;
 pub mod contact;
 pub mod contact_description;
@@ -21,6 +22,7 @@ mod validate;
 
 use std::collections::HashMap;
 
+pub use bearing::{BearingLaw, BearingTheory, HydrodynamicBearing};
 pub use constraint::{Constraint, ConstraintKind, LoopJoint, Reach};
 pub use description::ModelDescription;
 pub use jenkins::Jenkins;
@@ -272,6 +274,9 @@ pub enum ForceElement {
     },
     /// Jenkins elements on one joint velocity (evaluated by [`crate::forces::jenkins`]).
     Jenkins(Jenkins),
+    /// Hydrodynamic journal bearing between a journal and a shell (evaluated by
+    /// [`crate::forces::bearing`]).
+    HydrodynamicBearing(HydrodynamicBearing),
     /// Force and torque on a body.
     BodyForce {
         /// Name.
@@ -343,15 +348,19 @@ impl ForceElement {
             | ForceElement::JournalBearing { name, .. }
             | ForceElement::Callback { name, .. } => name,
             ForceElement::Jenkins(j) => &j.name,
+            ForceElement::HydrodynamicBearing(b) => &b.name,
         }
     }
 
     /// How many values the element records as its force (and as its deflection): 6 for a
     /// bushing, 1 for the elements acting along one coordinate; the loads record what they apply
     /// (a body force its force and torque, 6; a joint force one value per joint velocity; a Python
-    /// force its generalized forces, `nu` of a model of `nu` velocities) and no deflection.
+    /// force its generalized forces, `nu` of a model of `nu` velocities) and no deflection. A
+    /// hydrodynamic bearing records 3: as force its film force (shell x, y) and friction torque,
+    /// as deflection its eccentricity ε, the position angle φ and the attitude angle ψ.
     pub fn outputs(&self, nu: usize) -> usize {
         match self {
+            ForceElement::HydrodynamicBearing(_) => 3,
             ForceElement::Bushing { .. } | ForceElement::BodyForce { .. } => 6,
             ForceElement::SpringDamper { .. }
             | ForceElement::SqueezeFilm { .. }

@@ -504,6 +504,7 @@ impl Model {
                 | ForceDescription::SqueezeFilm { name, .. }
                 | ForceDescription::JournalBearing { name, .. }
                 | ForceDescription::Jenkins { name, .. }
+                | ForceDescription::HydrodynamicBearing { name, .. }
                 | ForceDescription::Callback { name, .. } => name.clone(),
             };
             let what = format!("forces[{i}] '{name}'");
@@ -646,6 +647,52 @@ impl Model {
                         joint: ji,
                         c: crate::forces::damping::journal_bearing_coefficient(*radius, *length, *clearance, *eta, *eccentricity),
                     }
+                }
+                ForceDescription::HydrodynamicBearing {
+                    journal,
+                    journal_frame,
+                    shell,
+                    shell_frame,
+                    radius,
+                    length,
+                    clearance,
+                    viscosity,
+                    theory,
+                    ..
+                } => {
+                    let jb = body(journal, &format!("{what}.journal"))?;
+                    let sb = body(shell, &format!("{what}.shell"))?;
+                    crate::ensure!(jb != sb, Model, "{what}: journal and shell are the same body '{journal}'");
+                    for (x, key, unit) in [
+                        (radius, "radius", "m"),
+                        (length, "length", "m"),
+                        (clearance, "clearance", "m"),
+                        (viscosity, "viscosity", "Pa s"),
+                    ] {
+                        crate::ensure!(x.is_finite() && *x > 0.0, Model, "{what}.{key}: must be > 0 ({unit}), got {x}");
+                    }
+                    crate::ensure!(
+                        clearance < radius,
+                        Model,
+                        "{what}.clearance: must be smaller than the radius {radius} m, got {clearance} m"
+                    );
+                    let theory = BearingTheory::from_name(theory).ok_or_else(|| {
+                        err(format!("{what}.theory: expected one of {:?}, got '{theory}'", BearingTheory::NAMES))
+                    })?;
+                    ForceElement::HydrodynamicBearing(HydrodynamicBearing {
+                        name,
+                        journal: jb,
+                        journal_frame: frame(journal_frame, &format!("{what}.journal_frame"))?,
+                        shell: sb,
+                        shell_frame: frame(shell_frame, &format!("{what}.shell_frame"))?,
+                        law: BearingLaw {
+                            theory,
+                            radius: *radius,
+                            length: *length,
+                            clearance: *clearance,
+                            viscosity: *viscosity,
+                        },
+                    })
                 }
                 ForceDescription::Jenkins { joint, index, k, slip, shaft_stiffness, offset, .. } => {
                     let ji =
