@@ -192,7 +192,10 @@ def test_a_model_too_big_for_memory_is_refused_with_the_estimate():
 
 
 SAVER = r"""
+import signal
 import sys
+# a shell that starts jobs in the background leaves SIGINT ignored in them: Python's own handler
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import mechsys as ms
 m = ms.Model("chain", gravity=(0, -9.81, 0))
 parent = m.ground
