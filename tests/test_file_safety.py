@@ -248,3 +248,20 @@ def test_two_runs_writing_one_output_at_once_leave_one_complete_file(model, tmp_
     res = ms.Results.load(out)
     assert res.t[-1] in (2.0, 3.0) and len(res.t) in (201, 301)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pendulum.toml", "r.h5"]
+
+
+def test_default_results_names_of_different_models_do_not_collide():
+    from mechsys.cli import _safe_name
+
+    names = ["a\\b", "a\nb", "a b", " a ", "a", ".", "..", "/", "x" * 300]
+    stems = [_safe_name(n) for n in names]
+    assert len(set(stems)) == len(stems), stems
+    assert _safe_name("pendulum") == "pendulum" and all(len(s) <= 110 for s in stems)
+
+
+def test_an_output_below_a_file_names_that_file(model, tmp_path):
+    blocker = tmp_path / "victim.txt"
+    blocker.write_text("data")
+    p = mechsys("run", model, "--out", blocker / "x.h5", "--t-end", "0.1")
+    assert p.returncode != 0 and f"{blocker} is not a directory" in p.stderr
+    assert blocker.read_text() == "data"

@@ -95,8 +95,15 @@ def _fmt_vec(v: Sequence[float]) -> str:
 
 
 def _safe_name(name: str) -> str:
-    # a file-name stem: portable characters, at most 100 of them (file systems stop at 255 bytes)
-    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:100] or "model"
+    # a file-name stem: portable characters, at most 100 of them (file systems stop at 255 bytes);
+    # a name that had to be changed gets a short hash of itself, so that two models whose names
+    # differ only in what was replaced ("a\\b", "a\nb") do not share a results file
+    stem = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:100] or "model"
+    if stem != name:
+        import hashlib
+
+        stem += "-" + hashlib.sha1(name.encode("utf-8", "surrogatepass")).hexdigest()[:8]
+    return stem
 
 
 def _split_signals(values: Sequence[str]) -> list[str]:
