@@ -271,3 +271,20 @@ def test_an_output_below_a_file_names_that_file(model, tmp_path):
     p = mechsys("run", model, "--out", blocker / "x.h5", "--t-end", "0.1")
     assert p.returncode != 0 and f"{blocker} is not a directory" in p.stderr
     assert blocker.read_text() == "data"
+
+
+@pytest.mark.skipif(not Path("/proc/self/limits").exists(), reason="Linux resource limits")
+def test_a_run_over_an_address_space_limit_is_refused_not_aborted(model, tmp_path):
+    """Review F12: under `ulimit -v 4000000` a 2.5e7-sample run (6.6 GB estimated) aborted with
+    SIGABRT; the memory budget now includes the process's address-space limit."""
+    script = (
+        "import resource, sys\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (4_000_000_000, 4_000_000_000))\n"
+        "from mechsys.cli import main\n"
+        "sys.argv = ['mechsys', 'run', sys.argv[1], '--dt', '2e-7', '--output-dt', '2e-7', '--t-end', '5', '--out', sys.argv[2], '-q']\n"
+        "sys.exit(main())\n"
+    )
+    p = subprocess.run([sys.executable, "-c", script, str(model), str(tmp_path / "r.h5")], capture_output=True, text=True,
+                       cwd=ROOT, timeout=120)
+    assert p.returncode == 2, (p.returncode, p.stderr[-500:])
+    assert "bytes of results, more than the" in p.stderr and "Traceback" not in p.stderr

@@ -5,6 +5,7 @@ one `error:` line from the command line, never a traceback."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -141,3 +142,24 @@ def test_a_format_1_file_still_loads_with_a_warning(saved, tmp_path):
     with pytest.warns(UserWarning, match="format 1"):
         res = ms.Results.load(p)
     assert np.allclose(res["joint/hinge/q"][0], 0.5)
+
+
+@pytest.mark.parametrize("change, fragment", [
+    (lambda f: f.__delitem__("t"), "no sample times"),
+    (lambda f: (f.__delitem__("t"), f.create_dataset("t", data=np.zeros(()))), "signal 't' must be 1-D"),
+    (lambda f: (f.__delitem__("t"), f.create_dataset("t", data=np.full(21, np.nan))), "signal 't' must be 1-D, finite"),
+    (lambda f: (f.__delitem__("t"), f.create_dataset("t", data=np.arange(21.0)[::-1])), "non-decreasing"),
+    (lambda f: f.create_dataset("energy/odd", data=np.zeros(5)), "signal 'energy/odd' has shape (5,)"),
+])
+def test_results_without_the_schema_of_samples_are_refused(saved, tmp_path, change, fragment):
+    """Review F11: each of these gave a Python traceback (or a plot of garbage) from plot/signals."""
+    p = copy(saved, tmp_path, "schema.h5")
+    with h5py.File(p, "a") as f:
+        del f.attrs["complete"]  # edited by hand: claim format 1 so that checksums do not catch it first
+        f.attrs["format_version"] = 1
+        change(f)
+    with pytest.raises(ResultsError, match=re.escape(fragment)):
+        ms.Results.load(p)
+    proc = subprocess.run([sys.executable, "-m", "mechsys", "plot", str(p), "joint/hinge/q", "-o", str(tmp_path / "o.png")],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode != 0 and "Traceback" not in proc.stderr and proc.stderr.count("error:") == 1, proc.stderr

@@ -525,6 +525,7 @@ class Results:
                     raise ResultsError(f"'{path}': incomplete results file (no completeness marker: its writing stopped "
                                        "part-way); run the simulation again")
                 signals, units, columns = _read_signals(f, path, size, checksums=version >= 2)
+                _check_schema(signals, path)
                 if version >= 2 and int(f.attrs.get("signal_count", -1)) != len(signals):
                     raise ResultsError(f"'{path}': {len(signals)} signals, the file says {int(f.attrs.get('signal_count', -1))}")
                 attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
@@ -855,3 +856,16 @@ def _json_attr(attrs: dict, key: str, default: str):
         return json.loads(attrs.get(key, default))
     except (ValueError, TypeError):
         raise ResultsError(f"results attribute '{key}' is not readable JSON (the file is damaged)") from None
+
+
+def _check_schema(signals: dict, path: Path) -> None:
+    """The shape every results file has: a 1-D, finite, non-decreasing float time ``t`` and every
+    other signal one row per sample."""
+    t = signals.get("t")
+    if t is None:
+        raise ResultsError(f"'{path}': no sample times (signal 't' missing)")
+    if t.ndim != 1 or t.dtype.kind != "f" or not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0):
+        raise ResultsError(f"'{path}': signal 't' must be 1-D, finite, non-decreasing sample times (s)")
+    for name, a in signals.items():
+        if a.ndim == 0 or a.shape[0] != len(t):
+            raise ResultsError(f"'{path}': signal '{name}' has shape {a.shape}, not one row per sample ({len(t)})")

@@ -3,7 +3,7 @@
 //! process, past any error handling).
 
 /// The bytes a model or a run may use: half the memory available now (Linux: `MemAvailable` of
-/// /proc/meminfo), else 8 GB.
+/// /proc/meminfo, or the address-space limit if lower), else 8 GB.
 pub fn memory_budget() -> f64 {
     let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
         text.lines()
@@ -12,7 +12,14 @@ pub fn memory_budget() -> f64 {
             .and_then(|kb| kb.parse::<f64>().ok())
             .map(|kb| kb * 1024.0)
     });
-    0.5 * available.unwrap_or(16e9)
+    // a process address-space limit (ulimit -v) caps it too: past it an allocation aborts
+    let limit = std::fs::read_to_string("/proc/self/limits").ok().and_then(|text| {
+        text.lines()
+            .find(|l| l.starts_with("Max address space"))
+            .and_then(|l| l.split_whitespace().nth(3))
+            .and_then(|v| v.parse::<f64>().ok())
+    });
+    0.5 * available.unwrap_or(16e9).min(limit.unwrap_or(f64::INFINITY))
 }
 
 /// Bytes of the dense matrices of a model's workspace ([`crate::data::Data`]): the mass matrix
