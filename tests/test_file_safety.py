@@ -288,3 +288,61 @@ def test_a_run_over_an_address_space_limit_is_refused_not_aborted(model, tmp_pat
                        cwd=ROOT, timeout=120)
     assert p.returncode == 2, (p.returncode, p.stderr[-500:])
     assert "bytes of results, more than the" in p.stderr and "Traceback" not in p.stderr
+
+
+COLL_TOML = """
+name = "coll"
+[[bodies]]
+name = "a"
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+[[bodies]]
+name = "a/position"
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+[[joints]]
+type = "revolute"
+name = "j1"
+parent = "ground"
+child = "a"
+[[joints]]
+type = "revolute"
+name = "j2"
+parent = "a"
+child = "a/position"
+[simulation]
+t_end = 0.1
+integrator = { type = "rk4", dt = 1e-3 }
+"""
+
+
+def test_review_f3_colliding_names_leave_the_previous_results_intact(model, tmp_path):
+    prev = tmp_path / "prev.h5"
+    assert mechsys("run", model, "--out", prev, "--t-end", "0.1", "-q").returncode == 0
+    before = prev.read_bytes()
+    coll = tmp_path / "coll.toml"
+    coll.write_text(COLL_TOML)
+    p = mechsys("run", coll, "--out", prev, "-q")
+    assert p.returncode == 2 and "must not contain '/'" in p.stderr and "Traceback" not in p.stderr
+    assert prev.read_bytes() == before
+    assert mechsys("signals", prev).returncode == 0
+
+
+def test_review_f14_a_huge_model_file_is_an_error_line_not_an_abort(tmp_path):
+    n = 40_000
+    lines = []
+    for i in range(n):
+        lines.append(f'[[bodies]]\nname = "b{i}"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n')
+        parent = "ground" if i == 0 else f"b{i - 1}"
+        lines.append(f'[[joints]]\ntype = "free"\nname = "j{i}"\nparent = "{parent}"\nchild = "b{i}"\n')
+    big = tmp_path / "big.toml"
+    big.write_text('name = "big"\n' + "".join(lines))
+    p = mechsys("info", big)
+    assert p.returncode == 2, (p.returncode, p.stderr[-300:])
+    assert "need about" in p.stderr and "bytes of workspace" in p.stderr and "Traceback" not in p.stderr
+
+
+@pytest.mark.parametrize("command", ["run", "info", "linear"])
+def test_review_f15_the_help_of_every_command_loading_a_model_says_py_files_run(command):
+    p = mechsys(command, "--help")
+    assert p.returncode == 0 and "executed as Python code" in " ".join(p.stdout.split())

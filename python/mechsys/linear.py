@@ -1694,9 +1694,10 @@ def _figure(out, size):
 
 def _save(fig, out):
     if out is not None:
+        from .files import write_atomically
+
         path = Path(out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=150, format=path.suffix.lower()[1:])
+        write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=150, format=path.suffix.lower()[1:]))
     return fig
 
 
