@@ -386,7 +386,7 @@ pub struct MultibodySystem<'a> {
     passage_tau: f64,
     passage_k: [i32; 2],
     /// Workspace of the neighbouring states in [`Self::passage`] (made at the first passage).
-    neighbour: Option<Data>,
+    neighbour: Option<Neighbours>,
     /// Each constraint row's squared Jacobian norm at the last evaluation relative to the start.
     ratio: Vec<f64>,
     /// Squared norms of the constraint Jacobian's rows at the first evaluation.
@@ -567,14 +567,16 @@ impl MultibodySystem<'_> {
     /// well conditioned on one side (the motion stops at the singular point: a dead point).
     fn passage(&mut self, t: f64, q: &[f64], u: &[f64]) -> Result<crate::forces::Powers> {
         let model = self.model;
-        let nu = model.nu;
-        let rows: Vec<usize> = (0..model.nc).filter(|&r| self.data.skip_rows[r]).collect();
+        let (nu, nc) = (model.nu, model.nc);
         let speed = u.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let p = dynamics::forward_dynamics(model, &mut self.data, &mut self.ws, t, q, u, None, self.cb)?;
         if speed == 0.0 {
             return Ok(p);
         }
-        let mut data = self.neighbour.take().unwrap_or_else(|| Data::new(model));
+        // the workspace, made at the first passage and reused (nothing allocated per evaluation)
+        let mut w = self.neighbour.take().unwrap_or_else(|| Neighbours::new(model));
+        w.rows.clear();
+        w.rows.extend((0..nc).filter(|&r| self.data.skip_rows[r]));
         // the nearest shift on each side whose state lies outside the window, on the grid
         // σ_k = σ₀ 2^k fixed at the first passage (the smallest such k, searched from the last
         // one found: the result depends on the state only)
@@ -583,70 +585,70 @@ impl MultibodySystem<'_> {
         }
         let base = self.passage_tau;
         let mut edge = [0.0f64; 2];
-        let mut nodes: Vec<(f64, Vec<f64>, Vec<f64>)> = Vec::with_capacity(2 * PASSAGE_NODES);
+        let mut n = 0; // nodes filled
         for (side, sign) in [(0, 1.0), (1, -1.0)] {
             let mut k = self.passage_k[side];
-            let mut best: Option<(i32, (Vec<f64>, Vec<f64>))> = None;
+            let mut best = None;
             let mut rising = false;
             for _ in 0..64 {
                 let sigma = base * 2f64.powi(k);
                 if sigma * speed > 1.0 {
                     break;
                 }
-                match self.neighbour_state(&mut data, t, q, u, sign * sigma, &rows)? {
-                    Some(v) => {
-                        best = Some((k, v));
-                        if rising || k == 0 {
-                            break; // the one below was inside
-                        }
-                        k -= 1; // a smaller one may do as well
+                // node slot n holds the trial: kept when it is the last one outside
+                if self.neighbour_state(&mut w, n, t, q, u, sign * sigma)? {
+                    best = Some(k);
+                    if rising || k == 0 {
+                        break; // the one below was inside
                     }
-                    None if best.is_some() => break,
-                    None => {
-                        rising = true;
-                        k += 1;
-                    }
+                    w.save(n); // a smaller one may do as well
+                    k -= 1;
+                } else if best.is_some() {
+                    w.restore(n);
+                    break;
+                } else {
+                    rising = true;
+                    k += 1;
                 }
             }
-            let Some((k, (ud, lam))) = best else {
-                self.neighbour = Some(data);
+            let Some(k) = best else {
+                self.neighbour = Some(w);
                 return Ok(p);
             };
             self.passage_k[side] = k;
             edge[side] = base * 2f64.powi(k);
-            nodes.push((sign * edge[side], ud, lam));
+            w.sigma[n] = sign * edge[side];
+            n += 1;
         }
-        // two more on each side, spaced by a quarter of the gap across the window
+        // more on each side, spaced by a quarter of the gap across the window
         let d = 0.25 * (edge[0] + edge[1]);
         for (side, sign) in [(0, 1.0), (1, -1.0)] {
             for k in 1..PASSAGE_NODES {
                 let sigma = sign * (edge[side] + k as f64 * d);
-                match self.neighbour_state(&mut data, t, q, u, sigma, &rows)? {
-                    Some((ud, lam)) => nodes.push((sigma, ud, lam)),
-                    None => {
-                        self.neighbour = Some(data);
-                        return Ok(p);
-                    }
+                if !self.neighbour_state(&mut w, n, t, q, u, sigma)? {
+                    self.neighbour = Some(w);
+                    return Ok(p);
                 }
+                w.sigma[n] = sigma;
+                n += 1;
             }
         }
-        self.neighbour = Some(data);
-        // Lagrange weights of the nodes at σ = 0
-        let (mut udot, mut lam) = (vec![0.0; nu], vec![0.0; rows.len()]);
-        for (k, (sk, uk, lk)) in nodes.iter().enumerate() {
-            let w: f64 = nodes
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != k)
-                .map(|(_, (sj, _, _))| (0.0 - sj) / (sk - sj))
-                .product();
-            udot.iter_mut().zip(uk).for_each(|(a, b)| *a += w * b);
-            lam.iter_mut().zip(lk).for_each(|(a, b)| *a += w * b);
+        // the Lagrange polynomial through the nodes at σ = 0
+        self.data.udot.fill(0.0);
+        for &r in &w.rows {
+            self.data.lambda[r] = 0.0;
         }
-        self.data.udot.copy_from_slice(&udot);
-        for (k, &r) in rows.iter().enumerate() {
-            self.data.lambda[r] = lam[k];
+        for k in 0..n {
+            let sk = w.sigma[k];
+            let weight: f64 = (0..n).filter(|&j| j != k).map(|j| (0.0 - w.sigma[j]) / (sk - w.sigma[j])).product();
+            for i in 0..nu {
+                self.data.udot[i] += weight * w.udot[k * nu + i];
+            }
+            for &r in &w.rows {
+                self.data.lambda[r] += weight * w.lambda[k * nc + r];
+            }
         }
+        self.neighbour = Some(w);
         // body accelerations of these accelerations (without gravity), for records and reactions
         self.data.a[0] = crate::spatial::Motion::ZERO;
         let ud = std::mem::take(&mut self.data.udot);
@@ -655,38 +657,88 @@ impl MultibodySystem<'_> {
         Ok(p)
     }
 
-    /// The accelerations and the multipliers of `rows` at the state `q ⊕ σ u` at time `t + σ`
-    /// (along the motion, also for driven constraints) projected onto the constraints, or None
-    /// when it lies inside the window of one of `rows` (or does not project).
+    /// Evaluates the state `q ⊕ σ u` at time `t + σ` (along the motion, also for driven
+    /// constraints) projected onto the constraints into node slot `slot` of `w` (accelerations
+    /// and multipliers); false when it lies inside the window of one of `w.rows` (or does not
+    /// project).
+    #[allow(clippy::too_many_arguments)]
     fn neighbour_state(
         &mut self,
-        data: &mut Data,
+        w: &mut Neighbours,
+        slot: usize,
         t: f64,
         q: &[f64],
         u: &[f64],
         sigma: f64,
-        rows: &[usize],
-    ) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
+    ) -> Result<bool> {
         let model = self.model;
+        let (nu, nc) = (model.nu, model.nc);
         let ts = t + sigma;
-        let (mut qs, mut us) = (vec![0.0; model.nq], u.to_vec());
-        model.integrate(q, u, sigma, &mut qs);
-        model.normalize(&mut qs);
+        model.integrate(q, u, sigma, &mut w.qs);
+        model.normalize(&mut w.qs);
+        w.us.copy_from_slice(u);
+        let data = &mut w.data;
         data.skip_rows.fill(false);
         // twice: the second call finds the positions converged and projects the velocities with
         // G factored at the projected configuration itself (the first may reuse a factor from
         // one Newton step before, whose error near the singular point is not small)
         for _ in 0..2 {
-            if dynamics::constrained::project(model, data, &mut self.ws, ts, &mut qs, &mut us, self.cb).is_err() {
-                return Ok(None);
+            if dynamics::constrained::project(model, data, &mut self.ws, ts, &mut w.qs, &mut w.us, self.cb).is_err() {
+                return Ok(false);
             }
         }
-        dynamics::forward_dynamics(model, data, &mut self.ws, ts, &qs, &us, None, self.cb)?;
+        dynamics::forward_dynamics(model, data, &mut self.ws, ts, &w.qs, &w.us, None, self.cb)?;
         row_norms(data, &mut self.norms);
-        if rows.iter().any(|&r| self.norms[r] < NODE_MARGIN * SINGULAR_WINDOW * self.row0[r]) {
-            return Ok(None);
+        if w.rows.iter().any(|&r| self.norms[r] < NODE_MARGIN * SINGULAR_WINDOW * self.row0[r]) {
+            return Ok(false);
         }
-        Ok(Some((data.udot.clone(), rows.iter().map(|&r| data.lambda[r]).collect())))
+        w.udot[slot * nu..(slot + 1) * nu].copy_from_slice(&data.udot);
+        w.lambda[slot * nc..(slot + 1) * nc].copy_from_slice(&data.lambda);
+        Ok(true)
+    }
+}
+
+/// The workspace of [`MultibodySystem::passage`]: a model workspace for the neighbouring states,
+/// their coordinates, and the accelerations and multipliers of the interpolation nodes.
+struct Neighbours {
+    data: Data,
+    rows: Vec<usize>,
+    qs: Vec<f64>,
+    us: Vec<f64>,
+    sigma: Vec<f64>,
+    /// Per node, nu accelerations (node-major).
+    udot: Vec<f64>,
+    /// Per node, nc multipliers (node-major).
+    lambda: Vec<f64>,
+    /// One node kept aside while the search tries a smaller shift.
+    kept: (Vec<f64>, Vec<f64>),
+}
+
+impl Neighbours {
+    fn new(model: &Model) -> Self {
+        let (nu, nc, nodes) = (model.nu, model.nc, 2 * PASSAGE_NODES);
+        Neighbours {
+            data: Data::new(model),
+            rows: Vec::with_capacity(nc),
+            qs: vec![0.0; model.nq],
+            us: vec![0.0; nu],
+            sigma: vec![0.0; nodes],
+            udot: vec![0.0; nodes * nu],
+            lambda: vec![0.0; nodes * nc],
+            kept: (vec![0.0; nu], vec![0.0; nc]),
+        }
+    }
+    /// Keeps node `slot` aside.
+    fn save(&mut self, slot: usize) {
+        let (nu, nc) = (self.kept.0.len(), self.kept.1.len());
+        self.kept.0.copy_from_slice(&self.udot[slot * nu..(slot + 1) * nu]);
+        self.kept.1.copy_from_slice(&self.lambda[slot * nc..(slot + 1) * nc]);
+    }
+    /// Puts the node kept aside back into `slot`.
+    fn restore(&mut self, slot: usize) {
+        let (nu, nc) = (self.kept.0.len(), self.kept.1.len());
+        self.udot[slot * nu..(slot + 1) * nu].copy_from_slice(&self.kept.0);
+        self.lambda[slot * nc..(slot + 1) * nc].copy_from_slice(&self.kept.1);
     }
 }
 
