@@ -238,6 +238,43 @@ class Spherical(Joint):
 
 
 @dataclass
+class Path(Joint):
+    """Path coordinate (section 2.2.6), 1 DOF: the child frame's origin moves along a helix about
+    the joint frame's z-axis, ``q`` = its arc length s (m), ``u`` = ds/dt (m/s). ``radius`` (m,
+    > 0), ``pitch``: rise per turn (m; 0, the default, is a circle; negative: left-handed).
+    ``oriented``: the child frame turns with the curve's trihedral (x along the tangent t, y the
+    principal normal n towards the axis, z the binormal b), else it keeps the parent's axes (a
+    bead). At s = 0 the point is at (radius, 0, 0). Curvature radius / L^2, torsion c / L^2 with
+    c = pitch / 2 pi, L^2 = radius^2 + c^2."""
+
+    radius: float = 1.0
+    pitch: float = 0.0
+    oriented: bool = True
+
+    def __post_init__(self):
+        self.type = "path"
+
+    def _extra(self):
+        for key in ("radius", "pitch"):
+            v = getattr(self, key)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+                raise ModelError(f"joint '{self.name}'.{key}: expected a number, got {v!r}")
+        if not isinstance(self.oriented, (bool, np.bool_)):
+            raise ModelError(f"joint '{self.name}'.oriented: expected true or false, got {self.oriented!r}")
+        return {"radius": float(self.radius), "pitch": float(self.pitch), "oriented": bool(self.oriented)}
+
+    def curvature(self) -> float:
+        """kappa = R / (R^2 + c^2) (1/m)."""
+        c = self.pitch / (2 * np.pi)
+        return self.radius / (self.radius**2 + c**2)
+
+    def torsion(self) -> float:
+        """tau = c / (R^2 + c^2) (1/m)."""
+        c = self.pitch / (2 * np.pi)
+        return c / (self.radius**2 + c**2)
+
+
+@dataclass
 class Planar(Joint):
     """Planar joint in the joint frame's x-y plane, 3 DOF (q = [x, y, angle])."""
 
@@ -271,6 +308,7 @@ __all__ = [
     "Universal",
     "Spherical",
     "Planar",
+    "Path",
     "Free",
     "RotaryDamper",
     "RotarySpring",

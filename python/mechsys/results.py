@@ -71,6 +71,7 @@ from .errors import ResultsError
 _JOINT_COLUMNS = {
     "revolute": (["angle"], ["rad"], ["rate"], ["rad/s"]),
     "prismatic": (["position"], ["m"], ["rate"], ["m/s"]),
+    "path": (["s"], ["m"], ["s_rate"], ["m/s"]),
     "cylindrical": (["angle", "position"], ["rad", "m"], ["angle rate", "rate"], ["rad/s", "m/s"]),
     "universal": (["angle1", "angle2"], ["rad", "rad"], ["rate1", "rate2"], ["rad/s", "rad/s"]),
     "spherical": (["qw", "qx", "qy", "qz"], ["1"] * 4, ["wx", "wy", "wz"], ["rad/s"] * 3),
@@ -86,6 +87,7 @@ CONTACT_STATES = {"open": 0, "stick": 1, "slip": 2}
 _JOINT_UNITS = {
     "revolute": ("rad", "rad/s", "rad/s^2"),
     "prismatic": ("m", "m/s", "m/s^2"),
+    "path": ("m", "m/s", "m/s^2"),
     "cylindrical": ("rad, m", "rad/s, m/s", "rad/s^2, m/s^2"),
     "universal": ("rad", "rad/s", "rad/s^2"),
     "spherical": ("1 (quaternion)", "rad/s", "rad/s^2"),

@@ -29,6 +29,9 @@ fn mixed_tree() -> Model {
             child: child.into(),
             axis,
             axis2: None,
+            radius: None,
+            pitch: None,
+            oriented: None,
             parent_frame: FrameDescription {
                 position: pos,
                 rotation: Some(RotationDescription::Angles(AnglesDescription {

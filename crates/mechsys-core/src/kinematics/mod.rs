@@ -215,5 +215,7 @@ pub fn point_jacobian(
     }
 }
 
+pub mod path;
+
 #[cfg(test)]
 mod tests;

@@ -410,7 +410,7 @@ pub struct JointDamperDescription {
 pub struct JointDescription {
     /// Unique joint name.
     pub name: String,
-    /// Joint type: fixed, revolute, prismatic, cylindrical, universal, spherical, planar, free.
+    /// Joint type: fixed, revolute, prismatic, cylindrical, universal, spherical, planar, free, path.
     #[serde(rename = "type")]
     pub kind: String,
     /// Parent body name (`ground` for the inertial frame).
@@ -423,6 +423,15 @@ pub struct JointDescription {
     /// Second axis of a universal joint, in the child joint frame (default y; first axis default x).
     #[serde(default)]
     pub axis2: Option<[f64; 3]>,
+    /// Path joint: radius of the helix about the joint frame's z-axis (m), > 0.
+    #[serde(default)]
+    pub radius: Option<f64>,
+    /// Path joint: rise of the helix per turn (m; 0, the default, is a circle).
+    #[serde(default)]
+    pub pitch: Option<f64>,
+    /// Path joint: whether the child frame turns with the curve's trihedral (default true).
+    #[serde(default)]
+    pub oriented: Option<bool>,
     /// Joint frame on the parent body.
     #[serde(default)]
     pub parent_frame: FrameDescription,

@@ -52,6 +52,15 @@ pub enum JointKind {
     Planar,
     /// Six degrees of freedom.
     Free,
+    /// Path coordinate (section 2.2.6): the child frame's origin moves along a helix about the
+    /// parent frame's z-axis (a circle when its lead is zero), q = arc length s; `oriented`: the
+    /// child frame turns with the curve's trihedral [t n b], else it keeps the parent's axes.
+    Path {
+        /// The curve.
+        helix: crate::kinematics::path::Helix,
+        /// Whether the child frame follows the trihedral.
+        oriented: bool,
+    },
 }
 
 impl JointKind {
@@ -59,7 +68,7 @@ impl JointKind {
     pub fn nq(&self) -> usize {
         match self {
             JointKind::Fixed => 0,
-            JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 1,
+            JointKind::Revolute { .. } | JointKind::Prismatic { .. } | JointKind::Path { .. } => 1,
             JointKind::Cylindrical { .. } | JointKind::Universal { .. } => 2,
             JointKind::Spherical => 4,
             JointKind::Planar => 3,
@@ -70,7 +79,7 @@ impl JointKind {
     pub fn nu(&self) -> usize {
         match self {
             JointKind::Fixed => 0,
-            JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 1,
+            JointKind::Revolute { .. } | JointKind::Prismatic { .. } | JointKind::Path { .. } => 1,
             JointKind::Cylindrical { .. } | JointKind::Universal { .. } => 2,
             JointKind::Spherical | JointKind::Planar => 3,
             JointKind::Free => 6,
@@ -86,13 +95,14 @@ impl JointKind {
             JointKind::Universal { .. } => "universal",
             JointKind::Spherical => "spherical",
             JointKind::Planar => "planar",
+            JointKind::Path { .. } => "path",
             JointKind::Free => "free",
         }
     }
     /// Whether the motion subspace depends on q (so `c_J = Ṡ u ≠ 0`).
     #[inline]
     pub fn has_bias(&self) -> bool {
-        matches!(self, JointKind::Universal { .. } | JointKind::Planar)
+        matches!(self, JointKind::Universal { .. } | JointKind::Planar | JointKind::Path { oriented: false, .. })
     }
     /// Whether the coordinates contain a quaternion (and so `q̇ ≠ u`).
     pub fn has_quaternion(&self) -> bool {
@@ -122,6 +132,10 @@ impl JointKind {
             JointKind::Spherical => Pose::new(unit_quat_matrix(&q[0..4]), Vec3::zeros()),
             JointKind::Planar => Pose::new(axis_rotation(&Vec3::z(), q[2]), Vec3::new(q[0], q[1], 0.0)),
             JointKind::Free => Pose::new(unit_quat_matrix(&q[3..7]), Vec3::new(q[0], q[1], q[2])),
+            JointKind::Path { helix, oriented } => {
+                let (r, f) = helix.frame(q[0]);
+                Pose::new(if *oriented { f } else { Mat3::identity() }, r)
+            }
         }
     }
 
@@ -160,6 +174,14 @@ impl JointKind {
                     s[k + 3] = Motion::new(unit(k), z);
                 }
             }
+            JointKind::Path { helix, oriented: true } => {
+                // in the trihedral's own axes: v = t ṡ, ω = (τ t + κ b) ṡ (the Darboux vector)
+                s[0] = Motion::new(Vec3::new(helix.torsion(), 0.0, helix.curvature()), Vec3::x());
+            }
+            JointKind::Path { helix, oriented: false } => {
+                let (_, f) = helix.frame(q[0]);
+                s[0] = Motion::new(z, f.column(0).into_owned());
+            }
         }
     }
 
@@ -175,6 +197,11 @@ impl JointKind {
                 let (sn, c) = q[2].sin_cos();
                 let v = Vec3::new(c * u[0] + sn * u[1], -sn * u[0] + c * u[1], 0.0);
                 Motion::new(Vec3::zeros(), -(Vec3::z() * u[2]).cross(&v))
+            }
+            JointKind::Path { helix, oriented: false } => {
+                // d(t ṡ)/dt at constant ṡ: κ n ṡ²
+                let (_, f) = helix.frame(q[0]);
+                Motion::new(Vec3::zeros(), f.column(1) * (helix.curvature() * u[0] * u[0]))
             }
             _ => Motion::ZERO,
         }

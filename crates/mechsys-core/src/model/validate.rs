@@ -383,12 +383,31 @@ impl Model {
                 "spherical" | "ball" => JointKind::Spherical,
                 "planar" => JointKind::Planar,
                 "free" | "floating" => JointKind::Free,
+                "path" | "helix" => {
+                    let radius = j.radius.ok_or_else(|| err(format!("{what}.radius: a path joint needs the helix radius (m)")))?;
+                    crate::ensure!(
+                        radius.is_finite() && radius > 0.0,
+                        Model,
+                        "{what}.radius: must be > 0, got {radius} (a straight path is a prismatic joint)"
+                    );
+                    let pitch = j.pitch.unwrap_or(0.0);
+                    crate::ensure!(pitch.is_finite(), Model, "{what}.pitch: must be finite, got {pitch}");
+                    JointKind::Path {
+                        helix: crate::kinematics::path::Helix { radius, lead: pitch / std::f64::consts::TAU },
+                        oriented: j.oriented.unwrap_or(true),
+                    }
+                }
                 other => {
                     return Err(err(format!(
-                        "{what}.type: unknown joint type '{other}' (expected fixed, revolute, prismatic, cylindrical, universal, spherical, planar or free)"
+                        "{what}.type: unknown joint type '{other}' (expected fixed, revolute, prismatic, cylindrical, universal, spherical, planar, free or path)"
                     )))
                 }
             };
+            if !matches!(kind, JointKind::Path { .. }) {
+                for (given, key) in [(j.radius.is_some(), "radius"), (j.pitch.is_some(), "pitch"), (j.oriented.is_some(), "oriented")] {
+                    crate::ensure!(!given, Model, "{what}.{key}: only a path joint has a {key}");
+                }
+            }
             if !matches!(
                 kind,
                 JointKind::Revolute { .. }
