@@ -129,3 +129,17 @@ output_dt = 0.01
     f.write_text(f.read_text().replace('type = "path"', 'type = "revolute"'))
     p = subprocess.run([sys.executable, "-m", "mechsys", "run", str(f), "--out", str(out)], capture_output=True, text=True, cwd=ROOT)
     assert p.returncode != 0 and "radius: only a path joint has a radius" in p.stderr
+
+
+def test_tangential_and_normal_accelerations_are_signals():
+    m, j = bead(False)
+    res = ms.simulate(m, 1.0, ms.RK4(dt=1e-3), output_dt=1e-2)
+    a = -G * C / L
+    assert np.abs(res["joint/wire/tangential_acceleration"] - a).max() < 1e-12
+    sd = V0 + a * res.t
+    assert np.abs(res["joint/wire/normal_acceleration"] - j.curvature() * sd**2).max() < 1e-9
+    assert res.unit("joint/wire/normal_acceleration") == "m/s^2"
+    # they are the body's acceleration split along t and n
+    tt, n, _ = frenet(res["joint/wire/q"])
+    acc = res["body/bead/acceleration"]
+    assert np.abs(np.einsum("ij,ij->i", acc, n) - res["joint/wire/normal_acceleration"]).max() < 1e-9

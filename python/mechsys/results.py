@@ -149,6 +149,7 @@ class Results:
         else:
             complete = True
         acc = "udot" in raw
+        path_curvature = _path_curvatures(engine) if engine is not None and any(j["type"] == "path" for j in joints) else None
         put("t", raw["t"], "s")
         put("q", raw["q"], "mixed", qc, qu)
         put("u", raw["u"], "mixed", uc, uu_)
@@ -167,6 +168,11 @@ class Results:
             if acc:
                 put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua, None if one else c,
                     None if one or d is None else [_rate_unit(x) for x in d])
+            if j["type"] == "path" and acc and path_curvature is not None:
+                # along the path: the tangential acceleration s'' and the normal (centripetal)
+                # one kappa s'^2 towards the centre of curvature
+                put(f"joint/{j['name']}/tangential_acceleration", raw["udot"][:, j["iu"]], "m/s^2")
+                put(f"joint/{j['name']}/normal_acceleration", path_curvature(j["name"]) * raw["u"][:, j["iu"]] ** 2, "m/s^2")
         for k, b in enumerate(body_names):
             put(f"body/{b}/position", raw["body_position"][:, k, :], "m", xyz)
             put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1", ["w", "x", "y", "z"])
@@ -706,7 +712,7 @@ def _per_second(unit: str) -> str:
 
 # ---- selective recording (simulate(sensors=...)) ---------------------------------------------------
 _ACCELERATION_SUFFIXES = ("udot", "/acceleration", "/angular_acceleration", "/com_acceleration", "/reaction_force",
-                          "/reaction_torque")
+                          "/reaction_torque", "/tangential_acceleration", "/normal_acceleration")
 _CONTACT_SUFFIXES = ("g_n", "point", "normal", "gd_n", "gd_t", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
                      "friction_reserve")
 _GROUP_SUFFIXES = ("closed", "max_penetration", "impulse_n", "lambda_n", "pairs", "impulse_against", "force_against")
@@ -720,6 +726,8 @@ def signal_universe(engine) -> list[str]:
         if j["nq"]:
             names += [f"joint/{j['name']}/{x}" for x in ("q", "u", "udot")]
         names += [f"joint/{j['name']}/reaction_force", f"joint/{j['name']}/reaction_torque"]
+        if j["type"] == "path":
+            names += [f"joint/{j['name']}/tangential_acceleration", f"joint/{j['name']}/normal_acceleration"]
     for b in engine.bodies():
         n = b["name"]
         names += [f"body/{n}/{x}" for x in ("position", "orientation", "velocity", "angular_velocity", "acceleration",
@@ -871,3 +879,14 @@ def _check_schema(signals: dict, path: Path) -> None:
     for name, a in signals.items():
         if a.ndim == 0 or a.shape[0] != len(t):
             raise ResultsError(f"'{path}': signal '{name}' has shape {a.shape}, not one row per sample ({len(t)})")
+
+
+def _path_curvatures(engine):
+    """Curvature of each path joint's helix by joint name (from the model description)."""
+    desc = json.loads(engine.description_json())
+    out = {}
+    for j in desc.get("joints", []):
+        if str(j.get("type", "")).lower() in ("path", "helix"):
+            r, c = float(j["radius"]), float(j.get("pitch") or 0.0) / (2 * np.pi)
+            out[j["name"]] = r / (r * r + c * c)
+    return out.get
