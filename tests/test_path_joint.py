@@ -143,3 +143,21 @@ def test_tangential_and_normal_accelerations_are_signals():
     tt, n, _ = frenet(res["joint/wire/q"])
     acc = res["body/bead/acceleration"]
     assert np.abs(np.einsum("ij,ij->i", acc, n) - res["joint/wire/normal_acceleration"]).max() < 1e-9
+
+
+def test_a_trajectory_prescribed_along_the_path_and_its_forces():
+    """s(t) = v t on a horizontal circle without gravity: no drive force along the path, the
+    path's force m v^2 / R towards the centre."""
+    v = 1.5
+    m = ms.Model("carousel")
+    b = m.add_body("car", M, np.zeros((3, 3)))
+    m.add_joint(ms.joints.Path("track", m.ground, b, radius=R, oriented=False))
+    m.add_constraint(ms.constraints.Prescribed("drive", "track", ms.functions.Ramp(slope=v)))
+    res = ms.simulate(m, 1.0, ms.RK4(dt=1e-3), output_dt=1e-2)
+    assert np.abs(res["joint/track/q"] - v * res.t).max() < 1e-12
+    assert np.abs(res["constraint/drive/lambda"]).max() < 1e-9
+    f = res["joint/track/reaction_force"]
+    assert np.abs(np.linalg.norm(f, axis=1) - M * v**2 / R).max() < 1e-9
+    pos = res["body/car/position"]
+    assert np.abs(np.einsum("ij,ij->i", f, pos) / R + M * v**2 / R).max() < 1e-9  # towards the centre
+    assert np.abs(res["joint/track/normal_acceleration"] - v**2 / R).max() < 1e-9
