@@ -22,7 +22,6 @@ Usage: ``.venv/bin/python benches/bearing.py [--out docs/benchmarks.md] [--quick
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import sys
 import time
@@ -32,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, timed, write_doc  # noqa: E402
+from benchdoc import bench_args, fmt_time, machine, timed, write_doc  # noqa: E402
 
 import mechsys as ms  # noqa: E402
 
@@ -61,12 +60,8 @@ def held(speed: float, split: int = 1, push: float = 0.0) -> ms.Model:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path)
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--quick", action="store_true")
-    a = ap.parse_args(argv)
-    repeat = 1 if a.quick else a.repeat
+    a = bench_args(__doc__, argv)
+    repeat = a.repeat
     warnings.simplefilter("ignore")
     mach = machine()
     rows = []

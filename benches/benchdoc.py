@@ -13,6 +13,21 @@ import time
 from pathlib import Path
 
 
+def bench_args(doc: str, argv=None, repeat: int = 5):
+    """The common options of a benchmark script (``--out``, ``--repeat``, ``--quick``: one run):
+    the parsed arguments, with ``repeat`` already lowered by ``--quick``."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--out", type=Path)
+    ap.add_argument("--repeat", type=int, default=repeat)
+    ap.add_argument("--quick", action="store_true")
+    a = ap.parse_args(argv)
+    if a.quick:
+        a.repeat = 1
+    return a
+
+
 def timed(fn, repeat: int):
     """Runs ``fn`` ``repeat`` times: (min, median) wall time and the last result."""
     times, out = [], None

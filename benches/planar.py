@@ -16,7 +16,6 @@ Usage: ``.venv/bin/python benches/planar.py [--out docs/benchmarks.md] [--quick]
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -25,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, timed, write_doc  # noqa: E402
+from benchdoc import bench_args, fmt_time, machine, timed, write_doc  # noqa: E402
 
 import mechsys as ms  # noqa: E402
 
@@ -68,12 +67,8 @@ def four_bars(n: int, planar: bool) -> ms.Model:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path)
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--quick", action="store_true")
-    a = ap.parse_args(argv)
-    repeat = 1 if a.quick else a.repeat
+    a = bench_args(__doc__, argv)
+    repeat = a.repeat
     warnings.simplefilter("ignore")
     mach = machine()
     steps = int(round(T_END / DT))

@@ -17,7 +17,6 @@ Usage: ``.venv/bin/python benches/sensors.py [--out docs/benchmarks.md] [--quick
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -26,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, timed, write_doc  # noqa: E402
+from benchdoc import bench_args, fmt_time, machine, timed, write_doc  # noqa: E402
 
 import mechsys as ms  # noqa: E402
 
@@ -47,12 +46,8 @@ def chain(n: int = N) -> ms.Model:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path)
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--quick", action="store_true")
-    a = ap.parse_args(argv)
-    repeat = 1 if a.quick else a.repeat
+    a = bench_args(__doc__, argv)
+    repeat = a.repeat
     warnings.simplefilter("ignore")
     mach = machine()
     model = chain()

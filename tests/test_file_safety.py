@@ -346,3 +346,14 @@ def test_review_f14_a_huge_model_file_is_an_error_line_not_an_abort(tmp_path):
 def test_review_f15_the_help_of_every_command_loading_a_model_says_py_files_run(command):
     p = mechsys(command, "--help")
     assert p.returncode == 0 and "executed as Python code" in " ".join(p.stdout.split())
+
+
+def test_an_unwritable_output_directory_is_named_even_for_root(tmp_path, monkeypatch):
+    """The subprocess check above is skipped as root (root writes anywhere): the decision itself,
+    with the permission check answering no."""
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    real = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode, *a, **k: False if Path(p) == ro else real(p, mode, *a, **k))
+    with pytest.raises(ms.SettingsError, match=r"--out .*r.h5: cannot write in .*ro \(permission denied\)"):
+        check_outputs({}, {"--out": ro / "sub" / "r.h5"})

@@ -53,8 +53,7 @@ def test_mobility_counts_degrees_of_freedom_and_names_redundant_equations():
     assert (mob["nu"], mob["nc"], mob["rank"], mob["dof"]) == (3, 2, 2, 1) and mob["redundant"] == []
     # built in 3-D: three revolute joints, one loop closure (2 independent equations of 3)
     spatial = four_bar()
-    spatial.planar = False
-    spatial._invalidate()
+    spatial.planar = False  # rebuilds: the setter invalidates the built model
     mob = ms.mechanisms.mobility(spatial)
     assert (mob["nu"], mob["nc"], mob["rank"], mob["dof"]) == (3, 3, 2, 1)
     assert mob["redundant"] == [("b", 2)]

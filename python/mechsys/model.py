@@ -58,9 +58,10 @@ class Model:
     def __init__(self, name: str = "model", gravity: Sequence[float] = (0.0, 0.0, 0.0), *, planar: bool = False):
         self.name = name
         self.gravity = _vec3(gravity, "gravity")
-        if not isinstance(planar, (bool, np.bool_)):
-            raise ModelError(f"model '{name}'.planar: expected true or false, got {planar!r}")
-        self.planar = bool(planar)
+        self._planar = False
+        self._built = None
+        self._engine = None
+        self.planar = planar
         self._bodies: list[dict] = []
         self._joints: list[Joint | dict] = []
         self._forces: list[Any] = []
@@ -72,6 +73,18 @@ class Model:
         self._engine: tuple | None = None
         self._extra_callbacks: list = []
         self.ground = Body("ground", self)
+
+    @property
+    def planar(self) -> bool:
+        """Whether this is a planar model (see the class docstring); changing it rebuilds."""
+        return self._planar
+
+    @planar.setter
+    def planar(self, value: bool) -> None:
+        if not isinstance(value, (bool, np.bool_)):
+            raise ModelError(f"model '{self.name}'.planar: expected true or false, got {value!r}")
+        self._planar = bool(value)
+        self._invalidate()
 
     # ---- building ------------------------------------------------------------------------------
     def add_body(

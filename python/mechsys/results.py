@@ -149,7 +149,6 @@ class Results:
         else:
             complete = True
         acc = "udot" in raw
-        path_curvature = _path_curvatures(engine) if engine is not None and any(j["type"] == "path" for j in joints) else None
         put("t", raw["t"], "s")
         put("q", raw["q"], "mixed", qc, qu)
         put("u", raw["u"], "mixed", uc, uu_)
@@ -168,11 +167,11 @@ class Results:
             if acc:
                 put(f"joint/{j['name']}/udot", raw["udot"][:, j["iu"]] if one else raw["udot"][:, su], ua, None if one else c,
                     None if one or d is None else [_rate_unit(x) for x in d])
-            if j["type"] == "path" and acc and path_curvature is not None:
+            if j["type"] == "path" and acc and "curvature" in j:
                 # along the path: the tangential acceleration s'' and the normal (centripetal)
                 # one kappa s'^2 towards the centre of curvature
                 put(f"joint/{j['name']}/tangential_acceleration", raw["udot"][:, j["iu"]], "m/s^2")
-                put(f"joint/{j['name']}/normal_acceleration", path_curvature(j["name"]) * raw["u"][:, j["iu"]] ** 2, "m/s^2")
+                put(f"joint/{j['name']}/normal_acceleration", j["curvature"] * raw["u"][:, j["iu"]] ** 2, "m/s^2")
         for k, b in enumerate(body_names):
             put(f"body/{b}/position", raw["body_position"][:, k, :], "m", xyz)
             put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1", ["w", "x", "y", "z"])
@@ -879,14 +878,3 @@ def _check_schema(signals: dict, path: Path) -> None:
     for name, a in signals.items():
         if a.ndim == 0 or a.shape[0] != len(t):
             raise ResultsError(f"'{path}': signal '{name}' has shape {a.shape}, not one row per sample ({len(t)})")
-
-
-def _path_curvatures(engine):
-    """Curvature of each path joint's helix by joint name (from the model description)."""
-    desc = json.loads(engine.description_json())
-    out = {}
-    for j in desc.get("joints", []):
-        if str(j.get("type", "")).lower() in ("path", "helix"):
-            r, c = float(j["radius"]), float(j.get("pitch") or 0.0) / (2 * np.pi)
-            out[j["name"]] = r / (r * r + c * c)
-    return out.get

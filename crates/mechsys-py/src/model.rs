@@ -99,6 +99,11 @@ impl PyModel {
             d.set_item("nu", j.nu())?;
             d.set_item("q0", j.q0.clone())?;
             d.set_item("u0", j.u0.clone())?;
+            if let mechsys_core::model::JointKind::Path { helix, .. } = &j.kind {
+                // the path's geometry as the engine has it (for the path signals)
+                d.set_item("curvature", helix.curvature())?;
+                d.set_item("torsion", helix.torsion())?;
+            }
             out.push(d);
         }
         Ok(out)

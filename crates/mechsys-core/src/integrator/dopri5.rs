@@ -258,17 +258,7 @@ pub fn integrate<S: OdeSystem>(
             let t_new = t + h;
             sys.project(t_new, &mut st.ynew)?;
             check_finite(t_new, &st.ynew)?;
-            while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
-                let to = t_out[next];
-                if to >= t_new {
-                    obs(sys, to, &st.ynew, false)?;
-                } else {
-                    st.dense((to - t) / h, &mut yout);
-                    sys.project(to, &mut yout)?;
-                    obs(sys, to, &yout, false)?;
-                }
-                next += 1;
-            }
+            next = super::step_outputs(sys, obs, t_out, next, t, h, &st.ynew, &mut yout, |th, out| st.dense(th, out))?;
             sys.accepted(t_new, &mut st.ynew)?;
             stats.steps += 1;
             t = t_new;

@@ -191,6 +191,37 @@ pub(crate) fn step_floor(t: f64, t0: f64, t_end: f64) -> f64 {
     10.0 * f64::EPSILON * t.abs().max(1e-6 * (t_end - t0).abs()).max(f64::MIN_POSITIVE)
 }
 
+/// Calls the observer at every output time of an accepted step `[t, t + h]` that has not been
+/// served yet (from index `next`): at the step's end with its end state `y_new`, before it with
+/// the scheme's continuous extension `dense(θ, out)` (θ ∈ [0, 1)) projected onto the manifolds.
+/// Returns the next output index. One place for the adaptive schemes' outputs.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn step_outputs<S: OdeSystem>(
+    sys: &mut S,
+    obs: &mut Observer<'_, S>,
+    t_out: &[f64],
+    mut next: usize,
+    t: f64,
+    h: f64,
+    y_new: &[f64],
+    yout: &mut [f64],
+    mut dense: impl FnMut(f64, &mut [f64]),
+) -> Result<usize> {
+    let t_new = t + h;
+    while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
+        let to = t_out[next];
+        if to >= t_new {
+            obs(sys, to, y_new, false)?;
+        } else {
+            dense((to - t) / h, yout);
+            sys.project(to, yout)?;
+            obs(sys, to, yout, false)?;
+        }
+        next += 1;
+    }
+    Ok(next)
+}
+
 /// Fails with a solver error if y holds a NaN or inf, naming the time.
 pub(crate) fn check_finite(t: f64, y: &[f64]) -> Result<()> {
     if y.iter().all(|v| v.is_finite()) {

@@ -535,19 +535,16 @@ pub fn integrate_adaptive<S: OdeSystem>(
         }
         sys.project(t_new, &mut wk.ynew)?;
         check_finite(t_new, &wk.ynew)?;
-        while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
-            let to = t_out[next];
-            if to >= t_new {
-                obs(sys, to, &wk.ynew, false)?;
-            } else {
-                let wt = wk.tab.collocation_weights((to - t) / h);
+        {
+            // between the step's ends: the collocation polynomial through the stages
+            let (tab, z) = (&wk.tab, &wk.z);
+            let yy = &y;
+            next = crate::integrator::step_outputs(sys, obs, t_out, next, t, h, &wk.ynew, &mut wk.yout, |th, out| {
+                let wt = tab.collocation_weights(th);
                 for i in 0..n {
-                    wk.yout[i] = y[i] + wt[0] * wk.z[i] + wt[1] * wk.z[n + i] + wt[2] * wk.z[2 * n + i];
+                    out[i] = yy[i] + wt[0] * z[i] + wt[1] * z[n + i] + wt[2] * z[2 * n + i];
                 }
-                sys.project(to, &mut wk.yout)?;
-                obs(sys, to, &wk.yout, false)?;
-            }
-            next += 1;
+            })?;
         }
         sys.accepted(t_new, &mut wk.ynew)?;
         stats.steps += 1;
