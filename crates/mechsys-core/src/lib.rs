@@ -20,6 +20,7 @@ pub mod dynamics;
 pub mod error;
 pub mod fixtures;
 pub mod forces;
+pub mod geometry;
 pub mod integrator;
 pub mod kinematics;
 pub mod linear;
