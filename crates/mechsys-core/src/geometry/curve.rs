@@ -61,6 +61,19 @@ impl Convexity {
     }
 }
 
+/// Where a spline contour's solid lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solid {
+    /// Left of the direction of increasing parameter.
+    Left,
+    /// Right of it.
+    Right,
+    /// Inside a closed curve (either orientation of the points).
+    Inside,
+    /// Outside a closed curve: a hole.
+    Outside,
+}
+
 /// How a cam's follower touches it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Follower {
@@ -163,11 +176,12 @@ impl Curve {
 
     /// A C² cubic spline through `points` with chord-length parameter: `closed` makes it periodic
     /// (do not repeat the first point; a repeated last point is dropped), else natural and
-    /// continued along its end tangents. The solid lies to the left of the direction of the
-    /// points (`solid_left`), else to the right. Refused: fewer than 2 (open) or 3 (closed)
+    /// continued along its end tangents. `solid` says where the body's material is: left or
+    /// right of the points' direction, or (closed curves) inside or outside (a hole, a bore, a
+    /// groove seen from within). Refused: fewer than 2 (open) or 3 (closed)
     /// points, coincident consecutive points, data that turns back on itself (a corner the
     /// spline would overshoot), a self-intersecting curve, non-finite values.
-    pub fn spline(points: &[Vec2], closed: bool, solid_left: bool, what: &str) -> Result<Curve> {
+    pub fn spline(points: &[Vec2], closed: bool, solid: Solid, what: &str) -> Result<Curve> {
         let mut p: Vec<Vec2> = points.to_vec();
         for (i, v) in p.iter().enumerate() {
             ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: spline point {i} is not finite ({}, {})", v.x, v.y);
@@ -221,22 +235,27 @@ impl Curve {
             (Spline1::natural(&t, &xs, what)?, Spline1::natural(&t, &ys, what)?)
         };
         let per = (8 * segs).clamp(32, MAX_SAMPLES);
-        let sigma = if solid_left { 1.0 } else { -1.0 };
+        let sigma = match (solid, closed) {
+            (Solid::Left, _) => 1.0,
+            (Solid::Right, _) => -1.0,
+            (Solid::Inside | Solid::Outside, false) => {
+                return Err(crate::Error::Model(format!(
+                    "{what}: an open curve has no inside; put its solid on the left or the right of the points' direction"
+                )))
+            }
+            (Solid::Inside | Solid::Outside, true) => {
+                // the shoelace area is positive for counter-clockwise points, whose inside is on the left
+                let area: f64 = (0..n).map(|i| cross(&p[i], &p[(i + 1) % n])).sum();
+                let ccw = if area > 0.0 { 1.0 } else { -1.0 };
+                if solid == Solid::Inside {
+                    ccw
+                } else {
+                    -ccw
+                }
+            }
+        };
         let curve = Curve::build(Shape::Spline { x, y }, 0.0, sigma, 0.0, t[segs], closed, per, what)?;
         curve.check_simple(what)?;
-        if closed {
-            // counter-clockwise data with the solid on the left has positive area
-            let area: f64 = curve.samples.windows(2).map(|w| cross(&w[0].r, &w[1].r)).sum::<f64>()
-                + cross(&curve.samples[curve.samples.len() - 1].r, &curve.samples[0].r);
-            ensure!(
-                area * sigma > 0.0,
-                Model,
-                "{what}: a closed spline with the solid {} must run {} around it; reverse the points or set the solid \
-                 on the other side",
-                if solid_left { "on the left" } else { "on the right" },
-                if solid_left { "counter-clockwise" } else { "clockwise" }
-            );
-        }
         Ok(curve)
     }
 
@@ -685,7 +704,7 @@ mod tests {
     #[test]
     fn spline_through_circle_points_approaches_the_circle_and_knows_its_side() {
         let pts: Vec<Vec2> = (0..48).map(|i| TAU * i as f64 / 48.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.5).collect();
-        let c = Curve::spline(&pts, true, true, "ring").unwrap();
+        let c = Curve::spline(&pts, true, Solid::Inside, "ring").unwrap();
         // between knots (r''' jumps at the knots)
         for s in [0.013, 0.37, 1.21, 2.9] {
             let f = c.frame(s);
@@ -694,20 +713,26 @@ mod tests {
             assert!((f.curvature - 2.0).abs() < 5e-3, "{}", f.curvature);
             fd_check(&c, s);
         }
-        // the same points as a hole: the solid outside, concave
-        let hole = Curve::spline(&pts.iter().rev().cloned().collect::<Vec<_>>(), true, false, "bore").unwrap();
+        // the points reversed: still the disc (inside), or its complement (a bore)
+        let rev: Vec<Vec2> = pts.iter().rev().cloned().collect();
+        let disc = Curve::spline(&rev, true, Solid::Inside, "disc").unwrap();
+        assert_eq!(disc.convexity(), Convexity::Convex);
+        assert!((disc.curvature(0.3) - 2.0).abs() < 5e-3);
+        let hole = Curve::spline(&rev, true, Solid::Outside, "bore").unwrap();
         assert_eq!(hole.convexity(), Convexity::Concave);
         assert!(hole.frame(0.3).normal.dot(&hole.frame(0.3).point) < 0.0);
-        // clockwise data with the solid on the left is refused
-        let e = Curve::spline(&pts.iter().rev().cloned().collect::<Vec<_>>(), true, true, "c 'x'").unwrap_err();
-        assert!(e.to_string().contains("counter-clockwise"), "{e}");
+        assert!((hole.curvature(0.3) + 2.0).abs() < 5e-3);
+        // left/right follow the direction of the points
+        assert_eq!(Curve::spline(&pts, true, Solid::Right, "x").unwrap().convexity(), Convexity::Concave);
+        let e = Curve::spline(&pts[..5], false, Solid::Inside, "contour 'x'").unwrap_err();
+        assert!(e.to_string().contains("open curve has no inside"), "{e}");
     }
 
     #[test]
     fn bad_spline_data_is_named() {
         let err = |p: &[(f64, f64)], closed: bool| {
             let pts: Vec<Vec2> = p.iter().map(|&(x, y)| Vec2::new(x, y)).collect();
-            Curve::spline(&pts, closed, true, "contour 'track'").unwrap_err().to_string()
+            Curve::spline(&pts, closed, Solid::Left, "contour 'track'").unwrap_err().to_string()
         };
         assert!(err(&[(0.0, 0.0)], false).contains("at least 2 points"));
         assert!(err(&[(0.0, 0.0), (1.0, 0.0), (1.0, 0.0), (2.0, 1.0)], false).contains("points 1 and 2 coincide"));
