@@ -11,6 +11,7 @@ use crate::math::{Mat3, Vec3};
 use crate::spatial::Pose;
 
 use super::broad::Aabb;
+use crate::geometry::curve::Curve;
 
 /// 2-vector of `f64` (the coordinates of planar contours in the body's x-y plane).
 pub type Vec2 = nalgebra::Vector2<f64>;
@@ -91,6 +92,9 @@ pub enum Contour {
         /// Vertices (at least 3, convex, counter-clockwise; collinear vertices are allowed).
         vertices: Vec<Vec2>,
     },
+    /// Planar: a parametric contour (ellipse, spline, cam; see [`crate::geometry::curve`]),
+    /// validated when it was built.
+    Curve(Box<Curve>),
 }
 
 /// The kind of a contour, for dispatch tables and messages.
@@ -116,6 +120,8 @@ pub enum ContourKind {
     Line,
     /// [`Contour::Polygon`]
     Polygon,
+    /// [`Contour::Curve`]
+    Curve,
 }
 
 impl ContourKind {
@@ -132,12 +138,16 @@ impl ContourKind {
             ContourKind::Circle => "circle",
             ContourKind::Line => "line",
             ContourKind::Polygon => "polygon",
+            ContourKind::Curve => "curve",
         }
     }
 
     /// Whether the contour lives in the body's x-y plane.
     pub fn is_planar(self) -> bool {
-        matches!(self, ContourKind::Point2 | ContourKind::Circle | ContourKind::Line | ContourKind::Polygon)
+        matches!(
+            self,
+            ContourKind::Point2 | ContourKind::Circle | ContourKind::Line | ContourKind::Polygon | ContourKind::Curve
+        )
     }
 }
 
@@ -180,6 +190,7 @@ impl Contour {
             Contour::Circle { .. } => ContourKind::Circle,
             Contour::Line { .. } => ContourKind::Line,
             Contour::Polygon { .. } => ContourKind::Polygon,
+            Contour::Curve(_) => ContourKind::Curve,
         }
     }
 
@@ -266,6 +277,8 @@ impl Contour {
                 Ok(())
             }
             Contour::Polygon { vertices } => validate_polygon(vertices, what),
+            // checked by its constructor
+            Contour::Curve(_) => Ok(()),
         }
     }
 
@@ -338,6 +351,13 @@ impl Contour {
                 }
                 extruded(pose, b)
             }
+            Contour::Curve(c) if c.is_closed() => {
+                let (center, radius) = c.bound();
+                let h = Vec3::new(radius, radius, 0.0);
+                extruded(pose, Aabb { min: lift(&center) - h, max: lift(&center) + h })
+            }
+            // an open curve continues along its end tangents
+            Contour::Curve(_) => Aabb::EVERYTHING,
         }
     }
 }

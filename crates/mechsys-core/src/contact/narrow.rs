@@ -48,8 +48,10 @@ use crate::spatial::{Motion, Pose};
 
 use super::contour::{lift, Contour, ContourKind};
 use box_box::BoxShape;
+use curve_pair::{CurveGeometry, First};
 
 pub mod box_box;
+pub mod curve_pair;
 
 /// One candidate contact: gap, frame and the two surface points, world components.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -94,6 +96,8 @@ enum Geometry {
     BoxBox { a: BoxShape, b: BoxShape, scale: f64 },
     /// Planar: circles (or points, radius 0) extruded along body 2's z axis.
     CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
+    /// Planar parametric contours ([`curve_pair`]).
+    Curve(CurveGeometry),
 }
 
 /// A contour pair prepared for per-step evaluation.
@@ -164,7 +168,8 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
     use ContourKind as K;
     match b {
         K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder),
-        K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon),
+        K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
+        K::Curve => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Sphere => matches!(a, K::Point | K::Sphere),
         K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
         K::Box => matches!(a, K::Point | K::Sphere | K::Box),
@@ -183,7 +188,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, in either order)"
         )))
     }
 }
@@ -275,6 +280,28 @@ impl ContactPair {
         }
     }
 
+    /// Asks a pair with a parametric contour (other than a polygon's vertices, which have one
+    /// candidate each) for up to `points` contact points (1 to 8): the deepest local minima of
+    /// the distance, ordered along the curve. An error for other pairs or out of range.
+    pub fn with_points(mut self, points: usize) -> Result<Self> {
+        let name = format!("{}–{}", self.kinds.0, self.kinds.1);
+        let Geometry::Curve(g) = &mut self.geometry else {
+            return Err(Error::Model(format!(
+                "contact pair {name}: only pairs with a parametric contour (curve) take a number of contact points"
+            )));
+        };
+        ensure!(
+            (1..=curve_pair::MAX_POINTS).contains(&points),
+            Model,
+            "contact pair {name}: points must be 1 to {}, got {points}",
+            curve_pair::MAX_POINTS
+        );
+        ensure!(g.shared(), Model, "contact pair {name}: a polygon has one contact point per vertex; points does not apply");
+        g.set_points(points);
+        self.count = points;
+        Ok(self)
+    }
+
     /// Number of candidate points (the length `evaluate` fills).
     pub fn candidates(&self) -> usize {
         self.count
@@ -332,6 +359,19 @@ impl ContactPair {
             box_box::box_box_all(x1, x2, twists, a, b, *scale, out);
             return;
         }
+        if let Geometry::Curve(g) = &self.geometry {
+            if g.shared() {
+                if self.swapped {
+                    g.all(x2, x1, twists.map(|(a, b)| (b, a)), out);
+                    for o in out.iter_mut() {
+                        *o = o.reversed();
+                    }
+                } else {
+                    g.all(x1, x2, twists, out);
+                }
+                return;
+            }
+        }
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.candidate(k, x1, x2, twists);
         }
@@ -348,6 +388,16 @@ impl ContactPair {
         twists: Option<(&Motion, &Motion)>,
         mut f: impl FnMut(usize, &Raw),
     ) {
+        if let Geometry::Curve(g) = &self.geometry {
+            if g.shared() {
+                let mut buf = [Raw::default(); curve_pair::MAX_POINTS];
+                self.candidates_into(x1, x2, twists, &mut buf);
+                for (k, r) in buf[..self.count].iter().enumerate() {
+                    f(k, r);
+                }
+                return;
+            }
+        }
         if matches!(self.geometry, Geometry::BoxBox { .. }) {
             let mut buf = [Raw::default(); box_box::POINTS];
             self.candidates_into(x1, x2, twists, &mut buf);
@@ -439,6 +489,7 @@ impl ContactPair {
             }
             Geometry::CircleCircle { c1, r1, c2, r2 } => circle_circle(x1, x2, tw, c1, *r1, c2, *r2),
             Geometry::BoxBox { a, b, scale } => box_box::box_box(x1, x2, tw, a, b, *scale, k),
+            Geometry::Curve(g) => g.one(k, x1, x2, tw),
         }
     }
 }
@@ -454,6 +505,28 @@ fn box_corners(center: &Vec3, rotation: &Mat3, half: &Vec3) -> Vec<Vec3> {
 }
 
 fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
+    match (f, s) {
+        (Contour::Curve(c), Contour::Line { point, normal }) => {
+            return Geometry::Curve(CurveGeometry::OnLine {
+                curve: (**c).clone(),
+                point: *point,
+                normal: *normal,
+                count: 1,
+                reach: 0.0,
+            })
+        }
+        (_, Contour::Curve(second)) => {
+            let first = match f {
+                Contour::Point2 { p } => First::Points { centers: vec![lift(p)], radius: 0.0 },
+                Contour::Circle { center, radius } => First::Points { centers: vec![lift(center)], radius: *radius },
+                Contour::Polygon { vertices } => First::Points { centers: vertices.iter().map(lift).collect(), radius: 0.0 },
+                Contour::Curve(c) => First::Curve((**c).clone()),
+                _ => unreachable!("excluded by the dispatch table"),
+            };
+            return Geometry::Curve(CurveGeometry::OnCurve { first, second: (**second).clone(), count: 1, reach: 0.0 });
+        }
+        _ => {}
+    }
     // the second contour's half-space (plane or line), body 2 frame
     let half_space = |s: &Contour| match s {
         Contour::Plane { point, normal } => Some((*point, *normal)),
@@ -480,7 +553,9 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             Contour::Point2 { p } => (vec![lift(p)], 0.0),
             Contour::Circle { center, radius } => (vec![lift(center)], *radius),
             Contour::Polygon { vertices } => (vertices.iter().map(lift).collect(), 0.0),
-            Contour::Plane { .. } | Contour::Line { .. } => unreachable!("excluded by the dispatch table"),
+            Contour::Plane { .. } | Contour::Line { .. } | Contour::Curve(_) => {
+                unreachable!("excluded by the dispatch table")
+            }
         };
         return Geometry::PointsHalfSpace { centers, radius, point, normal };
     }

@@ -184,9 +184,60 @@ pub(crate) fn sample(kind: &str) -> Contour {
                 .map(|&(x, y)| Vec2::new(x, y))
                 .collect(),
         },
+        "ellipse" => curve_sample("ellipse"),
+        "ellipse_b" => curve_sample("ellipse_b"),
+        "blob" => curve_sample("blob"),
+        "cam" => curve_sample("cam"),
+        "bore" => curve_sample("bore"),
         _ => unreachable!("unknown sample {kind}"),
     }
 }
+
+/// Parametric contours for the curve pairs.
+pub(crate) fn curve_sample(kind: &str) -> Contour {
+    use crate::geometry::curve::{Curve, Follower, Solid};
+    use std::f64::consts::TAU;
+    let c = match kind {
+        "ellipse" => Curve::ellipse(Vec2::new(0.05, -0.02), 0.35, 0.2, 0.3, "ellipse").unwrap(),
+        "ellipse_b" => Curve::ellipse(Vec2::new(-0.03, 0.04), 0.25, 0.12, -0.7, "ellipse_b").unwrap(),
+        // a closed spline with a hollow flank (mixed convexity)
+        "blob" => {
+            let pts: Vec<Vec2> = (0..24)
+                .map(|i| TAU * i as f64 / 24.0)
+                .map(|t| Vec2::new(t.cos(), t.sin()) * (0.3 + 0.06 * (3.0 * t).cos()))
+                .collect();
+            Curve::spline(&pts, true, Solid::Inside, "blob").unwrap()
+        }
+        // a cam with a double dwell and a roller of 0.02
+        "cam" => {
+            let n = 72;
+            let a: Vec<f64> = (0..=n).map(|i| TAU * i as f64 / n as f64).collect();
+            let h: Vec<f64> = a.iter().map(|t| 0.03 * (1.0 - t.cos()) + 0.01 * (1.0 - (2.0 * t).cos())).collect();
+            Curve::cam(&a, &h, 0.2, Follower::Roller { radius: 0.02, eccentricity: 0.01 }, 1.0, "cam").unwrap()
+        }
+        // a circular bore of radius 0.9 (solid outside)
+        "bore" => {
+            let pts: Vec<Vec2> = (0..40).map(|i| TAU * i as f64 / 40.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.9).collect();
+            Curve::spline(&pts, true, Solid::Outside, "bore").unwrap()
+        }
+        _ => unreachable!("unknown curve sample {kind}"),
+    };
+    Contour::Curve(Box::new(c))
+}
+
+/// Pairs with a parametric contour, canonical order (sample names).
+pub(crate) const CURVE_PAIRS: [(&str, &str); 10] = [
+    ("point2", "ellipse"),
+    ("circle_b", "ellipse"),
+    ("polygon", "blob"),
+    ("circle_b", "cam"),
+    ("ellipse_b", "ellipse"),
+    ("blob", "ellipse"),
+    ("ellipse", "line"),
+    ("cam", "line"),
+    ("blob", "line"),
+    ("ellipse_b", "cam"),
+];
 
 /// Every supported pair in canonical order (sample names).
 pub(crate) const PAIRS: [(&str, &str); 17] = [
@@ -267,5 +318,40 @@ pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
                 })
                 .fold(f64::NEG_INFINITY, f64::max)
         }
+        Contour::Curve(c) => curve_sdf(c, &Vec2::new(xl.x, xl.y)).0,
     }
+}
+
+/// Signed distance from a body-frame point to a curve contour and the foot parameter, by dense
+/// sampling and golden-section refinement of the squared distance (independent of the contact
+/// search's Newton iteration). Offsets included.
+pub(crate) fn curve_sdf(c: &crate::geometry::curve::Curve, y: &Vec2) -> (f64, f64) {
+    let (lo, hi) = c.range();
+    let n = 20000;
+    let d2 = |s: f64| (y - c.eval(s)[0]).norm_squared();
+    let (mut best, mut sb) = (f64::INFINITY, lo);
+    for i in 0..=n {
+        let s = lo + (hi - lo) * i as f64 / n as f64;
+        let v = d2(s);
+        if v < best {
+            best = v;
+            sb = s;
+        }
+    }
+    let h = (hi - lo) / n as f64;
+    let (mut a, mut b) = (sb - 2.0 * h, sb + 2.0 * h);
+    let gr = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..200 {
+        let (m1, m2) = (b - gr * (b - a), a + gr * (b - a));
+        if d2(m1) < d2(m2) {
+            b = m2;
+        } else {
+            a = m1;
+        }
+    }
+    let s = 0.5 * (a + b);
+    let j = c.eval(s);
+    let nu = c.outward(&j[1]);
+    let sign = if (y - j[0]).dot(&nu) < 0.0 { -1.0 } else { 1.0 };
+    (sign * (y - j[0]).norm() - c.offset(), s)
 }

@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::*;
 use crate::contact::narrow::{evaluate, ContactPair};
-use crate::contact::test_util::{close, random_poses, rot, sample, Rng, Trajectory, PAIRS};
+use crate::contact::test_util::{close, random_poses, rot, sample, Rng, Trajectory, CURVE_PAIRS, PAIRS};
 use crate::contact::Contour;
 use crate::math::Mat3;
 
@@ -39,7 +39,7 @@ fn check(pair: &ContactPair, tr1: &Trajectory, tr2: &Trajectory, tag: &str) {
         let gd_fd = (gp1[k].g_n - gm1[k].g_n) / (2.0 * h1);
         assert!(close(c.gd_n, gd_fd, 1e-6), "{tag}: ġ_N {} vs difference {gd_fd}", c.gd_n);
         let gdd_fd2 = (gp[k].g_n - 2.0 * g0[k].g_n + gm[k].g_n) / (h2 * h2);
-        assert!(close(c.wbar_n, gdd_fd2, 1e-6), "{tag}: g̈_N {} vs second difference {gdd_fd2}", c.wbar_n);
+        assert!(close(c.wbar_n, gdd_fd2, 1e-6), "{tag}: g̈_N {} vs second difference {gdd_fd2} (g_N {})", c.wbar_n, c.point.g_n);
         let gdd_fd = (kp[k].gd_n - km[k].gd_n) / (2.0 * h1);
         assert!(close(c.wbar_n, gdd_fd, 1e-6), "{tag}: g̈_N {} vs difference of ġ_N {gdd_fd}", c.wbar_n);
         // material points at P1 and P2 frozen in their bodies
@@ -80,6 +80,47 @@ fn rates_match_finite_differences_for_every_pair() {
                     (Trajectory::random(&mut rng, &x1, 1.0, 0.5), Trajectory::random(&mut rng, &x2, 1.0, 0.5))
                 };
                 check(&pair, &tr1, &tr2, &format!("{a}–{b} order {order} #{it}"));
+            }
+        }
+    }
+}
+
+/// Parametric contours (section 2.2.7.1): the rates from the differentiated contact conditions
+/// (ṡ of eq. 2.109, ṅ of eq. 2.92) against differences of the searched contact, in plane motion
+/// and in general 3-D motion (where the curves are compared in body 2's plane), both orders.
+/// (With several points per pair a candidate may switch roots between the differenced states;
+/// those pairs are checked in `narrow::curve_tests`.)
+#[test]
+fn curve_pair_rates_match_finite_differences() {
+    let mut rng = Rng::new(77);
+    for (a, b) in CURVE_PAIRS {
+        let (c1, c2) = (sample(a), sample(b));
+        for (order, (ca, cb)) in [(c1.clone(), c2.clone()), (c2, c1)].into_iter().enumerate() {
+            {
+                let pair = ContactPair::new("p", ca.clone(), cb.clone()).unwrap();
+                for it in 0..8 {
+                    let planar = it % 3 != 2;
+                    let (mut x1, x2) = random_poses(&mut rng, true);
+                    // near touching rather than deeply overlapping (the samples are ~0.3 in size)
+                    let sep = x1.r - x2.r;
+                    x1.r = x2.r + sep * (rng.uniform(0.6, 0.95) / sep.norm());
+                    // slower motions than for the primitives: deep penetrations of curved
+                    // contours have large higher derivatives, which the differences truncate
+                    let (tr1, tr2) = if planar {
+                        (
+                            Trajectory::random_planar(&mut rng, &x1, 0.5, 0.25),
+                            Trajectory::random_planar(&mut rng, &x2, 0.5, 0.25),
+                        )
+                    } else {
+                        // a small tilt: the curves are compared in body 2's plane
+                        let tilt = |x: &Pose, rng: &mut Rng| {
+                            Pose::new(rot(&rng.unit(), 0.2) * x.a, x.r)
+                        };
+                        let (y1, y2) = (tilt(&x1, &mut rng), tilt(&x2, &mut rng));
+                        (Trajectory::random(&mut rng, &y1, 0.5, 0.25), Trajectory::random(&mut rng, &y2, 0.5, 0.25))
+                    };
+                    check(&pair, &tr1, &tr2, &format!("{a}–{b} order {order} #{it}"));
+                }
             }
         }
     }
@@ -341,3 +382,5 @@ fn degenerate_configurations_give_finite_rates() {
         }
     }
 }
+
+
