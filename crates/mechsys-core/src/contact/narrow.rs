@@ -831,3 +831,6 @@ pub fn evaluate(pair: &ContactPair, x1: &Pose, x2: &Pose, out: &mut [ContactPoin
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod curve_tests;

@@ -468,6 +468,25 @@ impl Curve {
         Ok(())
     }
 
+    /// The same curve with the solid on its other side: an ellipse's or a closed spline's
+    /// complement (an elliptical hole, a bore), an open track's other side.
+    pub fn flipped(mut self) -> Curve {
+        self.sigma = -self.sigma;
+        for smp in &mut self.samples {
+            smp.nu = -smp.nu;
+        }
+        self.offset = -self.offset;
+        self.kappa_range = (-self.kappa_range.1, -self.kappa_range.0);
+        self.convexity = match self.convexity {
+            Convexity::Convex => Convexity::Concave,
+            Convexity::Concave => Convexity::Convex,
+            Convexity::Mixed => Convexity::Mixed,
+        };
+        let (center, r) = self.bound;
+        self.bound = (center, r + self.offset.abs());
+        self
+    }
+
     /// Lift `[h, h', h'', h''']` of a cam at cam angle `s` (zeros for other shapes).
     fn lift(&self, s: f64) -> [f64; 4] {
         match &self.shape {
