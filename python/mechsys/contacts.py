@@ -26,6 +26,9 @@ class Contact:
     normal: Any = field(default_factory=laws.Signorini)
     friction: Any = None
     impact: Any = None
+    #: contact points a pair with a parametric contour looks for (1 to 8), e.g. both flanks
+    #: of a groove or several gear teeth; ``None``: one
+    points: Any = None
 
     def describe(self, callbacks: list) -> dict:
         what = f"contact '{self.name}'"
@@ -49,6 +52,10 @@ class Contact:
             if not isinstance(self.impact, (laws.Newton, laws.Poisson)):
                 raise ModelError(f"{what}.impact: expected mechsys.laws.Newton or Poisson, got {type(self.impact).__name__}")
             d["impact"] = self.impact.describe(f"{what}.impact")
+        if self.points is not None:
+            if isinstance(self.points, bool) or not isinstance(self.points, int) or not 1 <= self.points <= 8:
+                raise ModelError(f"{what}.points: expected a whole number from 1 to 8, got {self.points!r}")
+            d["points"] = int(self.points)
         return d
 
 

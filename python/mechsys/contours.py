@@ -6,13 +6,18 @@ Attach one to a body with ``body.contour(ms.contours.Sphere(radius=0.02))`` and 
 In space: :class:`Point`, :class:`Sphere`, :class:`Plane` (half-space below its normal),
 :class:`Box`, :class:`Capsule`, :class:`Cylinder`. In the plane (the body's x-y plane):
 :class:`Point`, :class:`Circle`, :class:`Line` (half-plane behind its normal), :class:`Polygon`
-(convex, vertices counter-clockwise).
+(convex, vertices counter-clockwise), and the parametric contours of section 2.2.7.1 —
+:class:`Ellipse`, :class:`Spline` (through points, or sampled from a function with
+:meth:`Spline.from_function`) and :class:`Cam` (a cam disc from a lift table or lift function) —
+which pair with points, circles, polygons, lines and each other through a Newton contact
+search on their parameters (see docs/contours.md).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Sequence
 
 from .errors import ModelError
 from .joints import _vec3
@@ -151,6 +156,177 @@ class Polygon(Contour):
         return {"type": "polygon", "vertices": out}
 
 
+_SOLIDS = ("left", "right", "inside", "outside")
+
+
+def _solid(x, what: str, allowed=_SOLIDS):
+    if x is None:
+        return None
+    if x not in allowed:
+        raise ModelError(f"{what}: expected one of {', '.join(repr(a) for a in allowed)}, got {x!r}")
+    return x
+
+
+def _numbers(xs, what: str) -> list:
+    try:
+        out = [float(v) for v in xs]
+    except (TypeError, ValueError):
+        raise ModelError(f"{what}: expected a sequence of numbers, got {xs!r}") from None
+    return out
+
+
+def _points2(pts, what: str) -> list:
+    out = []
+    try:
+        items = list(pts)
+    except TypeError:
+        raise ModelError(f"{what}: expected a sequence of (x, y) points, got {pts!r}") from None
+    for k, v in enumerate(items):
+        try:
+            x, y = (float(c) for c in v)
+        except (TypeError, ValueError):
+            raise ModelError(f"{what}[{k}]: expected two numbers (x, y), got {v!r}") from None
+        out.append([x, y])
+    return out
+
+
+@dataclass
+class Ellipse(Contour):
+    """An ellipse with semi-axes ``a`` (along its x axis, turned by ``angle`` from the body's) and
+    ``b``; ``solid="outside"`` makes it an elliptical hole. Parameter: the ellipse angle
+    ``s`` with ``r = c + R(angle) (a cos s, b sin s)``."""
+
+    a: float = 0.0
+    b: float = 0.0
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+    angle: float = 0.0
+    solid: str | None = None
+
+    def describe(self, what: str) -> dict:
+        d = {
+            "type": "ellipse",
+            "center": _vec3(self.center, f"{what}.center"),
+            "semi_axes": [_radius(self.a, f"{what}.a"), _radius(self.b, f"{what}.b")],
+            "angle": _radius(self.angle, f"{what}.angle"),
+        }
+        if self.solid is not None:
+            d["solid"] = _solid(self.solid, f"{what}.solid", ("inside", "outside"))
+        return d
+
+
+@dataclass
+class Spline(Contour):
+    """A C² cubic spline through ``points`` [(x, y), ...] in the body's x-y plane, with the chord
+    length as its parameter. ``closed=True`` makes it periodic (do not repeat the first point).
+    ``solid``: ``"inside"`` (default when closed) or ``"outside"`` (a bore, a groove seen from
+    within), or ``"left"`` (default when open) / ``"right"`` of the points' direction. An open
+    spline continues straight along its end tangents."""
+
+    points: Sequence[Sequence[float]] = ()
+    closed: bool = False
+    solid: str | None = None
+
+    @classmethod
+    def from_function(cls, f, s_range, samples: int = 400, closed: bool = False, solid: str | None = None) -> "Spline":
+        """Samples a curve ``f(s) -> (x, y)`` at ``samples`` parameters over ``s_range`` (for a
+        closed curve the end of the range is the start again and is not repeated). The spline's
+        error against ``f`` falls with the fourth power of the spacing (about ``h⁴ κ³`` for
+        spacing ``h`` and curvature ``κ``); check it with :func:`mechsys.contours.spline_error`."""
+        what = "Spline.from_function"
+        try:
+            lo, hi = (float(v) for v in s_range)
+        except (TypeError, ValueError):
+            raise ModelError(f"{what}: s_range must be two numbers (start, end), got {s_range!r}") from None
+        if not hi > lo:
+            raise ModelError(f"{what}: s_range must increase, got ({lo}, {hi})")
+        if isinstance(samples, bool) or not isinstance(samples, int) or samples < 3:
+            raise ModelError(f"{what}: samples must be a whole number ≥ 3, got {samples!r}")
+        n = samples
+        ss = [lo + (hi - lo) * k / (n if closed else n - 1) for k in range(n)]
+        pts = []
+        for s in ss:
+            try:
+                v = f(s)
+                x, y = float(v[0]), float(v[1])
+            except Exception as e:  # the user's function raised
+                raise ModelError(f"{what}: the curve function raised at s = {s}: {type(e).__name__}: {e}") from None
+            if not (math.isfinite(x) and math.isfinite(y)):
+                raise ModelError(f"{what}: the curve function returned a non-finite point ({x}, {y}) at s = {s}")
+            pts.append((x, y))
+        return cls(points=pts, closed=closed, solid=solid)
+
+    def describe(self, what: str) -> dict:
+        d = {"type": "spline", "points": _points2(self.points, f"{what}.points"), "closed": bool(self.closed)}
+        if self.solid is not None:
+            d["solid"] = _solid(self.solid, f"{what}.solid")
+        return d
+
+
+@dataclass
+class Cam(Contour):
+    """A cam disc whose follower translates along the +y axis of the frame the cam turns in (the
+    cam body's frame at cam angle 0), lifted by ``lift``: a table ``(angles, lifts)`` over
+    ``[0, 2π]`` (periodic: the lift at 2π equals the lift at 0) or a function of the cam angle
+    sampled at ``samples`` angles. ``base_radius`` is the base circle of the cam profile.
+    ``follower``: ``"roller"`` (radius ``roller_radius``, axis offset ``eccentricity`` from the
+    cam centre), ``"knife"`` or ``"flat"`` (a flat face normal to the follower axis).
+    ``direction=+1``: the cam turns counter-clockwise about its z axis as the angle grows.
+    Pair it with the follower's :class:`Circle` (roller), :class:`Point` (knife) or
+    :class:`Line` (flat face)."""
+
+    lift: Any = None
+    base_radius: float = 0.0
+    follower: str = "roller"
+    roller_radius: float = 0.0
+    eccentricity: float = 0.0
+    direction: int = 1
+    samples: int = 720
+
+    def table(self) -> tuple[list, list]:
+        """The lift table (angles, lifts) this cam is built from."""
+        what = "Cam.lift"
+        if callable(self.lift):
+            n = self.samples
+            if isinstance(n, bool) or not isinstance(n, int) or n < 8:
+                raise ModelError(f"Cam.samples: expected a whole number ≥ 8, got {n!r}")
+            angles = [2.0 * math.pi * k / n for k in range(n + 1)]
+            lifts = []
+            for a in angles:
+                try:
+                    h = float(self.lift(a))
+                except Exception as e:
+                    raise ModelError(f"{what}: the lift function raised at angle {a}: {type(e).__name__}: {e}") from None
+                if not math.isfinite(h):
+                    raise ModelError(f"{what}: the lift function returned {h} at angle {a}")
+                lifts.append(h)
+            if abs(lifts[-1] - lifts[0]) > 1e-9 * max(1.0, max(abs(v) for v in lifts)):
+                raise ModelError(f"{what}: the lift function is not periodic: {lifts[0]} at 0 but {lifts[-1]} at 2π")
+            lifts[-1] = lifts[0]
+            return angles, lifts
+        try:
+            angles, lifts = self.lift
+        except (TypeError, ValueError):
+            raise ModelError(f"{what}: expected a table (angles, lifts) or a function of the cam angle, got {self.lift!r}") from None
+        return _numbers(angles, f"{what} angles"), _numbers(lifts, f"{what} lifts")
+
+    def describe(self, what: str) -> dict:
+        angles, lifts = self.table()
+        if self.follower not in ("roller", "knife", "flat"):
+            raise ModelError(f"{what}.follower: expected 'roller', 'knife' or 'flat', got {self.follower!r}")
+        if self.direction not in (1, -1):
+            raise ModelError(f"{what}.direction: expected +1 or -1, got {self.direction!r}")
+        return {
+            "type": "cam",
+            "angles": angles,
+            "lift": lifts,
+            "base_radius": _radius(self.base_radius, f"{what}.base_radius"),
+            "follower": self.follower,
+            "roller_radius": _radius(self.roller_radius, f"{what}.roller_radius"),
+            "eccentricity": _radius(self.eccentricity, f"{what}.eccentricity"),
+            "direction": float(self.direction),
+        }
+
+
 @dataclass
 class OnBody:
     """A contour attached to a body (what :meth:`mechsys.Body.contour` returns)."""
@@ -159,4 +335,19 @@ class OnBody:
     contour: Contour
 
 
-__all__ = ["Contour", "Point", "Sphere", "Plane", "Box", "Capsule", "Cylinder", "Circle", "Line", "Polygon", "OnBody"]
+__all__ = [
+    "Contour",
+    "Point",
+    "Sphere",
+    "Plane",
+    "Box",
+    "Capsule",
+    "Cylinder",
+    "Circle",
+    "Line",
+    "Polygon",
+    "Ellipse",
+    "Spline",
+    "Cam",
+    "OnBody",
+]

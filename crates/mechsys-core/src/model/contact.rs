@@ -7,7 +7,9 @@ use crate::math::Vec3;
 
 use super::contact_description::{
     ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, ImpactDescription,
+    SolidSide,
 };
+use crate::geometry::curve::{Curve, Follower, Solid};
 
 /// Tangential law with its coefficients.
 #[derive(Debug, Clone, PartialEq)]
@@ -173,7 +175,12 @@ fn vec3(v: &[f64; 3]) -> Vec3 {
 fn planar(c: &ContourDescription) -> bool {
     matches!(
         c,
-        ContourDescription::Circle { .. } | ContourDescription::Line { .. } | ContourDescription::Polygon { .. }
+        ContourDescription::Circle { .. }
+            | ContourDescription::Line { .. }
+            | ContourDescription::Polygon { .. }
+            | ContourDescription::Ellipse { .. }
+            | ContourDescription::Spline { .. }
+            | ContourDescription::Cam { .. }
     )
 }
 
@@ -208,6 +215,44 @@ fn contour(
         }
         ContourDescription::Polygon { vertices } => {
             Contour::Polygon { vertices: vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect() }
+        }
+        ContourDescription::Ellipse { center, semi_axes, angle, solid } => {
+            let e = Curve::ellipse(Vec2::new(center[0], center[1]), semi_axes[0], semi_axes[1], *angle, what)?;
+            match solid {
+                None | Some(SolidSide::Inside) => Contour::Curve(Box::new(e)),
+                Some(SolidSide::Outside) => Contour::Curve(Box::new(e.flipped())),
+                Some(s) => {
+                    return Err(Error::Model(format!(
+                        "{what}: an ellipse's solid is 'inside' or 'outside', got '{}'",
+                        format!("{s:?}").to_lowercase()
+                    )))
+                }
+            }
+        }
+        ContourDescription::Spline { points, closed, solid } => {
+            let side = match solid {
+                Some(SolidSide::Left) => Solid::Left,
+                Some(SolidSide::Right) => Solid::Right,
+                Some(SolidSide::Inside) => Solid::Inside,
+                Some(SolidSide::Outside) => Solid::Outside,
+                None if *closed => Solid::Inside,
+                None => Solid::Left,
+            };
+            let pts: Vec<Vec2> = points.iter().map(|p| Vec2::new(p[0], p[1])).collect();
+            Contour::Curve(Box::new(Curve::spline(&pts, *closed, side, what)?))
+        }
+        ContourDescription::Cam { angles, lift, base_radius, follower, roller_radius, eccentricity, direction } => {
+            let f = match follower.as_deref().unwrap_or("roller") {
+                "roller" => Follower::Roller { radius: *roller_radius, eccentricity: *eccentricity },
+                "knife" => Follower::Roller { radius: 0.0, eccentricity: *eccentricity },
+                "flat" => Follower::Flat,
+                other => {
+                    return Err(Error::Model(format!(
+                        "{what}.follower: expected 'roller', 'knife' or 'flat', got '{other}'"
+                    )))
+                }
+            };
+            Contour::Curve(Box::new(Curve::cam(angles, lift, *base_radius, f, *direction, what)?))
         }
     })
 }
@@ -295,6 +340,13 @@ pub(super) fn validate(
     let c1 = contour(&d.contour1, planar(&d.contour2), &format!("{what}.contour1"), rotation)?;
     let c2 = contour(&d.contour2, planar(&d.contour1), &format!("{what}.contour2"), rotation)?;
     let pair = ContactPair::new(&d.name, c1, c2)?;
+    let pair = match d.points {
+        None => pair,
+        Some(p) => pair.with_points(p).map_err(|e| match e {
+            Error::Model(m) => Error::Model(format!("{what}.points: {m}")),
+            other => other,
+        })?,
+    };
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
     Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, friction, impact, first })

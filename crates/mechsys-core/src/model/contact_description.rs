@@ -31,6 +31,10 @@ pub struct ContactDescription {
     /// Impact law (a fully plastic Newton impact, ε = 0, if absent).
     #[serde(default)]
     pub impact: ImpactDescription,
+    /// Number of contact points a pair with a parametric contour looks for (1 if absent, at
+    /// most 8): the deepest local minima of the distance, e.g. both flanks of a groove.
+    #[serde(default)]
+    pub points: Option<usize>,
 }
 
 /// A contour: closed-form geometry attached to a body (all data in the body frame, m).
@@ -112,6 +116,71 @@ pub enum ContourDescription {
         /// Vertices `[x, y]`, at least 3.
         vertices: Vec<[f64; 2]>,
     },
+    /// An ellipse in the body's x-y plane (a parametric contour, section 2.2.7.1).
+    Ellipse {
+        /// Centre (z ignored).
+        #[serde(default)]
+        center: [f64; 3],
+        /// Semi-axes `[a, b]` (m), along the ellipse's x and y axes, > 0.
+        semi_axes: [f64; 2],
+        /// Angle of the ellipse's x axis from the body's x axis (rad).
+        #[serde(default)]
+        angle: f64,
+        /// `inside` (a solid ellipse, default) or `outside` (an elliptical hole).
+        #[serde(default)]
+        solid: Option<SolidSide>,
+    },
+    /// A C² cubic spline through points in the body's x-y plane.
+    Spline {
+        /// Points `[x, y]` (at least 2 open, 3 closed; a closed curve does not repeat its first).
+        points: Vec<[f64; 2]>,
+        /// Closed (periodic) or open (continued straight beyond its ends).
+        #[serde(default)]
+        closed: bool,
+        /// Where the solid lies: `left`/`right` of the points' direction, or for closed curves
+        /// `inside` (default) / `outside`; open curves default to `left`.
+        #[serde(default)]
+        solid: Option<SolidSide>,
+    },
+    /// A cam disc from a periodic lift table (section 2.2.7.1; see `geometry::curve::Curve::cam`).
+    Cam {
+        /// Cam angles (rad) from 0 to 2π, increasing.
+        angles: Vec<f64>,
+        /// Follower lift at those angles (m); periodic.
+        lift: Vec<f64>,
+        /// Radius of the base circle (m), > 0.
+        base_radius: f64,
+        /// `roller` (default), `knife` or `flat`.
+        #[serde(default)]
+        follower: Option<String>,
+        /// Roller radius (m) for a roller follower.
+        #[serde(default)]
+        roller_radius: f64,
+        /// Offset of the follower's axis from the cam centre (m).
+        #[serde(default)]
+        eccentricity: f64,
+        /// +1: the cam turns counter-clockwise about its z axis as the angle grows; -1: clockwise.
+        #[serde(default = "one")]
+        direction: f64,
+    },
+}
+
+/// Where a parametric contour's solid lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolidSide {
+    /// Left of the direction of the points.
+    Left,
+    /// Right of it.
+    Right,
+    /// Inside the closed curve.
+    Inside,
+    /// Outside the closed curve (a hole).
+    Outside,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// Tangential contact law.
