@@ -35,7 +35,7 @@ def lift(theta):
 
 def build(omega: float) -> ms.Model:
     m = ms.Model("cam-follower", gravity=(0.0, -G, 0.0), planar=True)
-    cam = m.add_body("cam", 1.0, ms.inertia.cylinder(1.0, 0.01, BASE))
+    cam = m.add_body("cam", 1.0, ms.inertia.cylinder(1.0, BASE, 0.01, axis="z"))
     follower = m.add_body("follower", MASS, ms.inertia.box(MASS, (0.01, 0.02, 0.01)))
     m.add_joint(ms.joints.Revolute("shaft", m.ground, cam, axis=(0, 0, 1)))
     y0 = BASE + ROLLER  # roller centre on the base circle

@@ -282,9 +282,9 @@ class Cam(Contour):
     direction: int = 1
     samples: int = 720
 
-    def table(self) -> tuple[list, list]:
+    def table(self, what: str = "Cam") -> tuple[list, list]:
         """The lift table (angles, lifts) this cam is built from."""
-        what = "Cam.lift"
+        what = f"{what}.lift"
         if callable(self.lift):
             n = self.samples
             if isinstance(n, bool) or not isinstance(n, int) or n < 8:
@@ -310,7 +310,7 @@ class Cam(Contour):
         return _numbers(angles, f"{what} angles"), _numbers(lifts, f"{what} lifts")
 
     def describe(self, what: str) -> dict:
-        angles, lifts = self.table()
+        angles, lifts = self.table(what)
         if self.follower not in ("roller", "knife", "flat"):
             raise ModelError(f"{what}.follower: expected 'roller', 'knife' or 'flat', got {self.follower!r}")
         if self.direction not in (1, -1):

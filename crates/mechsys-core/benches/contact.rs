@@ -17,6 +17,10 @@
 //! - `broad/sap_cold/N`: the same from an empty broad phase (full sort);
 //! - `broad/brute_force/1000`: the O(n²) test of every pair, for comparison.
 //!
+//! - `narrow_curve/<pair>_evaluate/100`, `narrow_curve/<pair>_kinematics/100`: planar
+//!   parametric pairs (roller–cam, circle–ellipse, ellipse–line, ellipse–ellipse) at random
+//!   placements near contact, both bodies turning, beside the closed-form circle–circle pair;
+//!
 //! Run with `cargo bench -p mechsys-core --bench contact` (about a minute; `-- --quick` for a
 //! rough figure).
 
@@ -109,6 +113,76 @@ fn bench_narrow(c: &mut Criterion) {
     });
     g.finish();
     bench_box_box(c);
+    bench_curves(c);
+}
+
+/// Planar parametric pairs near contact, in plane motion: [`evaluate`] and
+/// [`contact_kinematics`] per pair (the global start over the sampled chunks and Newton on the
+/// parameters each call; there is no warm start), next to the closed-form circle–circle pair.
+fn bench_curves(c: &mut Criterion) {
+    use mechsys_core::geometry::curve::{Curve, Follower, Vec2};
+    use std::f64::consts::TAU;
+    let n = 100;
+    let mut rng = Rng(0x5eed_c0de_0000_0001);
+    let ellipse = |a, b| Contour::Curve(Box::new(Curve::ellipse(Vec2::zeros(), a, b, 0.0, "e").expect("valid")));
+    let ang: Vec<f64> = (0..=360).map(|i| TAU * i as f64 / 360.0).collect();
+    let lift: Vec<f64> = ang.iter().map(|t| 0.004 * (1.0 - t.cos())).collect();
+    let cam = Contour::Curve(Box::new(
+        Curve::cam(&ang, &lift, 0.03, Follower::Roller { radius: 0.01, eccentricity: 0.0 }, 1.0, "cam").expect("valid"),
+    ));
+    let roller = Contour::Circle { center: Vec2::zeros(), radius: 0.01 };
+    let line = Contour::Line { point: Vec2::zeros(), normal: Vec2::y() };
+    // (name, contour 1, contour 2, distance between the body origins)
+    let cases = [
+        ("circle_circle", roller.clone(), Contour::Circle { center: Vec2::zeros(), radius: 0.3 }, 0.31),
+        ("circle_ellipse", roller.clone(), ellipse(0.3, 0.2), 0.25),
+        ("roller_cam", roller, cam.clone(), 0.045),
+        ("ellipse_line", ellipse(0.3, 0.2), line, 0.25),
+        ("ellipse_ellipse", ellipse(0.3, 0.2), ellipse(0.25, 0.15), 0.45),
+    ];
+    let mut g = c.benchmark_group("narrow_curve");
+    g.throughput(Throughput::Elements(n as u64));
+    for (name, c1, c2, dist) in cases {
+        let pair = ContactPair::new(name, c1, c2).expect("valid pair");
+        let bodies: Vec<(BodyMotion, BodyMotion)> = (0..n)
+            .map(|_| {
+                let dir = rng.uniform(0.0, TAU);
+                let rz = |t: f64| nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), t).into_inner();
+                let r = Vec3::new(dir.cos(), dir.sin(), 0.0) * dist;
+                let w = Vec3::new(0.0, 0.0, rng.uniform(-5.0, 5.0));
+                let b1 = BodyMotion {
+                    pose: Pose::new(rz(rng.uniform(-3.0, 3.0)), r),
+                    twist: Motion::new(w, Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 0.0) - w.cross(&r)),
+                    acc: Motion::ZERO,
+                };
+                let b2 = BodyMotion {
+                    pose: Pose::new(rz(rng.uniform(-3.0, 3.0)), Vec3::zeros()),
+                    twist: Motion::new(Vec3::new(0.0, 0.0, rng.uniform(-5.0, 5.0)), Vec3::zeros()),
+                    acc: Motion::ZERO,
+                };
+                (b1, b2)
+            })
+            .collect();
+        let mut points = vec![ContactPoint::default(); n];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_evaluate"), n), &n, |b, _| {
+            b.iter(|| {
+                for ((b1, b2), out) in bodies.iter().zip(points.iter_mut()) {
+                    evaluate(&pair, &b1.pose, &b2.pose, std::slice::from_mut(out)).expect("room for 1");
+                }
+                black_box(&points);
+            })
+        });
+        let mut kin = vec![ContactKinematics::default(); n];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_kinematics"), n), &n, |b, _| {
+            b.iter(|| {
+                for ((b1, b2), out) in bodies.iter().zip(kin.iter_mut()) {
+                    contact_kinematics(&pair, b1, b2, std::slice::from_mut(out)).expect("room for 1");
+                }
+                black_box(&kin);
+            })
+        });
+    }
+    g.finish();
 }
 
 /// 100 box–box pairs near contact, moving: [`evaluate`] and [`contact_kinematics`] per pair.

@@ -454,8 +454,9 @@ impl Curve {
                 }
                 let u = cross(&(c - a), &d2) / den;
                 let v = cross(&(c - a), &d1) / den;
+                // half-open: two chords through one sample point cross there too
                 ensure!(
-                    !(u > 0.0 && u < 1.0 && v > 0.0 && v < 1.0),
+                    !((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v)),
                     Model,
                     "{what}: the curve intersects itself near ({:.4}, {:.4}) (parameters {:.4} and {:.4})",
                     a.x + u * d1.x,
