@@ -62,13 +62,19 @@ class Sphere(Contour):
 
 @dataclass
 class Plane(Contour):
-    """The plane through ``point`` with outward ``normal``; the solid side is below it."""
+    """The plane through ``point`` with outward ``normal``; the solid side is below it.
+    ``surface_velocity`` (body frame, m/s, in the plane) makes it a moving surface, a conveyor
+    belt: contacts then stick by moving with it."""
 
     normal: Sequence[float] = (0.0, 0.0, 1.0)
     point: Sequence[float] = (0.0, 0.0, 0.0)
+    surface_velocity: Sequence[float] | None = None
 
     def describe(self, what: str) -> dict:
-        return {"type": "plane", "point": _vec3(self.point, f"{what}.point"), "normal": _vec3(self.normal, f"{what}.normal")}
+        d = {"type": "plane", "point": _vec3(self.point, f"{what}.point"), "normal": _vec3(self.normal, f"{what}.normal")}
+        if self.surface_velocity is not None:
+            d["surface_velocity"] = _vec3(self.surface_velocity, f"{what}.surface_velocity")
+        return d
 
 
 @dataclass
@@ -130,13 +136,19 @@ class Circle(Contour):
 
 @dataclass
 class Line(Contour):
-    """The line through ``point`` in the body's x-y plane; the solid side is behind ``normal``."""
+    """The line through ``point`` in the body's x-y plane; the solid side is behind ``normal``.
+    ``surface_velocity`` (body frame, m/s, along the line) makes it a moving surface, a conveyor
+    belt: contacts then stick by moving with it."""
 
     normal: Sequence[float] = (0.0, 1.0, 0.0)
     point: Sequence[float] = (0.0, 0.0, 0.0)
+    surface_velocity: Sequence[float] | None = None
 
     def describe(self, what: str) -> dict:
-        return {"type": "line", "point": _vec3(self.point, f"{what}.point"), "normal": _vec3(self.normal, f"{what}.normal")}
+        d = {"type": "line", "point": _vec3(self.point, f"{what}.point"), "normal": _vec3(self.normal, f"{what}.normal")}
+        if self.surface_velocity is not None:
+            d["surface_velocity"] = _vec3(self.surface_velocity, f"{what}.surface_velocity")
+        return d
 
 
 @dataclass

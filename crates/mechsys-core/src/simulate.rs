@@ -1398,6 +1398,10 @@ fn time_stepping(
         acc_t.fill([0.0; 2]);
         rec.dissipated_impact.push(stepper.dissipated_impact);
         rec.dissipated_friction.push(stepper.dissipated_friction);
+        // the work of moving surfaces (conveyors) is external work done through the contacts
+        if let Some(w) = rec.external_work.last_mut() {
+            *w += stepper.surface_work;
+        }
         // contact groups: what happened since the previous sample
         stepper.take_group_stats(&mut group_stats);
         for g in &group_stats {

@@ -90,6 +90,9 @@ pub struct ContactKinematics {
     pub wbar_n: f64,
     /// `w̄_T` (`d ġ_T/dt` if the full accelerations were given).
     pub wbar_t: [f64; 2],
+    /// The part of `ġ_T` that the contours' moving surfaces add (a conveyor belt's speed), the
+    /// rheonomic `w̃_T` of eq. 2.112: `ġ_T = W_Tᵀ u + w̃_T` (zero without moving surfaces).
+    pub gd_t_surface: [f64; 2],
 }
 
 /// Fills `out[..pair.candidates()]` for body 1 in state `b1` and body 2 in `b2`. No allocation;
@@ -125,22 +128,34 @@ pub fn contact_kinematics(
 ) -> Result<()> {
     pair.check_len(out.len())?;
     let (tw1, tw2) = (&b1.twist, &b2.twist);
+    let surface = pair.surface_velocity();
     // one evaluation of the pair: shared work (a box–box manifold) is done once for all candidates
     pair.each_candidate(&b1.pose, &b2.pose, Some((tw1, tw2)), |k, r| {
         let t = pair.tangents(&b2.pose, &r.n, Some((&tw2.w, &r.nd)));
         let (v1, v2) = (b1.point_velocity(&r.p1), b2.point_velocity(&r.p2));
+        // a moving surface: its material slides over its contour at the body-fixed velocity u_i,
+        // so it moves at v_i(P) + A_i u_i; tangential, so ġ_N and the W-part are unchanged
+        let (ws1, ws2) = (b1.pose.a * surface[0], b2.pose.a * surface[1]);
+        let dws = ws1 - ws2;
         let dv = v1 - v2;
         // σ_i: motion of the contact point over contour i
         let (s1, s2) = (r.p1d - v1, r.p2d - v2);
         // d/dt v_i(P_i(t)) = a_i(P_i) + ω_i × σ_i
         let da = b1.point_acceleration(&r.p1) - b2.point_acceleration(&r.p2) + tw1.w.cross(&s1) - tw2.w.cross(&s2);
+        let surf = [t.t1.dot(&dws), t.t2.dot(&dws)];
+        // d/dt (A_i u_i) = ω_i × A_i u_i for a constant body-fixed surface velocity
+        let dws_dt = tw1.w.cross(&ws1) - tw2.w.cross(&ws2);
         out[k] = ContactKinematics {
             point: ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 },
             gd_n: r.n.dot(&dv),
-            gd_t: [t.t1.dot(&dv), t.t2.dot(&dv)],
+            gd_t: [t.t1.dot(&dv) + surf[0], t.t2.dot(&dv) + surf[1]],
             // eqs. 2.114, 2.115 / 2.128
             wbar_n: r.nd.dot(&dv) + r.n.dot(&da),
-            wbar_t: [t.t1d.dot(&dv) + t.t1.dot(&da), t.t2d.dot(&dv) + t.t2.dot(&da)],
+            wbar_t: [
+                t.t1d.dot(&(dv + dws)) + t.t1.dot(&(da + dws_dt)),
+                t.t2d.dot(&(dv + dws)) + t.t2.dot(&(da + dws_dt)),
+            ],
+            gd_t_surface: surf,
         };
     });
     Ok(())

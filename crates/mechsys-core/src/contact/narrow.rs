@@ -129,6 +129,9 @@ pub struct ContactPair {
     planar: bool,
     /// Tangent reference axes, body 2 frame (the caller's body 2).
     tangent_ref: [Vec3; 2],
+    /// Velocity of each contour's surface material over the contour, body frames, caller's
+    /// order (zero unless a plane or line is a moving surface, a conveyor belt).
+    surface: [Vec3; 2],
 }
 
 /// Raw candidate: geometry and, when asked, rates (zero otherwise).
@@ -255,7 +258,7 @@ impl ContactPair {
             Contour::Box { rotation, .. } => [rotation.column(0).into_owned(), rotation.column(1).into_owned()],
             _ => [Vec3::x(), Vec3::y()],
         };
-        Ok(ContactPair { kinds: (k1, k2), geometry, swapped, count, planar, tangent_ref })
+        Ok(ContactPair { kinds: (k1, k2), geometry, swapped, count, planar, tangent_ref, surface: [Vec3::zeros(); 2] })
     }
 
     /// The box–box feature pair chosen at these placements (tests).
@@ -300,6 +303,49 @@ impl ContactPair {
         g.set_points(points);
         self.count = points;
         Ok(self)
+    }
+
+    /// Makes contour `which` (1 or 2), a plane or a line, a moving surface: its material moves
+    /// over it at `velocity` (body frame, m/s, in its plane), as a conveyor belt does. The
+    /// contact's tangential velocity is then measured against the moving material, so sticking
+    /// means moving with the belt. An error for other contours, or a velocity with a normal part.
+    pub fn with_surface_velocity(mut self, which: usize, velocity: Vec3) -> Result<Self> {
+        let name = format!("{}–{}", self.kinds.0, self.kinds.1);
+        ensure!(which == 1 || which == 2, Model, "contact pair {name}: the moving contour is 1 or 2, got {which}");
+        ensure!(
+            velocity.iter().all(|v| v.is_finite()),
+            Model,
+            "contact pair {name}: surface velocity must be finite, got {:?}",
+            velocity.as_slice()
+        );
+        let normal = match (&self.geometry, which == 2, self.swapped) {
+            // the canonical body 2 holds the plane or line
+            (Geometry::PointsHalfSpace { normal, .. } | Geometry::CylinderHalfSpace { normal, .. }, is2, sw)
+                if is2 != sw =>
+            {
+                *normal
+            }
+            (Geometry::Curve(CurveGeometry::OnLine { normal, .. }), is2, sw) if is2 != sw => lift(normal),
+            _ => {
+                return Err(Error::Model(format!(
+                    "contact pair {name}: only a plane or a line can be a moving surface (contour {which} is a {})",
+                    if which == 1 { self.kinds.0 } else { self.kinds.1 }
+                )))
+            }
+        };
+        let along = velocity.dot(&normal) / normal.norm();
+        ensure!(
+            along.abs() <= 1e-12 * (1.0 + velocity.norm()),
+            Model,
+            "contact pair {name}: a surface velocity must lie in the surface; it has {along} m/s along the normal"
+        );
+        self.surface[which - 1] = velocity;
+        Ok(self)
+    }
+
+    /// Surface velocities of contours 1 and 2 (body frames).
+    pub fn surface_velocity(&self) -> &[Vec3; 2] {
+        &self.surface
     }
 
     /// Number of candidate points (the length `evaluate` fills).

@@ -182,6 +182,8 @@ pub struct MoreauJean {
     pub dissipated_impact: f64,
     /// Energy dissipated so far by tangential impulses (J).
     pub dissipated_friction: f64,
+    /// Work done on the system by moving surfaces (conveyor belts) through friction (J).
+    pub surface_work: f64,
     /// Bilateral constraint impulse of the last step (nc), N s.
     pub bilateral_impulse: Vec<f64>,
     /// Steps whose contact problem did not reach the solver tolerance, and the worst residual.
@@ -255,6 +257,7 @@ impl MoreauJean {
             painleve: Vec::with_capacity(np),
             dissipated_impact: 0.0,
             dissipated_friction: 0.0,
+            surface_work: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
             unconverged: (0, 0.0),
             groups: model.contact_groups.iter().map(GroupPhase::new).collect(),
@@ -482,6 +485,16 @@ impl MoreauJean {
                     self.gd_before[a] = s0;
                 }
             }
+            // moving surfaces: ġ_T = W_Tᵀ u + w̃_T (eq. 2.112), the belt's speed at the midpoint
+            for (ai, a) in self.act.iter().enumerate() {
+                if let Source::Point(pt) = a.source {
+                    let s = self.kin[pt].gd_t_surface;
+                    for k in 1..d {
+                        self.problem.q[ai * d + k] += s[k - 1];
+                        self.gd_before[ai * d + k] += s[k - 1];
+                    }
+                }
+            }
             // the local problem: restitution, gap allowance, friction coefficients, warm start
             self.problem.dim = d;
             self.problem.mu.clear();
@@ -667,6 +680,14 @@ impl MoreauJean {
                     for (row, af) in after.iter_mut().enumerate().take(d) {
                         let a = ai * d + row;
                         *af = (0..nu).map(|i| self.w_rows[(a, i)] * u[i]).sum();
+                    }
+                }
+                // a moving surface: ġ_T⁺ includes its speed, and it works on the system by -Λ_Tᵀ w̃_T
+                if let Source::Point(pt) = self.act[ai].source {
+                    let w = self.kin[pt].gd_t_surface;
+                    for row in 1..d {
+                        after[row] += w[row - 1];
+                        self.surface_work -= self.r[ai * d + row] * w[row - 1];
                     }
                 }
                 let mut e_point = 0.0;

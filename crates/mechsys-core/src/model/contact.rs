@@ -184,6 +184,16 @@ fn planar(c: &ContourDescription) -> bool {
     )
 }
 
+/// The surface velocity of a moving plane or line (a conveyor belt).
+fn surface_velocity(c: &ContourDescription) -> Option<[f64; 3]> {
+    match c {
+        ContourDescription::Plane { surface_velocity, .. } | ContourDescription::Line { surface_velocity, .. } => {
+            *surface_velocity
+        }
+        _ => None,
+    }
+}
+
 /// The engine contour of a description; a `point` is planar when its partner is.
 fn contour(
     c: &ContourDescription,
@@ -197,7 +207,7 @@ fn contour(
         }
         ContourDescription::Point { position } => Contour::Point { p: vec3(position) },
         ContourDescription::Sphere { center, radius } => Contour::Sphere { center: vec3(center), radius: *radius },
-        ContourDescription::Plane { point, normal } => Contour::Plane { point: vec3(point), normal: vec3(normal) },
+        ContourDescription::Plane { point, normal, .. } => Contour::Plane { point: vec3(point), normal: vec3(normal) },
         ContourDescription::Box { center, rotation: r, half_extents } => Contour::Box {
             center: vec3(center),
             rotation: rotation(r, &format!("{what}.rotation"))?,
@@ -210,7 +220,7 @@ fn contour(
         ContourDescription::Circle { center, radius } => {
             Contour::Circle { center: Vec2::new(center[0], center[1]), radius: *radius }
         }
-        ContourDescription::Line { point, normal } => {
+        ContourDescription::Line { point, normal, .. } => {
             Contour::Line { point: Vec2::new(point[0], point[1]), normal: Vec2::new(normal[0], normal[1]) }
         }
         ContourDescription::Polygon { vertices } => {
@@ -340,6 +350,15 @@ pub(super) fn validate(
     let c1 = contour(&d.contour1, planar(&d.contour2), &format!("{what}.contour1"), rotation)?;
     let c2 = contour(&d.contour2, planar(&d.contour1), &format!("{what}.contour2"), rotation)?;
     let pair = ContactPair::new(&d.name, c1, c2)?;
+    let mut pair = pair;
+    for (which, c) in [(1, &d.contour1), (2, &d.contour2)] {
+        if let Some(v) = surface_velocity(c) {
+            pair = pair.with_surface_velocity(which, vec3(&v)).map_err(|e| match e {
+                Error::Model(m) => Error::Model(format!("{what}.contour{which}.surface_velocity: {m}")),
+                other => other,
+            })?;
+        }
+    }
     let pair = match d.points {
         None => pair,
         Some(p) => pair.with_points(p).map_err(|e| match e {
@@ -380,6 +399,11 @@ pub(super) fn validate_group(
             .map(|(k, m)| {
                 let w = format!("{what}.{key}[{k}]");
                 let b = body(&m.body, &format!("{w}.body"))?;
+                crate::ensure!(
+                    surface_velocity(&m.contour).is_none(),
+                    Model,
+                    "{w}.contour.surface_velocity: moving surfaces are supported on explicit contacts, not in groups"
+                );
                 let c = contour(&m.contour, any_planar, &format!("{w}.contour"), rotation)?;
                 c.validate(&format!("{w}.contour ({})", c.kind()))?;
                 Ok(GroupContour { body: b, contour: c.normalized() })

@@ -62,6 +62,10 @@ pub enum ContourDescription {
         point: [f64; 3],
         /// Outward normal (normalised when read).
         normal: [f64; 3],
+        /// A moving surface (a conveyor belt): the velocity of its material over the plane, body
+        /// frame (m/s), in the plane.
+        #[serde(default)]
+        surface_velocity: Option<[f64; 3]>,
     },
     /// A box.
     Box {
@@ -110,6 +114,10 @@ pub enum ContourDescription {
         point: [f64; 3],
         /// Outward normal in the x-y plane (normalised when read).
         normal: [f64; 3],
+        /// A moving surface (a conveyor belt): the velocity of its material along the line, body
+        /// frame (m/s), in the x-y plane and along the line.
+        #[serde(default)]
+        surface_velocity: Option<[f64; 3]>,
     },
     /// A convex polygon in the body's x-y plane, vertices counter-clockwise.
     Polygon {

@@ -384,3 +384,60 @@ fn degenerate_configurations_give_finite_rates() {
 }
 
 
+
+/// A moving surface (conveyor belt) on a turning, moving body 2: `ġ_T` is the sliding velocity
+/// against the belt's material (the material points' relative velocity plus the belt's speed
+/// `w̃_T`), `ġ_N` is unchanged, and `d ġ_T/dt` matches differences of `ġ_T`.
+#[test]
+fn moving_surface_adds_its_speed_to_the_tangential_velocity() {
+    let mut rng = Rng::new(99);
+    for (c1, c2, belt) in [
+        (sample("sphere"), sample("plane"), Vec3::new(0.0, 0.0, 0.0)),
+        (sample("circle"), sample("line"), Vec3::new(0.0, 0.0, 0.0)),
+        (crate::contact::test_util::curve_sample("ellipse"), sample("line"), Vec3::new(0.0, 0.0, 0.0)),
+    ] {
+        // a belt speed along the surface: the plane's or line's own tangent, 0.7 m/s
+        let normal = match &c2 {
+            Contour::Plane { normal, .. } => normal.normalize(),
+            Contour::Line { normal, .. } => Vec3::new(normal.x, normal.y, 0.0).normalize(),
+            _ => unreachable!(),
+        };
+        let along = (Vec3::z().cross(&normal) + belt).normalize() * 0.7;
+        let plain = ContactPair::new("b", c1.clone(), c2.clone()).unwrap();
+        let moving = ContactPair::new("b", c1, c2).unwrap().with_surface_velocity(2, along).unwrap();
+        let planar = plain.is_planar();
+        let (x1, x2) = random_poses(&mut rng, planar);
+        let (tr1, tr2) = if planar {
+            (Trajectory::random_planar(&mut rng, &x1, 0.5, 0.25), Trajectory::random_planar(&mut rng, &x2, 0.5, 0.25))
+        } else {
+            (Trajectory::random(&mut rng, &x1, 0.5, 0.25), Trajectory::random(&mut rng, &x2, 0.5, 0.25))
+        };
+        let (a, b) = (kin(&plain, &tr1.at(0.0), &tr2.at(0.0)), kin(&moving, &tr1.at(0.0), &tr2.at(0.0)));
+        let w = tr2.at(0.0).pose.a * along;
+        for (p, m) in a.iter().zip(&b) {
+            assert_eq!(p.gd_n, m.gd_n);
+            assert_eq!(p.wbar_n, m.wbar_n);
+            // the belt material moves at v2(P2) + A2 u: sliding against it is the difference
+            for k in 0..2 {
+                let t = [m.point.t1, m.point.t2][k];
+                assert!((m.gd_t[k] - (p.gd_t[k] - t.dot(&w))).abs() < 1e-14, "ġ_T[{k}]");
+                assert!((m.gd_t_surface[k] + t.dot(&w)).abs() < 1e-14);
+                let h = 1e-5;
+                let fd = (kin(&moving, &tr1.at(h), &tr2.at(h))[0].gd_t[k] - kin(&moving, &tr1.at(-h), &tr2.at(-h))[0].gd_t[k])
+                    / (2.0 * h);
+                assert!(close(m.wbar_t[k], fd, 1e-6), "d ġ_T[{k}]/dt {} vs difference {fd}", m.wbar_t[k]);
+            }
+        }
+    }
+}
+
+#[test]
+fn moving_surface_is_refused_off_planes_and_lines_and_out_of_the_surface() {
+    let pair = ContactPair::new("b", sample("sphere"), sample("plane")).unwrap();
+    let e = pair.clone().with_surface_velocity(1, Vec3::x()).unwrap_err().to_string();
+    assert!(e.contains("only a plane or a line can be a moving surface") && e.contains("sphere"), "{e}");
+    let e = pair.clone().with_surface_velocity(2, Vec3::new(0.1, 0.2, 1.0)).unwrap_err().to_string();
+    assert!(e.contains("must lie in the surface"), "{e}");
+    let e = pair.with_surface_velocity(2, Vec3::new(f64::NAN, 0.0, 0.0)).unwrap_err().to_string();
+    assert!(e.contains("must be finite"), "{e}");
+}

@@ -60,7 +60,8 @@ impl Phase<'_> {
         before.clear();
         before.resize(dm, 0.0);
         for (a, b) in before.iter_mut().enumerate() {
-            *b = (0..nu).map(|i| self.rows[(a, i)] * u[i]).sum();
+            // ġ = Wᵀu + w̃ (a moving surface's speed in the tangential rows)
+            *b = (0..nu).map(|i| self.rows[(a, i)] * u[i]).sum::<f64>() + self.surface_rate(pts[a / d], a % d);
         }
         self.fc.mu.clear();
         for &pt in pts {
@@ -195,6 +196,17 @@ impl Phase<'_> {
         Ok(())
     }
 
+    /// The rheonomic part `w̃` of relative velocity `k` (0 normal, 1–2 tangential) of point `pt`:
+    /// a moving surface's speed (eq. 2.112); zero otherwise.
+    #[inline]
+    fn surface_rate(&self, pt: usize, k: usize) -> f64 {
+        if k == 0 {
+            0.0
+        } else {
+            self.kin[pt].gd_t_surface[k - 1]
+        }
+    }
+
     /// Closed points keep the relative velocities the transition took as zero (up to
     /// `velocity_tol`): a small impulse makes them exactly zero (normal, and tangential for
     /// sticking points), so that a resting contact does not creep apart or slide.
@@ -231,7 +243,8 @@ impl Phase<'_> {
             for j in 0..n {
                 self.mat[i * n + j] = self.coupling(i, j);
             }
-            self.rhs[i] = -(0..nu).map(|c| self.rows[(i, c)] * u[c]).sum::<f64>();
+            let (pt, k) = self.unk[i];
+            self.rhs[i] = -(0..nu).map(|c| self.rows[(i, c)] * u[c]).sum::<f64>() - self.surface_rate(pt, k);
         }
         let mut before = std::mem::take(&mut self.ev.before);
         before.clear();
@@ -257,7 +270,7 @@ impl Phase<'_> {
             let l = self.rhs[j];
             let (pt, k) = self.unk[j];
             imp[3 * pt + k] += l;
-            let after: f64 = (0..nu).map(|c| self.rows[(j, c)] * u[c]).sum();
+            let after: f64 = (0..nu).map(|c| self.rows[(j, c)] * u[c]).sum::<f64>() + self.surface_rate(pt, k);
             let e = -l * 0.5 * (before[j] + after);
             self.ev.point_energy[pt] += e;
             if k == 0 {

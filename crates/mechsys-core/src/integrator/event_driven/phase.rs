@@ -559,7 +559,14 @@ impl OdeSystem for Phase<'_> {
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
         let e = nq + nu;
         dy[e] = p.dissipated;
-        dy[e + 1] = p.external;
+        // a moving surface (conveyor) works on the system through the friction force: -λ_Tᵀ w̃_T
+        let belt: f64 = (0..np)
+            .map(|pt| {
+                let w = self.kin[pt].gd_t_surface;
+                -(self.lam_t[pt][0] * w[0] + self.lam_t[pt][1] * w[1])
+            })
+            .sum();
+        dy[e + 1] = p.external + belt;
         dy[e + 2] = self.friction_power;
         for pt in 0..np {
             dy[e + 3 + pt] = self.lam_n[pt];
