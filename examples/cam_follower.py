@@ -55,7 +55,7 @@ simulation = dict(t_end=2 * 2 * np.pi / (0.9 * OMEGA_C), integrator=ms.EventDriv
 
 
 def contact_force_closed_form(res) -> np.ndarray:
-    """Vertical contact force while the roller follows the cam (zero-mass-error closed form)."""
+    """Vertical contact force while the roller follows the cam: m omega^2 h'' + k h + F0 + m g."""
     omega = np.gradient(res["joint/shaft/q"], res.t)
     theta = res["joint/shaft/q"]
     hdd = 0.5 * LIFT * np.cos(theta) * omega**2

@@ -25,7 +25,7 @@
 
 use crate::ensure;
 use crate::error::Result;
-use crate::geometry::spline::{wrap, Spline1};
+use crate::geometry::spline::{wrap, Quintic1, Spline1};
 
 /// 2-vector of `f64`.
 pub type Vec2 = nalgebra::Vector2<f64>;
@@ -98,7 +98,28 @@ enum Shape {
     /// A cam disc: the follower axis is the +y axis of the frame the cam turns in; at cam angle
     /// `s` the cam has turned by `dir · s`; `w = base + h(s)` is the follower's position along its
     /// axis (the roller centre, or the flat face).
-    Cam { lift: Spline1, base: f64, eccentricity: f64, dir: f64, flat: bool },
+    Cam { lift: Lift, base: f64, eccentricity: f64, dir: f64, flat: bool },
+}
+
+/// A cam's lift table as a periodic spline: quintic (C⁴) on equally spaced angles, else cubic.
+#[derive(Debug, Clone, PartialEq)]
+enum Lift {
+    Cubic(Spline1),
+    Quintic(Quintic1),
+}
+
+impl Lift {
+    /// `[h, h', h'', h''', h'''']`.
+    #[inline]
+    fn eval(&self, s: f64) -> [f64; 5] {
+        match self {
+            Lift::Cubic(c) => {
+                let j = c.eval(s);
+                [j[0], j[1], j[2], j[3], 0.0]
+            }
+            Lift::Quintic(q) => q.eval(s),
+        }
+    }
 }
 
 /// One sample of the base curve.
@@ -261,7 +282,8 @@ impl Curve {
 
     /// A cam disc from a periodic lift table: `angles` (rad, increasing, from 0 to 2π inclusive)
     /// and `lift` (m) with `lift[last] = lift[0]` (a table ending before 2π is closed with the
-    /// first value). `base_radius` is the radius of the cam's base circle (its profile where the
+    /// first value), interpolated by a periodic quintic spline (C⁴) when the angles are equally
+    /// spaced, else by a periodic cubic spline (C²). `base_radius` is the radius of the cam's base circle (its profile where the
     /// lift is 0). The cam turns about its body's z axis by `direction · angle` (`direction` ±1);
     /// the follower translates along the +y axis of the frame it turns in (the cam body at
     /// angle 0), so at cam angle θ the follower is at `base_radius (+ roller radius) + h(θ)`.
@@ -302,7 +324,12 @@ impl Curve {
             t.push(tau);
             h.push(h[0]);
         }
-        let spline = Spline1::periodic(&t, &h, what)?;
+        // equally spaced angles (a sampled lift function, most tables): a C⁴ quintic spline, so
+        // the follower's jerk stays continuous; otherwise a C² cubic
+        let spline = match Quintic1::periodic(&t, &h, what)? {
+            Some(q) => Lift::Quintic(q),
+            None => Lift::Cubic(Spline1::periodic(&t, &h, what)?),
+        };
         let (eccentricity, radius, flat) = match follower {
             Follower::Roller { radius, eccentricity } => {
                 ensure!(radius >= 0.0 && radius.is_finite(), Model, "{what}: cam roller radius must be ≥ 0, got {radius}");
@@ -488,11 +515,11 @@ impl Curve {
         self
     }
 
-    /// Lift `[h, h', h'', h''']` of a cam at cam angle `s` (zeros for other shapes).
-    fn lift(&self, s: f64) -> [f64; 4] {
+    /// Lift `[h, h', h'', h''', h'''']` of a cam at cam angle `s` (zeros for other shapes).
+    fn lift(&self, s: f64) -> [f64; 5] {
         match &self.shape {
             Shape::Cam { lift, .. } => lift.eval(s),
-            _ => [0.0; 4],
+            _ => [0.0; 5],
         }
     }
 
@@ -530,12 +557,12 @@ impl Curve {
                 let u = Vec2::new(d * sn, cs);
                 if *flat {
                     // envelope of the face lines u·x = ρ: x = ρ u + d ρ' a
-                    let (r0, r1, r2, r3) = (base + h[0], h[1], h[2], h[3]);
+                    let (r0, r1, r2, r3, r4) = (base + h[0], h[1], h[2], h[3], h[4]);
                     [
                         u * r0 + a * (d * r1),
                         a * (d * (r0 + r2)),
                         a * (d * (r1 + r3)) - u * (r0 + r2),
-                        a * (-d * r0) - u * (2.0 * (r1 + r3)),
+                        a * (d * (r4 - r0)) - u * (2.0 * (r1 + r3)),
                     ]
                 } else {
                     // pitch curve p = e a + w u, w = base + h
@@ -699,7 +726,7 @@ mod tests {
         let (fm, f0, fp) = (c.frame(s - h), c.frame(s), c.frame(s + h));
         let dsigma = (fp.point - fm.point).norm();
         let fd = (fp.curvature - fm.curvature) / dsigma;
-        assert!((fd - f0.curvature_rate).abs() < 1e-5 * (1.0 + f0.curvature_rate.abs()), "{}: κ' {fd} vs {}", c.shape_name(), f0.curvature_rate);
+        assert!((fd - f0.curvature_rate).abs() < 1e-5 * (1.0 + f0.curvature_rate.abs()), "{} (offset {}) at {s}: κ' {fd} vs {}", c.shape_name(), c.offset(), f0.curvature_rate);
         // outward normal ⟂ tangent, eq. 2.89: t' = -κ ν per arc length (ν outward = -n)
         let tfd = (fp.tangent - fm.tangent) / dsigma;
         assert!((tfd + f0.normal * f0.curvature).norm() < 1e-5 * (1.0 + f0.curvature.abs()));

@@ -123,6 +123,109 @@ impl Spline1 {
     }
 }
 
+/// A periodic quintic spline on equally spaced knots, C⁴: `f(t) = Σ c_j B₅((t - t_j) / h)` with
+/// the centred quintic B-spline `B₅`. Interpolation gives the cyclic system
+/// `(c_{i-2} + 26 c_{i-1} + 66 c_i + 26 c_{i+1} + c_{i+2}) / 120 = y_i`, strictly diagonally
+/// dominant, solved by Gauss–Seidel when built. A smooth motion law tabulated on such knots keeps
+/// four continuous derivatives (a cubic spline's third derivative jumps at every knot, which an
+/// error-controlled integrator pays for with rejected steps).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Quintic1 {
+    t0: f64,
+    h: f64,
+    /// Per segment the polynomial in the local coordinate `τ ∈ [0, 1)`: `Σ a_p τ^p` (built from
+    /// the B-spline coefficients once, so evaluation is a stable Horner scheme).
+    seg: Vec<[f64; 6]>,
+}
+
+/// Value and the first four derivatives.
+pub type Jet1x = [f64; 5];
+
+impl Quintic1 {
+    /// Through `(t_i, y_i)`, `i = 0..=n`, equally spaced, `y_n = y_0` (at least 6 distinct points);
+    /// `None` when the knots are not equally spaced (to 1e-9 of the spacing).
+    pub fn periodic(t: &[f64], y: &[f64], what: &str) -> Result<Option<Self>> {
+        check(t, y, 7, what)?;
+        let n = t.len() - 1;
+        let h = (t[n] - t[0]) / n as f64;
+        if (0..=n).any(|i| (t[i] - (t[0] + h * i as f64)).abs() > 1e-9 * h) {
+            return Ok(None);
+        }
+        let scale = y.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+        ensure!(
+            (y[n] - y[0]).abs() <= 1e-12 * scale,
+            Model,
+            "{what}: a periodic spline must end where it starts, got {} at the start and {} at the end",
+            y[0],
+            y[n]
+        );
+        let mut c: Vec<f64> = y[..n].to_vec();
+        let at = |k: isize| ((k % n as isize + n as isize) % n as isize) as usize;
+        for _ in 0..2000 {
+            let mut change: f64 = 0.0;
+            for i in 0..n {
+                let ii = i as isize;
+                let off = c[at(ii - 2)] + 26.0 * c[at(ii - 1)] + 26.0 * c[at(ii + 1)] + c[at(ii + 2)];
+                let new = (120.0 * y[i] - off) / 66.0;
+                change = change.max((new - c[i]).abs());
+                c[i] = new;
+            }
+            if change <= 1e-16 * scale {
+                break;
+            }
+        }
+        // the pieces of B₅ over one unit interval, as polynomials in τ: B₅(τ + m) for the shift
+        // m = i - j ∈ {-3, ..., 2} of knot j relative to segment i (exact small-integer arithmetic)
+        const BINOM6: [f64; 7] = [1.0, -6.0, 15.0, -20.0, 15.0, -6.0, 1.0];
+        const BINOM5: [f64; 6] = [1.0, 5.0, 10.0, 10.0, 5.0, 1.0];
+        let mut piece = [[0.0; 6]; 6];
+        for (idx, m) in (-3i32..=2).enumerate() {
+            for (k, b) in BINOM6.iter().enumerate() {
+                let shift = m + 3 - k as i32;
+                if shift < 0 {
+                    continue;
+                }
+                // (τ + shift)⁵ = Σ_p C(5, p) shift^(5-p) τ^p
+                for (pw, c5) in BINOM5.iter().enumerate() {
+                    piece[idx][pw] += b * c5 * (shift as f64).powi(5 - pw as i32) / 120.0;
+                }
+            }
+        }
+        let seg = (0..n)
+            .map(|i| {
+                let mut a = [0.0; 6];
+                for (idx, m) in (-3i32..=2).enumerate() {
+                    let cj = c[at(i as isize - m as isize)];
+                    for p in 0..6 {
+                        a[p] += cj * piece[idx][p];
+                    }
+                }
+                a
+            })
+            .collect();
+        Ok(Some(Quintic1 { t0: t[0], h, seg }))
+    }
+
+    /// `[f, f', f'', f''', f'''']` at `t` (wrapped into the period). No allocation.
+    #[inline]
+    pub fn eval(&self, t: f64) -> Jet1x {
+        let n = self.seg.len();
+        let period = self.h * n as f64;
+        let x = (wrap(t, self.t0, self.t0 + period) - self.t0) / self.h;
+        let i = (x.floor() as usize).min(n - 1);
+        let tau = x - i as f64;
+        let a = &self.seg[i];
+        // Horner for the value and the derivatives in τ
+        let f0 = a[0] + tau * (a[1] + tau * (a[2] + tau * (a[3] + tau * (a[4] + tau * a[5]))));
+        let f1 = a[1] + tau * (2.0 * a[2] + tau * (3.0 * a[3] + tau * (4.0 * a[4] + tau * 5.0 * a[5])));
+        let f2 = 2.0 * a[2] + tau * (6.0 * a[3] + tau * (12.0 * a[4] + tau * 20.0 * a[5]));
+        let f3 = 6.0 * a[3] + tau * (24.0 * a[4] + tau * 60.0 * a[5]);
+        let f4 = 24.0 * a[4] + tau * 120.0 * a[5];
+        let ih = 1.0 / self.h;
+        [f0, f1 * ih, f2 * ih * ih, f3 * ih * ih * ih, f4 * ih * ih * ih * ih]
+    }
+}
+
 /// `t` wrapped into `[lo, hi)`.
 #[inline]
 pub fn wrap(t: f64, lo: f64, hi: f64) -> f64 {
@@ -249,6 +352,44 @@ mod tests {
         assert!(a.iter().zip(&b).all(|(p, q)| (p - q).abs() < 1e-9));
         let (c, d) = (s.eval(-1e-13), s.eval(1e-13));
         assert!((c[1] - d[1]).abs() < 1e-9 && (c[2] - d[2]).abs() < 1e-8);
+    }
+
+    #[test]
+    fn periodic_quintic_interpolates_is_c4_and_converges_at_sixth_order() {
+        let tau = std::f64::consts::TAU;
+        let err = |n: usize| {
+            let t: Vec<f64> = (0..=n).map(|i| tau * i as f64 / n as f64).collect();
+            let mut y: Vec<f64> = t.iter().map(|x| (x.cos() + 0.3 * (2.0 * x).sin()).exp()).collect();
+            y[n] = y[0];
+            let s = Quintic1::periodic(&t, &y, "q").unwrap().unwrap();
+            // interpolates
+            for (a, b) in t.iter().zip(&y) {
+                assert!((s.eval(*a)[0] - b).abs() < 1e-12);
+            }
+            let f = |x: f64| (x.cos() + 0.3 * (2.0 * x).sin()).exp();
+            (0..300).map(|k| 0.0209 * k as f64 + 0.004).map(|x| (s.eval(x)[0] - f(x)).abs()).fold(0.0, f64::max)
+        };
+        let (e1, e2) = (err(40), err(80));
+        assert!((e1 / e2).log2() > 5.5, "{e1} {e2}");
+        // derivatives against differences and continuity of the fourth across a knot
+        let n = 24;
+        let t: Vec<f64> = (0..=n).map(|i| tau * i as f64 / n as f64).collect();
+        let mut y: Vec<f64> = t.iter().map(|x| (3.0 * x).sin() * 0.2 + x.cos()).collect();
+        y[n] = y[0];
+        let s = Quintic1::periodic(&t, &y, "q").unwrap().unwrap();
+        let (x, h) = (0.77, 1e-5);
+        let (a, b, c) = (s.eval(x - h), s.eval(x), s.eval(x + h));
+        for k in 0..4 {
+            let fd = (c[k] - a[k]) / (2.0 * h);
+            assert!((fd - b[k + 1]).abs() < 1e-5 * (1.0 + b[k + 1].abs()), "derivative {k}: {fd} vs {}", b[k + 1]);
+        }
+        let knot = t[5];
+        let (l, r) = (s.eval(knot - 1e-10), s.eval(knot + 1e-10));
+        assert!((l[4] - r[4]).abs() < 1e-6 * (1.0 + l[4].abs()));
+        // unequal spacing: not for this spline
+        let mut t2 = t.clone();
+        t2[3] += 0.01;
+        assert!(Quintic1::periodic(&t2, &y, "q").unwrap().is_none());
     }
 
     #[test]
