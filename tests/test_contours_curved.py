@@ -205,3 +205,16 @@ def test_points_is_checked_and_only_for_parametric_pairs():
         m.build()
     with pytest.raises(ms.ModelError, match="expected a whole number from 1 to 8"):
         ms.Contact("c", b.contour(ms.contours.Circle(radius=0.1)), m.ground.contour(ms.contours.Ellipse(a=1, b=1)), points=9).describe([])
+
+
+def test_ball_rolling_in_a_spline_track_conserves_energy_and_oscillates_with_the_bottom_radius():
+    ex = _example("ball_in_track")
+    res = ms.simulate(ex.model, **ex.simulation)
+    # rolling does no work: the energy stays (event-driven, rtol 1e-10)
+    assert np.ptp(res["energy/total"]) < 1e-6
+    assert set(res["contact/track/state"].tolist()) == {1}
+    # the period of a disc rolling in a circle of the bottom's radius, longer by the finite
+    # amplitude (the parabola flattens away from the bottom): within 0.3 %
+    expected = 2 * math.pi * math.sqrt(3 * (ex.R0 - ex.RADIUS) / (2 * ex.G))
+    assert ex.period(res) == pytest.approx(expected, rel=3e-3)
+    assert ex.period(res) > expected
