@@ -218,3 +218,30 @@ def test_ball_rolling_in_a_spline_track_conserves_energy_and_oscillates_with_the
     expected = 2 * math.pi * math.sqrt(3 * (ex.R0 - ex.RADIUS) / (2 * ex.G))
     assert ex.period(res) == pytest.approx(expected, rel=3e-3)
     assert ex.period(res) > expected
+
+
+def test_contact_geometry_query_gives_gap_witness_points_normal_and_curvatures():
+    # the cam of benches/cam.py: the exact lift of an eccentric circle of radius R, so the
+    # profile is that circle; roller and cam curvatures 1/r and 1/R at the contact
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benches"))
+    import cam as bench_cam
+
+    m = bench_cam.build(True)
+    for angle in (0.3, 1.7, 4.0):
+        q = np.array(m.engine()[0].q0())
+        # shaft angle, then the follower where the roller touches the circle: y = e cos + sqrt(...)
+        e, R, r = bench_cam.E, bench_cam.R, bench_cam.ROLLER
+        y = e * math.cos(angle) + math.sqrt((R + r) ** 2 - (e * math.sin(angle)) ** 2) + 1e-3
+        q[0], q[1] = angle, y
+        g = ms.dynamics.contact_geometry(m, q)
+        assert g["contact"] == ["cam"]
+        centre = np.array([-e * math.sin(angle), e * math.cos(angle), 0.0])
+        roller = np.array([0.0, y, 0.0])
+        assert g["gap"][0] == pytest.approx(np.linalg.norm(roller - centre) - R - r, abs=1e-10)
+        assert np.allclose(g["point1"][0] - g["point2"][0], g["gap"][0] * g["normal"][0], atol=1e-15)
+        # the normal points from the cam's circle centre towards the roller centre
+        assert np.allclose(g["normal"][0], (roller - centre) / np.linalg.norm(roller - centre), atol=1e-9)
+        assert g["curvature1"][0] == pytest.approx([1 / r, 0.0])
+        assert g["curvature2"][0][0] == pytest.approx(1 / R, rel=1e-6)

@@ -77,5 +77,18 @@ aba = forward_dynamics
 crba = mass_matrix
 rnea = inverse_dynamics
 
-__all__ = ["mass_matrix", "forward_dynamics", "inverse_dynamics", "nonlinear_effects", "energies", "contact_matrices", "aba",
+def contact_geometry(model: Model, q) -> dict:
+    """The contact geometry of every candidate point of the explicit contacts at ``q``, outside a
+    simulation (sections 2.2.7.1, 2.5): ``gap`` (points, m), the witness points ``point1``,
+    ``point2`` on the two contours (points x 3, world, m; point1 - point2 = gap * normal), the
+    unit ``normal`` from contour 2 towards contour 1 and the tangents ``tangent1``, ``tangent2``,
+    and each contour's principal curvatures at its witness point, ``curvature1``, ``curvature2``
+    (points x 2, 1/m: convex > 0, hollow < 0; planar contours [kappa, 0]; inf at a point, vertex
+    or edge), with ``contact`` naming the contact of each point. Unused candidates of a pair
+    asked for several points have a gap larger than any real one."""
+    core, _ = model.engine()
+    return _core.contact_geometry(core, _arr(q))
+
+
+__all__ = ["contact_geometry", "mass_matrix", "forward_dynamics", "inverse_dynamics", "nonlinear_effects", "energies", "contact_matrices", "aba",
            "crba", "rnea"]

@@ -463,5 +463,53 @@ fn contact_matrices<'py>(
 }
 
 pub fn register_contact_matrices(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(contact_matrices, m)?)
+    m.add_function(wrap_pyfunction!(contact_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(contact_geometry, m)?)
+}
+
+/// The contact geometry at q for every candidate point of the explicit contacts: gap, the
+/// witness points on each contour, the normal and tangents, and each contour's principal
+/// curvatures at its witness point (planar contours: [κ, 0]; ∞ at points, vertices, edges).
+#[pyfunction]
+fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    use mechsys_core::contact::{evaluate, ContactPoint};
+    let m = &model.model;
+    let q = q_slice(model, q)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let zero = vec![0.0; m.nu];
+    kinematics::forward_kinematics(m, &mut data, q, &zero);
+    let (mut names, mut gap) = (Vec::new(), Vec::new());
+    let (mut p1, mut p2, mut n, mut t1, mut t2, mut k1, mut k2) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for con in &m.contacts {
+        let mut pts = vec![ContactPoint::default(); con.pair.candidates()];
+        let (x1, x2) = (data.x_abs[con.body1], data.x_abs[con.body2]);
+        evaluate(&con.pair, &x1, &x2, &mut pts).map_err(PyMechsysError::from)?;
+        for c in &pts {
+            names.push(con.name.clone());
+            gap.push(c.g_n);
+            p1.extend_from_slice(c.p1.as_slice());
+            p2.extend_from_slice(c.p2.as_slice());
+            n.extend_from_slice(c.n.as_slice());
+            t1.extend_from_slice(c.t1.as_slice());
+            t2.extend_from_slice(c.t2.as_slice());
+            k1.extend_from_slice(&con.contours[0].curvatures_at(&x1, &c.p1));
+            k2.extend_from_slice(&con.contours[1].curvatures_at(&x2, &c.p2));
+        }
+    }
+    let np = gap.len();
+    let d = PyDict::new(py);
+    let shaped = |v: Vec<f64>, shape: &[usize]| -> PyResult<Bound<'py, PyAny>> {
+        Ok(PyArray1::from_vec(py, v).reshape(shape.to_vec())?.into_any())
+    };
+    d.set_item("contact", names)?;
+    d.set_item("gap", shaped(gap, &[np])?)?;
+    d.set_item("point1", shaped(p1, &[np, 3])?)?;
+    d.set_item("point2", shaped(p2, &[np, 3])?)?;
+    d.set_item("normal", shaped(n, &[np, 3])?)?;
+    d.set_item("tangent1", shaped(t1, &[np, 3])?)?;
+    d.set_item("tangent2", shaped(t2, &[np, 3])?)?;
+    d.set_item("curvature1", shaped(k1, &[np, 2])?)?;
+    d.set_item("curvature2", shaped(k2, &[np, 2])?)?;
+    Ok(d)
 }

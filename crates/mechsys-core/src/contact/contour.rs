@@ -363,6 +363,80 @@ impl Contour {
 }
 
 /// A planar vector as a 3-vector of the body's x-y plane.
+impl Contour {
+    /// Principal curvatures (1/m; convex > 0, hollow < 0; `∞` at a point, a vertex or an edge,
+    /// where no curvature is defined) of the contour's surface at the world point `p` on it, the
+    /// body at `pose`. Planar contours are extruded along z, so their second curvature is 0.
+    /// For queries and reports, not the step loop (a curve searches its parameter).
+    ///
+    /// # Example
+    /// ```
+    /// use mechsys_core::contact::Contour;
+    /// use mechsys_core::math::Vec3;
+    /// use mechsys_core::spatial::Pose;
+    /// let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.5 };
+    /// assert_eq!(ball.curvatures_at(&Pose::IDENTITY, &Vec3::new(0.0, 0.0, 0.5)), [2.0, 2.0]);
+    /// ```
+    pub fn curvatures_at(&self, pose: &Pose, p: &Vec3) -> [f64; 2] {
+        let l = pose.a.transpose() * (p - pose.r);
+        let inf = f64::INFINITY;
+        match self {
+            Contour::Point { .. } | Contour::Point2 { .. } => [inf, inf],
+            Contour::Sphere { radius, .. } => [1.0 / radius, 1.0 / radius],
+            Contour::Plane { .. } | Contour::Line { .. } => [0.0, 0.0],
+            Contour::Box { center, rotation, half_extents } => {
+                // on a face: flat; on two or three faces at once (an edge, a corner): undefined
+                let q = rotation.transpose() * (l - center);
+                let tol = 1e-9 * half_extents.max();
+                let on = (0..3).filter(|&k| (q[k].abs() - half_extents[k]).abs() <= tol).count();
+                if on <= 1 {
+                    [0.0, 0.0]
+                } else {
+                    [inf, inf]
+                }
+            }
+            Contour::Capsule { a, b, radius } => {
+                let d = b - a;
+                let s = (l - a).dot(&d) / d.norm_squared();
+                if s > 0.0 && s < 1.0 {
+                    [1.0 / radius, 0.0]
+                } else {
+                    [1.0 / radius, 1.0 / radius]
+                }
+            }
+            Contour::Cylinder { center, axis, radius, half_length } => {
+                let u = axis.normalize();
+                let y = l - center;
+                let z = y.dot(&u);
+                let rho = (y - u * z).norm();
+                let tol = 1e-9 * radius.max(*half_length);
+                let side = (rho - radius).abs() <= tol;
+                let cap = (z.abs() - half_length).abs() <= tol;
+                match (side, cap) {
+                    (true, false) => [1.0 / radius, 0.0],
+                    (false, true) => [0.0, 0.0],
+                    _ => [inf, inf],
+                }
+            }
+            Contour::Circle { radius, .. } => [1.0 / radius, 0.0],
+            Contour::Polygon { vertices } => {
+                let on_vertex =
+                    vertices.iter().any(|v| (Vec2::new(l.x, l.y) - v).norm() <= 1e-9 * (1.0 + v.norm()));
+                if on_vertex {
+                    [inf, 0.0]
+                } else {
+                    [0.0, 0.0]
+                }
+            }
+            Contour::Curve(c) => {
+                // the point lies on the offset contour: its foot on the base curve is the same
+                let s = c.closest_parameter(&Vec2::new(l.x, l.y));
+                [c.curvature(s), 0.0]
+            }
+        }
+    }
+}
+
 #[inline]
 pub(crate) fn lift(v: &Vec2) -> Vec3 {
     Vec3::new(v.x, v.y, 0.0)

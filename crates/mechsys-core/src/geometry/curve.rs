@@ -149,6 +149,12 @@ pub struct Chunk {
 
 /// Samples per chunk of the bounding hierarchy.
 pub const CHUNK: usize = 8;
+/// Newton iterations of a contact-parameter search from one seed.
+pub const NEWTON_ITERATIONS: usize = 40;
+/// Newton stops when its step is below this fraction of the sample spacing (the quadratic
+/// convergence leaves an error of about its square).
+pub const CONVERGED: f64 = 1e-10;
+
 /// Upper bound on the samples of one curve (the search's stack buffers are this long).
 pub const MAX_SAMPLES: usize = 4096;
 
@@ -625,6 +631,45 @@ impl Curve {
             curvature: k / den,
             curvature_rate: kd / (den * den * den),
         }
+    }
+
+    /// The foot point of `y` (body frame) on the base curve by Newton on `F(s) = (y - r)·r'` from
+    /// `s`, steps limited to two sample spacings; `None` unless it converges to a distance
+    /// minimum (a maximum — the far side of a hollow arc — is refused). No allocation.
+    pub fn foot(&self, y: &Vec2, mut s: f64) -> Option<f64> {
+        let cap = 2.0 * self.step;
+        for _ in 0..NEWTON_ITERATIONS {
+            let j = self.eval(s);
+            let d = y - j[0];
+            let f = d.dot(&j[1]);
+            let fs = -j[1].norm_squared() + d.dot(&j[2]);
+            if !(fs < 0.0) {
+                // not a minimum direction here: step along the gradient of the squared distance
+                s += (f / j[1].norm_squared()).clamp(-cap, cap);
+                continue;
+            }
+            let ds = (-f / fs).clamp(-cap, cap);
+            s += ds;
+            if ds.abs() <= CONVERGED * self.step {
+                let j = self.eval(s);
+                let fs = -j[1].norm_squared() + (y - j[0]).dot(&j[2]);
+                return (fs < 0.0).then_some(s);
+            }
+        }
+        None
+    }
+
+    /// The parameter of the contour point nearest to `y` (body frame): the nearest sample,
+    /// refined by [`Self::foot`] (the sample itself if that does not converge). For queries,
+    /// not the step loop.
+    pub fn closest_parameter(&self, y: &Vec2) -> f64 {
+        let best = self
+            .samples
+            .iter()
+            .min_by(|a, b| (y - a.r).norm_squared().total_cmp(&(y - b.r).norm_squared()))
+            .map(|smp| smp.s)
+            .unwrap_or(self.lo);
+        self.foot(y, best).map(|s| self.wrap(s)).unwrap_or(best)
     }
 
     /// Parameter range `[lo, hi]` (the period for closed curves).

@@ -116,6 +116,8 @@ pub struct Contact {
     pub body2: usize,
     /// The prepared pair of contours.
     pub pair: ContactPair,
+    /// The two contours (body-frame data, normalized), for queries and reports.
+    pub contours: [Contour; 2],
     /// Friction law.
     pub friction: FrictionLaw,
     /// Impact law.
@@ -349,6 +351,7 @@ pub(super) fn validate(
     crate::ensure!(b1 != b2, Model, "{what}: body1 and body2 are the same body '{}'", d.body1);
     let c1 = contour(&d.contour1, planar(&d.contour2), &format!("{what}.contour1"), rotation)?;
     let c2 = contour(&d.contour2, planar(&d.contour1), &format!("{what}.contour2"), rotation)?;
+    let contours = [c1.normalized(), c2.normalized()];
     let pair = ContactPair::new(&d.name, c1, c2)?;
     let mut pair = pair;
     for (which, c) in [(1, &d.contour1), (2, &d.contour2)] {
@@ -368,7 +371,7 @@ pub(super) fn validate(
     };
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
-    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, friction, impact, first })
+    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, contours, friction, impact, first })
 }
 
 /// Validates one contact group (body indices resolved by `body`): names, contours, that every

@@ -40,11 +40,7 @@ use super::{vel, Raw};
 pub const MAX_POINTS: usize = 8;
 /// Roots kept during one search.
 const MAX_ROOTS: usize = 16;
-/// Newton iterations per seed.
-const NEWTON_ITERATIONS: usize = 40;
-/// Newton stops when its step is below this fraction of the sample spacing (the quadratic
-/// convergence leaves an error of about its square).
-const CONVERGED: f64 = 1e-10;
+use crate::geometry::curve::{CONVERGED, NEWTON_ITERATIONS};
 
 /// What body 1 (canonical order) brings against a curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -355,7 +351,7 @@ fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
             let prev = if i > 0 { dist(i - 1) } else if curve.is_closed() { dist(n - 1) } else { f64::INFINITY };
             let next = if i + 1 < n { dist(i + 1) } else if curve.is_closed() { dist(0) } else { f64::INFINITY };
             if di <= prev && di <= next {
-                if let Some(s) = newton_foot(curve, y, samples[i].s) {
+                if let Some(s) = curve.foot(y, samples[i].s) {
                     let j = curve.eval(s);
                     let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
                     roots.push(Root { s1: 0.0, s2: curve.wrap(s), key }, |a, b| same_param(curve, a.s2, b.s2));
@@ -366,32 +362,6 @@ fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
     if roots.len == 0 && best.0.is_finite() {
         roots.push(Root { s1: 0.0, s2: samples[best.1].s, key: best.0 }, |_, _| false);
     }
-}
-
-/// Newton on `F(s) = (y - r(s))·r'(s)` from `s`, steps limited to two sample spacings; `None`
-/// unless it converges to a distance minimum.
-fn newton_foot(curve: &Curve, y: &Vec2, mut s: f64) -> Option<f64> {
-    let cap = 2.0 * curve.step();
-    for _ in 0..NEWTON_ITERATIONS {
-        let j = curve.eval(s);
-        let d = y - j[0];
-        let f = d.dot(&j[1]);
-        let fs = -j[1].norm_squared() + d.dot(&j[2]);
-        if !(fs < 0.0) {
-            // not a minimum direction here: step along the gradient of the squared distance
-            let ds = (f / j[1].norm_squared()).clamp(-cap, cap);
-            s += ds;
-            continue;
-        }
-        let ds = (-f / fs).clamp(-cap, cap);
-        s += ds;
-        if ds.abs() <= CONVERGED * curve.step() {
-            let j = curve.eval(s);
-            let fs = -j[1].norm_squared() + (y - j[0]).dot(&j[2]);
-            return (fs < 0.0).then_some(s);
-        }
-    }
-    None
 }
 
 /// A curve on body 1 against the half-plane of body 2 (2-D `point`, unit `normal`).
@@ -568,7 +538,7 @@ fn curve_curve(
         let mut ok = false;
         for _ in 0..NEWTON_ITERATIONS {
             let r1 = jets(a, b).0;
-            let Some(foot) = newton_foot(c2, &r1[0], b) else { break };
+            let Some(foot) = c2.foot(&r1[0], b) else { break };
             b = foot;
             let j2 = c2.eval(b);
             let d = r1[0] - j2[0];
@@ -581,7 +551,7 @@ fn curve_curve(
             a += da;
             b += db_da * da;
             if da.abs() <= CONVERGED * c1.step() {
-                ok = newton_foot(c2, &jets(a, b).0[0], b).map(|f| b = f).is_some() && fpp > 0.0;
+                ok = c2.foot(&jets(a, b).0[0], b).map(|f| b = f).is_some() && fpp > 0.0;
                 break;
             }
         }
