@@ -67,6 +67,24 @@ pub enum Contour {
         /// Half the length along the axis (> 0).
         half_length: f64,
     },
+    /// A spherical cavity (a bowl, a ball race seen from within): the solid lies outside the
+    /// sphere of `radius` about `center`.
+    Bowl {
+        /// Centre.
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// A cylindrical cavity (a bore, a bearing shell), infinite along `axis`: the solid lies
+    /// outside the cylinder of `radius` about the axis through `center`.
+    Bore {
+        /// A point of the axis.
+        center: Vec3,
+        /// Axis direction (nonzero; normalized when a pair is built).
+        axis: Vec3,
+        /// Radius (> 0).
+        radius: f64,
+    },
     /// Planar: a point of the x-y plane.
     Point2 {
         /// The point.
@@ -112,6 +130,10 @@ pub enum ContourKind {
     Capsule,
     /// [`Contour::Cylinder`]
     Cylinder,
+    /// [`Contour::Bowl`]
+    Bowl,
+    /// [`Contour::Bore`]
+    Bore,
     /// [`Contour::Point2`]
     Point2,
     /// [`Contour::Circle`]
@@ -134,6 +156,8 @@ impl ContourKind {
             ContourKind::Box => "box",
             ContourKind::Capsule => "capsule",
             ContourKind::Cylinder => "cylinder",
+            ContourKind::Bowl => "bowl",
+            ContourKind::Bore => "bore",
             ContourKind::Point2 => "point2",
             ContourKind::Circle => "circle",
             ContourKind::Line => "line",
@@ -186,6 +210,8 @@ impl Contour {
             Contour::Box { .. } => ContourKind::Box,
             Contour::Capsule { .. } => ContourKind::Capsule,
             Contour::Cylinder { .. } => ContourKind::Cylinder,
+            Contour::Bowl { .. } => ContourKind::Bowl,
+            Contour::Bore { .. } => ContourKind::Bore,
             Contour::Point2 { .. } => ContourKind::Point2,
             Contour::Circle { .. } => ContourKind::Circle,
             Contour::Line { .. } => ContourKind::Line,
@@ -260,6 +286,21 @@ impl Contour {
                 positive(*radius, what, "cylinder radius")?;
                 positive(*half_length, what, "cylinder half_length")
             }
+            Contour::Bowl { center, radius } => {
+                finite3(center, what, "bowl center")?;
+                positive(*radius, what, "bowl radius")
+            }
+            Contour::Bore { center, axis, radius } => {
+                finite3(center, what, "bore center")?;
+                finite3(axis, what, "bore axis")?;
+                ensure!(
+                    axis.norm() > MIN_DIRECTION,
+                    Model,
+                    "{what}: bore axis must not be the zero vector, got {:?}",
+                    axis.as_slice()
+                );
+                positive(*radius, what, "bore radius")
+            }
             Contour::Point2 { p } => finite2(p, what, "point2 p"),
             Contour::Circle { center, radius } => {
                 finite2(center, what, "circle center")?;
@@ -294,6 +335,9 @@ impl Contour {
                 radius: *radius,
                 half_length: *half_length,
             },
+            Contour::Bore { center, axis, radius } => {
+                Contour::Bore { center: *center, axis: axis.normalize(), radius: *radius }
+            }
             Contour::Box { center, rotation, half_extents } => {
                 // Gram–Schmidt on the columns; the third is the cross product so det = +1
                 let x = rotation.column(0).normalize();
@@ -333,6 +377,8 @@ impl Contour {
                 let e = Vec3::from_fn(|k, _| u[k].abs() * half_length + radius * (1.0 - u[k] * u[k]).max(0.0).sqrt());
                 Aabb { min: c - e, max: c + e }
             }
+            // a cavity's solid surrounds it: unbounded
+            Contour::Bowl { .. } | Contour::Bore { .. } => Aabb::EVERYTHING,
             Contour::Point2 { p } => extruded(pose, Aabb::point(&lift(p))),
             Contour::Circle { center, radius } => {
                 let c = lift(center);
@@ -383,6 +429,8 @@ impl Contour {
         match self {
             Contour::Point { .. } | Contour::Point2 { .. } => [inf, inf],
             Contour::Sphere { radius, .. } => [1.0 / radius, 1.0 / radius],
+            Contour::Bowl { radius, .. } => [-1.0 / radius, -1.0 / radius],
+            Contour::Bore { radius, .. } => [-1.0 / radius, 0.0],
             Contour::Plane { .. } | Contour::Line { .. } => [0.0, 0.0],
             Contour::Box { center, rotation, half_extents } => {
                 // on a face: flat; on two or three faces at once (an edge, a corner): undefined

@@ -98,6 +98,9 @@ enum Geometry {
     CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
     /// Planar parametric contours ([`curve_pair`]).
     Curve(CurveGeometry),
+    /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
+    /// cavity of body 2.
+    Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
 }
 
 /// A contour pair prepared for per-step evaluation.
@@ -177,6 +180,7 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
         K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
         K::Box => matches!(a, K::Point | K::Sphere | K::Box),
         K::Circle => matches!(a, K::Point2 | K::Circle),
+        K::Bowl | K::Bore => matches!(a, K::Point | K::Sphere),
         _ => false,
     }
 }
@@ -191,7 +195,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore, in either order)"
         )))
     }
 }
@@ -254,7 +258,7 @@ impl ContactPair {
                 let d = (b - a).normalize();
                 [d, perpendicular(&d)]
             }
-            Contour::Cylinder { axis, .. } => [*axis, perpendicular(axis)],
+            Contour::Cylinder { axis, .. } | Contour::Bore { axis, .. } => [*axis, perpendicular(axis)],
             Contour::Box { rotation, .. } => [rotation.column(0).into_owned(), rotation.column(1).into_owned()],
             _ => [Vec3::x(), Vec3::y()],
         };
@@ -536,6 +540,7 @@ impl ContactPair {
             Geometry::CircleCircle { c1, r1, c2, r2 } => circle_circle(x1, x2, tw, c1, *r1, c2, *r2),
             Geometry::BoxBox { a, b, scale } => box_box::box_box(x1, x2, tw, a, b, *scale, k),
             Geometry::Curve(g) => g.one(k, x1, x2, tw),
+            Geometry::Cavity { c1, r1, c2, axis, r2, across } => cavity(x1, x2, tw, c1, *r1, c2, axis, *r2, across),
         }
     }
 }
@@ -599,11 +604,25 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             Contour::Point2 { p } => (vec![lift(p)], 0.0),
             Contour::Circle { center, radius } => (vec![lift(center)], *radius),
             Contour::Polygon { vertices } => (vertices.iter().map(lift).collect(), 0.0),
-            Contour::Plane { .. } | Contour::Line { .. } | Contour::Curve(_) => {
+            Contour::Plane { .. }
+            | Contour::Line { .. }
+            | Contour::Curve(_)
+            | Contour::Bowl { .. }
+            | Contour::Bore { .. } => {
                 unreachable!("excluded by the dispatch table")
             }
         };
         return Geometry::PointsHalfSpace { centers, radius, point, normal };
+    }
+    if let Contour::Bowl { center, radius } | Contour::Bore { center, radius, .. } = s {
+        let (c1, r1) = match f {
+            Contour::Point { p } => (*p, 0.0),
+            Contour::Sphere { center, radius } => (*center, *radius),
+            _ => unreachable!("excluded by the dispatch table"),
+        };
+        let axis = if let Contour::Bore { axis, .. } = s { *axis } else { Vec3::zeros() };
+        let across = if axis.norm() > 0.0 { perpendicular(&axis) } else { Vec3::x() };
+        return Geometry::Cavity { c1, r1, c2: *center, axis, r2: *radius, across };
     }
     let segment = |c: &Contour| match c {
         Contour::Point { p } => (*p, Vec3::zeros(), 0.0),
@@ -860,6 +879,52 @@ fn circle_circle(
         out.nd = if degenerate { t2.w.cross(&n) } else { (dpd - n * lend) / len };
         out.p1d = c1d - out.nd * r1;
         out.p2d = c1d - n * lend - out.nd * (len - r2);
+    }
+    out
+}
+
+/// A sphere (centre on body 1, radius `r1`; a point when 0) inside a cavity of body 2: a
+/// spherical one (`axis = 0`) or a cylindrical one along `axis`. With `d` the centre's offset from
+/// the cavity's centre (or axis), `n = -d/|d|` points from the wall into the cavity,
+/// `g_N = r2 - |d| - r1`, `P1 = c1 - r1 n`, `P2 = P1 - g_N n` on the wall. At the centre (axis) the
+/// normal is a fixed direction of body 2 ⟂ the axis.
+#[allow(clippy::too_many_arguments)]
+fn cavity(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    c1b: &Vec3,
+    r1: f64,
+    c2b: &Vec3,
+    axis_b: &Vec3,
+    r2: f64,
+    across: &Vec3,
+) -> Raw {
+    let c1 = x1.point_to_parent(c1b);
+    let c2 = x2.point_to_parent(c2b);
+    let a = x2.a * axis_b;
+    let e = c1 - c2;
+    let d = e - a * a.dot(&e);
+    let len = d.norm();
+    let degenerate = !(len > TINY * (1.0 + r2));
+    let n = if degenerate { x2.a * across } else { -d / len };
+    let g = r2 - len - r1;
+    let p1 = c1 - n * r1;
+    let mut out = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        let c1d = vel(t1, &c1);
+        let ed = c1d - vel(t2, &c2);
+        let ad = t2.w.cross(&a);
+        let dd = ed - ad * a.dot(&e) - a * (ad.dot(&e) + a.dot(&ed));
+        let (gd, nd) = if degenerate {
+            (0.0, t2.w.cross(&n))
+        } else {
+            let u = d / len;
+            (-u.dot(&dd), -(dd - u * u.dot(&dd)) / len)
+        };
+        out.nd = nd;
+        out.p1d = c1d - nd * r1;
+        out.p2d = out.p1d - n * gd - nd * g;
     }
     out
 }

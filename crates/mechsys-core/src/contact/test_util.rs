@@ -184,11 +184,13 @@ pub(crate) fn sample(kind: &str) -> Contour {
                 .map(|&(x, y)| Vec2::new(x, y))
                 .collect(),
         },
+        "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
+        "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
         "ellipse" => curve_sample("ellipse"),
         "ellipse_b" => curve_sample("ellipse_b"),
         "blob" => curve_sample("blob"),
         "cam" => curve_sample("cam"),
-        "bore" => curve_sample("bore"),
+        "spline_bore" => curve_sample("bore"),
         _ => unreachable!("unknown sample {kind}"),
     }
 }
@@ -240,7 +242,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 10] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 17] = [
+pub(crate) const PAIRS: [(&str, &str); 21] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -258,6 +260,10 @@ pub(crate) const PAIRS: [(&str, &str); 17] = [
     ("sphere", "box"),
     ("point2", "circle"),
     ("circle_b", "circle"),
+    ("point", "bowl"),
+    ("sphere", "bowl"),
+    ("point", "bore"),
+    ("sphere", "bore"),
 ];
 
 /// Random placements of two bodies near each other (plane motion: rotations about z, z = 0).
@@ -319,6 +325,13 @@ pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
                 .fold(f64::NEG_INFINITY, f64::max)
         }
         Contour::Curve(c) => curve_sdf(c, &Vec2::new(xl.x, xl.y)).0,
+        // inside the cavity is free space: positive distance to the wall
+        Contour::Bowl { center, radius } => radius - (xl - center).norm(),
+        Contour::Bore { center, axis, radius } => {
+            let a = axis.normalize();
+            let y = xl - center;
+            radius - (y - a * a.dot(&y)).norm()
+        }
     }
 }
 

@@ -40,6 +40,8 @@ use super::{vel, Raw};
 pub const MAX_POINTS: usize = 8;
 /// Roots kept during one search.
 const MAX_ROOTS: usize = 16;
+/// Most seeds refined by Newton in a curve–curve search (the deepest local minima).
+const MAX_SEEDS: usize = 10;
 use crate::geometry::curve::{CONVERGED, NEWTON_ITERATIONS};
 
 /// What body 1 (canonical order) brings against a curve.
@@ -474,10 +476,25 @@ fn curve_curve(
     for (a, ca) in ch1.iter().enumerate() {
         centers1[a] = rel.point(&ca.center);
     }
-    let mut ub = f64::INFINITY;
+    // an upper bound of the distance between the curves: the closest sample pair of the chunk
+    // pair with the smallest lower bound (much tighter than the chunks' own bounds)
+    let mut lowest = (f64::INFINITY, 0usize, 0usize);
     for (a, ca) in ch1.iter().enumerate() {
-        for cb in ch2 {
-            ub = ub.min((centers1[a] - cb.center).norm() + ca.radius + cb.radius);
+        for (b, cb) in ch2.iter().enumerate() {
+            let lb = (centers1[a] - cb.center).norm() - ca.radius - cb.radius;
+            if lb < lowest.0 {
+                lowest = (lb, a, b);
+            }
+        }
+    }
+    let mut ub = f64::INFINITY;
+    if lowest.0.is_finite() {
+        let (ca, cb) = (&ch1[lowest.1], &ch2[lowest.2]);
+        for i in ca.first..ca.first + ca.count {
+            let p = rel.point(&s1[i].r);
+            for smp in &s2[cb.first..cb.first + cb.count] {
+                ub = ub.min((p - smp.r).norm());
+            }
         }
     }
     for (a, ca) in ch1.iter().enumerate() {
@@ -519,19 +536,52 @@ fn curve_curve(
     let mut roots = Roots::new(count.max(1));
     let mut best = (f64::INFINITY, 0usize, 0usize);
     let cap1 = 2.0 * c1.step();
-    for i in 0..n1 {
-        if !keep1[i / CHUNK] {
+    // seeds: the local minima of φ along curve 1 within the kept chunks, the deepest few only
+    let max_seeds = (count + 2).min(MAX_SEEDS);
+    let mut seeds = [(f64::INFINITY, 0usize, 0usize); MAX_SEEDS];
+    let mut nseeds = 0;
+    let neighbour = |i: isize| -> Option<usize> {
+        if i >= 0 && (i as usize) < n1 {
+            Some(i as usize)
+        } else if c1.is_closed() {
+            Some(i.rem_euclid(n1 as isize) as usize)
+        } else {
+            None
+        }
+    };
+    for (a, ca) in ch1.iter().enumerate() {
+        if !keep1[a] {
             continue;
         }
-        let (pi, partner) = phi(i);
-        if pi < best.0 {
-            best = (pi, i, partner);
+        // φ of the chunk's samples and of one neighbour on each side
+        let mut vals = [(f64::INFINITY, 0usize); CHUNK + 2];
+        for (k, v) in vals.iter_mut().enumerate().take(ca.count + 2) {
+            if let Some(i) = neighbour(ca.first as isize + k as isize - 1) {
+                *v = phi(i);
+            }
         }
-        let prev = if i > 0 { phi(i - 1).0 } else if c1.is_closed() { phi(n1 - 1).0 } else { f64::INFINITY };
-        let next = if i + 1 < n1 { phi(i + 1).0 } else if c1.is_closed() { phi(0).0 } else { f64::INFINITY };
-        if !(pi <= prev && pi <= next) {
-            continue;
+        for k in 1..=ca.count {
+            let (pi, partner) = vals[k];
+            let i = ca.first + k - 1;
+            if pi < best.0 {
+                best = (pi, i, partner);
+            }
+            if pi.is_finite() && pi <= vals[k - 1].0 && pi <= vals[k + 1].0 {
+                // insert sorted by φ, keeping the deepest max_seeds
+                let mut j = nseeds.min(max_seeds - 1);
+                if nseeds == max_seeds && pi >= seeds[j].0 {
+                    continue;
+                }
+                while j > 0 && seeds[j - 1].0 > pi {
+                    seeds[j] = seeds[j - 1];
+                    j -= 1;
+                }
+                seeds[j] = (pi, i, partner);
+                nseeds = (nseeds + 1).min(max_seeds);
+            }
         }
+    }
+    for &(_, i, partner) in &seeds[..nseeds] {
         // minimize the signed distance φ(s1) of curve 1's point to curve 2 (the foot point s2
         // follows s1): φ' = ν2·ρ1' (envelope theorem), φ'' = ν2·ρ1'' + ν2'·ρ1' ds2/ds1
         let (mut a, mut b) = (s1[i].s, s2[partner].s);
@@ -613,4 +663,5 @@ fn curve_curve(
         };
     });
 }
+
 
