@@ -168,6 +168,33 @@ class Polygon(Contour):
         return {"type": "polygon", "vertices": out}
 
 
+@dataclass
+class Bowl(Contour):
+    """A spherical cavity of ``radius`` about ``center``: the solid lies outside the sphere (a
+    bowl, a ball race seen from within). Pairs with a point or a sphere inside it."""
+
+    radius: float = 0.0
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, what: str) -> dict:
+        return {"type": "bowl", "center": _vec3(self.center, f"{what}.center"), "radius": _radius(self.radius, f"{what}.radius")}
+
+
+@dataclass
+class Bore(Contour):
+    """A cylindrical cavity of ``radius`` about the axis through ``center`` along ``axis``,
+    infinitely long: the solid lies outside the cylinder (a bore, a bearing shell). Pairs with a
+    point or a sphere inside it."""
+
+    radius: float = 0.0
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, what: str) -> dict:
+        return {"type": "bore", "center": _vec3(self.center, f"{what}.center"), "axis": _vec3(self.axis, f"{what}.axis"),
+                "radius": _radius(self.radius, f"{what}.radius")}
+
+
 _SOLIDS = ("left", "right", "inside", "outside")
 
 
@@ -358,6 +385,8 @@ __all__ = [
     "Circle",
     "Line",
     "Polygon",
+    "Bowl",
+    "Bore",
     "Ellipse",
     "Spline",
     "Cam",

@@ -219,6 +219,10 @@ fn contour(
         ContourDescription::Cylinder { center, axis, radius, half_length } => {
             Contour::Cylinder { center: vec3(center), axis: vec3(axis), radius: *radius, half_length: *half_length }
         }
+        ContourDescription::Bowl { center, radius } => Contour::Bowl { center: vec3(center), radius: *radius },
+        ContourDescription::Bore { center, axis, radius } => {
+            Contour::Bore { center: vec3(center), axis: vec3(axis), radius: *radius }
+        }
         ContourDescription::Circle { center, radius } => {
             Contour::Circle { center: Vec2::new(center[0], center[1]), radius: *radius }
         }

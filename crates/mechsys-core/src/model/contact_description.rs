@@ -99,6 +99,24 @@ pub enum ContourDescription {
         /// Half the length along the axis, > 0.
         half_length: f64,
     },
+    /// A spherical cavity (a bowl): the solid lies outside the sphere.
+    Bowl {
+        /// Centre.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// A cylindrical cavity (a bore), infinite along `axis`: the solid lies outside the cylinder.
+    Bore {
+        /// A point of the axis.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Axis direction (normalised when read).
+        axis: [f64; 3],
+        /// Radius, > 0.
+        radius: f64,
+    },
     /// A circle in the body's x-y plane.
     Circle {
         /// Centre (z ignored).
