@@ -16,9 +16,9 @@ pub mod contact_description;
 pub mod description;
 pub mod jenkins;
 pub mod joint;
-pub mod rotation_description;
 mod planar;
-mod validate;
+pub mod rotation_description;
+pub mod validate;
 
 use std::collections::HashMap;
 
