@@ -280,17 +280,7 @@ impl PyModel {
                 F::JointForce { joint, .. } => ("joint_force", joint_units(*joint).0, ""),
                 F::Servo { joint, position, .. } => {
                     let (a, b) = joint_units(*joint);
-                    (
-                        "servo",
-                        a,
-                        if *position {
-                            b
-                        } else if b == "rad" {
-                            "rad/s"
-                        } else {
-                            "m/s"
-                        },
-                    )
+                    ("servo", a, if *position { b } else if b == "rad" { "rad/s" } else { "m/s" })
                 }
                 F::Callback { .. } => ("python_force", "mixed", ""),
                 // force: F_x, F_y (shell frame), torque; deflection: ε, position angle, attitude angle
