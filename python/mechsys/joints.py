@@ -320,6 +320,8 @@ class Path(Joint):
     def _number(self, key: str, value) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
             raise ModelError(f"{key}: expected a number, got {value!r}")
+        if not np.isfinite(value):
+            raise ModelError(f"{key}: must be a finite number, got {value}")
         return float(value)
 
     def _flag(self, key: str, value) -> bool:
@@ -358,6 +360,9 @@ class Path(Joint):
                 raise ModelError(f"points: expected a list of (x, y, z) points, got shape {pts.shape}")
             if pts.shape[1] == 2:
                 pts = np.c_[pts, np.zeros(len(pts))]
+            bad = np.flatnonzero(~np.all(np.isfinite(pts), axis=1))
+            if bad.size:
+                raise ModelError(f"points[{bad[0]}]: must be finite, got {pts[bad[0]].tolist()}")
             d.update(points=pts.tolist(), closed=self._flag("closed", self.closed))
         elif curve == "hermite":
             smp = self._samples()
