@@ -251,7 +251,7 @@ impl Spline {
         let mut order = [0, 1, 2];
         order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
         let total = sp.length();
-        let straight = eig.eigenvalues[order[1]] <= 1e-20 * total;
+        let straight = eig.eigenvalues[order[1]] <= 1e-12 * total;
         let up = match up {
             Some(u) => {
                 if !(u.iter().all(|x| x.is_finite()) && u.norm() > 0.0) {
