@@ -329,19 +329,41 @@ fn bad_curves_are_errors_naming_the_joint_and_the_key() {
         Model::from_description(ModelDescription::from_json(&json).unwrap()).map(|_| ()).unwrap_err().to_string()
     };
     for (joint, want) in [
-        (r#""curve": "spline", "points": [[0, 0, 0]]"#, "joints[0] 'wire'.points: an open spline needs at least 2 points, got 1"),
-        (r#""curve": "spline", "points": [[0, 0, 0], [1, 0, 0]], "closed": true"#, "joints[0] 'wire'.points: a closed spline needs at least 3"),
-        (r#""curve": "spline", "points": [[0, 0, 0], [1, 0, 0], [1, 0, 0]]"#, "joints[0] 'wire'.points[2]: repeats points[1]"),
-        (r#""curve": "spline", "points": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 0, 0]], "closed": true"#, "joints[0] 'wire'.points[3]: repeats points[0]"),
-        (r#""curve": "spline", "points": [[0, 0, 0], [0, 0, 1]], "up": [0, 0, 1]"#, "joints[0] 'wire'.up: the path runs within 0.00°"),
+        (
+            r#""curve": "spline", "points": [[0, 0, 0]]"#,
+            "joints[0] 'wire'.points: an open spline needs at least 2 points, got 1",
+        ),
+        (
+            r#""curve": "spline", "points": [[0, 0, 0], [1, 0, 0]], "closed": true"#,
+            "joints[0] 'wire'.points: a closed spline needs at least 3",
+        ),
+        (
+            r#""curve": "spline", "points": [[0, 0, 0], [1, 0, 0], [1, 0, 0]]"#,
+            "joints[0] 'wire'.points[2]: repeats points[1]",
+        ),
+        (
+            r#""curve": "spline", "points": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 0, 0]], "closed": true"#,
+            "joints[0] 'wire'.points[3]: repeats points[0]",
+        ),
+        (
+            r#""curve": "spline", "points": [[0, 0, 0], [0, 0, 1]], "up": [0, 0, 1]"#,
+            "joints[0] 'wire'.up: the path runs within 0.00°",
+        ),
         (r#""curve": "clothoid", "A": -1.0"#, "joints[0] 'wire'.A: must be > 0, got -1"),
         (r#""curve": "clothoid""#, "joints[0] 'wire'.A: a clothoid needs its parameter A"),
-        (r#""curve": "clothoid", "A": 1.0, "radius": 2.0"#, "joints[0] 'wire'.radius: a clothoid path has no radius (its keys: A, kappa0)"),
+        (
+            r#""curve": "clothoid", "A": 1.0, "radius": 2.0"#,
+            "joints[0] 'wire'.radius: a clothoid path has no radius (its keys: A, kappa0)",
+        ),
         (r#""curve": "bezier""#, "joints[0] 'wire'.curve: unknown path curve 'bezier'"),
-        (r#""curve": "hermite", "parameters": [0, 1], "points": [[0, 0, 0], [1, 0, 0]], "tangents": [[1, 0, 0]], "second_derivatives": [[0, 0, 0], [0, 0, 0]]"#,
-         "joints[0] 'wire'.tangents: 1 rows for 2 parameter values"),
-        (r#""curve": "hermite", "parameters": [0, 0], "points": [[0, 0, 0], [1, 0, 0]], "tangents": [[1, 0, 0], [1, 0, 0]], "second_derivatives": [[0, 0, 0], [0, 0, 0]]"#,
-         "joints[0] 'wire'.parameters[1]: must increase"),
+        (
+            r#""curve": "hermite", "parameters": [0, 1], "points": [[0, 0, 0], [1, 0, 0]], "tangents": [[1, 0, 0]], "second_derivatives": [[0, 0, 0], [0, 0, 0]]"#,
+            "joints[0] 'wire'.tangents: 1 rows for 2 parameter values",
+        ),
+        (
+            r#""curve": "hermite", "parameters": [0, 0], "points": [[0, 0, 0], [1, 0, 0]], "tangents": [[1, 0, 0], [1, 0, 0]], "second_derivatives": [[0, 0, 0], [0, 0, 0]]"#,
+            "joints[0] 'wire'.parameters[1]: must increase",
+        ),
     ] {
         let e = build(joint);
         assert!(e.contains(want), "{joint}:\n{e}\nwanted: {want}");
