@@ -483,3 +483,42 @@ oriented = false
     f.write_text(head + 'curve = "clothoid"\n')
     with pytest.raises(ms.ModelError, match=r"wire'\.A: a clothoid needs its parameter A"):
         load_model(f)[0].build()
+
+
+def tilde(w):
+    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+
+
+@pytest.mark.parametrize("kind", ["helix", "clothoid", "spline", "closed space spline", "function"])
+def test_frenet_serret_by_differences_for_every_curve(kind):
+    """dr/ds = t, d[t n b]/ds = [t n b] Omega~ (Omega = (tau, 0, kappa) for Frenet's trihedral),
+    and with the reported curvature and torsion dt/ds = kappa n_F, dn_F/ds = -kappa t + tau b_F,
+    db_F/ds = -tau n_F (eq. 2.75), by central differences of the engine's geometry."""
+    j = {
+        "helix": lambda: ms.joints.Path("w", "ground", "b", radius=R, pitch=PITCH),
+        "clothoid": lambda: ms.joints.Path.clothoid("w", "ground", "b", A=1.3, kappa0=-0.6),
+        "spline": lambda: ms.joints.Path.spline("w", "ground", "b", [(0, 0, 0), (1, 0.6, 0), (2, 0, 0), (3, -0.8, 0)]),
+        "closed space spline": lambda: ms.joints.Path.spline("w", "ground", "b", loop_points(), closed=True),
+        "function": lambda: ms.joints.Path.function("w", "ground", "b", lambda p: (np.cos(p), np.sin(2 * p), 0.3 * p**2),
+                                                    (0.0, 3.0), samples=101),
+    }[kind]()
+    s = np.array([0.23, 0.71, 1.37, 2.06])
+    e = 1e-5
+    g, gp, gm = j.geometry(s), j.geometry(s + e), j.geometry(s - e)
+    f = g["frame"]
+    assert np.abs(np.einsum("kji,kjl->kil", f, f) - np.eye(3)).max() < 1e-13
+    assert np.abs((gp["position"] - gm["position"]) / (2 * e) - f[:, :, 0]).max() < 1e-9
+    df = (gp["frame"] - gm["frame"]) / (2 * e)
+    assert np.abs(df - np.array([fk @ tilde(w) for fk, w in zip(f, g["omega"])])).max() < 1e-7
+    k, tau = g["curvature"], g["torsion"]
+    assert np.abs(df[:, :, 0] - g["tangent_rate"]).max() < 1e-7
+    assert np.abs(np.linalg.norm(g["tangent_rate"], axis=1) - np.abs(k)).max() < 1e-12
+
+    def frenet(q):
+        n = q["tangent_rate"] / np.linalg.norm(q["tangent_rate"], axis=1)[:, None]
+        return n, np.cross(q["frame"][:, :, 0], n)
+
+    (n, b), (n_p, b_p), (n_m, b_m) = frenet(g), frenet(gp), frenet(gm)
+    t = f[:, :, 0]
+    assert np.abs((n_p - n_m) / (2 * e) - (-np.abs(k)[:, None] * t + tau[:, None] * b)).max() < 1e-6
+    assert np.abs((b_p - b_m) / (2 * e) + tau[:, None] * n).max() < 1e-6

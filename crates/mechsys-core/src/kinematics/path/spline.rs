@@ -414,7 +414,7 @@ impl Spline {
         } else {
             s0
         };
-        if !self.closed && !(s >= 0.0 && s <= total) {
+        if !self.closed && !(0.0..=total).contains(&s) {
             // straight on along the end tangent (s NaN: the start, so nothing downstream is NaN
             // but the caller's own NaN state)
             let (end, ds) = if s > total { (total, s - total) } else { (0.0, if s.is_nan() { 0.0 } else { s }) };
