@@ -350,7 +350,8 @@ def info(model_file: Path) -> None:
     click.echo(f"joints ({len(joints)}):")
     if joints:
         rows = [
-            (j["name"], j["type"], f"{j['parent']} -> {j['child']}", f"{j['nq']}/{j['nu']}", f"{j['iq']}/{j['iu']}")
+            (j["name"], f"path ({j['curve']})" if "curve" in j else j["type"], f"{j['parent']} -> {j['child']}",
+             f"{j['nq']}/{j['nu']}", f"{j['iq']}/{j['iu']}")
             for j in joints
         ]
         click.echo(_table(["name", "type", "parent -> child", "nq/nu", "iq/iu"], rows))

@@ -15,6 +15,7 @@ Universal     2   2   angle about ``axis`` (parent), then ``axis2`` (child)  rat
 Spherical     4   3   unit quaternion [w, x, y, z]                           angular velocity, child frame
 Planar        3   3   x, y in the joint frame's x-y plane, angle about z     rates
 Free          7   6   position (parent frame), quaternion                    velocity, angular velocity, child frame
+Path          1   1   arc length s along a helix, clothoid or spline (m)     ds/dt
 ============  ==  ==  =====================================================  ==========================
 """
 
@@ -239,39 +240,192 @@ class Spherical(Joint):
 
 @dataclass
 class Path(Joint):
-    """Path coordinate (section 2.2.6), 1 DOF: the child frame's origin moves along a helix about
-    the joint frame's z-axis, ``q`` = its arc length s (m), ``u`` = ds/dt (m/s). ``radius`` (m,
-    > 0), ``pitch``: rise per turn (m; 0, the default, is a circle; negative: left-handed).
-    ``oriented``: the child frame turns with the curve's trihedral (x along the tangent t, y the
-    principal normal n towards the axis, z the binormal b), else it keeps the parent's axes (a
-    bead). At s = 0 the point is at (radius, 0, 0). Curvature radius / L^2, torsion c / L^2 with
-    c = pitch / 2 pi, L^2 = radius^2 + c^2."""
+    """Path coordinate (section 2.2.6), 1 DOF: the child frame's origin moves along a curve in the
+    parent joint frame, ``q`` = its arc length s (m), ``u`` = ds/dt (m/s). ``oriented``: the child
+    frame turns with the curve's frame [t n b] (x along the tangent t), else it keeps the parent's
+    axes (a bead). The curve (``curve``):
+
+    - ``"helix"`` (the default; ``Path(...)`` or :meth:`helix`): about the joint frame's z-axis,
+      ``radius`` (m, > 0), ``pitch``: rise per turn (m; 0, the default, is a circle; negative:
+      left-handed); at s = 0 at (radius, 0, 0). n points to the axis. Curvature radius / L^2,
+      torsion c / L^2 with c = pitch / 2 pi, L^2 = radius^2 + c^2.
+    - ``"clothoid"`` (:meth:`clothoid`): the Euler spiral in the x-y plane, curvature
+      kappa0 + s / A^2, from the origin along x; b = z and n = z x t (the left normal, so the
+      curvature is signed and the frame passes smoothly through kappa = 0).
+    - ``"spline"`` (:meth:`spline`): the C2 cubic through ``points``, ``closed`` or with natural
+      ends (straight on along the end tangents beyond them).
+    - ``"hermite"`` (:meth:`function`): a user's function r(p) sampled with its derivatives.
+
+    For the splines b is the part of a reference direction ``up`` across the tangent and
+    n = b x t: for a plane curve (default ``up``: the plane's normal) the Frenet trihedral with
+    signed curvature, for a space curve a frame without the Frenet frame's flips where the
+    curvature vanishes (see docs/usage.md, "Path coordinates")."""
 
     radius: float = 1.0
     pitch: float = 0.0
     oriented: bool = True
+    curve: str = "helix"
+    A: float | None = None
+    kappa0: float = 0.0
+    points: Any = None
+    closed: bool = False
+    up: Sequence[float] | None = None
+    f: Any = None
+    p_range: Sequence[float] | None = None
+    samples: int = 200
+    df: Any = None
+    d2f: Any = None
+    _sampled: Any = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         self.type = "path"
 
+    # ---- the curves ------------------------------------------------------------------------------
+    @classmethod
+    def helix(cls, name: str, parent, child, radius: float, pitch: float = 0.0, oriented: bool = True, **joint) -> "Path":
+        """A helix about the joint frame's z-axis (a circle for ``pitch = 0``); ``joint``: the
+        other joint arguments (``parent_frame``, ``q0``, ``u0``, ``spring``, ...)."""
+        return cls(name, parent, child, radius=radius, pitch=pitch, oriented=oriented, **joint)
+
+    @classmethod
+    def clothoid(cls, name: str, parent, child, A: float, kappa0: float = 0.0, oriented: bool = True, **joint) -> "Path":
+        """The clothoid kappa(s) = kappa0 + s / A^2 in the joint frame's x-y plane, from the origin
+        along x (A in m, > 0; kappa0 in 1/m)."""
+        return cls(name, parent, child, curve="clothoid", A=A, kappa0=kappa0, oriented=oriented, **joint)
+
+    @classmethod
+    def spline(cls, name: str, parent, child, points, closed: bool = False, up=None, oriented: bool = True,
+               **joint) -> "Path":
+        """The C2 cubic spline through ``points`` ((n, 3), joint frame; chord-length knots), open
+        with natural ends (at least 2 points) or ``closed`` (at least 3, each given once). ``up``:
+        the frame's reference direction (default: the points' plane normal, or the direction the
+        path runs along least)."""
+        return cls(name, parent, child, curve="spline", points=points, closed=closed, up=up, oriented=oriented, **joint)
+
+    @classmethod
+    def function(cls, name: str, parent, child, f, p_range, samples: int = 200, df=None, d2f=None, closed: bool = False,
+                 up=None, oriented: bool = True, **joint) -> "Path":
+        """A curve given as a function ``f(p) -> (x, y, z)`` over ``p_range = (p0, p1)``: sampled
+        at ``samples`` equally spaced p when the model is built, with its first and second
+        derivatives (``df``, ``d2f`` if given; else exactly by Taylor arithmetic, or the complex
+        step, or differences), into a quintic Hermite spline that the engine re-parameterizes by
+        arc length. p need not be the arc length: the joint's s runs from 0 at f(p0).
+        ``closed``: f is periodic over p_range. The interpolation error is at most
+        h^6 max|r^(6)| / 46080 (h the sample spacing in p) and :attr:`sampling_error` gives the
+        one measured at the interval midpoints."""
+        return cls(name, parent, child, curve="hermite", f=f, p_range=p_range, samples=samples, df=df, d2f=d2f,
+                   closed=closed, up=up, oriented=oriented, **joint)
+
+    # ---- description -----------------------------------------------------------------------------
+    def _number(self, key: str, value) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+            raise ModelError(f"{key}: expected a number, got {value!r}")
+        if not np.isfinite(value):
+            raise ModelError(f"{key}: must be a finite number, got {value}")
+        return float(value)
+
+    def _flag(self, key: str, value) -> bool:
+        if not isinstance(value, (bool, np.bool_)):
+            raise ModelError(f"{key}: expected true or false, got {value!r}")
+        return bool(value)
+
+    def _samples(self) -> dict:
+        """The sampled function (once per function and settings)."""
+        from ._pathsample import sample
+
+        key = (id(self.f), tuple(self.p_range) if self.p_range is not None else None, self.samples, id(self.df), id(self.d2f))
+        if self._sampled is None or self._sampled[0] != key:
+            if self.f is None or self.p_range is None:
+                raise ModelError("f: a function path needs f and p_range")
+            self._sampled = (key, sample(self.f, self.p_range, self.samples, self.df, self.d2f))
+        return self._sampled[1]
+
     def _extra(self):
-        for key in ("radius", "pitch"):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-                raise ModelError(f"joint '{self.name}'.{key}: expected a number, got {v!r}")
-        if not isinstance(self.oriented, (bool, np.bool_)):
-            raise ModelError(f"joint '{self.name}'.oriented: expected true or false, got {self.oriented!r}")
-        return {"radius": float(self.radius), "pitch": float(self.pitch), "oriented": bool(self.oriented)}
+        curve = self.curve.lower() if isinstance(self.curve, str) else self.curve
+        d: dict = {"oriented": self._flag("oriented", self.oriented)}
+        if curve in ("helix", "circle"):
+            d.update(radius=self._number("radius", self.radius), pitch=self._number("pitch", self.pitch))
+            return d
+        d["curve"] = curve
+        if curve == "clothoid":
+            if self.A is None:
+                raise ModelError("A: a clothoid needs its parameter A (m)")
+            d.update(A=self._number("A", self.A), kappa0=self._number("kappa0", self.kappa0))
+        elif curve == "spline":
+            try:
+                pts = np.asarray(self.points, dtype=float)
+            except (TypeError, ValueError):
+                raise ModelError(f"points: expected a list of (x, y, z) points, got {self.points!r}") from None
+            if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+                raise ModelError(f"points: expected a list of (x, y, z) points, got shape {pts.shape}")
+            if pts.shape[1] == 2:
+                pts = np.c_[pts, np.zeros(len(pts))]
+            bad = np.flatnonzero(~np.all(np.isfinite(pts), axis=1))
+            if bad.size:
+                raise ModelError(f"points[{bad[0]}]: must be finite, got {pts[bad[0]].tolist()}")
+            d.update(points=pts.tolist(), closed=self._flag("closed", self.closed))
+        elif curve == "hermite":
+            smp = self._samples()
+            d.update({k: np.asarray(smp[k]).tolist() for k in ("parameters", "points", "tangents", "second_derivatives")})
+            d["closed"] = self._flag("closed", self.closed)
+        else:
+            raise ModelError(f"curve: unknown path curve {self.curve!r} (helix, clothoid, spline or hermite)")
+        if self.up is not None:
+            d["up"] = _vec3(self.up, "up")
+        return d
 
-    def curvature(self) -> float:
-        """kappa = R / (R^2 + c^2) (1/m)."""
-        c = self.pitch / (2 * np.pi)
-        return self.radius / (self.radius**2 + c**2)
+    @property
+    def sampling_error(self) -> float | None:
+        """For a function path: the largest distance (m) between the spline and f at the middles
+        of the sample intervals; None otherwise."""
+        return self._sample_info("error")
 
-    def torsion(self) -> float:
-        """tau = c / (R^2 + c^2) (1/m)."""
-        c = self.pitch / (2 * np.pi)
-        return c / (self.radius**2 + c**2)
+    @property
+    def derivatives_by(self) -> str | None:
+        """For a function path: how the derivatives were found (user, taylor, complex step,
+        differences); None otherwise."""
+        return self._sample_info("method")
+
+    def _sample_info(self, key: str):
+        if self.curve != "hermite":
+            return None
+        try:
+            return self._samples()[key]
+        except ModelError as e:
+            raise ModelError(f"joint '{self.name}'.{e}") from None
+
+    # ---- geometry --------------------------------------------------------------------------------
+    def geometry(self, s) -> dict:
+        """The curve at arc lengths ``s`` as the engine has it: position (n, 3), frame (n, 3, 3;
+        columns t, n, b), tangent_rate (dt/ds), omega (the frame's Darboux vector in its own axes)
+        and omega_rate, curvature and torsion (n), in the parent joint frame."""
+        import json
+
+        from . import _core
+
+        d = self.describe()
+        return _core.path_curve_geometry(json.dumps(d), np.ascontiguousarray(np.atleast_1d(s), dtype=float))
+
+    def curvature(self, s=None):
+        """Curvature (1/m) at arc length(s) ``s`` (signed for a plane curve, about b); for a helix
+        the constant R / (R^2 + c^2) (s may be omitted)."""
+        if s is None and self.curve in ("helix", "circle"):
+            c = self.pitch / (2 * np.pi)
+            return self.radius / (self.radius**2 + c**2)
+        return self._at(s, "curvature")
+
+    def torsion(self, s=None):
+        """Torsion (1/m) at ``s``; for a helix the constant c / (R^2 + c^2)."""
+        if s is None and self.curve in ("helix", "circle"):
+            c = self.pitch / (2 * np.pi)
+            return c / (self.radius**2 + c**2)
+        return self._at(s, "torsion")
+
+    def _at(self, s, key: str):
+        if s is None:
+            raise ModelError(f"joint '{self.name}': the {key} of a {self.curve} path depends on s; give s")
+        v = self.geometry(s)[key]
+        return float(v[0]) if np.ndim(s) == 0 else v
 
 
 @dataclass

@@ -169,9 +169,16 @@ class Results:
                     None if one or d is None else [_rate_unit(x) for x in d])
             if j["type"] == "path" and acc and "curvature" in j:
                 # along the path: the tangential acceleration s'' and the normal (centripetal)
-                # one kappa s'^2 towards the centre of curvature
+                # one kappa s'^2 towards the centre of curvature (signed for a plane curve: along
+                # n = b x t); kappa at each sample's s unless the curve has a constant one
+                kappa = j["curvature"]
+                if not j.get("constant_curvature", True) and engine is not None:
+                    from . import _core
+
+                    s_q = np.ascontiguousarray(raw["q"][:, j["iq"]])
+                    kappa = _core.path_geometry(engine, j["name"], s_q)["curvature"]
                 put(f"joint/{j['name']}/tangential_acceleration", raw["udot"][:, j["iu"]], "m/s^2")
-                put(f"joint/{j['name']}/normal_acceleration", j["curvature"] * raw["u"][:, j["iu"]] ** 2, "m/s^2")
+                put(f"joint/{j['name']}/normal_acceleration", kappa * raw["u"][:, j["iu"]] ** 2, "m/s^2")
         for k, b in enumerate(body_names):
             put(f"body/{b}/position", raw["body_position"][:, k, :], "m", xyz)
             put(f"body/{b}/orientation", raw["body_orientation"][:, k, :], "1", ["w", "x", "y", "z"])

@@ -3,11 +3,11 @@
 use mechsys_core::kinematics;
 use mechsys_core::math::Vec3;
 use nalgebra::DMatrix;
-use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::settings;
+use crate::errors::{settings, PyMechsysError};
 use crate::model::{check_len, q_checked, PyModel};
 
 fn body_index(model: &PyModel, body: &str) -> PyResult<usize> {
@@ -99,7 +99,77 @@ fn point_position<'py>(
     Ok(PyArray1::from_slice(py, p.as_slice()))
 }
 
+/// The geometry of a path curve at the arc lengths `s`, as arrays: position (n × 3), frame
+/// (n × 3 × 3, columns t n b), tangent_rate (n × 3, dt/ds), omega and omega_rate (n × 3, the
+/// frame's Darboux vector in its own axes and its rate), curvature, torsion (n), in the parent
+/// joint frame.
+fn geometry<'py>(
+    py: Python<'py>,
+    curve: &mechsys_core::kinematics::path::PathCurve,
+    s: &[f64],
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = s.len();
+    let (mut pos, mut frame, mut dt, mut w, mut dw) = (vec![], vec![], vec![], vec![], vec![]);
+    let (mut k, mut tau) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for &si in s {
+        let p = curve.point(si);
+        pos.extend_from_slice(p.r.as_slice());
+        // row-major 3 × 3
+        frame.extend((0..9).map(|i| p.frame[(i / 3, i % 3)]));
+        dt.extend_from_slice(p.tangent_rate.as_slice());
+        w.extend_from_slice(p.omega.as_slice());
+        dw.extend_from_slice(p.omega_rate.as_slice());
+        k.push(p.curvature);
+        tau.push(p.torsion);
+    }
+    let d = PyDict::new(py);
+    d.set_item("position", PyArray1::from_vec(py, pos).reshape([n, 3])?)?;
+    d.set_item("frame", PyArray1::from_vec(py, frame).reshape([n, 3, 3])?)?;
+    d.set_item("tangent_rate", PyArray1::from_vec(py, dt).reshape([n, 3])?)?;
+    d.set_item("omega", PyArray1::from_vec(py, w).reshape([n, 3])?)?;
+    d.set_item("omega_rate", PyArray1::from_vec(py, dw).reshape([n, 3])?)?;
+    d.set_item("curvature", PyArray1::from_vec(py, k))?;
+    d.set_item("torsion", PyArray1::from_vec(py, tau))?;
+    Ok(d)
+}
+
+/// Geometry of the path joint `joint` of a model at arc lengths `s` (see the module's
+/// `geometry`): what the engine computes in a step.
+#[pyfunction]
+fn path_geometry<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    joint: &str,
+    s: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let j = model
+        .model
+        .joints
+        .iter()
+        .find(|j| j.name == joint)
+        .ok_or_else(|| settings(format!("joint: unknown joint '{joint}'")))?;
+    let mechsys_core::model::JointKind::Path { curve, .. } = &j.kind else {
+        return Err(settings(format!("joint '{joint}' is a {} joint, not a path", j.kind.type_name())));
+    };
+    let s = s.as_slice().map_err(|_| settings("s: must be a contiguous float64 array"))?;
+    geometry(py, curve, s)
+}
+
+/// Geometry of a path joint described alone (the JSON of one joint entry), before any model.
+#[pyfunction]
+fn path_curve_geometry<'py>(
+    py: Python<'py>,
+    joint_json: &str,
+    s: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let curve = mechsys_core::model::validate::path_curve_from_json(joint_json).map_err(PyMechsysError::from)?;
+    let s = s.as_slice().map_err(|_| settings("s: must be a contiguous float64 array"))?;
+    geometry(py, &curve, s)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(path_geometry, m)?)?;
+    m.add_function(wrap_pyfunction!(path_curve_geometry, m)?)?;
     m.add_function(wrap_pyfunction!(body_states, m)?)?;
     m.add_function(wrap_pyfunction!(point_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(point_position, m)?)?;

@@ -99,10 +99,19 @@ impl PyModel {
             d.set_item("nu", j.nu())?;
             d.set_item("q0", j.q0.clone())?;
             d.set_item("u0", j.u0.clone())?;
-            if let mechsys_core::model::JointKind::Path { helix, .. } = &j.kind {
-                // the path's geometry as the engine has it (for the path signals)
-                d.set_item("curvature", helix.curvature())?;
-                d.set_item("torsion", helix.torsion())?;
+            if let mechsys_core::model::JointKind::Path { curve, oriented } = &j.kind {
+                // the path's geometry as the engine has it, at the initial s (for the path
+                // signals and reports; `path_geometry` gives it at any s)
+                let p = curve.point(j.q0[0]);
+                d.set_item("curve", curve.kind_name())?;
+                d.set_item("oriented", *oriented)?;
+                d.set_item("curvature", p.curvature)?;
+                d.set_item("torsion", p.torsion)?;
+                d.set_item("constant_curvature", curve.constant_darboux())?;
+                if let mechsys_core::kinematics::path::PathCurve::Spline(sp) = curve {
+                    d.set_item("length", sp.length())?;
+                    d.set_item("closed", sp.closed())?;
+                }
             }
             out.push(d);
         }

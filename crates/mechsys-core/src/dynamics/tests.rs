@@ -32,6 +32,15 @@ fn mixed_tree() -> Model {
             radius: None,
             pitch: None,
             oriented: None,
+            curve: None,
+            clothoid_a: None,
+            kappa0: None,
+            points: None,
+            closed: None,
+            up: None,
+            parameters: None,
+            tangents: None,
+            second_derivatives: None,
             parent_frame: FrameDescription {
                 position: pos,
                 rotation: Some(RotationDescription::Angles(AnglesDescription {

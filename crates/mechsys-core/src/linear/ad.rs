@@ -224,9 +224,9 @@ fn placement<T: Real>(kind: &JointKind, q: &[T]) -> Frame<T> {
         JointKind::Spherical => Frame { a: unit_quat_matrix(&q[0..4]), r: z },
         JointKind::Planar => Frame { a: axis_rotation(&Vec3::z(), q[2]), r: V3::new(q[0], q[1], cst(0.0)) },
         JointKind::Free => Frame { a: unit_quat_matrix(&q[3..7]), r: V3::new(q[0], q[1], q[2]) },
-        JointKind::Path { helix, oriented } => {
-            let (r, f) = helix.frame(q[0]);
-            Frame { a: if *oriented { f } else { M3::identity() }, r }
+        JointKind::Path { curve, oriented } => {
+            let p = curve.local(q[0]);
+            Frame { a: if *oriented { p.frame } else { M3::identity() }, r: p.r }
         }
     }
 }
@@ -269,12 +269,11 @@ fn subspace<T: Real>(kind: &JointKind, q: &[T], s: &mut [Twist<T>; 6]) {
                 s[k + 3] = Twist { w: unit(k), v: z };
             }
         }
-        JointKind::Path { helix, oriented: true } => {
-            s[0] = Twist { w: V3::new(cst(helix.torsion()), cst(0.0), cst(helix.curvature())), v: unit(0) };
+        JointKind::Path { curve, oriented: true } => {
+            s[0] = Twist { w: curve.local(q[0]).omega, v: unit(0) };
         }
-        JointKind::Path { helix, oriented: false } => {
-            let (_, f) = helix.frame(q[0]);
-            s[0] = Twist { w: z, v: f.column(0).into_owned() };
+        JointKind::Path { curve, oriented: false } => {
+            s[0] = Twist { w: z, v: curve.local(q[0]).frame.column(0).into_owned() };
         }
     }
 }
@@ -291,9 +290,11 @@ fn bias<T: Real>(kind: &JointKind, q: &[T], u: &[T]) -> Twist<T> {
             let v = V3::new(c * u[0] + sn * u[1], -sn * u[0] + c * u[1], cst(0.0));
             Twist { w: V3::zeros(), v: -(unit::<T>(2) * u[2]).cross(&v) }
         }
-        JointKind::Path { helix, oriented: false } => {
-            let (_, f) = helix.frame(q[0]);
-            Twist { w: V3::zeros(), v: f.column(1) * (u[0] * u[0] * helix.curvature()) }
+        JointKind::Path { curve, oriented: false } => {
+            Twist { w: V3::zeros(), v: curve.local(q[0]).tangent_rate * (u[0] * u[0]) }
+        }
+        JointKind::Path { curve, oriented: true } => {
+            Twist { w: curve.local(q[0]).omega_rate * (u[0] * u[0]), v: V3::zeros() }
         }
         _ => Twist::zero(),
     }

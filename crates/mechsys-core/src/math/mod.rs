@@ -5,7 +5,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 pub mod frames;
+pub mod fresnel;
 pub mod linalg;
+pub mod quadrature;
 pub mod rotation;
 pub mod trig;
 

@@ -432,6 +432,35 @@ pub struct JointDescription {
     /// Path joint: whether the child frame turns with the curve's trihedral (default true).
     #[serde(default)]
     pub oriented: Option<bool>,
+    /// Path joint: the curve, `helix` (default), `clothoid`, `spline` (through `points`) or
+    /// `hermite` (through samples with derivatives, as `joints.Path.function` writes them).
+    #[serde(default)]
+    pub curve: Option<String>,
+    /// Clothoid: the parameter A (m, > 0), κ(s) = κ₀ + s/A².
+    #[serde(default, rename = "A")]
+    pub clothoid_a: Option<f64>,
+    /// Clothoid: the curvature at s = 0 (1/m, default 0).
+    #[serde(default)]
+    pub kappa0: Option<f64>,
+    /// Spline: the points it passes through (m, joint frame); hermite: the sampled positions.
+    #[serde(default)]
+    pub points: Option<Vec<[f64; 3]>>,
+    /// Spline or hermite: whether the curve closes on itself (default false).
+    #[serde(default)]
+    pub closed: Option<bool>,
+    /// Spline or hermite: the reference direction of the child frame's binormal (see
+    /// `kinematics::path`); default the plane's normal, or the direction the path runs along least.
+    #[serde(default)]
+    pub up: Option<[f64; 3]>,
+    /// Hermite: the sample parameter values (increasing).
+    #[serde(default)]
+    pub parameters: Option<Vec<f64>>,
+    /// Hermite: dr/dp at the samples.
+    #[serde(default)]
+    pub tangents: Option<Vec<[f64; 3]>>,
+    /// Hermite: d²r/dp² at the samples.
+    #[serde(default)]
+    pub second_derivatives: Option<Vec<[f64; 3]>>,
     /// Joint frame on the parent body.
     #[serde(default)]
     pub parent_frame: FrameDescription,
@@ -751,7 +780,8 @@ enum OneOrMany {
 }
 
 fn one_or_many<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Vec<f64>, D::Error> {
-    let v = OneOrMany::deserialize(d).map_err(|_| serde::de::Error::custom("expected a finite number or a list of finite numbers"))?;
+    let v = OneOrMany::deserialize(d)
+        .map_err(|_| serde::de::Error::custom("expected a finite number or a list of finite numbers"))?;
     Ok(match v {
         OneOrMany::One(x) => vec![x],
         OneOrMany::Many(v) => v,

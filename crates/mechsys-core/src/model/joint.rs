@@ -20,7 +20,7 @@ use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};
 
 /// The joint types, with their per-type constant data.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum JointKind {
     /// Rigid connection.
     Fixed,
@@ -52,12 +52,13 @@ pub enum JointKind {
     Planar,
     /// Six degrees of freedom.
     Free,
-    /// Path coordinate (section 2.2.6): the child frame's origin moves along a helix about the
-    /// parent frame's z-axis (a circle when its lead is zero), q = arc length s; `oriented`: the
-    /// child frame turns with the curve's trihedral [t n b], else it keeps the parent's axes.
+    /// Path coordinate (section 2.2.6): the child frame's origin moves along a curve in the
+    /// parent joint frame (helix, clothoid, spline), q = its arc length s; `oriented`: the child
+    /// frame turns with the curve's frame [t n b] (`kinematics::path`), else it keeps the
+    /// parent's axes.
     Path {
         /// The curve.
-        helix: crate::kinematics::path::Helix,
+        curve: crate::kinematics::path::PathCurve,
         /// Whether the child frame follows the trihedral.
         oriented: bool,
     },
@@ -102,7 +103,12 @@ impl JointKind {
     /// Whether the motion subspace depends on q (so `c_J = Ṡ u ≠ 0`).
     #[inline]
     pub fn has_bias(&self) -> bool {
-        matches!(self, JointKind::Universal { .. } | JointKind::Planar | JointKind::Path { oriented: false, .. })
+        match self {
+            JointKind::Universal { .. } | JointKind::Planar => true,
+            // oriented: S = (Ω(s), t) in the child's own axes, constant only for the helix
+            JointKind::Path { curve, oriented } => !oriented || !curve.constant_darboux(),
+            _ => false,
+        }
     }
     /// Whether the coordinates contain a quaternion (and so `q̇ ≠ u`).
     pub fn has_quaternion(&self) -> bool {
@@ -132,9 +138,9 @@ impl JointKind {
             JointKind::Spherical => Pose::new(unit_quat_matrix(&q[0..4]), Vec3::zeros()),
             JointKind::Planar => Pose::new(axis_rotation(&Vec3::z(), q[2]), Vec3::new(q[0], q[1], 0.0)),
             JointKind::Free => Pose::new(unit_quat_matrix(&q[3..7]), Vec3::new(q[0], q[1], q[2])),
-            JointKind::Path { helix, oriented } => {
-                let (r, f) = helix.frame(q[0]);
-                Pose::new(if *oriented { f } else { Mat3::identity() }, r)
+            JointKind::Path { curve, oriented } => {
+                let p = curve.point(q[0]);
+                Pose::new(if *oriented { p.frame } else { Mat3::identity() }, p.r)
             }
         }
     }
@@ -174,13 +180,13 @@ impl JointKind {
                     s[k + 3] = Motion::new(unit(k), z);
                 }
             }
-            JointKind::Path { helix, oriented: true } => {
-                // in the trihedral's own axes: v = t ṡ, ω = (τ t + κ b) ṡ (the Darboux vector)
-                s[0] = Motion::new(Vec3::new(helix.torsion(), 0.0, helix.curvature()), Vec3::x());
+            JointKind::Path { curve, oriented: true } => {
+                // in the trihedral's own axes: v = t ṡ, ω = Ω ṡ (the Darboux vector, (τ, 0, κ)
+                // for the Frenet trihedral)
+                s[0] = Motion::new(curve.point(q[0]).omega, Vec3::x());
             }
-            JointKind::Path { helix, oriented: false } => {
-                let (_, f) = helix.frame(q[0]);
-                s[0] = Motion::new(z, f.column(0).into_owned());
+            JointKind::Path { curve, oriented: false } => {
+                s[0] = Motion::new(z, curve.point(q[0]).frame.column(0).into_owned());
             }
         }
     }
@@ -198,10 +204,13 @@ impl JointKind {
                 let v = Vec3::new(c * u[0] + sn * u[1], -sn * u[0] + c * u[1], 0.0);
                 Motion::new(Vec3::zeros(), -(Vec3::z() * u[2]).cross(&v))
             }
-            JointKind::Path { helix, oriented: false } => {
-                // d(t ṡ)/dt at constant ṡ: κ n ṡ²
-                let (_, f) = helix.frame(q[0]);
-                Motion::new(Vec3::zeros(), f.column(1) * (helix.curvature() * u[0] * u[0]))
+            JointKind::Path { curve, oriented: false } => {
+                // d(t ṡ)/dt at constant ṡ: t′ ṡ² = κ n ṡ² (eq. 2.74)
+                Motion::new(Vec3::zeros(), curve.point(q[0]).tangent_rate * (u[0] * u[0]))
+            }
+            JointKind::Path { curve, oriented: true } => {
+                // S = (Ω(s), e_x) in the child's axes: Ṡ u = (Ω′ ṡ², 0)
+                Motion::new(curve.point(q[0]).omega_rate * (u[0] * u[0]), Vec3::zeros())
             }
             _ => Motion::ZERO,
         }

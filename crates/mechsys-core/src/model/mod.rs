@@ -18,7 +18,7 @@ pub mod jenkins;
 pub mod joint;
 pub mod rotation_description;
 mod planar;
-mod validate;
+pub mod validate;
 
 use std::collections::HashMap;
 

@@ -33,6 +33,133 @@ pub(crate) fn check_name(name: &str, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// The curve of one path joint described alone (JSON of a joint entry), for looking at a path
+/// before any model holds it. Errors name the joint.
+pub fn path_curve_from_json(json: &str) -> Result<crate::kinematics::path::PathCurve> {
+    let j: JointDescription =
+        serde_json::from_str(json).map_err(|e| Error::Description { path: "joint".into(), message: e.to_string() })?;
+    path_curve(&j, &format!("joint '{}'", j.name), j.oriented.unwrap_or(true))
+}
+
+/// The keys of a path joint's curves, with whether each is given.
+fn path_keys(j: &JointDescription) -> [(bool, &'static str); 11] {
+    [
+        (j.curve.is_some(), "curve"),
+        (j.radius.is_some(), "radius"),
+        (j.pitch.is_some(), "pitch"),
+        (j.clothoid_a.is_some(), "A"),
+        (j.kappa0.is_some(), "kappa0"),
+        (j.points.is_some(), "points"),
+        (j.closed.is_some(), "closed"),
+        (j.up.is_some(), "up"),
+        (j.parameters.is_some(), "parameters"),
+        (j.tangents.is_some(), "tangents"),
+        (j.second_derivatives.is_some(), "second_derivatives"),
+    ]
+}
+
+/// The curve of a path joint (`kinematics::path`) from its keys, each checked; `what` names the
+/// joint. An oriented joint's spline must keep its tangent away from the frame's `up`.
+pub fn path_curve(j: &JointDescription, what: &str, oriented: bool) -> Result<crate::kinematics::path::PathCurve> {
+    use crate::kinematics::path::{Clothoid, Helix, PathCurve, Spline};
+    let curve = j.curve.as_deref().unwrap_or("helix").to_ascii_lowercase();
+    crate::ensure!(
+        !(j.kind.eq_ignore_ascii_case("helix") && curve != "helix"),
+        Model,
+        "{what}.curve: a joint of type 'helix' is a helix; use type = \"path\" for a {curve}"
+    );
+    let own: &[&str] = match curve.as_str() {
+        "helix" | "circle" => &["radius", "pitch"],
+        "clothoid" | "euler_spiral" => &["A", "kappa0"],
+        "spline" => &["points", "closed", "up"],
+        "hermite" => &["parameters", "points", "tangents", "second_derivatives", "closed", "up"],
+        other => {
+            return Err(err(format!(
+                "{what}.curve: unknown path curve '{other}' (expected helix, clothoid, spline or hermite)"
+            )))
+        }
+    };
+    for (given, key) in path_keys(j) {
+        crate::ensure!(
+            !given || key == "curve" || own.contains(&key),
+            Model,
+            "{what}.{key}: a {curve} path has no {key} (its keys: {})",
+            own.join(", ")
+        );
+    }
+    let to_vec = |a: &[f64; 3]| Vec3::new(a[0], a[1], a[2]);
+    let spline = |r: std::result::Result<Spline, String>| -> Result<PathCurve> {
+        let sp = r.map_err(|m| err(format!("{what}.{m}")))?;
+        if oriented {
+            let (clear, at) = sp.up_clearance;
+            let min = 5f64.to_radians().sin();
+            crate::ensure!(
+                clear >= min,
+                Model,
+                "{what}.up: the path runs within {:.2}° of the frame's reference direction up = [{:.4}, {:.4}, {:.4}] \
+                 (near s = {at:.4} m), where its binormal is undefined; an oriented path needs 5° or more: give an `up` \
+                 across the path, or oriented = false",
+                clear.asin().to_degrees(),
+                sp.up.x,
+                sp.up.y,
+                sp.up.z
+            );
+        }
+        Ok(PathCurve::Spline(std::sync::Arc::new(sp)))
+    };
+    match curve.as_str() {
+        "helix" | "circle" => {
+            let radius =
+                j.radius.ok_or_else(|| err(format!("{what}.radius: a path joint needs the helix radius (m)")))?;
+            crate::ensure!(
+                radius.is_finite() && radius > 0.0,
+                Model,
+                "{what}.radius: must be > 0, got {radius} (a straight path is a prismatic joint)"
+            );
+            let pitch = j.pitch.unwrap_or(0.0);
+            crate::ensure!(pitch.is_finite(), Model, "{what}.pitch: must be finite, got {pitch}");
+            Ok(PathCurve::Helix(Helix { radius, lead: pitch / std::f64::consts::TAU }))
+        }
+        "clothoid" | "euler_spiral" => {
+            let a = j
+                .clothoid_a
+                .ok_or_else(|| err(format!("{what}.A: a clothoid needs its parameter A (m; κ = κ0 + s/A²)")))?;
+            crate::ensure!(a.is_finite() && a > 0.0, Model, "{what}.A: must be > 0, got {a}");
+            let kappa0 = j.kappa0.unwrap_or(0.0);
+            crate::ensure!(kappa0.is_finite(), Model, "{what}.kappa0: must be finite, got {kappa0}");
+            Ok(PathCurve::Clothoid(Clothoid { a, kappa0 }))
+        }
+        "spline" => {
+            let pts = j
+                .points
+                .as_ref()
+                .ok_or_else(|| err(format!("{what}.points: a spline needs the points it passes through")))?;
+            let pts: Vec<Vec3> = pts.iter().map(to_vec).collect();
+            spline(Spline::through_points(&pts, j.closed.unwrap_or(false), j.up.as_ref().map(to_vec)))
+        }
+        _ => {
+            let need = |v: &Option<Vec<[f64; 3]>>, key: &str| -> Result<Vec<Vec3>> {
+                v.as_ref().map(|x| x.iter().map(to_vec).collect()).ok_or_else(|| {
+                    err(format!(
+                        "{what}.{key}: a hermite path needs parameters, points, tangents and second_derivatives"
+                    ))
+                })
+            };
+            let p = j.parameters.clone().ok_or_else(|| {
+                err(format!(
+                    "{what}.parameters: a hermite path needs parameters, points, tangents and second_derivatives"
+                ))
+            })?;
+            let (r, d1, d2) = (
+                need(&j.points, "points")?,
+                need(&j.tangents, "tangents")?,
+                need(&j.second_derivatives, "second_derivatives")?,
+            );
+            spline(Spline::hermite(&p, &r, &d1, &d2, j.closed.unwrap_or(false), j.up.as_ref().map(to_vec)))
+        }
+    }
+}
+
 fn finite3(v: &[f64; 3], what: &str) -> Result<Vec3> {
     crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: must be finite, got {v:?}");
     Ok(Vec3::new(v[0], v[1], v[2]))
@@ -384,18 +511,8 @@ impl Model {
                 "planar" => JointKind::Planar,
                 "free" | "floating" => JointKind::Free,
                 "path" | "helix" => {
-                    let radius = j.radius.ok_or_else(|| err(format!("{what}.radius: a path joint needs the helix radius (m)")))?;
-                    crate::ensure!(
-                        radius.is_finite() && radius > 0.0,
-                        Model,
-                        "{what}.radius: must be > 0, got {radius} (a straight path is a prismatic joint)"
-                    );
-                    let pitch = j.pitch.unwrap_or(0.0);
-                    crate::ensure!(pitch.is_finite(), Model, "{what}.pitch: must be finite, got {pitch}");
-                    JointKind::Path {
-                        helix: crate::kinematics::path::Helix { radius, lead: pitch / std::f64::consts::TAU },
-                        oriented: j.oriented.unwrap_or(true),
-                    }
+                    let oriented = j.oriented.unwrap_or(true);
+                    JointKind::Path { curve: path_curve(j, &what, oriented)?, oriented }
                 }
                 other => {
                     return Err(err(format!(
@@ -404,9 +521,10 @@ impl Model {
                 }
             };
             if !matches!(kind, JointKind::Path { .. }) {
-                for (given, key) in [(j.radius.is_some(), "radius"), (j.pitch.is_some(), "pitch"), (j.oriented.is_some(), "oriented")] {
+                for (given, key) in path_keys(j) {
                     crate::ensure!(!given, Model, "{what}.{key}: only a path joint has a {key}");
                 }
+                crate::ensure!(j.oriented.is_none(), Model, "{what}.oriented: only a path joint has an oriented");
             }
             if !matches!(
                 kind,
@@ -480,6 +598,10 @@ impl Model {
             };
             let child_frame = frame(&j.child_frame, &format!("{what}.child_frame"))?;
             let parent_frame = frame(&j.parent_frame, &format!("{what}.parent_frame"))?;
+            let coordinate_axis = match kind {
+                JointKind::Revolute { axis } => (0..3).find(|&k| axis[k] == 1.0),
+                _ => None,
+            };
             joints.push(Joint {
                 name: j.name.clone(),
                 kind,
@@ -489,10 +611,7 @@ impl Model {
                 child_frame,
                 child_frame_inv: child_frame.inverse(),
                 frames_plain: (parent_frame.rotation_is_identity(), child_frame.rotation_is_identity()),
-                coordinate_axis: match kind {
-                    JointKind::Revolute { axis } => (0..3).find(|&k| axis[k] == 1.0),
-                    _ => None,
-                },
+                coordinate_axis,
                 iq,
                 iu,
                 q0,
