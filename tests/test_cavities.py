@@ -1,0 +1,79 @@
+"""Concave contours (issue 14, part 5): a ball rolling in a spherical bowl and a sphere in a
+cylindrical bore, against closed forms."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import mechsys as ms
+
+G = 9.81
+
+
+def _ball_in_bowl(R: float, r: float, phi0: float, mu: float | None = 1.0) -> ms.Model:
+    m = ms.Model("bowl", gravity=(0.0, 0.0, -G))
+    ball = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, r))
+    x0, z0 = (R - r) * math.sin(phi0), -(R - r) * math.cos(phi0)
+    m.add_joint(ms.joints.Free("free", m.ground, ball, q0=[x0, 0.0, z0, 1.0, 0.0, 0.0, 0.0]))
+    m.add_contact(ms.Contact("bowl", ball.contour(ms.contours.Sphere(radius=r)), m.ground.contour(ms.contours.Bowl(radius=R)),
+                             friction=None if mu is None else ms.laws.Coulomb(mu=mu)))
+    return m
+
+
+def test_a_ball_rolling_in_a_spherical_bowl_has_the_closed_form_period():
+    # a solid ball rolling without slip: T = 2 pi sqrt(7 (R - r) / (5 g)) for small swings
+    R, r, phi0 = 0.5, 0.05, 0.02
+    res = ms.simulate(_ball_in_bowl(R, r, phi0), t_end=3.0, integrator=ms.EventDriven(), output_dt=1e-3)
+    x = res["joint/free/q"][:, 0]
+    k = np.where((x[:-1] > 0) & (x[1:] <= 0))[0]
+    tc = res.t[k] + (res.t[k + 1] - res.t[k]) * x[k] / (x[k] - x[k + 1])
+    period = np.diff(tc).mean() if len(tc) > 1 else 2 * (tc[0] - 0.0)
+    expected = 2 * math.pi * math.sqrt(7 * (R - r) / (5 * G))
+    assert period == pytest.approx(expected, rel=2e-4)
+    # it rolls: sticking throughout, energy kept, on the bowl (gap zero)
+    assert set(res["contact/bowl/state"].tolist()) == {1}
+    assert np.ptp(res["energy/total"]) < 1e-8
+    assert np.abs(res["contact/bowl/g_n"]).max() < 1e-9
+    # frictionless it slides instead: the period of a point mass, 2 pi sqrt((R - r) / g)
+    m = _ball_in_bowl(R, r, phi0, mu=None)
+    res = ms.simulate(m, t_end=3.0, integrator=ms.EventDriven(), output_dt=1e-3)
+    x = res["joint/free/q"][:, 0]
+    k = np.where((x[:-1] > 0) & (x[1:] <= 0))[0]
+    tc = res.t[k] + (res.t[k + 1] - res.t[k]) * x[k] / (x[k] - x[k + 1])
+    assert np.diff(tc).mean() == pytest.approx(2 * math.pi * math.sqrt((R - r) / G), rel=2e-4)
+
+
+def test_a_sphere_resting_in_a_bore_sits_on_its_bottom_line():
+    R, r = 0.3, 0.1
+    m = ms.Model("bore", gravity=(0.0, 0.0, -G))
+    ball = m.add_body("ball", 2.0, ms.inertia.sphere(2.0, r))
+    m.add_joint(ms.joints.Free("free", m.ground, ball, q0=[0.0, 0.3, 0.0, 1.0, 0.0, 0.0, 0.0]))
+    m.add_contact(ms.Contact("bore", ball.contour(ms.contours.Sphere(radius=r)),
+                             m.ground.contour(ms.contours.Bore(radius=R, axis=(0, 1, 0))), friction=ms.laws.Coulomb(mu=0.5)))
+    res = ms.simulate(m, t_end=1.0, integrator=ms.EventDriven(), output_dt=1e-2)
+    q = res["joint/free/q"][-1]
+    # fallen from the axis onto the bottom line of the bore: centre at z = -(R - r), y unchanged
+    assert q[2] == pytest.approx(-(R - r), abs=1e-9)
+    assert q[1] == pytest.approx(0.3, abs=1e-9)
+    assert res["contact/bore/lambda_n"][-1] == pytest.approx(2.0 * G, rel=1e-6)
+    g = ms.dynamics.contact_geometry(m, res["joint/free/q"][-1])
+    assert g["curvature2"][0] == pytest.approx([-1 / R, 0.0])
+    assert g["curvature1"][0] == pytest.approx([1 / r, 1 / r])
+
+
+def test_cavity_errors_name_the_contact():
+    m = ms.Model("bad")
+    b = m.add_body("b", 1.0, ms.inertia.sphere(1.0, 0.1))
+    m.add_joint(ms.joints.Free("free", m.ground, b))
+    m.add_contact(ms.Contact("shell", b.contour(ms.contours.Sphere(radius=0.1)), m.ground.contour(ms.contours.Bore(radius=0.3, axis=(0, 0, 0)))))
+    with pytest.raises(ms.ModelError, match=r"shell.*bore axis must not be the zero vector"):
+        m.build()
+    m2 = ms.Model("bad2")
+    b2 = m2.add_body("b", 1.0, ms.inertia.sphere(1.0, 0.1))
+    m2.add_joint(ms.joints.Free("free", m2.ground, b2))
+    m2.add_contact(ms.Contact("cup", b2.contour(ms.contours.Box(half_extents=(0.1, 0.1, 0.1))), m2.ground.contour(ms.contours.Bowl(radius=1.0))))
+    with pytest.raises(ms.ModelError, match=r"cup.*box–bowl"):
+        m2.build()
