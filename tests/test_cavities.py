@@ -77,3 +77,29 @@ def test_cavity_errors_name_the_contact():
     m2.add_contact(ms.Contact("cup", b2.contour(ms.contours.Box(half_extents=(0.1, 0.1, 0.1))), m2.ground.contour(ms.contours.Bowl(radius=1.0))))
     with pytest.raises(ms.ModelError, match=r"cup.*box–bowl"):
         m2.build()
+
+
+def test_an_ellipsoid_rocking_on_a_floor_without_slipping_has_the_closed_form_frequency():
+    # resting on the end of its c axis, rocking about y: the contact rolls over a radius of
+    # curvature rho = a² / c below a centre at h = c, so omega² = m g (rho - h) / (I_y + m h²)
+    a, b, c, mass = 0.3, 0.2, 0.1, 2.0
+    m = ms.Model("egg", gravity=(0.0, 0.0, -G))
+    inertia = ms.inertia.ellipsoid(mass, (a, b, c))
+    egg = m.add_body("egg", mass, inertia)
+    tilt = 0.01
+    q0 = [0.0, 0.0, c, math.cos(tilt / 2), 0.0, math.sin(tilt / 2), 0.0]
+    # start on the floor at the tilted support height
+    q0[2] = math.sqrt((a * math.sin(tilt)) ** 2 + (c * math.cos(tilt)) ** 2)
+    m.add_joint(ms.joints.Free("free", m.ground, egg, q0=q0))
+    m.add_contact(ms.Contact("floor", egg.contour(ms.contours.Ellipsoid(semi_axes=(a, b, c))), m.ground.contour(ms.contours.Plane()),
+                             friction=ms.laws.Coulomb(mu=1.0)))
+    res = ms.simulate(m, t_end=2.0, integrator=ms.EventDriven(), output_dt=1e-3)
+    quat = res["joint/free/q"][:, 3:7]
+    theta = 2 * np.arctan2(quat[:, 2], quat[:, 0])  # rotation about y
+    k = np.where((theta[:-1] > 0) & (theta[1:] <= 0))[0]
+    tc = res.t[k] + (res.t[k + 1] - res.t[k]) * theta[k] / (theta[k] - theta[k + 1])
+    i_y = mass * (a * a + c * c) / 5
+    omega = math.sqrt(mass * G * (a * a / c - c) / (i_y + mass * c * c))
+    assert np.diff(tc).mean() == pytest.approx(2 * math.pi / omega, rel=1e-3)
+    assert set(res["contact/floor/state"].tolist()) == {1}
+    assert np.ptp(res["energy/total"]) < 1e-8

@@ -169,6 +169,23 @@ class Polygon(Contour):
 
 
 @dataclass
+class Ellipsoid(Contour):
+    """A solid ellipsoid with ``semi_axes`` (a, b, c) about ``center``; ``cardan`` angles (x-y-z)
+    turn its axes in the body. Pairs with a plane (the support point, closed form)."""
+
+    semi_axes: Sequence[float] = (0.0, 0.0, 0.0)
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+    cardan: Sequence[float] | None = None
+
+    def describe(self, what: str) -> dict:
+        d = {"type": "ellipsoid", "center": _vec3(self.center, f"{what}.center"),
+             "semi_axes": _vec3(self.semi_axes, f"{what}.semi_axes")}
+        if self.cardan is not None:
+            d["rotation"] = {"cardan": _vec3(self.cardan, f"{what}.cardan")}
+        return d
+
+
+@dataclass
 class Bowl(Contour):
     """A spherical cavity of ``radius`` about ``center``: the solid lies outside the sphere (a
     bowl, a ball race seen from within). Pairs with a point or a sphere inside it."""
@@ -385,6 +402,7 @@ __all__ = [
     "Circle",
     "Line",
     "Polygon",
+    "Ellipsoid",
     "Bowl",
     "Bore",
     "Ellipse",

@@ -67,6 +67,15 @@ pub enum Contour {
         /// Half the length along the axis (> 0).
         half_length: f64,
     },
+    /// A solid ellipsoid (section 2.2.7.2): `(x - c)ᵀ R diag(a, b, c)⁻² Rᵀ (x - c) ≤ 1`.
+    Ellipsoid {
+        /// Centre.
+        center: Vec3,
+        /// Rotation ellipsoid frame → body frame (orthonormal, determinant +1).
+        rotation: Mat3,
+        /// Semi-axes along the ellipsoid's x, y, z axes (> 0).
+        semi_axes: Vec3,
+    },
     /// A spherical cavity (a bowl, a ball race seen from within): the solid lies outside the
     /// sphere of `radius` about `center`.
     Bowl {
@@ -130,6 +139,8 @@ pub enum ContourKind {
     Capsule,
     /// [`Contour::Cylinder`]
     Cylinder,
+    /// [`Contour::Ellipsoid`]
+    Ellipsoid,
     /// [`Contour::Bowl`]
     Bowl,
     /// [`Contour::Bore`]
@@ -156,6 +167,7 @@ impl ContourKind {
             ContourKind::Box => "box",
             ContourKind::Capsule => "capsule",
             ContourKind::Cylinder => "cylinder",
+            ContourKind::Ellipsoid => "ellipsoid",
             ContourKind::Bowl => "bowl",
             ContourKind::Bore => "bore",
             ContourKind::Point2 => "point2",
@@ -210,6 +222,7 @@ impl Contour {
             Contour::Box { .. } => ContourKind::Box,
             Contour::Capsule { .. } => ContourKind::Capsule,
             Contour::Cylinder { .. } => ContourKind::Cylinder,
+            Contour::Ellipsoid { .. } => ContourKind::Ellipsoid,
             Contour::Bowl { .. } => ContourKind::Bowl,
             Contour::Bore { .. } => ContourKind::Bore,
             Contour::Point2 { .. } => ContourKind::Point2,
@@ -285,6 +298,20 @@ impl Contour {
                 );
                 positive(*radius, what, "cylinder radius")?;
                 positive(*half_length, what, "cylinder half_length")
+            }
+            Contour::Ellipsoid { center, rotation, semi_axes } => {
+                finite3(center, what, "ellipsoid center")?;
+                ensure!(rotation.iter().all(|x| x.is_finite()), Model, "{what}: ellipsoid rotation must be finite");
+                let e = (rotation.transpose() * rotation - Mat3::identity()).norm();
+                ensure!(
+                    e < 1e-6 && rotation.determinant() > 0.0,
+                    Model,
+                    "{what}: ellipsoid rotation must be orthonormal with determinant +1 (|AᵀA - E| = {e:.2e})"
+                );
+                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                    positive(semi_axes[k], what, &format!("ellipsoid semi-axis along {axis}"))?;
+                }
+                Ok(())
             }
             Contour::Bowl { center, radius } => {
                 finite3(center, what, "bowl center")?;
@@ -377,6 +404,13 @@ impl Contour {
                 let e = Vec3::from_fn(|k, _| u[k].abs() * half_length + radius * (1.0 - u[k] * u[k]).max(0.0).sqrt());
                 Aabb { min: c - e, max: c + e }
             }
+            Contour::Ellipsoid { center, rotation, semi_axes } => {
+                // the extent along world axis k is √(Σ_j (A_kj a_j)²)
+                let a = pose.a * rotation;
+                let c = pose.point_to_parent(center);
+                let e = Vec3::from_fn(|k, _| (0..3).map(|j| (a[(k, j)] * semi_axes[j]).powi(2)).sum::<f64>().sqrt());
+                Aabb { min: c - e, max: c + e }
+            }
             // a cavity's solid surrounds it: unbounded
             Contour::Bowl { .. } | Contour::Bore { .. } => Aabb::EVERYTHING,
             Contour::Point2 { p } => extruded(pose, Aabb::point(&lift(p))),
@@ -430,6 +464,22 @@ impl Contour {
             Contour::Point { .. } | Contour::Point2 { .. } => [inf, inf],
             Contour::Sphere { radius, .. } => [1.0 / radius, 1.0 / radius],
             Contour::Bowl { radius, .. } => [-1.0 / radius, -1.0 / radius],
+            Contour::Ellipsoid { center, rotation, semi_axes } => {
+                // principal curvatures of the quadric at the point: the shape operator restricted to
+                // the tangent plane, from the gradient and Hessian of F = ½ yᵀ D⁻² y
+                let y = rotation.transpose() * (l - center);
+                let dinv = Vec3::from_fn(|k, _| 1.0 / (semi_axes[k] * semi_axes[k]));
+                let grad = y.component_mul(&dinv);
+                let gn = grad.norm();
+                let nrm = grad / gn;
+                let t1 = if nrm.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+                let t1 = (t1 - nrm * nrm.dot(&t1)).normalize();
+                let t2 = nrm.cross(&t1);
+                let h = |u: &Vec3, v: &Vec3| u.component_mul(&dinv).dot(v) / gn;
+                let (a11, a12, a22) = (h(&t1, &t1), h(&t1, &t2), h(&t2, &t2));
+                let (m, d) = (0.5 * (a11 + a22), (0.25 * (a11 - a22).powi(2) + a12 * a12).sqrt());
+                [m + d, m - d]
+            }
             Contour::Bore { radius, .. } => [-1.0 / radius, 0.0],
             Contour::Plane { .. } | Contour::Line { .. } => [0.0, 0.0],
             Contour::Box { center, rotation, half_extents } => {

@@ -98,6 +98,9 @@ enum Geometry {
     CircleCircle { c1: Vec3, r1: f64, c2: Vec3, r2: f64 },
     /// Planar parametric contours ([`curve_pair`]).
     Curve(CurveGeometry),
+    /// An ellipsoid on body 1 (`S = R diag(a², b², c²) Rᵀ` in its body frame) against the
+    /// half-space of body 2.
+    EllipsoidHalfSpace { center: Vec3, shape: Mat3, point: Vec3, normal: Vec3 },
     /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
     /// cavity of body 2.
     Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
@@ -173,7 +176,7 @@ pub(crate) struct Tangents {
 fn canonical(a: ContourKind, b: ContourKind) -> bool {
     use ContourKind as K;
     match b {
-        K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder),
+        K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder | K::Ellipsoid),
         K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Curve => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Sphere => matches!(a, K::Point | K::Sphere),
@@ -193,7 +196,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Ok(true)
     } else {
         Err(Error::Model(format!(
-            "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder–plane, \
+            "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
              point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore, in either order)"
         )))
@@ -541,6 +544,9 @@ impl ContactPair {
             Geometry::BoxBox { a, b, scale } => box_box::box_box(x1, x2, tw, a, b, *scale, k),
             Geometry::Curve(g) => g.one(k, x1, x2, tw),
             Geometry::Cavity { c1, r1, c2, axis, r2, across } => cavity(x1, x2, tw, c1, *r1, c2, axis, *r2, across),
+            Geometry::EllipsoidHalfSpace { center, shape, point, normal } => {
+                ellipsoid_half_space(x1, x2, tw, center, shape, point, normal)
+            }
         }
     }
 }
@@ -585,6 +591,10 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
         _ => None,
     };
     if let Some((point, normal)) = half_space(s) {
+        if let Contour::Ellipsoid { center, rotation, semi_axes } = f {
+            let d = Mat3::from_diagonal(&semi_axes.component_mul(semi_axes));
+            return Geometry::EllipsoidHalfSpace { center: *center, shape: rotation * d * rotation.transpose(), point, normal };
+        }
         let (centers, radius) = match f {
             Contour::Point { p } => (vec![*p], 0.0),
             Contour::Sphere { center, radius } => (vec![*center], *radius),
@@ -608,7 +618,8 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             | Contour::Line { .. }
             | Contour::Curve(_)
             | Contour::Bowl { .. }
-            | Contour::Bore { .. } => {
+            | Contour::Bore { .. }
+            | Contour::Ellipsoid { .. } => {
                 unreachable!("excluded by the dispatch table")
             }
         };
@@ -879,6 +890,44 @@ fn circle_circle(
         out.nd = if degenerate { t2.w.cross(&n) } else { (dpd - n * lend) / len };
         out.p1d = c1d - out.nd * r1;
         out.p2d = c1d - n * lend - out.nd * (len - r2);
+    }
+    out
+}
+
+/// An ellipsoid against a half-space (section 2.2.7.2 for a quadric and a plane): with the world
+/// shape matrix `S = A1 S_b A1ᵀ` and the plane's normal `m`, the deepest point is the support
+/// point `P1 = c - S m / √(mᵀ S m)` (where the ellipsoid's normal is `-m`), `g_N = m·(P1 - p)`.
+/// Its rate follows from `Ṡ = ω1 × S - S ω1 ×` and `ṁ = ω2 × m`; the contact point slides over
+/// the ellipsoid as it rolls.
+fn ellipsoid_half_space(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    center: &Vec3,
+    shape: &Mat3,
+    point: &Vec3,
+    normal: &Vec3,
+) -> Raw {
+    let c = x1.point_to_parent(center);
+    let s = x1.a * shape * x1.a.transpose();
+    let m = x2.a * normal;
+    let p = x2.point_to_parent(point);
+    let sm = s * m;
+    let k = m.dot(&sm).sqrt();
+    let p1 = c - sm / k;
+    let g = m.dot(&(p1 - p));
+    let mut out = Raw { g, n: m, p1, p2: p1 - m * g, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        let md = t2.w.cross(&m);
+        // Ṡ m = ω1 × (S m) - S (ω1 × m)
+        let sdm = t1.w.cross(&sm) - s * t1.w.cross(&m);
+        let smd = sdm + s * md;
+        let kd = (m.dot(&sdm) + 2.0 * sm.dot(&md)) / (2.0 * k);
+        let p1d = vel(t1, &c) - smd / k + sm * (kd / (k * k));
+        let gd = md.dot(&(p1 - p)) + m.dot(&(p1d - vel(t2, &p)));
+        out.nd = md;
+        out.p1d = p1d;
+        out.p2d = p1d - m * gd - md * g;
     }
     out
 }

@@ -184,6 +184,11 @@ pub(crate) fn sample(kind: &str) -> Contour {
                 .map(|&(x, y)| Vec2::new(x, y))
                 .collect(),
         },
+        "ellipsoid" => Contour::Ellipsoid {
+            center: Vec3::new(0.05, -0.03, 0.02),
+            rotation: rot(&Vec3::new(0.3, -1.0, 0.6), 0.8),
+            semi_axes: Vec3::new(0.4, 0.25, 0.15),
+        },
         "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
         "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
         "ellipse" => curve_sample("ellipse"),
@@ -242,7 +247,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 10] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 21] = [
+pub(crate) const PAIRS: [(&str, &str); 22] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -260,6 +265,7 @@ pub(crate) const PAIRS: [(&str, &str); 21] = [
     ("sphere", "box"),
     ("point2", "circle"),
     ("circle_b", "circle"),
+    ("ellipsoid", "plane"),
     ("point", "bowl"),
     ("sphere", "bowl"),
     ("point", "bore"),
@@ -325,6 +331,12 @@ pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
                 .fold(f64::NEG_INFINITY, f64::max)
         }
         Contour::Curve(c) => curve_sdf(c, &Vec2::new(xl.x, xl.y)).0,
+        // not a distance: the level set √(yᵀ D⁻² y) - 1 scaled by the smallest semi-axis, zero on
+        // the surface (the tests only ask whether points lie on it)
+        Contour::Ellipsoid { center, rotation, semi_axes } => {
+            let y = rotation.transpose() * (xl - center);
+            (y.component_div(semi_axes).norm() - 1.0) * semi_axes.min()
+        }
         // inside the cavity is free space: positive distance to the wall
         Contour::Bowl { center, radius } => radius - (xl - center).norm(),
         Contour::Bore { center, axis, radius } => {

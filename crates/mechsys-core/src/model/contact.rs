@@ -219,6 +219,11 @@ fn contour(
         ContourDescription::Cylinder { center, axis, radius, half_length } => {
             Contour::Cylinder { center: vec3(center), axis: vec3(axis), radius: *radius, half_length: *half_length }
         }
+        ContourDescription::Ellipsoid { center, rotation: r, semi_axes } => Contour::Ellipsoid {
+            center: vec3(center),
+            rotation: rotation(r, &format!("{what}.rotation"))?,
+            semi_axes: vec3(semi_axes),
+        },
         ContourDescription::Bowl { center, radius } => Contour::Bowl { center: vec3(center), radius: *radius },
         ContourDescription::Bore { center, axis, radius } => {
             Contour::Bore { center: vec3(center), axis: vec3(axis), radius: *radius }

@@ -99,6 +99,17 @@ pub enum ContourDescription {
         /// Half the length along the axis, > 0.
         half_length: f64,
     },
+    /// A solid ellipsoid.
+    Ellipsoid {
+        /// Centre.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Orientation of the ellipsoid's axes in the body frame (identity if absent).
+        #[serde(default)]
+        rotation: Option<RotationDescription>,
+        /// Semi-axes along the ellipsoid's x, y, z axes, each > 0.
+        semi_axes: [f64; 3],
+    },
     /// A spherical cavity (a bowl): the solid lies outside the sphere.
     Bowl {
         /// Centre.

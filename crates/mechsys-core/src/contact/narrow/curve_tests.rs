@@ -187,3 +187,53 @@ fn curve_pairs_give_finite_values_in_degenerate_placements() {
         }
     }
 }
+
+#[test]
+fn ellipsoid_on_a_plane_against_sampled_support_and_curvatures_at_the_axes() {
+    let mut rng = Rng::new(21);
+    let (a, b, c) = (0.4, 0.25, 0.15);
+    let shape = Contour::Ellipsoid { center: Vec3::new(0.05, 0.0, -0.02), rotation: rot(&Vec3::new(1.0, 2.0, 0.5), 0.7), semi_axes: Vec3::new(a, b, c) };
+    let ground = Contour::Plane { point: Vec3::zeros(), normal: Vec3::new(0.1, -0.2, 1.0) };
+    let pair = ContactPair::new("egg", shape.clone(), ground.clone()).unwrap();
+    let Contour::Ellipsoid { center, rotation, .. } = &shape else { unreachable!() };
+    for it in 0..10 {
+        let x1 = Pose::new(rng.rotation(), rng.vec3(0.5));
+        let c0 = eval(&pair, &x1, &Pose::IDENTITY)[0];
+        // reference: the lowest surface point along the normal by dense sampling of the angles,
+        // refined on a finer grid around the best
+        let m = Vec3::new(0.1, -0.2, 1.0).normalize();
+        let height = |u: f64, v: f64| {
+            let y = Vec3::new(a * u.cos() * v.cos(), b * u.sin() * v.cos(), c * v.sin());
+            m.dot(&x1.point_to_parent(&(center + rotation * y)))
+        };
+        let (mut best, mut bu, mut bv) = (f64::INFINITY, 0.0, 0.0);
+        for i in 0..720 {
+            for j in 0..=360 {
+                let (u, v) = (TAU * i as f64 / 720.0, -1.5707963 + std::f64::consts::PI * j as f64 / 360.0);
+                let h = height(u, v);
+                if h < best {
+                    (best, bu, bv) = (h, u, v);
+                }
+            }
+        }
+        let mut step = TAU / 720.0;
+        for _ in 0..60 {
+            let mut moved = false;
+            for (du, dv) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)] {
+                let h = height(bu + du, bv + dv);
+                if h < best {
+                    (best, bu, bv, moved) = (h, bu + du, bv + dv, true);
+                }
+            }
+            if !moved {
+                step *= 0.5;
+            }
+        }
+        assert!((c0.g_n - best).abs() < 1e-10, "#{it}: gap {} vs sampled {best}", c0.g_n);
+        assert!((c0.n - m).norm() < 1e-15);
+    }
+    // principal curvatures at the end of the a axis: a/b², a/c²
+    let e = Contour::Ellipsoid { center: Vec3::zeros(), rotation: Mat3::identity(), semi_axes: Vec3::new(a, b, c) };
+    let k = e.curvatures_at(&Pose::IDENTITY, &Vec3::new(a, 0.0, 0.0));
+    assert!((k[0] - a / (c * c)).abs() < 1e-12 && (k[1] - a / (b * b)).abs() < 1e-12, "{k:?}");
+}
