@@ -37,6 +37,13 @@ def test_a_ball_rolling_in_a_spherical_bowl_has_the_closed_form_period():
     assert set(res["contact/bowl/state"].tolist()) == {1}
     assert np.ptp(res["energy/total"]) < 1e-8
     assert np.abs(res["contact/bowl/g_n"]).max() < 1e-9
+    # spin and rolling: the ball's angular velocity (the bowl is at rest) in the contact frame
+    w = res["body/ball/angular_velocity"]
+    n = res["contact/bowl/normal"]
+    assert np.allclose(res["contact/bowl/spin"], np.einsum("ij,ij->i", w, n), atol=1e-12)
+    roll = res["contact/bowl/rolling"]
+    assert roll.shape == (len(res.t), 2)
+    assert np.allclose(np.linalg.norm(roll, axis=1) ** 2 + res["contact/bowl/spin"] ** 2, np.einsum("ij,ij->i", w, w), atol=1e-10)
     # frictionless it slides instead: the period of a point mass, 2 pi sqrt((R - r) / g)
     m = _ball_in_bowl(R, r, phi0, mu=None)
     res = ms.simulate(m, t_end=3.0, integrator=ms.EventDriven(), output_dt=1e-3)

@@ -218,6 +218,11 @@ def test_ball_rolling_in_a_spline_track_conserves_energy_and_oscillates_with_the
     expected = 2 * math.pi * math.sqrt(3 * (ex.R0 - ex.RADIUS) / (2 * ex.G))
     assert ex.period(res) == pytest.approx(expected, rel=3e-3)
     assert ex.period(res) > expected
+    # the rolling velocity: the disc's angular velocity about the out-of-plane tangent (the
+    # track does not turn); no spin in the plane
+    assert np.allclose(res["contact/track/rolling"], res["joint/free/u"][:, 2], atol=1e-12)
+    assert np.abs(res["contact/track/spin"]).max() < 1e-12
+    assert res.unit("contact/track/rolling") == "rad/s"
 
 
 def test_contact_geometry_query_gives_gap_witness_points_normal_and_curvatures():

@@ -266,6 +266,12 @@ class Results:
                     put(f"{pre}/normal", raw["contact_normal"][:, sl, :], "1", xyz if n == 1 else None)
                 put(f"{pre}/gd_n", raw["contact_gd_n"][:, sl], "m/s")
                 put(f"{pre}/gd_t", raw["contact_gd_t"][:, sl, :nt] if nt > 1 else raw["contact_gd_t"][:, sl, 0], "m/s")
+                if "contact_omega" in raw:
+                    # relative angular velocity in the contact frame: spin (drilling) about the normal,
+                    # rolling about the tangents (in the plane: about the out-of-plane tangent only)
+                    om = raw["contact_omega"]
+                    put(f"{pre}/spin", om[:, sl, 0], "rad/s")
+                    put(f"{pre}/rolling", om[:, sl, 1:3] if nt > 1 else om[:, sl, 2], "rad/s")
                 put(f"{pre}/lambda_n", raw["contact_lambda_n"][:, sl], "N")
                 put(f"{pre}/lambda_t", raw["contact_lambda_t"][:, sl, :nt] if nt > 1 else raw["contact_lambda_t"][:, sl, 0], "N")
                 put(f"{pre}/impulse_n", raw["contact_impulse_n"][:, sl], "N s")
@@ -719,7 +725,7 @@ def _per_second(unit: str) -> str:
 # ---- selective recording (simulate(sensors=...)) ---------------------------------------------------
 _ACCELERATION_SUFFIXES = ("udot", "/acceleration", "/angular_acceleration", "/com_acceleration", "/reaction_force",
                           "/reaction_torque", "/tangential_acceleration", "/normal_acceleration")
-_CONTACT_SUFFIXES = ("g_n", "point", "normal", "gd_n", "gd_t", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
+_CONTACT_SUFFIXES = ("g_n", "point", "normal", "gd_n", "gd_t", "spin", "rolling", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
                      "friction_reserve")
 _GROUP_SUFFIXES = ("closed", "max_penetration", "impulse_n", "lambda_n", "pairs", "impulse_against", "force_against")
 

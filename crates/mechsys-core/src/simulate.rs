@@ -234,6 +234,9 @@ pub struct Recording {
     pub contact_gd_n: Vec<f64>,
     /// Relative tangential velocities ġ_T (n_out × n_points × 2), m/s.
     pub contact_gd_t: Vec<f64>,
+    /// Relative angular velocities in the contact frame, [spin about n, rolling about t1, t2]
+    /// (n_out × n_points × 3), rad/s.
+    pub contact_omega: Vec<f64>,
     /// Normal contact force λ_N: the impulse since the previous sample over that interval
     /// (n_out × n_points), N.
     pub contact_lambda_n: Vec<f64>,
@@ -1384,6 +1387,7 @@ fn time_stepping(
             rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
             rec.contact_gd_n.push(kk.gd_n);
             rec.contact_gd_t.extend_from_slice(&kk.gd_t);
+            rec.contact_omega.extend_from_slice(&kk.omega_rel);
             rec.contact_impulse_n.push(in_);
             rec.contact_impulse_t.extend_from_slice(&it);
             rec.contact_lambda_n.push(in_ / span);
@@ -1478,6 +1482,7 @@ fn event_driven(
             rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
             rec.contact_gd_n.push(kk.gd_n);
             rec.contact_gd_t.extend_from_slice(&kk.gd_t);
+            rec.contact_omega.extend_from_slice(&kk.omega_rel);
             rec.contact_impulse_n.push(i_n);
             rec.contact_impulse_t.extend_from_slice(&i_t);
             rec.contact_lambda_n.push(ph.lam_n[pt]);

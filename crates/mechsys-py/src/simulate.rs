@@ -289,6 +289,7 @@ fn simulate<'py>(
         put("contact_normal", rec.contact_normal, &[n, np, 3])?;
         put("contact_gd_n", rec.contact_gd_n, &[n, np])?;
         put("contact_gd_t", rec.contact_gd_t, &[n, np, 2])?;
+        put("contact_omega", rec.contact_omega, &[n, np, 3])?;
         put("contact_lambda_n", rec.contact_lambda_n, &[n, np])?;
         put("contact_lambda_t", rec.contact_lambda_t, &[n, np, 2])?;
         put("contact_impulse_n", rec.contact_impulse_n, &[n, np])?;

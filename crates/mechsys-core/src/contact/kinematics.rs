@@ -90,6 +90,9 @@ pub struct ContactKinematics {
     pub wbar_n: f64,
     /// `w̄_T` (`d ġ_T/dt` if the full accelerations were given).
     pub wbar_t: [f64; 2],
+    /// Relative angular velocity `ω1 - ω2` in the contact frame: `[n·Δω` (spin, drilling),
+    /// `t1·Δω, t2·Δω]` (rolling); rad/s.
+    pub omega_rel: [f64; 3],
     /// The part of `ġ_T` that the contours' moving surfaces add (a conveyor belt's speed), the
     /// rheonomic `w̃_T` of eq. 2.112: `ġ_T = W_Tᵀ u + w̃_T` (zero without moving surfaces).
     pub gd_t_surface: [f64; 2],
@@ -143,6 +146,7 @@ pub fn contact_kinematics(
         // d/dt v_i(P_i(t)) = a_i(P_i) + ω_i × σ_i
         let da = b1.point_acceleration(&r.p1) - b2.point_acceleration(&r.p2) + tw1.w.cross(&s1) - tw2.w.cross(&s2);
         let surf = [t.t1.dot(&dws), t.t2.dot(&dws)];
+        let dw = tw1.w - tw2.w;
         // d/dt (A_i u_i) = ω_i × A_i u_i for a constant body-fixed surface velocity
         let dws_dt = tw1.w.cross(&ws1) - tw2.w.cross(&ws2);
         out[k] = ContactKinematics {
@@ -156,6 +160,7 @@ pub fn contact_kinematics(
                 t.t2d.dot(&(dv + dws)) + t.t2.dot(&(da + dws_dt)),
             ],
             gd_t_surface: surf,
+            omega_rel: [r.n.dot(&dw), t.t1.dot(&dw), t.t2.dot(&dw)],
         };
     });
     Ok(())
