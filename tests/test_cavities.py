@@ -110,3 +110,52 @@ def test_an_ellipsoid_rocking_on_a_floor_without_slipping_has_the_closed_form_fr
     assert np.diff(tc).mean() == pytest.approx(2 * math.pi / omega, rel=1e-3)
     assert set(res["contact/floor/state"].tolist()) == {1}
     assert np.ptp(res["energy/total"]) < 1e-8
+
+
+def test_a_ball_dropped_on_an_ellipsoidal_dome_bounces_off_its_surface_normal():
+    # a fixed ellipsoid (semi-axes a, b, c) and a ball dropped off-centre: the impact happens where
+    # the ball's centre reaches the surface offset by r, the normal is the ellipsoid's there
+    a, b, c, r = 0.4, 0.3, 0.2, 0.05
+    m = ms.Model("dome", gravity=(0.0, 0.0, -G))
+    ball = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, r))
+    x0, y0 = 0.1, 0.05
+    m.add_joint(ms.joints.Free("free", m.ground, ball, q0=[x0, y0, 0.5, 1.0, 0.0, 0.0, 0.0]))
+    m.add_contact(ms.Contact("dome", ball.contour(ms.contours.Sphere(radius=r)),
+                             m.ground.contour(ms.contours.Ellipsoid(semi_axes=(a, b, c))), impact=ms.laws.Newton(eps=1.0)))
+    res = ms.simulate(m, t_end=0.4, integrator=ms.EventDriven(), output_dt=1e-3)
+    impacts = [e for e in res.events if e["event"] == "impact"]
+    assert impacts
+    t_hit = impacts[0]["t"]
+    # reference: the height where the vertical line through (x0, y0) meets the surface offset by r,
+    # by bisection on the distance to the ellipsoid (dense-sampling check in the engine's tests)
+    g = ms.dynamics.contact_geometry
+    lo, hi = 0.0, 0.5
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        gap = g(m, [x0, y0, mid, 1.0, 0.0, 0.0, 0.0])["gap"][0]
+        lo, hi = (mid, hi) if gap < 0 else (lo, mid)
+    z_hit = 0.5 * (lo + hi)
+    assert 0.5 - 0.5 * G * t_hit**2 == pytest.approx(z_hit, abs=1e-9)
+    # the geometry at the hit: normal along the ellipsoid's gradient at the foot point
+    geo = g(m, [x0, y0, z_hit, 1.0, 0.0, 0.0, 0.0])
+    p2 = geo["point2"][0]
+    grad = np.array([p2[0] / a**2, p2[1] / b**2, p2[2] / c**2])
+    assert np.allclose(geo["normal"][0], grad / np.linalg.norm(grad), atol=1e-12)
+    assert (p2[0] / a) ** 2 + (p2[1] / b) ** 2 + (p2[2] / c) ** 2 == pytest.approx(1.0, abs=1e-12)
+    # elastic: energy kept through the impact
+    assert np.ptp(res["energy/total"]) < 1e-8
+
+
+def test_event_driven_steps_do_not_tunnel_through_a_closed_contour():
+    # free fall is a polynomial: the error estimate is zero and the step would grow past the
+    # whole passage through a fixed ball (whose gap is positive again below it); the step cap
+    # from the predicted gap makes the crossing a sign change the event search finds
+    m = ms.Model("drop", gravity=(0.0, 0.0, -G))
+    ball = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, 0.05))
+    m.add_joint(ms.joints.Free("free", m.ground, ball, q0=[0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0]))
+    m.add_contact(ms.Contact("hit", ball.contour(ms.contours.Sphere(radius=0.05)), m.ground.contour(ms.contours.Sphere(radius=0.2)),
+                             impact=ms.laws.Newton(eps=1.0)))
+    res = ms.simulate(m, t_end=0.6, integrator=ms.EventDriven(), output_dt=1e-2)
+    hits = [e["t"] for e in res.events if e["event"] == "impact"]
+    assert hits and hits[0] == pytest.approx(math.sqrt(2 * (0.5 - 0.25) / G), rel=1e-9)
+    assert res["contact/hit/g_n"].min() > -1e-9

@@ -101,6 +101,8 @@ enum Geometry {
     /// An ellipsoid on body 1 (`S = R diag(a², b², c²) Rᵀ` in its body frame) against the
     /// half-space of body 2.
     EllipsoidHalfSpace { center: Vec3, shape: Mat3, point: Vec3, normal: Vec3 },
+    /// A sphere (or point, radius 0) on body 1 against an ellipsoid on body 2.
+    SphereEllipsoid { center: Vec3, radius: f64, e_center: Vec3, e_rotation: Mat3, semi: Vec3 },
     /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
     /// cavity of body 2.
     Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
@@ -183,7 +185,7 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
         K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
         K::Box => matches!(a, K::Point | K::Sphere | K::Box),
         K::Circle => matches!(a, K::Point2 | K::Circle),
-        K::Bowl | K::Bore => matches!(a, K::Point | K::Sphere),
+        K::Bowl | K::Bore | K::Ellipsoid => matches!(a, K::Point | K::Sphere),
         _ => false,
     }
 }
@@ -198,7 +200,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, in either order)"
         )))
     }
 }
@@ -547,6 +549,9 @@ impl ContactPair {
             Geometry::EllipsoidHalfSpace { center, shape, point, normal } => {
                 ellipsoid_half_space(x1, x2, tw, center, shape, point, normal)
             }
+            Geometry::SphereEllipsoid { center, radius, e_center, e_rotation, semi } => {
+                sphere_ellipsoid(x1, x2, tw, center, *radius, e_center, e_rotation, semi)
+            }
         }
     }
 }
@@ -624,6 +629,14 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             }
         };
         return Geometry::PointsHalfSpace { centers, radius, point, normal };
+    }
+    if let Contour::Ellipsoid { center: ec, rotation, semi_axes } = s {
+        let (center, radius) = match f {
+            Contour::Point { p } => (*p, 0.0),
+            Contour::Sphere { center, radius } => (*center, *radius),
+            _ => unreachable!("excluded by the dispatch table"),
+        };
+        return Geometry::SphereEllipsoid { center, radius, e_center: *ec, e_rotation: *rotation, semi: *semi_axes };
     }
     if let Contour::Bowl { center, radius } | Contour::Bore { center, radius, .. } = s {
         let (c1, r1) = match f {
@@ -928,6 +941,94 @@ fn ellipsoid_half_space(
         out.nd = md;
         out.p1d = p1d;
         out.p2d = p1d - m * gd - md * g;
+    }
+    out
+}
+
+/// The foot point of `y` (ellipsoid frame) on the ellipsoid with semi-axes `a`: `x = (I + t D⁻²)⁻¹ y`
+/// with `D = diag(a)` and `t` the root of `Σ (a_i y_i / (a_i² + t))² = 1` above `-min a_i²`
+/// (decreasing there: bisection safeguarding Newton). Returns `(x, t)`.
+pub(crate) fn ellipsoid_foot(y: &Vec3, a: &Vec3) -> (Vec3, f64) {
+    let a2 = a.component_mul(a);
+    let f = |t: f64| -> (f64, f64) {
+        let mut v = -1.0;
+        let mut d = 0.0;
+        for i in 0..3 {
+            let q = a[i] * y[i] / (a2[i] + t);
+            v += q * q;
+            d -= 2.0 * q * q / (a2[i] + t);
+        }
+        (v, d)
+    };
+    let amin2 = a2.min();
+    // bracket: F > 0 just above -amin² unless the point lies on the smallest axis' plane, F < 0 far out
+    let mut lo = -amin2 * (1.0 - 1e-15);
+    let mut hi = a.max() * y.norm() + a2.max();
+    let mut t = if f(0.0).0 > 0.0 { 0.5 * hi } else { 0.5 * lo };
+    for _ in 0..200 {
+        let (v, d) = f(t);
+        if v > 0.0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+        let newton = t - v / d;
+        let next = if d < 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        if (next - t).abs() <= 1e-15 * (1.0 + t.abs()) || hi - lo <= 1e-15 * (1.0 + t.abs()) {
+            t = next;
+            break;
+        }
+        t = next;
+    }
+    (Vec3::from_fn(|i, _| a2[i] * y[i] / (a2[i] + t)), t)
+}
+
+/// A sphere (centre on body 1, radius `r1`) against an ellipsoid of body 2 (section 2.2.7.2 with
+/// one surface a point): the foot point `x` of the centre `y` on the ellipsoid (its frame),
+/// `ν = D⁻²x / |D⁻²x|`, `g_N = (y - x)·ν - r1`. The rates solve the differentiated foot
+/// conditions `ẏ = (I + t D⁻²) ẋ + ṫ D⁻² x`, `xᵀ D⁻² ẋ = 0` (4 × 4).
+#[allow(clippy::too_many_arguments)]
+fn sphere_ellipsoid(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    center: &Vec3,
+    r1: f64,
+    e_center: &Vec3,
+    e_rotation: &Mat3,
+    semi: &Vec3,
+) -> Raw {
+    let c = x1.point_to_parent(center);
+    let ae = x2.a * e_rotation;
+    let ce = x2.point_to_parent(e_center);
+    let y = ae.transpose() * (c - ce);
+    let (xf, t) = ellipsoid_foot(&y, semi);
+    let dinv = Vec3::from_fn(|i, _| 1.0 / (semi[i] * semi[i]));
+    let grad = xf.component_mul(&dinv);
+    let gl = grad.norm();
+    let nu = grad / gl;
+    let g = (y - xf).dot(&nu) - r1;
+    let n = ae * nu;
+    let p1 = c - n * r1;
+    let mut out = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        let c1d = vel(t1, &c);
+        let yd = ae.transpose() * (c1d - vel(t2, &c));
+        let mut m = nalgebra::Matrix4::<f64>::zeros();
+        for i in 0..3 {
+            m[(i, i)] = 1.0 + t * dinv[i];
+            m[(i, 3)] = grad[i];
+            m[(3, i)] = grad[i];
+        }
+        let rhs = nalgebra::Vector4::new(yd.x, yd.y, yd.z, 0.0);
+        let sol = m.lu().solve(&rhs).unwrap_or_else(nalgebra::Vector4::zeros);
+        let xd = Vec3::new(sol[0], sol[1], sol[2]);
+        let gd_l = xd.component_mul(&dinv);
+        let nud = (gd_l - nu * nu.dot(&gd_l)) / gl;
+        let gd = (yd - xd).dot(&nu) + (y - xf).dot(&nud);
+        out.nd = t2.w.cross(&n) + ae * nud;
+        out.p1d = c1d - out.nd * r1;
+        out.p2d = out.p1d - n * gd - out.nd * g;
     }
     out
 }

@@ -495,8 +495,12 @@ impl<'a> Phase<'a> {
     }
 
     /// After an accepted step: slipping points remember their current direction, and the step
-    /// is capped so that an open point moving apart cannot come back within one step unseen
-    /// (the time to its apex, from `g̈_N` at the step's end). Uses the last evaluation.
+    /// is capped so that no open point changes its gap unseen: one moving apart cannot come back
+    /// within the step (the time to its apex, from `g̈_N` at the step's end), and one approaching
+    /// cannot pass through a closed contour (a ball through a sphere, whose gap is positive again
+    /// on the far side) — the step ends before the gap, predicted from `g`, `ġ_N` and `g̈_N`,
+    /// would reach `-g`, so the crossing is a sign change the event search sees. Uses the last
+    /// evaluation.
     pub fn after_step(&mut self) -> Result<f64> {
         let np = self.status.len();
         let mut cap = f64::INFINITY;
@@ -511,7 +515,7 @@ impl<'a> Phase<'a> {
         // full accelerations are in data.a: contact_kinematics then gives g̈_N in wbar_n
         for con in &self.model.contacts {
             let pts = con.first..con.first + con.points();
-            if !pts.clone().any(|pt| self.status[pt] == OPEN && self.kin[pt].gd_n > 0.0) {
+            if !pts.clone().any(|pt| self.status[pt] == OPEN) {
                 continue;
             }
             // (every contact's points, not a fixed-size buffer: none may be skipped)
@@ -521,8 +525,15 @@ impl<'a> Phase<'a> {
             contact_kinematics(&con.pair, &b1, &b2, &mut k[..n])?;
             for (j, kk) in k[..n].iter().enumerate() {
                 let pt = con.first + j;
-                if self.status[pt] == OPEN && kk.gd_n > 0.0 && kk.wbar_n < 0.0 {
-                    cap = cap.min(kk.gd_n / -kk.wbar_n);
+                if self.status[pt] != OPEN {
+                    continue;
+                }
+                let (g, v, a) = (kk.point.g_n, kk.gd_n, kk.wbar_n);
+                if v > 0.0 && a < 0.0 {
+                    cap = cap.min(v / -a);
+                }
+                if g > 0.0 {
+                    cap = cap.min(time_to_gap(g, v, a, -g));
                 }
             }
         }
@@ -601,3 +612,47 @@ impl OdeSystem for Phase<'_> {
         Ok(())
     }
 }
+
+/// The first time `t > 0` at which `g + v t + a t²/2` reaches `target` (< g), or infinity if it
+/// never does.
+fn time_to_gap(g: f64, v: f64, a: f64, target: f64) -> f64 {
+    // ½ a t² + v t + (g - target) = 0 with g - target > 0
+    let c = g - target;
+    if a.abs() <= 1e-300 {
+        return if v < 0.0 { c / -v } else { f64::INFINITY };
+    }
+    let disc = v * v - 2.0 * a * c;
+    if disc < 0.0 {
+        return f64::INFINITY;
+    }
+    let sq = disc.sqrt();
+    // the roots (-v ± sq) / a; the smallest positive one, computed without cancellation
+    let q = -0.5 * (v + v.signum() * sq) * 2.0;
+    let mut best = f64::INFINITY;
+    for t in [q / a, if q != 0.0 { 2.0 * c / q } else { f64::INFINITY }] {
+        if t > 0.0 && t < best {
+            best = t;
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod gap_time_tests {
+    use super::time_to_gap;
+
+    #[test]
+    fn time_to_gap_solves_the_quadratic() {
+        // falling from rest: 0.25 - 4.905 t² = -0.25
+        let t = time_to_gap(0.25, 0.0, -9.81, -0.25);
+        assert!((t - (0.5f64 / 4.905).sqrt()).abs() < 1e-14);
+        // constant approach speed
+        assert!((time_to_gap(0.1, -2.0, 0.0, -0.1) - 0.1).abs() < 1e-15);
+        // moving apart and decelerating, comes back
+        let t = time_to_gap(0.1, 1.0, -2.0, -0.1);
+        assert!((0.1 + t - t * t - (-0.1)).abs() < 1e-14, "{t}");
+        // moving apart, accelerating away: never
+        assert!(time_to_gap(0.1, 1.0, 2.0, -0.1).is_infinite());
+    }
+}
+
