@@ -33,31 +33,13 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
             "spherical" => vec![(0.5f64).cos(), 0.0, (0.5f64).sin() * 0.6, (0.5f64).sin() * 0.8],
             _ => (0..nq).map(|k| 0.1 + 0.05 * (i + k) as f64).collect(),
         };
+        let (name, parent, child) =
+            (format!("j{}", i + 1), if i == 0 { "ground".to_string() } else { format!("link{i}") }, format!("link{}", i + 1));
         joints.push(JointDescription {
-            name: format!("j{}", i + 1),
-            kind: joint_type.to_string(),
-            parent: if i == 0 { "ground".into() } else { format!("link{i}") },
-            child: format!("link{}", i + 1),
             axis: if joint_type == "revolute" { Some(axes[i % 3]) } else { None },
-            axis2: None,
-            radius: None,
-            pitch: None,
-            oriented: None,
-            curve: None,
-            clothoid_a: None,
-            kappa0: None,
-            points: None,
-            closed: None,
-            up: None,
-            parameters: None,
-            tangents: None,
-            second_derivatives: None,
             parent_frame: FrameDescription { position: [if i == 0 { 0.0 } else { l }, 0.0, 0.0], rotation: None },
-            child_frame: FrameDescription::default(),
             q0: Some(q0),
-            u0: None,
-            spring: None,
-            damper: None,
+            ..JointDescription::new(&name, joint_type, &parent, &child)
         });
     }
     ModelDescription {

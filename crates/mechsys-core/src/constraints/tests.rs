@@ -31,30 +31,10 @@ pub(super) fn joint(
     q0: Option<Vec<f64>>,
 ) -> JointDescription {
     JointDescription {
-        name: name.into(),
-        kind: kind.into(),
-        parent: parent.into(),
-        child: child.into(),
         axis,
-        axis2: None,
-        radius: None,
-        pitch: None,
-        oriented: None,
-        curve: None,
-        clothoid_a: None,
-        kappa0: None,
-        points: None,
-        closed: None,
-        up: None,
-        parameters: None,
-        tangents: None,
-        second_derivatives: None,
         parent_frame: FrameDescription { position: pos, rotation: None },
-        child_frame: FrameDescription::default(),
         q0,
-        u0: None,
-        spring: None,
-        damper: None,
+        ..JointDescription::new(name, kind, parent, child)
     }
 }
 

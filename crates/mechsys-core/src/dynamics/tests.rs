@@ -23,24 +23,7 @@ fn mixed_tree() -> Model {
     };
     let joint =
         |name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis: Option<[f64; 3]>| JointDescription {
-            name: name.into(),
-            kind: kind.into(),
-            parent: parent.into(),
-            child: child.into(),
             axis,
-            axis2: None,
-            radius: None,
-            pitch: None,
-            oriented: None,
-            curve: None,
-            clothoid_a: None,
-            kappa0: None,
-            points: None,
-            closed: None,
-            up: None,
-            parameters: None,
-            tangents: None,
-            second_derivatives: None,
             parent_frame: FrameDescription {
                 position: pos,
                 rotation: Some(RotationDescription::Angles(AnglesDescription {
@@ -50,10 +33,7 @@ fn mixed_tree() -> Model {
                 })),
             },
             child_frame: FrameDescription { position: [-0.05, 0.02, 0.01], rotation: None },
-            q0: None,
-            u0: None,
-            spring: None,
-            damper: None,
+            ..JointDescription::new(name, kind, parent, child)
         };
     let names = ["free", "rev", "pri", "uni", "sph", "pla", "cyl", "rev2"];
     let mut bodies = vec![];

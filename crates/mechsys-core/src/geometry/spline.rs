@@ -58,14 +58,7 @@ impl Spline1 {
     pub fn periodic(t: &[f64], y: &[f64], what: &str) -> Result<Self> {
         check(t, y, 4, what)?;
         let n = t.len() - 1;
-        let scale = y.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
-        ensure!(
-            (y[n] - y[0]).abs() <= 1e-12 * scale,
-            Model,
-            "{what}: a periodic spline must end where it starts, got {} at the start and {} at the end",
-            y[0],
-            y[n]
-        );
+        closes(y, what)?;
         let h: Vec<f64> = (0..n).map(|i| t[i + 1] - t[i]).collect();
         // unknowns m_0..m_{n-1} (m_n = m_0); cyclic tridiagonal, solved densely (built once, n small)
         let mut a = vec![0.0; n * n];
@@ -151,14 +144,7 @@ impl Quintic1 {
         if (0..=n).any(|i| (t[i] - (t[0] + h * i as f64)).abs() > 1e-9 * h) {
             return Ok(None);
         }
-        let scale = y.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
-        ensure!(
-            (y[n] - y[0]).abs() <= 1e-12 * scale,
-            Model,
-            "{what}: a periodic spline must end where it starts, got {} at the start and {} at the end",
-            y[0],
-            y[n]
-        );
+        closes(y, what)?;
         let mut c: Vec<f64> = y[..n].to_vec();
         let at = |k: isize| ((k % n as isize + n as isize) % n as isize) as usize;
         for _ in 0..2000 {
@@ -170,7 +156,7 @@ impl Quintic1 {
                 change = change.max((new - c[i]).abs());
                 c[i] = new;
             }
-            if change <= 1e-16 * scale {
+            if change <= 1e-16 * y.iter().fold(1e-300f64, |a, v| a.max(v.abs())) {
                 break;
             }
         }
@@ -258,6 +244,20 @@ fn coefficients(h: &[f64], y: &[f64], m: &[f64]) -> Vec<[f64; 4]> {
             [y[i], (y[i + 1] - y[i]) / hi - hi * (2.0 * m[i] + m[i + 1]) / 6.0, m[i] / 2.0, (m[i + 1] - m[i]) / (6.0 * hi)]
         })
         .collect()
+}
+
+/// A periodic spline's data must end where it starts.
+fn closes(y: &[f64], what: &str) -> Result<()> {
+    let n = y.len() - 1;
+    let scale = y.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+    ensure!(
+        (y[n] - y[0]).abs() <= 1e-12 * scale,
+        Model,
+        "{what}: a periodic spline must end where it starts, got {} at the start and {} at the end",
+        y[0],
+        y[n]
+    );
+    Ok(())
 }
 
 fn check(t: &[f64], y: &[f64], min: usize, what: &str) -> Result<()> {

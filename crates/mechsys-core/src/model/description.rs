@@ -481,6 +481,39 @@ pub struct JointDescription {
     pub damper: Option<JointDamperDescription>,
 }
 
+impl JointDescription {
+    /// A joint of type `kind` from `parent` to `child` with every optional key at its default
+    /// (for building descriptions in code: `JointDescription { axis, ..JointDescription::new(..) }`).
+    pub fn new(name: &str, kind: &str, parent: &str, child: &str) -> Self {
+        JointDescription {
+            name: name.into(),
+            kind: kind.into(),
+            parent: parent.into(),
+            child: child.into(),
+            axis: None,
+            axis2: None,
+            radius: None,
+            pitch: None,
+            oriented: None,
+            curve: None,
+            clothoid_a: None,
+            kappa0: None,
+            points: None,
+            closed: None,
+            up: None,
+            parameters: None,
+            tangents: None,
+            second_derivatives: None,
+            parent_frame: FrameDescription::default(),
+            child_frame: FrameDescription::default(),
+            q0: None,
+            u0: None,
+            spring: None,
+            damper: None,
+        }
+    }
+}
+
 /// A scalar function of time.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
