@@ -20,11 +20,13 @@
 //!
 //! Shapes: [`Curve::ellipse`], [`Curve::spline`] (cubic, C², natural or periodic, through points),
 //! [`Curve::cam`] (a cam disc from a periodic lift table for a roller, knife-edge or flat-faced
-//! translating follower). Constructors validate the data and name the contour in errors; they
+//! translating follower), [`Curve::gear`] (an involute spur gear outline, see
+//! [`crate::geometry::gear`]). Constructors validate the data and name the contour in errors; they
 //! also precompute the samples and the bounding-circle hierarchy of the contact search.
 
 use crate::ensure;
 use crate::error::Result;
+use crate::geometry::gear::{Gear, GearSpec};
 use crate::geometry::spline::{wrap, Spline1};
 
 /// 2-vector of `f64`.
@@ -99,6 +101,8 @@ enum Shape {
     /// `s` the cam has turned by `dir · s`; `w = base + h(s)` is the follower's position along its
     /// axis (the roller centre, or the flat face).
     Cam { lift: Spline1, base: f64, eccentricity: f64, dir: f64, flat: bool },
+    /// An involute spur gear outline, arc-length parameter.
+    Gear(Box<Gear>),
 }
 
 /// One sample of the base curve.
@@ -356,6 +360,43 @@ impl Curve {
         Ok(curve)
     }
 
+    /// An external involute spur gear outline (see [`crate::geometry::gear`] for the geometry):
+    /// one closed G1 contour, solid inside, parameterized by its arc length from the middle of the
+    /// gap before tooth 0, counter-clockwise. Refused, naming the contour: fewer than 5 teeth,
+    /// a non-positive module, a pressure angle outside (0°, 60°), teeth that fill the pitch,
+    /// pointed teeth, a tip inside the base circle, roundings that do not fit.
+    ///
+    /// # Example
+    /// ```
+    /// use mechsys_core::geometry::curve::Curve;
+    /// use mechsys_core::geometry::gear::GearSpec;
+    /// let c = Curve::gear(&GearSpec::new(0.002, 17), "contour 'pinion'")?;
+    /// let g = c.as_gear().unwrap();
+    /// assert!((g.base_radius() - 0.017 * 20f64.to_radians().cos()).abs() < 1e-15);
+    /// assert!(Curve::gear(&GearSpec::new(0.002, 3), "contour 'pinion'").is_err());
+    /// # Ok::<(), mechsys_core::Error>(())
+    /// ```
+    pub fn gear(spec: &GearSpec, what: &str) -> Result<Curve> {
+        let gear = Gear::new(spec, what)?;
+        let (period, per) = (gear.period(), gear.samples());
+        // the curvature's range in closed form (the samples may step over the small roundings):
+        // the fillet's -1/ρ_f, the tip rounding's 1/ρ_a or the involute's 1/(r_b φ) at its start
+        let (rho_a, rho_f) = gear.roundings();
+        let kmax = (1.0 / rho_a).max(1.0 / (gear.base_radius() * gear.roll_range().0));
+        let mut c = Curve::build(Shape::Gear(Box::new(gear)), 0.0, 1.0, 0.0, period, true, per, what)?;
+        c.kappa_range = (-1.0 / rho_f, kmax);
+        c.convexity = Convexity::Mixed;
+        Ok(c)
+    }
+
+    /// The gear's geometry (radii, roll angles, pieces) if this contour is a gear.
+    pub fn as_gear(&self) -> Option<&Gear> {
+        match &self.shape {
+            Shape::Gear(g) => Some(g),
+            _ => None,
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn build(shape: Shape, offset: f64, sigma: f64, lo: f64, hi: f64, closed: bool, per: usize, what: &str) -> Result<Curve> {
         let mut c = Curve {
@@ -549,6 +590,7 @@ impl Curve {
                     ]
                 }
             }
+            Shape::Gear(g) => g.eval(s),
         }
     }
 
@@ -647,12 +689,13 @@ impl Curve {
         self.bound
     }
 
-    /// Name of the shape for messages ("ellipse", "spline", "cam").
+    /// Name of the shape for messages ("ellipse", "spline", "cam", "gear").
     pub fn shape_name(&self) -> &'static str {
         match self.shape {
             Shape::Ellipse { .. } => "ellipse",
             Shape::Spline { .. } => "spline",
             Shape::Cam { .. } => "cam",
+            Shape::Gear(_) => "gear",
         }
     }
 
