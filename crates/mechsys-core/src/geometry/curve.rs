@@ -684,6 +684,14 @@ impl Curve {
         self.step
     }
 
+    /// How far beyond the closest point a search for several contact points looks, where the
+    /// contour knows the scale of its features: a gear's module (the flanks in mesh, drive and
+    /// coast, lie within the backlash of each other, a fraction of it). `None`: the search uses a
+    /// tenth of the bounding radius.
+    pub fn reach(&self) -> Option<f64> {
+        self.as_gear().map(|g| g.spec().module)
+    }
+
     /// Bounding circle of the contour (centre, radius), offset included.
     pub fn bound(&self) -> (Vec2, f64) {
         self.bound

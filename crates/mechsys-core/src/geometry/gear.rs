@@ -427,9 +427,10 @@ impl Gear {
     #[inline]
     pub fn eval(&self, s: f64) -> Jet2 {
         let z = self.turns.len();
-        let s = s.rem_euclid(self.period());
-        let k = ((s / self.tooth) as usize).min(z - 1);
-        let u = s - k as f64 * self.tooth;
+        // tooth index by division (no fmod); parameters outside one period wrap
+        let kf = (s / self.tooth).floor();
+        let u = (s - kf * self.tooth).clamp(0.0, self.tooth);
+        let k = (kf.rem_euclid(z as f64) as usize).min(z - 1);
         self.tooth_eval(k, u, u > self.half)
     }
 

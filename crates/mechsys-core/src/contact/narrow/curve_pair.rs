@@ -197,21 +197,23 @@ fn normal_rate(curve_sigma_normal: &Vec2, j: &Jet2) -> Vec2 {
 }
 
 impl CurveGeometry {
-    /// Sets the number of candidates (shared searches only) and the reach of the search: a
-    /// tenth of the smaller bounding radius when several points are wanted.
+    /// Sets the number of candidates (shared searches only) and the reach of the search when
+    /// several points are wanted: a tenth of the smaller bounding radius, or less where a
+    /// contour knows the scale of its features (a gear: its module, see [`Curve::reach`]).
     pub(crate) fn set_points(&mut self, points: usize) {
+        let scale = |c: &Curve| c.reach().unwrap_or(0.1 * c.bound().1);
         match self {
             CurveGeometry::OnCurve { first, second, count, reach } => {
                 *count = points;
                 let r1 = match first {
-                    First::Curve(c) => c.bound().1,
+                    First::Curve(c) => scale(c),
                     First::Points { .. } => f64::INFINITY,
                 };
-                *reach = if points > 1 { 0.1 * r1.min(second.bound().1) } else { 0.0 };
+                *reach = if points > 1 { r1.min(scale(second)) } else { 0.0 };
             }
             CurveGeometry::OnLine { curve, count, reach, .. } => {
                 *count = points;
-                *reach = if points > 1 { 0.1 * curve.bound().1 } else { 0.0 };
+                *reach = if points > 1 { scale(curve) } else { 0.0 };
             }
         }
     }
@@ -368,23 +370,67 @@ fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
     }
 }
 
-/// Newton on `F(s) = (y - r(s))·r'(s)` from `s`, steps limited to two sample spacings; `None`
-/// unless it converges to a distance minimum.
+/// A sign change of a function that increases through the wanted root (the derivative of a
+/// distance at its minimum): negative at `lo`, positive at `hi`. A Newton step that leaves it is
+/// replaced by bisection: where the curvature jumps (the joints of a gear's pieces, the corner
+/// of a tip rounding seen from a flank) a damped Newton iteration can cycle about the root.
+#[derive(Debug, Clone, Copy)]
+struct Bracket {
+    lo: f64,
+    hi: f64,
+}
+
+impl Bracket {
+    fn new() -> Self {
+        Bracket { lo: f64::NEG_INFINITY, hi: f64::INFINITY }
+    }
+    /// Records the sign of `f` at `x` (ignored if it contradicts the bracket: a maximum between).
+    #[inline]
+    fn update(&mut self, x: f64, f: f64) {
+        if x > self.lo && x < self.hi {
+            if f < 0.0 {
+                self.lo = x;
+            } else if f > 0.0 {
+                self.hi = x;
+            }
+        }
+    }
+    /// `x + dx`, or the middle of the bracket if that leaves it (or lands on one of its ends:
+    /// a step capped at exactly the distance back to an earlier iterate would cycle); steps
+    /// below `tiny` (converged) are taken as they are.
+    #[inline]
+    fn step(&self, x: f64, dx: f64, tiny: f64) -> f64 {
+        let y = x + dx;
+        if dx.abs() > tiny && self.lo.is_finite() && self.hi.is_finite() && !(y > self.lo && y < self.hi) {
+            0.5 * (self.lo + self.hi)
+        } else {
+            y
+        }
+    }
+}
+
+/// Newton on `F(s) = (y - r(s))·r'(s)` from `s`, steps limited to two sample spacings and kept
+/// within the sign change of `F` once one is known; `None` unless it converges to a distance
+/// minimum.
 fn newton_foot(curve: &Curve, y: &Vec2, mut s: f64) -> Option<f64> {
     let cap = 2.0 * curve.step();
+    let mut bracket = Bracket::new();
     for _ in 0..NEWTON_ITERATIONS {
         let j = curve.eval(s);
         let d = y - j[0];
         let f = d.dot(&j[1]);
         let fs = -j[1].norm_squared() + d.dot(&j[2]);
+        // -F is the derivative of half the squared distance
+        bracket.update(s, -f);
         if !(fs < 0.0) {
             // not a minimum direction here: step along the gradient of the squared distance
             let ds = (f / j[1].norm_squared()).clamp(-cap, cap);
-            s += ds;
+            s = bracket.step(s, ds, 0.0);
             continue;
         }
-        let ds = (-f / fs).clamp(-cap, cap);
-        s += ds;
+        let next = bracket.step(s, (-f / fs).clamp(-cap, cap), CONVERGED * curve.step());
+        let ds = next - s;
+        s = next;
         if ds.abs() <= CONVERGED * curve.step() {
             let j = curve.eval(s);
             let fs = -j[1].norm_squared() + (y - j[0]).dot(&j[2]);
@@ -497,48 +543,129 @@ fn curve_curve(
     let (s1, ch1) = (c1.samples(), c1.chunks());
     let (s2, ch2) = (c2.samples(), c2.chunks());
     let n1 = s1.len();
-    // chunk pruning: keep chunks that may hold a point within the best upper bound (+ reach)
-    let mut keep1 = [false; MAX_SAMPLES / CHUNK + 1];
-    let mut keep2 = [false; MAX_SAMPLES / CHUNK + 1];
-    let mut centers1 = [Vec2::zeros(); MAX_SAMPLES / CHUNK + 1];
+    // chunk pruning: keep the chunks that may hold a point within the best upper bound (+ reach).
+    // Only chunks reaching into the other curve's bounding circle give the upper bound, and only
+    // chunks that may come that close to the other's bounding circle are paired (a gear pair
+    // meshes over a few of its hundreds of chunks).
+    const N: usize = MAX_SAMPLES / CHUNK + 1;
+    let mut keep1 = [false; N];
+    let mut keep2 = [false; N];
+    let mut centers1 = [Vec2::zeros(); N];
     for (a, ca) in ch1.iter().enumerate() {
         centers1[a] = rel.point(&ca.center);
     }
-    let mut ub = f64::INFINITY;
-    for (a, ca) in ch1.iter().enumerate() {
-        for cb in ch2 {
-            ub = ub.min((centers1[a] - cb.center).norm() + ca.radius + cb.radius);
+    let (b1c, b1r) = (rel.point(&c1.bound().0), c1.bound().1);
+    let (b2c, b2r) = c2.bound();
+    let mut list1 = [0u16; N];
+    let mut list2 = [0u16; N];
+    let near = |list: &mut [u16; N], centers: &dyn Fn(usize) -> (Vec2, f64), n: usize, c: &Vec2, r: f64, by: f64| {
+        let mut len = 0;
+        for a in 0..n {
+            let (ca, ra) = centers(a);
+            if (ca - c).norm_squared() <= (ra + r + by).powi(2) {
+                list[len] = a as u16;
+                len += 1;
+            }
+        }
+        len
+    };
+    let chunk1 = |a: usize| (centers1[a], ch1[a].radius);
+    let chunk2 = |b: usize| (ch2[b].center, ch2[b].radius);
+    let mut n1n = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, 0.0);
+    let mut n2n = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, 0.0);
+    if n1n == 0 || n2n == 0 {
+        // the bounding circles are apart: every chunk may give the bound
+        (n1n, n2n) = (ch1.len(), ch2.len());
+        for (a, l) in list1.iter_mut().enumerate().take(n1n) {
+            *l = a as u16;
+        }
+        for (b, l) in list2.iter_mut().enumerate().take(n2n) {
+            *l = b as u16;
         }
     }
-    for (a, ca) in ch1.iter().enumerate() {
-        for (b, cb) in ch2.iter().enumerate() {
-            if (centers1[a] - cb.center).norm() - ca.radius - cb.radius <= ub + reach {
-                keep1[a] = true;
-                keep2[b] = true;
+    // the chunk pair with the closest bounding circles, and the closest of its samples: every
+    // sample lies on its curve, so that distance bounds the curves' distance from above
+    let mut closest = (f64::INFINITY, 0usize, 0usize);
+    for &a in &list1[..n1n] {
+        let (ca, ra) = chunk1(a as usize);
+        for &b in &list2[..n2n] {
+            let (cb, rb) = chunk2(b as usize);
+            let d = (ca - cb).norm() - ra - rb;
+            if d < closest.0 {
+                closest = (d, a as usize, b as usize);
             }
         }
     }
+    let mut ub = f64::INFINITY;
+    let (ka, kb) = (&ch1[closest.1], &ch2[closest.2]);
+    for i in ka.first..ka.first + ka.count {
+        let p = rel.point(&s1[i].r);
+        for jdx in kb.first..kb.first + kb.count {
+            ub = ub.min((p - s2[jdx].r).norm_squared());
+        }
+    }
+    let ub = ub.sqrt();
+    let n1k = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, ub + reach);
+    let n2k = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, ub + reach);
+    for &a in &list1[..n1k] {
+        let (ca, ra) = chunk1(a as usize);
+        for &b in &list2[..n2k] {
+            let (cb, rb) = chunk2(b as usize);
+            if (ca - cb).norm_squared() <= (ub + reach + ra + rb).powi(2) {
+                keep1[a as usize] = true;
+                keep2[b as usize] = true;
+            }
+        }
+    }
+    let mut kept2 = [0u16; N];
+    let mut n2kept = 0;
+    for (b, k) in keep2.iter().enumerate().take(ch2.len()) {
+        if *k {
+            kept2[n2kept] = b as u16;
+            n2kept += 1;
+        }
+    }
     // signed distance of a kept sample of curve 1 to the kept samples of curve 2 (recomputed for
-    // the neighbours instead of stored: no buffers of sample length on the stack)
-    let phi = |i: usize| -> (f64, usize) {
+    // the neighbours instead of stored: no buffers of sample length on the stack; a small cache
+    // serves a sample's value to its neighbours)
+    // (squared distances; the chunk that held the previous sample's partner is tried first)
+    let last = std::cell::Cell::new(0usize);
+    let phi_of = |i: usize| -> (f64, usize) {
         if !keep1[i / CHUNK] {
             return (f64::INFINITY, 0);
         }
         let p = rel.point(&s1[i].r);
         let mut best = (f64::INFINITY, 0usize);
-        for (b, cb) in ch2.iter().enumerate() {
-            if !keep2[b] || (p - cb.center).norm() - cb.radius > best.0 {
+        let first = last.get().min(n2kept.saturating_sub(1));
+        for k in std::iter::once(first).chain((0..n2kept).filter(|&k| k != first)) {
+            let cb = &ch2[kept2[k] as usize];
+            let reach = best.0.sqrt() + cb.radius;
+            if best.0.is_finite() && (p - cb.center).norm_squared() > reach * reach {
                 continue;
             }
             for jdx in cb.first..cb.first + cb.count {
-                let dd = (p - s2[jdx].r).norm();
+                let dd = (p - s2[jdx].r).norm_squared();
                 if dd < best.0 {
                     best = (dd, jdx);
+                    last.set(k);
                 }
             }
         }
         let sign = if (p - s2[best.1].r).dot(&s2[best.1].nu) < 0.0 { -1.0 } else { 1.0 };
-        (sign * best.0, best.1)
+        (sign * best.0.sqrt(), best.1)
+    };
+    let cache = std::cell::RefCell::new(([usize::MAX; 4], [(0.0, 0usize); 4], 0usize));
+    let phi = |i: usize| -> (f64, usize) {
+        let mut c = cache.borrow_mut();
+        if let Some(k) = c.0.iter().position(|&j| j == i) {
+            return c.1[k];
+        }
+        let v = phi_of(i);
+        let slot = c.2;
+        c.0[slot] = i;
+        c.1[slot] = v;
+        c.2 = (slot + 1) % 4;
+        v
     };
     let handed = rel.handed();
     let jets = |a: f64, b: f64| {
@@ -549,10 +676,8 @@ fn curve_curve(
     let mut roots = Roots::new(count.max(1));
     let mut best = (f64::INFINITY, 0usize, 0usize);
     let cap1 = 2.0 * c1.step();
-    for i in 0..n1 {
-        if !keep1[i / CHUNK] {
-            continue;
-        }
+    let samples1 = (0..ch1.len()).filter(|&a| keep1[a]).flat_map(|a| ch1[a].first..ch1[a].first + ch1[a].count);
+    for i in samples1 {
         let (pi, partner) = phi(i);
         if pi < best.0 {
             best = (pi, i, partner);
@@ -566,6 +691,7 @@ fn curve_curve(
         // follows s1): φ' = ν2·ρ1' (envelope theorem), φ'' = ν2·ρ1'' + ν2'·ρ1' ds2/ds1
         let (mut a, mut b) = (s1[i].s, s2[partner].s);
         let mut ok = false;
+        let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
             let r1 = jets(a, b).0;
             let Some(foot) = newton_foot(c2, &r1[0], b) else { break };
@@ -577,7 +703,9 @@ fn curve_curve(
             let foot_s = -j2[1].norm_squared() + d.dot(&j2[2]);
             let db_da = -r1[1].dot(&j2[1]) / foot_s;
             let fpp = nu2.dot(&r1[2]) + normal_rate(&nu2, &j2).dot(&r1[1]) * db_da;
+            bracket.update(a, fp);
             let da = if fpp > 0.0 { (-fp / fpp).clamp(-cap1, cap1) } else { -fp.signum() * cap1 };
+            let da = bracket.step(a, da, CONVERGED * c1.step()) - a;
             a += da;
             b += db_da * da;
             if da.abs() <= CONVERGED * c1.step() {
