@@ -20,6 +20,10 @@
 //! - `narrow_curve/<pair>_evaluate/100`, `narrow_curve/<pair>_kinematics/100`: planar
 //!   parametric pairs (roller–cam, circle–ellipse, ellipse–line, ellipse–ellipse) at random
 //!   placements near contact, both bodies turning, beside the closed-form circle–circle pair;
+//! - `narrow_curve/gears_<z1>_<z2>_evaluate/100`, `..._kinematics/100`: two involute gears in mesh
+//!   (m = 2 mm, backlash 0.05 m each, standard centre distance, 4 points per pair: drive and
+//!   coast flanks), gear 1 at random angles and gear 2 at the conjugate angle with the drive
+//!   flanks 10 µm apart, both turning;
 //!
 //! Run with `cargo bench -p mechsys-core --bench contact` (about a minute; `-- --quick` for a
 //! rough figure).
@@ -114,6 +118,74 @@ fn bench_narrow(c: &mut Criterion) {
     g.finish();
     bench_box_box(c);
     bench_curves(c);
+    bench_gears(c);
+}
+
+/// Gear pairs in mesh: [`evaluate`] and [`contact_kinematics`] with 4 candidates per pair.
+fn bench_gears(c: &mut Criterion) {
+    use mechsys_core::geometry::curve::Curve;
+    use mechsys_core::geometry::gear::GearSpec;
+    use std::f64::consts::TAU;
+    let n = 100;
+    let mut rng = Rng(0x9ea2_5eed_0000_0017);
+    let mut g = c.benchmark_group("narrow_curve");
+    g.throughput(Throughput::Elements(n as u64));
+    for (z1, z2) in [(17usize, 31usize), (40, 97)] {
+        let m = 0.002;
+        let gear = |z| {
+            let spec = GearSpec { backlash: 0.05 * m, ..GearSpec::new(m, z) };
+            Curve::gear(&spec, "gear").expect("valid")
+        };
+        let (g1, g2) = (gear(z1), gear(z2));
+        let (q1, q2) = (g1.as_gear().expect("gear").clone(), g2.as_gear().expect("gear").clone());
+        let alpha = 20f64.to_radians();
+        let a = 0.5 * m * (z1 + z2) as f64;
+        // drive flanks (upper flanks of both) on the line of action, 10 µm apart
+        let phi1 = q1.base_half_angle() + alpha;
+        let phi2 = (a * alpha.sin() - 1e-5 - q1.base_radius() * phi1) / q2.base_radius();
+        let c0 = std::f64::consts::PI - alpha + phi2 - q2.base_half_angle();
+        let pair = ContactPair::new("mesh", Contour::Curve(Box::new(g1)), Contour::Curve(Box::new(g2)))
+            .expect("valid pair")
+            .with_points(4)
+            .expect("4 points");
+        let rz = |t: f64| nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), t).into_inner();
+        let bodies: Vec<(BodyMotion, BodyMotion)> = (0..n)
+            .map(|_| {
+                let t1 = rng.uniform(0.0, TAU);
+                let t2 = c0 - (z1 as f64 / z2 as f64) * t1;
+                let w = rng.uniform(10.0, 100.0);
+                let b1 = BodyMotion {
+                    pose: Pose::new(rz(t1), Vec3::zeros()),
+                    twist: Motion::new(Vec3::new(0.0, 0.0, w), Vec3::zeros()),
+                    acc: Motion::ZERO,
+                };
+                let r2 = Vec3::new(a, 0.0, 0.0);
+                let w2 = Vec3::new(0.0, 0.0, -w * z1 as f64 / z2 as f64);
+                let b2 =
+                    BodyMotion { pose: Pose::new(rz(t2), r2), twist: Motion::new(w2, -w2.cross(&r2)), acc: Motion::ZERO };
+                (b1, b2)
+            })
+            .collect();
+        let mut points = vec![ContactPoint::default(); 4 * n];
+        g.bench_with_input(BenchmarkId::new(format!("gears_{z1}_{z2}_evaluate"), n), &n, |b, _| {
+            b.iter(|| {
+                for ((b1, b2), out) in bodies.iter().zip(points.chunks_mut(4)) {
+                    evaluate(&pair, &b1.pose, &b2.pose, out).expect("room for 4");
+                }
+                black_box(&points);
+            })
+        });
+        let mut kin = vec![ContactKinematics::default(); 4 * n];
+        g.bench_with_input(BenchmarkId::new(format!("gears_{z1}_{z2}_kinematics"), n), &n, |b, _| {
+            b.iter(|| {
+                for ((b1, b2), out) in bodies.iter().zip(kin.chunks_mut(4)) {
+                    contact_kinematics(&pair, b1, b2, out).expect("room for 4");
+                }
+                black_box(&kin);
+            })
+        });
+    }
+    g.finish();
 }
 
 /// Planar parametric pairs near contact, in plane motion: [`evaluate`] and

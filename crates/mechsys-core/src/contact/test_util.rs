@@ -198,6 +198,8 @@ pub(crate) fn sample(kind: &str) -> Contour {
         "blob" => curve_sample("blob"),
         "cam" => curve_sample("cam"),
         "spline_bore" => curve_sample("bore"),
+        "gear" => curve_sample("gear"),
+        "gear_b" => curve_sample("gear_b"),
         _ => unreachable!("unknown sample {kind}"),
     }
 }
@@ -229,13 +231,42 @@ pub(crate) fn curve_sample(kind: &str) -> Contour {
             let pts: Vec<Vec2> = (0..40).map(|i| TAU * i as f64 / 40.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.9).collect();
             Curve::spline(&pts, true, Solid::Outside, "bore").unwrap()
         }
+        // involute gears of about the samples' size, off their body origins
+        "gear" => {
+            use crate::geometry::gear::GearSpec;
+            let spec =
+                GearSpec { center: Vec2::new(0.02, -0.01), phase: 0.1, backlash: 0.002, ..GearSpec::new(0.04, 17) };
+            Curve::gear(&spec, "gear").unwrap()
+        }
+        "gear_b" => {
+            use crate::geometry::gear::GearSpec;
+            let spec = GearSpec { shift: 0.3, pressure_angle: 0.4, ..GearSpec::new(0.05, 9) };
+            Curve::gear(&spec, "gear_b").unwrap()
+        }
         _ => unreachable!("unknown curve sample {kind}"),
     };
     Contour::Curve(Box::new(c))
 }
 
+/// The points of a gear contour where its pieces meet (its curvature jumps there), body frame;
+/// empty for other contours.
+pub(crate) fn curve_joints(c: &Contour) -> Vec<Vec2> {
+    let Contour::Curve(c) = c else { return Vec::new() };
+    let Some(g) = c.as_gear() else { return Vec::new() };
+    let l = g.tooth_length();
+    let mut out = Vec::new();
+    for k in 0..g.teeth() {
+        for (u, _) in g.joints() {
+            out.push(g.tooth_eval(k, u, false)[0]);
+            out.push(g.tooth_eval(k, l - u, true)[0]);
+        }
+        out.push(g.tooth_eval(k, 0.5 * l, false)[0]);
+    }
+    out
+}
+
 /// Pairs with a parametric contour, canonical order (sample names).
-pub(crate) const CURVE_PAIRS: [(&str, &str); 10] = [
+pub(crate) const CURVE_PAIRS: [(&str, &str); 13] = [
     ("point2", "ellipse"),
     ("circle_b", "ellipse"),
     ("polygon", "blob"),
@@ -246,6 +277,9 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 10] = [
     ("cam", "line"),
     ("blob", "line"),
     ("ellipse_b", "cam"),
+    ("circle_b", "gear"),
+    ("gear_b", "gear"),
+    ("gear", "line"),
 ];
 
 /// Every supported pair in canonical order (sample names).

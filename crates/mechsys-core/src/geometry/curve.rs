@@ -20,11 +20,13 @@
 //!
 //! Shapes: [`Curve::ellipse`], [`Curve::spline`] (cubic, C², natural or periodic, through points),
 //! [`Curve::cam`] (a cam disc from a periodic lift table for a roller, knife-edge or flat-faced
-//! translating follower). Constructors validate the data and name the contour in errors; they
+//! translating follower), [`Curve::gear`] (an involute spur gear outline, see
+//! [`crate::geometry::gear`]). Constructors validate the data and name the contour in errors; they
 //! also precompute the samples and the bounding-circle hierarchy of the contact search.
 
 use crate::ensure;
 use crate::error::Result;
+use crate::geometry::gear::{Gear, GearSpec};
 use crate::geometry::spline::{wrap, Quintic1, Spline1};
 
 /// 2-vector of `f64`.
@@ -99,6 +101,8 @@ enum Shape {
     /// `s` the cam has turned by `dir · s`; `w = base + h(s)` is the follower's position along its
     /// axis (the roller centre, or the flat face).
     Cam { lift: Lift, base: f64, eccentricity: f64, dir: f64, flat: bool },
+    /// An involute spur gear outline, arc-length parameter.
+    Gear(Box<Gear>),
 }
 
 /// A cam's lift table as a periodic spline: quintic (C⁴) on equally spaced angles, else cubic.
@@ -154,6 +158,45 @@ pub const NEWTON_ITERATIONS: usize = 40;
 /// Newton stops when its step is below this fraction of the sample spacing (the quadratic
 /// convergence leaves an error of about its square).
 pub const CONVERGED: f64 = 1e-10;
+
+/// A sign change of a function that increases through the wanted root (the derivative of a
+/// distance at its minimum): negative at `lo`, positive at `hi`. A Newton step that leaves it is
+/// replaced by bisection: where the curvature jumps (the joints of a gear's pieces, the corner
+/// of a tip rounding seen from a flank) a damped Newton iteration can cycle about the root.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Bracket {
+    pub(crate) lo: f64,
+    pub(crate) hi: f64,
+}
+
+impl Bracket {
+    pub(crate) fn new() -> Self {
+        Bracket { lo: f64::NEG_INFINITY, hi: f64::INFINITY }
+    }
+    /// Records the sign of `f` at `x` (ignored if it contradicts the bracket: a maximum between).
+    #[inline]
+    pub(crate) fn update(&mut self, x: f64, f: f64) {
+        if x > self.lo && x < self.hi {
+            if f < 0.0 {
+                self.lo = x;
+            } else if f > 0.0 {
+                self.hi = x;
+            }
+        }
+    }
+    /// `x + dx`, or the middle of the bracket if that leaves it (or lands on one of its ends:
+    /// a step capped at exactly the distance back to an earlier iterate would cycle); steps
+    /// below `tiny` (converged) are taken as they are.
+    #[inline]
+    pub(crate) fn step(&self, x: f64, dx: f64, tiny: f64) -> f64 {
+        let y = x + dx;
+        if dx.abs() > tiny && self.lo.is_finite() && self.hi.is_finite() && !(y > self.lo && y < self.hi) {
+            0.5 * (self.lo + self.hi)
+        } else {
+            y
+        }
+    }
+}
 
 /// Upper bound on the samples of one curve (the search's stack buffers are this long).
 pub const MAX_SAMPLES: usize = 4096;
@@ -389,6 +432,43 @@ impl Curve {
         Ok(curve)
     }
 
+    /// An external involute spur gear outline (see [`crate::geometry::gear`] for the geometry):
+    /// one closed G1 contour, solid inside, parameterized by its arc length from the middle of the
+    /// gap before tooth 0, counter-clockwise. Refused, naming the contour: fewer than 5 teeth,
+    /// a non-positive module, a pressure angle outside (0°, 60°), teeth that fill the pitch,
+    /// pointed teeth, a tip inside the base circle, roundings that do not fit.
+    ///
+    /// # Example
+    /// ```
+    /// use mechsys_core::geometry::curve::Curve;
+    /// use mechsys_core::geometry::gear::GearSpec;
+    /// let c = Curve::gear(&GearSpec::new(0.002, 17), "contour 'pinion'")?;
+    /// let g = c.as_gear().unwrap();
+    /// assert!((g.base_radius() - 0.017 * 20f64.to_radians().cos()).abs() < 1e-15);
+    /// assert!(Curve::gear(&GearSpec::new(0.002, 3), "contour 'pinion'").is_err());
+    /// # Ok::<(), mechsys_core::Error>(())
+    /// ```
+    pub fn gear(spec: &GearSpec, what: &str) -> Result<Curve> {
+        let gear = Gear::new(spec, what)?;
+        let (period, per) = (gear.period(), gear.samples());
+        // the curvature's range in closed form (the samples may step over the small roundings):
+        // the fillet's -1/ρ_f, the tip rounding's 1/ρ_a or the involute's 1/(r_b φ) at its start
+        let (rho_a, rho_f) = gear.roundings();
+        let kmax = (1.0 / rho_a).max(1.0 / (gear.base_radius() * gear.roll_range().0));
+        let mut c = Curve::build(Shape::Gear(Box::new(gear)), 0.0, 1.0, 0.0, period, true, per, what)?;
+        c.kappa_range = (-1.0 / rho_f, kmax);
+        c.convexity = Convexity::Mixed;
+        Ok(c)
+    }
+
+    /// The gear's geometry (radii, roll angles, pieces) if this contour is a gear.
+    pub fn as_gear(&self) -> Option<&Gear> {
+        match &self.shape {
+            Shape::Gear(g) => Some(g),
+            _ => None,
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn build(shape: Shape, offset: f64, sigma: f64, lo: f64, hi: f64, closed: bool, per: usize, what: &str) -> Result<Curve> {
         let mut c = Curve {
@@ -582,6 +662,7 @@ impl Curve {
                     ]
                 }
             }
+            Shape::Gear(g) => g.eval(s),
         }
     }
 
@@ -634,22 +715,28 @@ impl Curve {
     }
 
     /// The foot point of `y` (body frame) on the base curve by Newton on `F(s) = (y - r)·r'` from
-    /// `s`, steps limited to two sample spacings; `None` unless it converges to a distance
-    /// minimum (a maximum — the far side of a hollow arc — is refused). No allocation.
+    /// `s`, steps limited to two sample spacings and kept within the sign change of `F` once one
+    /// is known ([`Bracket`]); `None` unless it converges to a distance minimum (a maximum — the
+    /// far side of a hollow arc — is refused). No allocation.
     pub fn foot(&self, y: &Vec2, mut s: f64) -> Option<f64> {
         let cap = 2.0 * self.step;
+        let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
             let j = self.eval(s);
             let d = y - j[0];
             let f = d.dot(&j[1]);
             let fs = -j[1].norm_squared() + d.dot(&j[2]);
+            // -F is the derivative of half the squared distance
+            bracket.update(s, -f);
             if !(fs < 0.0) {
                 // not a minimum direction here: step along the gradient of the squared distance
-                s += (f / j[1].norm_squared()).clamp(-cap, cap);
+                let ds = (f / j[1].norm_squared()).clamp(-cap, cap);
+                s = bracket.step(s, ds, 0.0);
                 continue;
             }
-            let ds = (-f / fs).clamp(-cap, cap);
-            s += ds;
+            let next = bracket.step(s, (-f / fs).clamp(-cap, cap), CONVERGED * self.step);
+            let ds = next - s;
+            s = next;
             if ds.abs() <= CONVERGED * self.step {
                 let j = self.eval(s);
                 let fs = -j[1].norm_squared() + (y - j[0]).dot(&j[2]);
@@ -714,17 +801,26 @@ impl Curve {
         self.step
     }
 
+    /// How far beyond the closest point a search for several contact points looks, where the
+    /// contour knows the scale of its features: a gear's module (the flanks in mesh, drive and
+    /// coast, lie within the backlash of each other, a fraction of it). `None`: the search uses a
+    /// tenth of the bounding radius.
+    pub fn reach(&self) -> Option<f64> {
+        self.as_gear().map(|g| g.spec().module)
+    }
+
     /// Bounding circle of the contour (centre, radius), offset included.
     pub fn bound(&self) -> (Vec2, f64) {
         self.bound
     }
 
-    /// Name of the shape for messages ("ellipse", "spline", "cam").
+    /// Name of the shape for messages ("ellipse", "spline", "cam", "gear").
     pub fn shape_name(&self) -> &'static str {
         match self.shape {
             Shape::Ellipse { .. } => "ellipse",
             Shape::Spline { .. } => "spline",
             Shape::Cam { .. } => "cam",
+            Shape::Gear(_) => "gear",
         }
     }
 

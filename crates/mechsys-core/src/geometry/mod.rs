@@ -1,5 +1,7 @@
 //! Parametric contact geometry (section 2.2.7): planar contours `r(s)` with their moving
-//! trihedral and curvature ([`curve`]), built on C² cubic splines ([`spline`]).
+//! trihedral and curvature ([`curve`]), built on C² cubic splines ([`spline`]) or on involute gear
+//! outlines ([`gear`]).
 
 pub mod curve;
+pub mod gear;
 pub mod spline;

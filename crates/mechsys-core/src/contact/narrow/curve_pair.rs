@@ -30,7 +30,7 @@
 //! parameter on the curve (so a candidate keeps its index while its root persists); slots
 //! without a root are *unused* candidates whose gap exceeds any real one.
 
-use crate::geometry::curve::{cross, Curve, Jet2, Vec2, CHUNK, MAX_SAMPLES};
+use crate::geometry::curve::{cross, Bracket, Curve, Jet2, Vec2, CHUNK, CONVERGED, MAX_SAMPLES, NEWTON_ITERATIONS};
 use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};
 
@@ -40,9 +40,6 @@ use super::{vel, Raw};
 pub const MAX_POINTS: usize = 8;
 /// Roots kept during one search.
 const MAX_ROOTS: usize = 16;
-/// Most seeds refined by Newton in a curve–curve search (the deepest local minima).
-const MAX_SEEDS: usize = 10;
-use crate::geometry::curve::{CONVERGED, NEWTON_ITERATIONS};
 
 /// What body 1 (canonical order) brings against a curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -195,21 +192,23 @@ fn normal_rate(curve_sigma_normal: &Vec2, j: &Jet2) -> Vec2 {
 }
 
 impl CurveGeometry {
-    /// Sets the number of candidates (shared searches only) and the reach of the search: a
-    /// tenth of the smaller bounding radius when several points are wanted.
+    /// Sets the number of candidates (shared searches only) and the reach of the search when
+    /// several points are wanted: a tenth of the smaller bounding radius, or less where a
+    /// contour knows the scale of its features (a gear: its module, see [`Curve::reach`]).
     pub(crate) fn set_points(&mut self, points: usize) {
+        let scale = |c: &Curve| c.reach().unwrap_or(0.1 * c.bound().1);
         match self {
             CurveGeometry::OnCurve { first, second, count, reach } => {
                 *count = points;
                 let r1 = match first {
-                    First::Curve(c) => c.bound().1,
+                    First::Curve(c) => scale(c),
                     First::Points { .. } => f64::INFINITY,
                 };
-                *reach = if points > 1 { 0.1 * r1.min(second.bound().1) } else { 0.0 };
+                *reach = if points > 1 { r1.min(scale(second)) } else { 0.0 };
             }
             CurveGeometry::OnLine { curve, count, reach, .. } => {
                 *count = points;
-                *reach = if points > 1 { 0.1 * curve.bound().1 } else { 0.0 };
+                *reach = if points > 1 { scale(curve) } else { 0.0 };
             }
         }
     }
@@ -469,63 +468,129 @@ fn curve_curve(
     let (s1, ch1) = (c1.samples(), c1.chunks());
     let (s2, ch2) = (c2.samples(), c2.chunks());
     let n1 = s1.len();
-    // chunk pruning: keep chunks that may hold a point within the best upper bound (+ reach)
-    let mut keep1 = [false; MAX_SAMPLES / CHUNK + 1];
-    let mut keep2 = [false; MAX_SAMPLES / CHUNK + 1];
-    let mut centers1 = [Vec2::zeros(); MAX_SAMPLES / CHUNK + 1];
+    // chunk pruning: keep the chunks that may hold a point within the best upper bound (+ reach).
+    // Only chunks reaching into the other curve's bounding circle give the upper bound, and only
+    // chunks that may come that close to the other's bounding circle are paired (a gear pair
+    // meshes over a few of its hundreds of chunks).
+    const N: usize = MAX_SAMPLES / CHUNK + 1;
+    let mut keep1 = [false; N];
+    let mut keep2 = [false; N];
+    let mut centers1 = [Vec2::zeros(); N];
     for (a, ca) in ch1.iter().enumerate() {
         centers1[a] = rel.point(&ca.center);
     }
-    // an upper bound of the distance between the curves: the closest sample pair of the chunk
-    // pair with the smallest lower bound (much tighter than the chunks' own bounds)
-    let mut lowest = (f64::INFINITY, 0usize, 0usize);
-    for (a, ca) in ch1.iter().enumerate() {
-        for (b, cb) in ch2.iter().enumerate() {
-            let lb = (centers1[a] - cb.center).norm() - ca.radius - cb.radius;
-            if lb < lowest.0 {
-                lowest = (lb, a, b);
+    let (b1c, b1r) = (rel.point(&c1.bound().0), c1.bound().1);
+    let (b2c, b2r) = c2.bound();
+    let mut list1 = [0u16; N];
+    let mut list2 = [0u16; N];
+    let near = |list: &mut [u16; N], centers: &dyn Fn(usize) -> (Vec2, f64), n: usize, c: &Vec2, r: f64, by: f64| {
+        let mut len = 0;
+        for a in 0..n {
+            let (ca, ra) = centers(a);
+            if (ca - c).norm_squared() <= (ra + r + by).powi(2) {
+                list[len] = a as u16;
+                len += 1;
+            }
+        }
+        len
+    };
+    let chunk1 = |a: usize| (centers1[a], ch1[a].radius);
+    let chunk2 = |b: usize| (ch2[b].center, ch2[b].radius);
+    let mut n1n = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, 0.0);
+    let mut n2n = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, 0.0);
+    if n1n == 0 || n2n == 0 {
+        // the bounding circles are apart: every chunk may give the bound
+        (n1n, n2n) = (ch1.len(), ch2.len());
+        for (a, l) in list1.iter_mut().enumerate().take(n1n) {
+            *l = a as u16;
+        }
+        for (b, l) in list2.iter_mut().enumerate().take(n2n) {
+            *l = b as u16;
+        }
+    }
+    // the chunk pair with the closest bounding circles, and the closest of its samples: every
+    // sample lies on its curve, so that distance bounds the curves' distance from above
+    let mut closest = (f64::INFINITY, 0usize, 0usize);
+    for &a in &list1[..n1n] {
+        let (ca, ra) = chunk1(a as usize);
+        for &b in &list2[..n2n] {
+            let (cb, rb) = chunk2(b as usize);
+            let d = (ca - cb).norm() - ra - rb;
+            if d < closest.0 {
+                closest = (d, a as usize, b as usize);
             }
         }
     }
     let mut ub = f64::INFINITY;
-    if lowest.0.is_finite() {
-        let (ca, cb) = (&ch1[lowest.1], &ch2[lowest.2]);
-        for i in ca.first..ca.first + ca.count {
-            let p = rel.point(&s1[i].r);
-            for smp in &s2[cb.first..cb.first + cb.count] {
-                ub = ub.min((p - smp.r).norm());
+    let (ka, kb) = (&ch1[closest.1], &ch2[closest.2]);
+    for i in ka.first..ka.first + ka.count {
+        let p = rel.point(&s1[i].r);
+        for jdx in kb.first..kb.first + kb.count {
+            ub = ub.min((p - s2[jdx].r).norm_squared());
+        }
+    }
+    let ub = ub.sqrt();
+    let n1k = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, ub + reach);
+    let n2k = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, ub + reach);
+    for &a in &list1[..n1k] {
+        let (ca, ra) = chunk1(a as usize);
+        for &b in &list2[..n2k] {
+            let (cb, rb) = chunk2(b as usize);
+            if (ca - cb).norm_squared() <= (ub + reach + ra + rb).powi(2) {
+                keep1[a as usize] = true;
+                keep2[b as usize] = true;
             }
         }
     }
-    for (a, ca) in ch1.iter().enumerate() {
-        for (b, cb) in ch2.iter().enumerate() {
-            if (centers1[a] - cb.center).norm() - ca.radius - cb.radius <= ub + reach {
-                keep1[a] = true;
-                keep2[b] = true;
-            }
+    let mut kept2 = [0u16; N];
+    let mut n2kept = 0;
+    for (b, k) in keep2.iter().enumerate().take(ch2.len()) {
+        if *k {
+            kept2[n2kept] = b as u16;
+            n2kept += 1;
         }
     }
     // signed distance of a kept sample of curve 1 to the kept samples of curve 2 (recomputed for
-    // the neighbours instead of stored: no buffers of sample length on the stack)
-    let phi = |i: usize| -> (f64, usize) {
+    // the neighbours instead of stored: no buffers of sample length on the stack; a small cache
+    // serves a sample's value to its neighbours)
+    // (squared distances; the chunk that held the previous sample's partner is tried first)
+    let last = std::cell::Cell::new(0usize);
+    let phi_of = |i: usize| -> (f64, usize) {
         if !keep1[i / CHUNK] {
             return (f64::INFINITY, 0);
         }
         let p = rel.point(&s1[i].r);
         let mut best = (f64::INFINITY, 0usize);
-        for (b, cb) in ch2.iter().enumerate() {
-            if !keep2[b] || (p - cb.center).norm() - cb.radius > best.0 {
+        let first = last.get().min(n2kept.saturating_sub(1));
+        for k in std::iter::once(first).chain((0..n2kept).filter(|&k| k != first)) {
+            let cb = &ch2[kept2[k] as usize];
+            let reach = best.0.sqrt() + cb.radius;
+            if best.0.is_finite() && (p - cb.center).norm_squared() > reach * reach {
                 continue;
             }
             for jdx in cb.first..cb.first + cb.count {
-                let dd = (p - s2[jdx].r).norm();
+                let dd = (p - s2[jdx].r).norm_squared();
                 if dd < best.0 {
                     best = (dd, jdx);
+                    last.set(k);
                 }
             }
         }
         let sign = if (p - s2[best.1].r).dot(&s2[best.1].nu) < 0.0 { -1.0 } else { 1.0 };
-        (sign * best.0, best.1)
+        (sign * best.0.sqrt(), best.1)
+    };
+    let cache = std::cell::RefCell::new(([usize::MAX; 4], [(0.0, 0usize); 4], 0usize));
+    let phi = |i: usize| -> (f64, usize) {
+        let mut c = cache.borrow_mut();
+        if let Some(k) = c.0.iter().position(|&j| j == i) {
+            return c.1[k];
+        }
+        let v = phi_of(i);
+        let slot = c.2;
+        c.0[slot] = i;
+        c.1[slot] = v;
+        c.2 = (slot + 1) % 4;
+        v
     };
     let handed = rel.handed();
     let jets = |a: f64, b: f64| {
@@ -536,56 +601,22 @@ fn curve_curve(
     let mut roots = Roots::new(count.max(1));
     let mut best = (f64::INFINITY, 0usize, 0usize);
     let cap1 = 2.0 * c1.step();
-    // seeds: the local minima of φ along curve 1 within the kept chunks, the deepest few only
-    let max_seeds = (count + 2).min(MAX_SEEDS);
-    let mut seeds = [(f64::INFINITY, 0usize, 0usize); MAX_SEEDS];
-    let mut nseeds = 0;
-    let neighbour = |i: isize| -> Option<usize> {
-        if i >= 0 && (i as usize) < n1 {
-            Some(i as usize)
-        } else if c1.is_closed() {
-            Some(i.rem_euclid(n1 as isize) as usize)
-        } else {
-            None
+    let samples1 = (0..ch1.len()).filter(|&a| keep1[a]).flat_map(|a| ch1[a].first..ch1[a].first + ch1[a].count);
+    for i in samples1 {
+        let (pi, partner) = phi(i);
+        if pi < best.0 {
+            best = (pi, i, partner);
         }
-    };
-    for (a, ca) in ch1.iter().enumerate() {
-        if !keep1[a] {
+        let prev = if i > 0 { phi(i - 1).0 } else if c1.is_closed() { phi(n1 - 1).0 } else { f64::INFINITY };
+        let next = if i + 1 < n1 { phi(i + 1).0 } else if c1.is_closed() { phi(0).0 } else { f64::INFINITY };
+        if !(pi <= prev && pi <= next) {
             continue;
         }
-        // φ of the chunk's samples and of one neighbour on each side
-        let mut vals = [(f64::INFINITY, 0usize); CHUNK + 2];
-        for (k, v) in vals.iter_mut().enumerate().take(ca.count + 2) {
-            if let Some(i) = neighbour(ca.first as isize + k as isize - 1) {
-                *v = phi(i);
-            }
-        }
-        for k in 1..=ca.count {
-            let (pi, partner) = vals[k];
-            let i = ca.first + k - 1;
-            if pi < best.0 {
-                best = (pi, i, partner);
-            }
-            if pi.is_finite() && pi <= vals[k - 1].0 && pi <= vals[k + 1].0 {
-                // insert sorted by φ, keeping the deepest max_seeds
-                let mut j = nseeds.min(max_seeds - 1);
-                if nseeds == max_seeds && pi >= seeds[j].0 {
-                    continue;
-                }
-                while j > 0 && seeds[j - 1].0 > pi {
-                    seeds[j] = seeds[j - 1];
-                    j -= 1;
-                }
-                seeds[j] = (pi, i, partner);
-                nseeds = (nseeds + 1).min(max_seeds);
-            }
-        }
-    }
-    for &(_, i, partner) in &seeds[..nseeds] {
         // minimize the signed distance φ(s1) of curve 1's point to curve 2 (the foot point s2
         // follows s1): φ' = ν2·ρ1' (envelope theorem), φ'' = ν2·ρ1'' + ν2'·ρ1' ds2/ds1
         let (mut a, mut b) = (s1[i].s, s2[partner].s);
         let mut ok = false;
+        let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
             let r1 = jets(a, b).0;
             let Some(foot) = c2.foot(&r1[0], b) else { break };
@@ -597,7 +628,9 @@ fn curve_curve(
             let foot_s = -j2[1].norm_squared() + d.dot(&j2[2]);
             let db_da = -r1[1].dot(&j2[1]) / foot_s;
             let fpp = nu2.dot(&r1[2]) + normal_rate(&nu2, &j2).dot(&r1[1]) * db_da;
+            bracket.update(a, fp);
             let da = if fpp > 0.0 { (-fp / fpp).clamp(-cap1, cap1) } else { -fp.signum() * cap1 };
+            let da = bracket.step(a, da, CONVERGED * c1.step()) - a;
             a += da;
             b += db_da * da;
             if da.abs() <= CONVERGED * c1.step() {
@@ -663,5 +696,4 @@ fn curve_curve(
         };
     });
 }
-
 

@@ -5,7 +5,7 @@
 use super::*;
 use crate::contact::test_util::{curve_sample, curve_sdf, rot, Rng};
 use crate::geometry::curve::{Curve, Follower, Vec2};
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
 
 fn curve(c: &Contour) -> &Curve {
     match c {
@@ -236,4 +236,104 @@ fn ellipsoid_on_a_plane_against_sampled_support_and_curvatures_at_the_axes() {
     let e = Contour::Ellipsoid { center: Vec3::zeros(), rotation: Mat3::identity(), semi_axes: Vec3::new(a, b, c) };
     let k = e.curvatures_at(&Pose::IDENTITY, &Vec3::new(a, 0.0, 0.0));
     assert!((k[0] - a / (c * c)).abs() < 1e-12 && (k[1] - a / (b * b)).abs() < 1e-12, "{k:?}");
+}
+
+/// Two involute gears in mesh, z1 = 17 and z2 = 31, m = 2 mm, backlash on both, at the standard
+/// centre distance; gear 2 follows gear 1 at the speed ratio -z1/z2 with the drive flanks a gap
+/// `delta` apart. Reference (the involutes' own geometry, not the search): a flank pair meets the
+/// line of action (the common tangent of the base circles, tangent points T1, T2) at distances
+/// `r_b φ` (roll angles) from T1 and T2, so its gap along it is `a sin α - r_b1 φ1 - r_b2 φ2`, the
+/// same for every pair in mesh; drive and coast gaps add up to the normal backlash
+/// `p_b - s_b1 - s_b2 + 2 (r_b1 + r_b2) inv α`.
+#[test]
+fn gear_pair_gaps_and_normals_follow_the_lines_of_action() {
+    use crate::geometry::gear::{involute_function, GearSpec};
+    let (m, z1, z2) = (0.002, 17usize, 31usize);
+    let alpha = 20f64.to_radians();
+    let j = 0.05 * m;
+    let g1 = Curve::gear(&GearSpec { backlash: j, ..GearSpec::new(m, z1) }, "pinion").unwrap();
+    let g2 = Curve::gear(&GearSpec { backlash: j, ..GearSpec::new(m, z2) }, "wheel").unwrap();
+    let (q1, q2) = (g1.as_gear().unwrap().clone(), g2.as_gear().unwrap().clone());
+    let (rb1, rb2) = (q1.base_radius(), q2.base_radius());
+    let a = 0.5 * m * (z1 + z2) as f64;
+    let (psi1, psi2) = (q1.base_half_angle(), q2.base_half_angle());
+    let pb = TAU * rb1 / z1 as f64;
+    let jn = pb - 2.0 * rb1 * psi1 - 2.0 * rb2 * psi2 + 2.0 * (rb1 + rb2) * involute_function(alpha);
+    assert!((jn - 2.0 * j * alpha.cos()).abs() < 1e-15, "normal backlash {jn}");
+    let delta = 0.3 * jn;
+    let pair = ContactPair::new("mesh", Contour::Curve(Box::new(g1)), Contour::Curve(Box::new(g2)))
+        .unwrap()
+        .with_points(4)
+        .unwrap();
+    let wrap = |x: f64| x.rem_euclid(TAU);
+    let (lo1, hi1) = q1.roll_range();
+    let (lo2, hi2) = q2.roll_range();
+    // gear 2's angle for gear 1 at 0: tooth 0 of both on the drive line of action at gap delta
+    let phi1 = psi1 + alpha;
+    let phi2 = (a * alpha.sin() - delta - rb1 * phi1) / rb2;
+    let c = PI - alpha + phi2 - psi2;
+    // drive: gear 1's upper flanks (unwound clockwise from θ1 + 2πk/z1 + ψ_b1) against gear 2's
+    // upper flanks, line of action T1 = r_b1 (cos α, -sin α) → T2, direction e = (sin α, cos α);
+    // coast: the lower flanks, mirrored about the centre line
+    let pairs_in_mesh = |t1: f64, t2: f64, coast: bool| {
+        let mut gaps = Vec::new();
+        let sgn = if coast { -1.0 } else { 1.0 };
+        for k in 0..z1 {
+            let b1 = t1 + TAU * k as f64 / z1 as f64 + sgn * psi1;
+            let f1 = wrap(sgn * b1 + alpha);
+            for jj in 0..z2 {
+                let b2 = t2 + TAU * jj as f64 / z2 as f64 + sgn * psi2;
+                let f2 = wrap(sgn * (b2 - PI) + alpha);
+                let margin = 1e-6;
+                let g = a * alpha.sin() - rb1 * f1 - rb2 * f2;
+                // facing flanks (the others are a base pitch or more apart along the line)
+                let inside = f1 > lo1 + margin && f1 < hi1 - margin && f2 > lo2 + margin && f2 < hi2 - margin;
+                if inside && g.abs() < 0.5 * pb {
+                    gaps.push(g);
+                }
+            }
+        }
+        gaps
+    };
+    let x2 = |t2: f64| planar_pose(t2, a, 0.0);
+    let n = 60;
+    let (mut two, mut worst) = (0, 0.0f64);
+    for i in 0..n {
+        let t1 = 2.0 * TAU / z1 as f64 * i as f64 / n as f64 + 1e-3;
+        let t2 = c - (z1 as f64 / z2 as f64) * t1;
+        let (drive, coast) = (pairs_in_mesh(t1, t2, false), pairs_in_mesh(t1, t2, true));
+        assert!(!drive.is_empty() && !coast.is_empty(), "contact ratio > 1: always a pair in mesh");
+        for g in drive.iter() {
+            assert!((g - delta).abs() < 1e-15, "conjugate: every drive pair at delta, {g}");
+        }
+        for g in coast.iter() {
+            assert!((g - (jn - delta)).abs() < 1e-15);
+        }
+        two += (drive.len() == 2) as usize;
+        let pts = eval(&pair, &planar_pose(t1, 0.0, 0.0), &x2(t2));
+        let e_drive = Vec3::new(alpha.sin(), alpha.cos(), 0.0);
+        let e_coast = Vec3::new(alpha.sin(), -alpha.cos(), 0.0);
+        let near = |p: &ContactPoint, g: f64| (p.g_n - g).abs() < 1e-12;
+        let (mut nd, mut nc) = (0, 0);
+        for p in &pts {
+            if near(p, delta) {
+                nd += 1;
+                // n points from body 2's contour towards body 1: against the drive direction
+                assert!((p.n + e_drive).norm() < 1e-10, "t1 = {t1}: drive normal {:?}", p.n);
+            } else if near(p, jn - delta) {
+                nc += 1;
+                assert!((p.n + e_coast).norm() < 1e-10, "t1 = {t1}: coast normal {:?}", p.n);
+            }
+            let err = (p.g_n - delta).abs().min((p.g_n - jn + delta).abs());
+            if err < 1e-9 {
+                worst = worst.max(err);
+            }
+        }
+        let least = pts.iter().map(|p| p.g_n).fold(f64::INFINITY, f64::min);
+        assert!((least - delta).abs() < 1e-12, "t1 = {t1}: least gap {least} vs {delta}");
+        assert_eq!(nd, drive.len(), "t1 = {t1}: drive pairs found {nd}, in mesh {}", drive.len());
+        assert!(nc >= 1 && nc <= coast.len(), "t1 = {t1}: coast pairs found {nc}, in mesh {}", coast.len());
+    }
+    assert!(two > n / 4 && two < n, "two pairs in mesh part of the time: {two} of {n}");
+    eprintln!("gear pair: worst gap error {worst:e}");
 }
