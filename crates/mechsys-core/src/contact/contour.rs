@@ -203,6 +203,23 @@ fn finite2(v: &Vec2, what: &str, key: &str) -> Result<()> {
     Ok(())
 }
 
+/// A solid with a centre, a rotation of its axes and three positive extents along them (a box, an
+/// ellipsoid).
+fn oriented_solid(center: &Vec3, rotation: &Mat3, extents: &Vec3, what: &str, shape: &str, extent: &str) -> Result<()> {
+    finite3(center, what, &format!("{shape} center"))?;
+    ensure!(rotation.iter().all(|x| x.is_finite()), Model, "{what}: {shape} rotation must be finite");
+    let e = (rotation.transpose() * rotation - Mat3::identity()).norm();
+    ensure!(
+        e < 1e-6 && rotation.determinant() > 0.0,
+        Model,
+        "{what}: {shape} rotation must be orthonormal with determinant +1 (|AᵀA - E| = {e:.2e})"
+    );
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        positive(extents[k], what, &format!("{shape} {extent} along {axis}"))?;
+    }
+    Ok(())
+}
+
 fn positive(x: f64, what: &str, key: &str) -> Result<()> {
     // `!(x > 0)` also rejects NaN; the upper bound rejects infinity
     ensure!(x > 0.0 && x.is_finite(), Model, "{what}: {key} must be > 0 and finite, got {x}");
@@ -262,18 +279,7 @@ impl Contour {
                 Ok(())
             }
             Contour::Box { center, rotation, half_extents } => {
-                finite3(center, what, "box center")?;
-                ensure!(rotation.iter().all(|x| x.is_finite()), Model, "{what}: box rotation must be finite");
-                let e = (rotation.transpose() * rotation - Mat3::identity()).norm();
-                ensure!(
-                    e < 1e-6 && rotation.determinant() > 0.0,
-                    Model,
-                    "{what}: box rotation must be orthonormal with determinant +1 (|AᵀA - E| = {e:.2e})"
-                );
-                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-                    positive(half_extents[k], what, &format!("box half extent along {axis}"))?;
-                }
-                Ok(())
+                oriented_solid(center, rotation, half_extents, what, "box", "half extent")
             }
             Contour::Capsule { a, b, radius } => {
                 finite3(a, what, "capsule end a")?;
@@ -300,18 +306,7 @@ impl Contour {
                 positive(*half_length, what, "cylinder half_length")
             }
             Contour::Ellipsoid { center, rotation, semi_axes } => {
-                finite3(center, what, "ellipsoid center")?;
-                ensure!(rotation.iter().all(|x| x.is_finite()), Model, "{what}: ellipsoid rotation must be finite");
-                let e = (rotation.transpose() * rotation - Mat3::identity()).norm();
-                ensure!(
-                    e < 1e-6 && rotation.determinant() > 0.0,
-                    Model,
-                    "{what}: ellipsoid rotation must be orthonormal with determinant +1 (|AᵀA - E| = {e:.2e})"
-                );
-                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-                    positive(semi_axes[k], what, &format!("ellipsoid semi-axis along {axis}"))?;
-                }
-                Ok(())
+                oriented_solid(center, rotation, semi_axes, what, "ellipsoid", "semi-axis")
             }
             Contour::Bowl { center, radius } => {
                 finite3(center, what, "bowl center")?;

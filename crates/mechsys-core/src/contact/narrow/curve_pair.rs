@@ -30,7 +30,7 @@
 //! parameter on the curve (so a candidate keeps its index while its root persists); slots
 //! without a root are *unused* candidates whose gap exceeds any real one.
 
-use crate::geometry::curve::{cross, Bracket, Curve, Jet2, Vec2, CHUNK, CONVERGED, MAX_SAMPLES, NEWTON_ITERATIONS};
+use crate::geometry::curve::{cross, Bracket, Chunk, Curve, Jet2, Vec2, CHUNK, CONVERGED, MAX_SAMPLES, NEWTON_ITERATIONS};
 use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};
 
@@ -333,33 +333,50 @@ fn point_curve(
     });
 }
 
-/// Local minima of the distance from `y` to the curve's samples, refined to foot points.
-fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
-    let (samples, chunks) = (curve.samples(), curve.chunks());
-    let n = samples.len();
-    let ub = chunks.iter().map(|c| (y - c.center).norm() + c.radius).fold(f64::INFINITY, f64::min);
-    let dist = |i: usize| (y - samples[i].r).norm();
+/// Calls `at_min(i)` for every local minimum of the sampled `value(i)` over the samples of the
+/// chunks that `keep` admits (a closed curve wraps; beyond an open curve's ends counts as higher);
+/// returns the smallest sampled value and its sample (`∞` if no chunk is kept).
+fn sampled_minima(
+    curve: &Curve,
+    keep: impl Fn(&Chunk) -> bool,
+    value: impl Fn(usize) -> f64,
+    mut at_min: impl FnMut(usize),
+) -> (f64, usize) {
+    let n = curve.samples().len();
+    let closed = curve.is_closed();
     let mut best = (f64::INFINITY, 0usize);
-    for ch in chunks {
-        if (y - ch.center).norm() - ch.radius > ub + reach {
-            continue;
-        }
+    for ch in curve.chunks().iter().filter(|c| keep(c)) {
         for i in ch.first..ch.first + ch.count {
-            let di = dist(i);
-            if di < best.0 {
-                best = (di, i);
+            let vi = value(i);
+            if vi < best.0 {
+                best = (vi, i);
             }
-            let prev = if i > 0 { dist(i - 1) } else if curve.is_closed() { dist(n - 1) } else { f64::INFINITY };
-            let next = if i + 1 < n { dist(i + 1) } else if curve.is_closed() { dist(0) } else { f64::INFINITY };
-            if di <= prev && di <= next {
-                if let Some(s) = curve.foot(y, samples[i].s) {
-                    let j = curve.eval(s);
-                    let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
-                    roots.push(Root { s1: 0.0, s2: curve.wrap(s), key }, |a, b| same_param(curve, a.s2, b.s2));
-                }
+            let prev = if i > 0 { value(i - 1) } else if closed { value(n - 1) } else { f64::INFINITY };
+            let next = if i + 1 < n { value(i + 1) } else if closed { value(0) } else { f64::INFINITY };
+            if vi <= prev && vi <= next {
+                at_min(i);
             }
         }
     }
+    best
+}
+
+/// Local minima of the distance from `y` to the curve's samples, refined to foot points.
+fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
+    let samples = curve.samples();
+    let ub = curve.chunks().iter().map(|c| (y - c.center).norm() + c.radius).fold(f64::INFINITY, f64::min);
+    let best = sampled_minima(
+        curve,
+        |ch| (y - ch.center).norm() - ch.radius <= ub + reach,
+        |i| (y - samples[i].r).norm(),
+        |i| {
+            if let Some(s) = curve.foot(y, samples[i].s) {
+                let j = curve.eval(s);
+                let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
+                roots.push(Root { s1: 0.0, s2: curve.wrap(s), key }, |a, b| same_param(curve, a.s2, b.s2));
+            }
+        },
+    );
     if roots.len == 0 && best.0.is_finite() {
         roots.push(Root { s1: 0.0, s2: samples[best.1].s, key: best.0 }, |_, _| false);
     }
@@ -380,48 +397,38 @@ fn curve_line(
 ) {
     let rel = Relative::new(x1, x2);
     let (samples, chunks) = (curve.samples(), curve.chunks());
-    let ns = samples.len();
     let height = |i: usize| m.dot(&rel.point(&samples[i].r));
     let ub = chunks.iter().map(|c| m.dot(&rel.point(&c.center)) + c.radius).fold(f64::INFINITY, f64::min);
     let mut roots = Roots::new(count.max(1));
-    let mut best = (f64::INFINITY, 0usize);
     let jet = |s: f64| {
         let j = curve.eval(s);
         (rel.point(&j[0]), rel.dir(&j[1]), rel.dir(&j[2]), j)
     };
-    for ch in chunks {
-        if m.dot(&rel.point(&ch.center)) - ch.radius > ub + reach {
-            continue;
-        }
-        for i in ch.first..ch.first + ch.count {
-            let hi = height(i);
-            if hi < best.0 {
-                best = (hi, i);
-            }
-            let prev = if i > 0 { height(i - 1) } else if curve.is_closed() { height(ns - 1) } else { f64::INFINITY };
-            let next = if i + 1 < ns { height(i + 1) } else if curve.is_closed() { height(0) } else { f64::INFINITY };
-            if hi <= prev && hi <= next {
-                // Newton on m·ρ1'(s) = 0 towards the minimum of the height
-                let cap = 2.0 * curve.step();
-                let mut s = samples[i].s;
-                let mut ok = false;
-                for _ in 0..NEWTON_ITERATIONS {
-                    let (_, r1, r2, _) = jet(s);
-                    let (f, fs) = (m.dot(&r1), m.dot(&r2));
-                    let ds = if fs > 0.0 { (-f / fs).clamp(-cap, cap) } else { -f.signum() * cap };
-                    s += ds;
-                    if ds.abs() <= CONVERGED * curve.step() {
-                        ok = m.dot(&jet(s).2) > 0.0;
-                        break;
-                    }
-                }
-                if ok {
-                    let key = m.dot(&(jet(s).0 - point));
-                    roots.push(Root { s1: curve.wrap(s), s2: 0.0, key }, |a, b| same_param(curve, a.s1, b.s1));
+    let best = sampled_minima(
+        curve,
+        |ch| m.dot(&rel.point(&ch.center)) - ch.radius <= ub + reach,
+        height,
+        |i| {
+            // Newton on m·ρ1'(s) = 0 towards the minimum of the height
+            let cap = 2.0 * curve.step();
+            let mut s = samples[i].s;
+            let mut ok = false;
+            for _ in 0..NEWTON_ITERATIONS {
+                let (_, r1, r2, _) = jet(s);
+                let (f, fs) = (m.dot(&r1), m.dot(&r2));
+                let ds = if fs > 0.0 { (-f / fs).clamp(-cap, cap) } else { -f.signum() * cap };
+                s += ds;
+                if ds.abs() <= CONVERGED * curve.step() {
+                    ok = m.dot(&jet(s).2) > 0.0;
+                    break;
                 }
             }
-        }
-    }
+            if ok {
+                let key = m.dot(&(jet(s).0 - point));
+                roots.push(Root { s1: curve.wrap(s), s2: 0.0, key }, |a, b| same_param(curve, a.s1, b.s1));
+            }
+        },
+    );
     if roots.len == 0 && best.0.is_finite() {
         roots.push(Root { s1: samples[best.1].s, s2: 0.0, key: best.0 }, |_, _| false);
     }
