@@ -159,3 +159,25 @@ def test_event_driven_steps_do_not_tunnel_through_a_closed_contour():
     hits = [e["t"] for e in res.events if e["event"] == "impact"]
     assert hits and hits[0] == pytest.approx(math.sqrt(2 * (0.5 - 0.25) / G), rel=1e-9)
     assert res["contact/hit/g_n"].min() > -1e-9
+
+
+def test_a_wheel_rolls_down_an_incline_with_the_closed_form_acceleration():
+    # a torus rim (R = 0.3, tube 0.01) rolling without slip down a 10° slope: a = g sin α / (1 + I / (m r²))
+    # with the rolling radius r = R + tube; I = m r² / 2 (a uniform disc of that radius)
+    R, tube, mass, alpha = 0.3, 0.01, 2.0, math.radians(10.0)
+    r = R + tube
+    m = ms.Model("wheel", gravity=(G * math.sin(alpha), 0.0, -G * math.cos(alpha)))  # the slope is the x-y plane
+    wheel = m.add_body("wheel", mass, ms.inertia.cylinder(mass, r, 0.02, axis="y"))
+    m.add_joint(ms.joints.Free("free", m.ground, wheel, q0=[0.0, 0.0, r, 1.0, 0.0, 0.0, 0.0]))
+    m.add_contact(ms.Contact("road", wheel.contour(ms.contours.Torus(radius=R, tube=tube, axis=(0, 1, 0))),
+                             m.ground.contour(ms.contours.Plane()), friction=ms.laws.Coulomb(mu=0.8)))
+    res = ms.simulate(m, t_end=1.0, integrator=ms.EventDriven(), output_dt=1e-2)
+    a = G * math.sin(alpha) / 1.5
+    x = res["joint/free/q"][:, 0]
+    assert np.abs(x - 0.5 * a * res.t**2).max() < 1e-8
+    assert set(res["contact/road/state"].tolist()) == {1}
+    # rolling: the wheel turns at v / r about its axle (the contact frame's rolling velocity)
+    v = res["body/wheel/velocity"][:, 0]  # world components (u of a free joint is in the body frame)
+    assert np.allclose(np.linalg.norm(res["contact/road/rolling"], axis=1), np.abs(v) / r, atol=1e-8)
+    assert np.abs(res["contact/road/spin"]).max() < 1e-10
+    assert res["contact/road/lambda_n"][-1] == pytest.approx(mass * G * math.cos(alpha), rel=1e-9)

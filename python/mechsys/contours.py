@@ -169,6 +169,22 @@ class Polygon(Contour):
 
 
 @dataclass
+class Torus(Contour):
+    """A torus: the points within ``tube`` of the circle of ``radius`` about ``axis`` through
+    ``center`` — a wheel's rim (``tube=0``: a thin disc's edge). Pairs with a plane (the lowest
+    rim point, closed form)."""
+
+    radius: float = 0.0
+    tube: float = 0.0
+    axis: Sequence[float] = (0.0, 0.0, 1.0)
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+
+    def describe(self, what: str) -> dict:
+        return {"type": "torus", "center": _vec3(self.center, f"{what}.center"), "axis": _vec3(self.axis, f"{what}.axis"),
+                "radius": _radius(self.radius, f"{what}.radius"), "tube": _radius(self.tube, f"{what}.tube")}
+
+
+@dataclass
 class Ellipsoid(Contour):
     """A solid ellipsoid with ``semi_axes`` (a, b, c) about ``center``; ``cardan`` angles (x-y-z)
     turn its axes in the body. Pairs with a plane (the support point, closed form)."""
@@ -402,6 +418,7 @@ __all__ = [
     "Circle",
     "Line",
     "Polygon",
+    "Torus",
     "Ellipsoid",
     "Bowl",
     "Bore",

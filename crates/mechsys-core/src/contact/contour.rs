@@ -67,6 +67,18 @@ pub enum Contour {
         /// Half the length along the axis (> 0).
         half_length: f64,
     },
+    /// A torus (a wheel's rim, a thin disc when `tube` is 0): the points within `tube` of the
+    /// circle of `radius` about the axis through `center`.
+    Torus {
+        /// Centre of the rim circle.
+        center: Vec3,
+        /// Axis of the wheel (nonzero; normalized when a pair is built).
+        axis: Vec3,
+        /// Radius of the rim circle (> 0).
+        radius: f64,
+        /// Tube radius (≥ 0, < radius).
+        tube: f64,
+    },
     /// A solid ellipsoid (section 2.2.7.2): `(x - c)ᵀ R diag(a, b, c)⁻² Rᵀ (x - c) ≤ 1`.
     Ellipsoid {
         /// Centre.
@@ -139,6 +151,8 @@ pub enum ContourKind {
     Capsule,
     /// [`Contour::Cylinder`]
     Cylinder,
+    /// [`Contour::Torus`]
+    Torus,
     /// [`Contour::Ellipsoid`]
     Ellipsoid,
     /// [`Contour::Bowl`]
@@ -167,6 +181,7 @@ impl ContourKind {
             ContourKind::Box => "box",
             ContourKind::Capsule => "capsule",
             ContourKind::Cylinder => "cylinder",
+            ContourKind::Torus => "torus",
             ContourKind::Ellipsoid => "ellipsoid",
             ContourKind::Bowl => "bowl",
             ContourKind::Bore => "bore",
@@ -239,6 +254,7 @@ impl Contour {
             Contour::Box { .. } => ContourKind::Box,
             Contour::Capsule { .. } => ContourKind::Capsule,
             Contour::Cylinder { .. } => ContourKind::Cylinder,
+            Contour::Torus { .. } => ContourKind::Torus,
             Contour::Ellipsoid { .. } => ContourKind::Ellipsoid,
             Contour::Bowl { .. } => ContourKind::Bowl,
             Contour::Bore { .. } => ContourKind::Bore,
@@ -308,6 +324,23 @@ impl Contour {
             Contour::Ellipsoid { center, rotation, semi_axes } => {
                 oriented_solid(center, rotation, semi_axes, what, "ellipsoid", "semi-axis")
             }
+            Contour::Torus { center, axis, radius, tube } => {
+                finite3(center, what, "torus center")?;
+                finite3(axis, what, "torus axis")?;
+                ensure!(
+                    axis.norm() > MIN_DIRECTION,
+                    Model,
+                    "{what}: torus axis must not be the zero vector, got {:?}",
+                    axis.as_slice()
+                );
+                positive(*radius, what, "torus radius")?;
+                ensure!(
+                    *tube >= 0.0 && *tube < *radius,
+                    Model,
+                    "{what}: torus tube must be ≥ 0 and smaller than the radius {radius}, got {tube}"
+                );
+                Ok(())
+            }
             Contour::Bowl { center, radius } => {
                 finite3(center, what, "bowl center")?;
                 positive(*radius, what, "bowl radius")
@@ -360,6 +393,9 @@ impl Contour {
             Contour::Bore { center, axis, radius } => {
                 Contour::Bore { center: *center, axis: axis.normalize(), radius: *radius }
             }
+            Contour::Torus { center, axis, radius, tube } => {
+                Contour::Torus { center: *center, axis: axis.normalize(), radius: *radius, tube: *tube }
+            }
             Contour::Box { center, rotation, half_extents } => {
                 // Gram–Schmidt on the columns; the third is the cross product so det = +1
                 let x = rotation.column(0).normalize();
@@ -397,6 +433,13 @@ impl Contour {
                 let u = pose.a * axis.normalize();
                 // a disc of radius R with unit normal u spans R √(1 - u_k²) along axis k
                 let e = Vec3::from_fn(|k, _| u[k].abs() * half_length + radius * (1.0 - u[k] * u[k]).max(0.0).sqrt());
+                Aabb { min: c - e, max: c + e }
+            }
+            Contour::Torus { center, axis, radius, tube } => {
+                let c = pose.point_to_parent(center);
+                let u = pose.a * axis.normalize();
+                // the rim circle spans R √(1 - u_k²) along axis k, the tube adds its radius
+                let e = Vec3::from_fn(|k, _| radius * (1.0 - u[k] * u[k]).max(0.0).sqrt() + tube);
                 Aabb { min: c - e, max: c + e }
             }
             Contour::Ellipsoid { center, rotation, semi_axes } => {
@@ -459,6 +502,20 @@ impl Contour {
             Contour::Point { .. } | Contour::Point2 { .. } => [inf, inf],
             Contour::Sphere { radius, .. } => [1.0 / radius, 1.0 / radius],
             Contour::Bowl { radius, .. } => [-1.0 / radius, -1.0 / radius],
+            Contour::Torus { center, axis, radius, tube } => {
+                // on the outer equator-like ring: the tube's curvature and the rim's (as seen
+                // through the tube): 1/ρ about the tube, cos φ / (R + ρ cos φ) along the rim
+                let u = axis.normalize();
+                let y = l - center;
+                let z = y.dot(&u);
+                let rho = (y - u * z).norm();
+                let cphi = ((rho - radius) / tube.max(1e-300)).clamp(-1.0, 1.0);
+                if *tube > 0.0 {
+                    [1.0 / tube, cphi / (radius + tube * cphi)]
+                } else {
+                    [inf, 1.0 / radius]
+                }
+            }
             Contour::Ellipsoid { center, rotation, semi_axes } => {
                 // principal curvatures of the quadric at the point: the shape operator restricted to
                 // the tangent plane, from the gradient and Hessian of F = ½ yᵀ D⁻² y

@@ -86,6 +86,8 @@ enum Geometry {
         half_length: f64,
         point: Vec3,
         normal: Vec3,
+        /// A torus: one rim (`half_length = 0`) inflated by this tube radius.
+        tube: f64,
     },
     /// Swept segments `a + s d`, `s ∈ [0, 1]` (a point when `d = 0`) with radii; `across` ⟂ d2.
     Swept { a1: Vec3, d1: Vec3, r1: f64, a2: Vec3, d2: Vec3, r2: f64, across: Vec3 },
@@ -178,7 +180,7 @@ pub(crate) struct Tangents {
 fn canonical(a: ContourKind, b: ContourKind) -> bool {
     use ContourKind as K;
     match b {
-        K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder | K::Ellipsoid),
+        K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder | K::Ellipsoid | K::Torus),
         K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Curve => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Sphere => matches!(a, K::Point | K::Sphere),
@@ -198,7 +200,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Ok(true)
     } else {
         Err(Error::Model(format!(
-            "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid–plane, \
+            "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid/torus–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
              point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, in either order)"
         )))
@@ -221,6 +223,7 @@ pub fn candidates(c1: &Contour, c2: &Contour) -> Result<usize> {
         Contour::Box { .. } => 8,
         // end spheres and rim circles; a capsule against a capsule has one closest pair
         Contour::Capsule { .. } | Contour::Cylinder { .. } if against_plane => 2,
+        Contour::Torus { .. } => 1,
         Contour::Polygon { vertices } => vertices.len(),
         _ => 1,
     })
@@ -263,7 +266,9 @@ impl ContactPair {
                 let d = (b - a).normalize();
                 [d, perpendicular(&d)]
             }
-            Contour::Cylinder { axis, .. } | Contour::Bore { axis, .. } => [*axis, perpendicular(axis)],
+            Contour::Cylinder { axis, .. } | Contour::Bore { axis, .. } | Contour::Torus { axis, .. } => {
+                [*axis, perpendicular(axis)]
+            }
             Contour::Box { rotation, .. } => [rotation.column(0).into_owned(), rotation.column(1).into_owned()],
             _ => [Vec3::x(), Vec3::y()],
         };
@@ -515,7 +520,7 @@ impl ContactPair {
                 let c = x1.point_to_parent(&centers[k]);
                 half_space(&c, tw.map(|(t1, _)| vel(t1, &c)), *radius, x2, point, normal, tw.map(|t| t.1))
             }
-            Geometry::CylinderHalfSpace { center, axis, across, radius, half_length, point, normal } => {
+            Geometry::CylinderHalfSpace { center, axis, across, radius, half_length, point, normal, tube } => {
                 let a = x1.a * axis;
                 let m = x2.a * normal;
                 let k_vec = m - a * m.dot(&a);
@@ -536,7 +541,7 @@ impl ContactPair {
                     };
                     vel(t1, &c) + ud * *radius
                 });
-                half_space(&q, qd, 0.0, x2, point, normal, tw.map(|t| t.1))
+                half_space(&q, qd, *tube, x2, point, normal, tw.map(|t| t.1))
             }
             Geometry::Swept { a1, d1, r1, a2, d2, r2, across } => swept(x1, x2, tw, a1, d1, *r1, a2, d2, *r2, across),
             Geometry::SphereBox { center, radius, box_center, box_rotation, half } => {
@@ -614,6 +619,20 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
                     half_length: *half_length,
                     point,
                     normal,
+                    tube: 0.0,
+                };
+            }
+            // a torus is one rim circle inflated by its tube: the lowest rim point, then the tube
+            Contour::Torus { center, axis, radius, tube } => {
+                return Geometry::CylinderHalfSpace {
+                    center: *center,
+                    axis: *axis,
+                    across: perpendicular(axis),
+                    radius: *radius,
+                    half_length: 0.0,
+                    point,
+                    normal,
+                    tube: *tube,
                 };
             }
             Contour::Point2 { p } => (vec![lift(p)], 0.0),

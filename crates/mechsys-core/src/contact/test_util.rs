@@ -191,6 +191,7 @@ pub(crate) fn sample(kind: &str) -> Contour {
             rotation: rot(&Vec3::new(0.3, -1.0, 0.6), 0.8),
             semi_axes: Vec3::new(0.4, 0.3, 0.25),
         },
+        "torus" => Contour::Torus { center: Vec3::new(0.05, 0.1, -0.02), axis: Vec3::new(0.2, 1.0, 0.3), radius: 0.35, tube: 0.05 },
         "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
         "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
         "ellipse" => curve_sample("ellipse"),
@@ -283,7 +284,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 13] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 24] = [
+pub(crate) const PAIRS: [(&str, &str); 25] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -302,6 +303,7 @@ pub(crate) const PAIRS: [(&str, &str); 24] = [
     ("point2", "circle"),
     ("circle_b", "circle"),
     ("ellipsoid", "plane"),
+    ("torus", "plane"),
     ("point", "ellipsoid"),
     ("sphere_b", "ellipsoid"),
     ("point", "bowl"),
@@ -369,6 +371,13 @@ pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
                 .fold(f64::NEG_INFINITY, f64::max)
         }
         Contour::Curve(c) => curve_sdf(c, &Vec2::new(xl.x, xl.y)).0,
+        Contour::Torus { center, axis, radius, tube } => {
+            let a = axis.normalize();
+            let y = xl - center;
+            let z = y.dot(&a);
+            let rho = (y - a * z).norm();
+            (rho - radius).hypot(z) - tube
+        }
         Contour::Ellipsoid { center, rotation, semi_axes } => {
             ellipsoid_sdf(&(rotation.transpose() * (xl - center)), semi_axes)
         }

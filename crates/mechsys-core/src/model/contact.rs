@@ -219,6 +219,9 @@ fn contour(
         ContourDescription::Cylinder { center, axis, radius, half_length } => {
             Contour::Cylinder { center: vec3(center), axis: vec3(axis), radius: *radius, half_length: *half_length }
         }
+        ContourDescription::Torus { center, axis, radius, tube } => {
+            Contour::Torus { center: vec3(center), axis: vec3(axis), radius: *radius, tube: *tube }
+        }
         ContourDescription::Ellipsoid { center, rotation: r, semi_axes } => Contour::Ellipsoid {
             center: vec3(center),
             rotation: rotation(r, &format!("{what}.rotation"))?,

@@ -99,6 +99,19 @@ pub enum ContourDescription {
         /// Half the length along the axis, > 0.
         half_length: f64,
     },
+    /// A torus (a wheel's rim; a thin disc with `tube = 0`).
+    Torus {
+        /// Centre of the rim circle.
+        #[serde(default)]
+        center: [f64; 3],
+        /// Wheel axis (normalised when read).
+        axis: [f64; 3],
+        /// Radius of the rim circle, > 0.
+        radius: f64,
+        /// Tube radius, ≥ 0 and below the radius.
+        #[serde(default)]
+        tube: f64,
+    },
     /// A solid ellipsoid.
     Ellipsoid {
         /// Centre.
