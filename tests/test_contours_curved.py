@@ -250,3 +250,20 @@ def test_contact_geometry_query_gives_gap_witness_points_normal_and_curvatures()
         assert np.allclose(g["normal"][0], (roller - centre) / np.linalg.norm(roller - centre), atol=1e-9)
         assert g["curvature1"][0] == pytest.approx([1 / r, 0.0])
         assert g["curvature2"][0][0] == pytest.approx(1 / R, rel=1e-6)
+
+
+def test_parametric_contours_in_a_contact_group_land_on_the_floor():
+    m = ms.Model("eggs", gravity=(0, -9.81, 0), planar=True)
+    members = []
+    for k in range(3):
+        b = m.add_body(f"e{k}", 1.0, ms.inertia.box(1.0, (0.2, 0.1, 0.05)))
+        m.add_joint(ms.joints.Planar(f"j{k}", m.ground, b, q0=(0.05 * k, 0.15 + 0.25 * k, 0.3 * k)))
+        members.append(b.contour(ms.contours.Ellipse(a=0.1, b=0.05)))
+    m.add_contact_group(ms.ContactGroup("pile", members=members, against=[m.ground.contour(ms.contours.Line(normal=(0, 1, 0)))],
+                                        friction=ms.laws.Coulomb(mu=0.3)))
+    res = ms.simulate(m, t_end=2.0, integrator=ms.MoreauJean(dt=1e-3), output_dt=1e-2)
+    for k in range(3):
+        y = res[f"joint/j{k}/q"][-1][1]
+        # resting or rolling on the floor: the centre between the semi-axes' heights
+        assert 0.05 - 5e-3 < y < 0.1 + 1e-6, (k, y)
+    assert res["contact/pile/max_penetration"].max() < 5e-3
