@@ -218,6 +218,19 @@ fn finite2(v: &Vec2, what: &str, key: &str) -> Result<()> {
     Ok(())
 }
 
+/// A finite centre and a finite, nonzero axis (a cylinder, a torus, a bore).
+fn point_and_axis(center: &Vec3, axis: &Vec3, what: &str, shape: &str) -> Result<()> {
+    finite3(center, what, &format!("{shape} center"))?;
+    finite3(axis, what, &format!("{shape} axis"))?;
+    ensure!(
+        axis.norm() > MIN_DIRECTION,
+        Model,
+        "{what}: {shape} axis must not be the zero vector, got {:?}",
+        axis.as_slice()
+    );
+    Ok(())
+}
+
 /// A solid with a centre, a rotation of its axes and three positive extents along them (a box, an
 /// ellipsoid).
 fn oriented_solid(center: &Vec3, rotation: &Mat3, extents: &Vec3, what: &str, shape: &str, extent: &str) -> Result<()> {
@@ -310,14 +323,7 @@ impl Contour {
                 Ok(())
             }
             Contour::Cylinder { center, axis, radius, half_length } => {
-                finite3(center, what, "cylinder center")?;
-                finite3(axis, what, "cylinder axis")?;
-                ensure!(
-                    axis.norm() > MIN_DIRECTION,
-                    Model,
-                    "{what}: cylinder axis must not be the zero vector, got {:?}",
-                    axis.as_slice()
-                );
+                point_and_axis(center, axis, what, "cylinder")?;
                 positive(*radius, what, "cylinder radius")?;
                 positive(*half_length, what, "cylinder half_length")
             }
@@ -325,14 +331,7 @@ impl Contour {
                 oriented_solid(center, rotation, semi_axes, what, "ellipsoid", "semi-axis")
             }
             Contour::Torus { center, axis, radius, tube } => {
-                finite3(center, what, "torus center")?;
-                finite3(axis, what, "torus axis")?;
-                ensure!(
-                    axis.norm() > MIN_DIRECTION,
-                    Model,
-                    "{what}: torus axis must not be the zero vector, got {:?}",
-                    axis.as_slice()
-                );
+                point_and_axis(center, axis, what, "torus")?;
                 positive(*radius, what, "torus radius")?;
                 ensure!(
                     *tube >= 0.0 && *tube < *radius,
@@ -346,14 +345,7 @@ impl Contour {
                 positive(*radius, what, "bowl radius")
             }
             Contour::Bore { center, axis, radius } => {
-                finite3(center, what, "bore center")?;
-                finite3(axis, what, "bore axis")?;
-                ensure!(
-                    axis.norm() > MIN_DIRECTION,
-                    Model,
-                    "{what}: bore axis must not be the zero vector, got {:?}",
-                    axis.as_slice()
-                );
+                point_and_axis(center, axis, what, "bore")?;
                 positive(*radius, what, "bore radius")
             }
             Contour::Point2 { p } => finite2(p, what, "point2 p"),
