@@ -8,13 +8,16 @@ In space: :class:`Point`, :class:`Sphere`, :class:`Plane` (half-space below its 
 :class:`Point`, :class:`Circle`, :class:`Line` (half-plane behind its normal), :class:`Polygon`
 (convex, vertices counter-clockwise), and the parametric contours of section 2.2.7.1 —
 :class:`Ellipse`, :class:`Spline` (through points, or sampled from a function with
-:meth:`Spline.from_function`) and :class:`Cam` (a cam disc from a lift table or lift function) —
-which pair with points, circles, polygons, lines and each other through a Newton contact
-search on their parameters (see docs/contours.md).
+:meth:`Spline.from_function`), :class:`Cam` (a cam disc from a lift table or lift function) and
+:class:`Gear` (an involute spur gear) — which pair with points, circles, polygons, lines and each
+other through a Newton contact search on their parameters (see docs/contours.md). For gear pairs,
+:func:`gear_center_distance` gives the tight-mesh centre distance of two (shifted, thinned) gears
+and :func:`gear_mesh` the working pressure angle, backlash and contact ratio of a pair.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from typing import Any, Sequence
@@ -399,6 +402,216 @@ class Cam(Contour):
         }
 
 
+def _teeth(z, what: str) -> int:
+    if isinstance(z, bool) or not isinstance(z, (int,)) and not (isinstance(z, float) and z.is_integer()):
+        raise ModelError(f"{what}: expected a whole number of teeth, got {z!r}")
+    return int(z)
+
+
+def _optional(x, what: str):
+    return None if x is None else _radius(x, what)
+
+
+#: The standard pressure angle, 20° (rad).
+PRESSURE_ANGLE = math.radians(20.0)
+
+
+@dataclass
+class Gear(Contour):
+    """An external involute spur gear in the body's x-y plane: ``module`` (or ``base_radius``,
+    ``r_b = m z cos α / 2``), ``teeth`` z, ``pressure_angle`` α (rad, 20° by default), profile
+    ``shift`` x, ``backlash`` (the teeth thinned by this arc length on the pitch circle),
+    ``addendum`` (default one module) and ``dedendum`` (1.25 modules) about the shifted pitch
+    circle, ``tip_radius`` and ``root_radius`` (the tip rounding and root fillet; by default 0.05
+    and 0.2 modules, or less where that does not fit), ``center`` and ``phase`` (the direction of
+    tooth 0's centre line). The flanks are exact involutes of the base circle, joined G1 to the
+    roundings; the contour's parameter is the arc length along the outline, counter-clockwise
+    from the middle of the gap before tooth 0 (see docs/contours.md). Pair two gears with
+    ``ms.Contact(..., points=4)``: drive and coast flanks of up to two tooth pairs."""
+
+    module: float | None = None
+    teeth: int = 0
+    pressure_angle: float = PRESSURE_ANGLE
+    shift: float = 0.0
+    backlash: float = 0.0
+    addendum: float | None = None
+    dedendum: float | None = None
+    tip_radius: float | None = None
+    root_radius: float | None = None
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+    phase: float = 0.0
+    base_radius: float | None = None
+
+    def describe(self, what: str) -> dict:
+        d = {
+            "type": "gear",
+            "teeth": _teeth(self.teeth, f"{what}.teeth"),
+            "pressure_angle": _radius(self.pressure_angle, f"{what}.pressure_angle"),
+            "shift": _radius(self.shift, f"{what}.shift"),
+            "backlash": _radius(self.backlash, f"{what}.backlash"),
+            "center": _vec3(self.center, f"{what}.center"),
+            "phase": _radius(self.phase, f"{what}.phase"),
+        }
+        for k in ("module", "base_radius", "addendum", "dedendum", "tip_radius", "root_radius"):
+            v = _optional(getattr(self, k), f"{what}.{k}")
+            if v is not None:
+                d[k] = v
+        return d
+
+    def geometry(self, samples: int = 0, what: str = "Gear") -> "GearGeometry":
+        """The gear as the engine builds it (radii, roll angles of the involute, roundings used);
+        with ``samples`` > 0 also that many points of its outline (body frame, for plots)."""
+        from . import _core
+
+        if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
+            raise ModelError(f"{what}.geometry: samples must be a whole number ≥ 0, got {samples!r}")
+        d = self.describe(what)
+        d.pop("type")
+        g = _core.gear_geometry(json.dumps(d), what, samples)
+        return GearGeometry(**{k: (tuple(v) if k == "roll_range" else v) for k, v in g.items()})
+
+
+@dataclass(frozen=True)
+class GearGeometry:
+    """A gear contour as the engine builds it (:meth:`Gear.geometry`); lengths in m, angles in
+    rad. The flank is the exact involute between the roll angles ``roll_range``; ``segment``: a
+    straight piece joins its start to the root fillet (the root circle lies inside the base
+    circle or close to it)."""
+
+    module: float
+    teeth: int
+    pressure_angle: float
+    shift: float
+    backlash: float
+    pitch_radius: float
+    base_radius: float
+    tip_radius: float
+    root_radius: float
+    base_half_angle: float
+    roll_range: tuple
+    tip_rounding: float
+    root_fillet: float
+    segment: bool
+    tooth_length: float
+    perimeter: float
+    outline: Any = None
+
+    @property
+    def base_pitch(self) -> float:
+        """Distance between the flanks of neighbouring teeth along a line of action, 2π r_b / z."""
+        return 2.0 * math.pi * self.base_radius / self.teeth
+
+    @property
+    def base_thickness(self) -> float:
+        """Tooth thickness on the base circle (arc), 2 r_b ψ_b (the involutes extended down to it)."""
+        return 2.0 * self.base_radius * self.base_half_angle
+
+
+def involute(alpha: float) -> float:
+    """The involute function inv α = tan α − α."""
+    return math.tan(alpha) - alpha
+
+
+def involute_inverse(value: float) -> float:
+    """The angle α in [0, π/2) with inv α = ``value`` ≥ 0 (Newton on tan α − α)."""
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ModelError(f"involute_inverse: expected a value ≥ 0, got {value!r}")
+    # start from the series inv α ≈ α³/3 for small angles, capped below π/2
+    a = min((3.0 * value) ** (1.0 / 3.0), 1.5)
+    for _ in range(100):
+        t = math.tan(a)
+        step = (t - a - value) / (t * t)
+        a = min(max(a - step, 0.5 * a), 0.5 * (a + math.pi / 2))
+        if abs(step) < 1e-16 * max(a, 1e-300):
+            break
+    return a
+
+
+def _thickness_angle(z: int, m: float, alpha: float, x: float, j: float) -> float:
+    """Half angle of a tooth at the base circle, ψ_b = s / (2r) + inv α."""
+    return (m * (math.pi / 2 + 2 * x * math.tan(alpha)) - j) / (m * z) + involute(alpha)
+
+
+def gear_center_distance(z1: int, z2: int, module: float, pressure_angle: float = PRESSURE_ANGLE,
+                         shift1: float = 0.0, shift2: float = 0.0, backlash1: float = 0.0,
+                         backlash2: float = 0.0) -> float:
+    """Centre distance at which two external gears mesh without backlash: from the tooth
+    thicknesses on the base circles, ``inv α_w = (s_b1 + s_b2 − p_b) / (2 (r_b1 + r_b2))`` and
+    ``a = (r_b1 + r_b2) / cos α_w`` (for unshifted, unthinned gears ``m (z1 + z2) / 2``;
+    for shifted ones the classical ``inv α_w = inv α + 2 tan α (x1 + x2) / (z1 + z2)``). Any extra
+    distance Δa opens a normal backlash of about ``2 Δa sin α_w``."""
+    what = "gear_center_distance"
+    z1, z2 = _teeth(z1, f"{what}: z1"), _teeth(z2, f"{what}: z2")
+    m, alpha = _radius(module, f"{what}: module"), _radius(pressure_angle, f"{what}: pressure_angle")
+    if not (m > 0 and math.isfinite(m)):
+        raise ModelError(f"{what}: module must be > 0, got {m}")
+    if not 0 < alpha < math.radians(60):
+        raise ModelError(f"{what}: pressure_angle must lie between 0 and 60° (rad), got {alpha}")
+    if z1 < 5 or z2 < 5:
+        raise ModelError(f"{what}: gears need at least 5 teeth, got {z1} and {z2}")
+    rb1, rb2 = 0.5 * m * z1 * math.cos(alpha), 0.5 * m * z2 * math.cos(alpha)
+    sb1 = 2 * rb1 * _thickness_angle(z1, m, alpha, float(shift1), float(backlash1))
+    sb2 = 2 * rb2 * _thickness_angle(z2, m, alpha, float(shift2), float(backlash2))
+    pb = math.pi * m * math.cos(alpha)
+    inv_w = (sb1 + sb2 - pb) / (2 * (rb1 + rb2))
+    if inv_w <= 0:
+        raise ModelError(f"{what}: the teeth are too thin to mesh tightly at any centre distance "
+                         f"(base thicknesses {sb1:.6g} + {sb2:.6g} ≤ base pitch {pb:.6g})")
+    return (rb1 + rb2) / math.cos(involute_inverse(inv_w))
+
+
+@dataclass(frozen=True)
+class GearMesh:
+    """Two gears at a centre distance (:func:`gear_mesh`); lengths in m, angles in rad."""
+
+    center_distance: float
+    #: Working pressure angle: the lines of action make it with the common tangent of the
+    #: working pitch circles, cos α_w = (r_b1 + r_b2) / a.
+    working_pressure_angle: float
+    #: Play along a line of action with the other flanks touching,
+    #: p_b − s_b1 − s_b2 + 2 (r_b1 + r_b2) inv α_w.
+    normal_backlash: float
+    #: The same turned into an angle of gear 1 (rad): normal_backlash / r_b1.
+    angular_backlash1: float
+    #: Length of the path of contact over the base pitch (the exact involutes only: the tip
+    #: roundings shorten it).
+    contact_ratio: float
+    #: Speed ratio ω2 / ω1 = −r_b1 / r_b2 = −z1 / z2.
+    ratio: float
+    #: Smallest gap between a tip circle and the other gear's root circle.
+    tip_clearance: float
+    #: Whether a tip reaches a flank below its involute (interference; the contact ratio then
+    #: counts only the involute part).
+    interference: bool
+
+
+def gear_mesh(gear1: Gear, gear2: Gear, center_distance: float) -> GearMesh:
+    """The mesh of two external gears (their own data; centres ``center_distance`` apart):
+    working pressure angle, normal backlash, contact ratio and tip clearance."""
+    what = "gear_mesh"
+    a = _radius(center_distance, f"{what}: center_distance")
+    g1, g2 = gear1.geometry(what=f"{what}: gear1"), gear2.geometry(what=f"{what}: gear2")
+    if abs(g1.base_pitch - g2.base_pitch) > 1e-9 * g1.base_pitch:
+        raise ModelError(f"{what}: the gears' base pitches differ ({g1.base_pitch:.9g} and {g2.base_pitch:.9g} m): "
+                         "involute gears mesh only with equal base pitch (module × cos of the pressure angle)")
+    rb1, rb2 = g1.base_radius, g2.base_radius
+    if not a > rb1 + rb2:
+        raise ModelError(f"{what}: the centre distance {a} must exceed the sum of the base radii {rb1 + rb2}")
+    clearance = min(a - g1.tip_radius - g2.root_radius, a - g2.tip_radius - g1.root_radius)
+    aw = math.acos((rb1 + rb2) / a)
+    jn = g1.base_pitch - g1.base_thickness - g2.base_thickness + 2 * (rb1 + rb2) * involute(aw)
+    length = a * math.sin(aw)  # between the tangent points T1, T2
+    # each involute along the line of action, measured from T1: r_b1 φ1 and L − r_b2 φ2
+    lo1, hi1 = (rb1 * p for p in g1.roll_range)
+    lo2, hi2 = (length - rb2 * p for p in reversed(g2.roll_range))
+    start, end = max(lo1, lo2), min(hi1, hi2)
+    # an involute's end (where the tip rounding begins) beyond the other's involute start
+    interference = lo2 < lo1 or hi1 > hi2
+    return GearMesh(center_distance=a, working_pressure_angle=aw, normal_backlash=jn, angular_backlash1=jn / rb1,
+                    contact_ratio=max(end - start, 0.0) / g1.base_pitch, ratio=-rb1 / rb2, tip_clearance=clearance,
+                    interference=bool(interference))
+
+
 @dataclass
 class OnBody:
     """A contour attached to a body (what :meth:`mechsys.Body.contour` returns)."""
@@ -425,5 +638,12 @@ __all__ = [
     "Ellipse",
     "Spline",
     "Cam",
+    "Gear",
+    "GearGeometry",
+    "GearMesh",
+    "gear_center_distance",
+    "gear_mesh",
+    "involute",
+    "involute_inverse",
     "OnBody",
 ]

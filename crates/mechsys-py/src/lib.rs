@@ -4,6 +4,7 @@
 mod bearing;
 mod dynamics;
 mod errors;
+mod geometry;
 mod kinematics;
 mod math;
 mod model;
@@ -17,6 +18,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     model::register(m)?;
     dynamics::register(m)?;
     bearing::register(m)?;
+    geometry::register(m)?;
     kinematics::register(m)?;
     math::register(m)?;
     simulate::register(m)?;

@@ -314,6 +314,7 @@ impl ContactPair {
             curve_pair::MAX_POINTS
         );
         ensure!(g.shared(), Model, "contact pair {name}: a polygon has one contact point per vertex; points does not apply");
+        g.check_points(points).map_err(|m| Error::Model(format!("contact pair {name}: {m}")))?;
         g.set_points(points);
         self.count = points;
         Ok(self)

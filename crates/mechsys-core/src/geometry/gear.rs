@@ -434,6 +434,14 @@ impl Gear {
         self.tooth_eval(k, u, u > self.half)
     }
 
+    /// The tooth (index) and flank (`true`: the upper one, facing counter-clockwise) at `s`.
+    pub fn tooth_at(&self, s: f64) -> (usize, bool) {
+        let z = self.turns.len();
+        let kf = (s / self.tooth).floor();
+        let u = s - kf * self.tooth;
+        ((kf.rem_euclid(z as f64) as usize).min(z - 1), u > self.half)
+    }
+
     /// Tooth `k` at its own parameter `u ∈ [0, L]`, from the formula of its lower (`upper =
     /// false`, `u ≤ L/2`) or upper half (both sides of a joint, for tests).
     #[inline]

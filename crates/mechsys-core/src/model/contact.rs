@@ -6,10 +6,11 @@ use crate::error::{Error, Result};
 use crate::math::Vec3;
 
 use super::contact_description::{
-    ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, ImpactDescription,
-    SolidSide,
+    ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, GearDescription,
+    ImpactDescription, SolidSide,
 };
 use crate::geometry::curve::{Curve, Follower, Solid};
+use crate::geometry::gear::GearSpec;
 
 /// Tangential law with its coefficients.
 #[derive(Debug, Clone, PartialEq)]
@@ -183,6 +184,7 @@ fn planar(c: &ContourDescription) -> bool {
             | ContourDescription::Ellipse { .. }
             | ContourDescription::Spline { .. }
             | ContourDescription::Cam { .. }
+            | ContourDescription::Gear(_)
     )
 }
 
@@ -194,6 +196,47 @@ fn surface_velocity(c: &ContourDescription) -> Option<[f64; 3]> {
         }
         _ => None,
     }
+}
+
+/// The gear of a description: `module` or `base_radius` (exactly one), defaults filled in;
+/// `what` names the contour in errors.
+pub fn gear_spec(g: &GearDescription, what: &str) -> Result<GearSpec> {
+    let alpha = g.pressure_angle.unwrap_or(20f64.to_radians());
+    crate::ensure!(
+        alpha.is_finite() && alpha > 0.0 && alpha < 60f64.to_radians(),
+        Model,
+        "{what}.pressure_angle: must lie between 0 and 60° (1.047 rad), got {alpha} rad"
+    );
+    let m = match (g.module, g.base_radius) {
+        (Some(m), None) => m,
+        (None, Some(rb)) => {
+            crate::ensure!(rb.is_finite() && rb > 0.0, Model, "{what}.base_radius: must be > 0, got {rb}");
+            crate::ensure!(g.teeth > 0, Model, "{what}.teeth: must be ≥ 5, got {}", g.teeth);
+            2.0 * rb / (g.teeth as f64 * alpha.cos())
+        }
+        (Some(_), Some(_)) => {
+            return Err(Error::Model(format!("{what}: give the gear's module or its base_radius, not both")))
+        }
+        (None, None) => return Err(Error::Model(format!("{what}: a gear needs its module (or base_radius)"))),
+    };
+    for (k, v) in [("shift", Some(g.shift)), ("backlash", Some(g.backlash)), ("addendum", g.addendum), ("dedendum", g.dedendum)] {
+        if let Some(v) = v {
+            finite(v, &format!("{what}.{k}"))?;
+        }
+    }
+    Ok(GearSpec {
+        module: m,
+        teeth: g.teeth,
+        pressure_angle: alpha,
+        shift: g.shift,
+        backlash: g.backlash,
+        addendum: g.addendum.unwrap_or(m),
+        dedendum: g.dedendum.unwrap_or(1.25 * m),
+        tip_radius: g.tip_radius,
+        root_radius: g.root_radius,
+        center: Vec2::new(g.center[0], g.center[1]),
+        phase: g.phase,
+    })
 }
 
 /// The engine contour of a description; a `point` is planar when its partner is.
@@ -278,6 +321,7 @@ fn contour(
             };
             Contour::Curve(Box::new(Curve::cam(angles, lift, *base_radius, f, *direction, what)?))
         }
+        ContourDescription::Gear(g) => Contour::Curve(Box::new(Curve::gear(&gear_spec(g, what)?, what)?)),
     })
 }
 

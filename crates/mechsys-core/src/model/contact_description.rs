@@ -3,7 +3,8 @@
 //!
 //! Contours in space: `point`, `sphere`, `plane` (half-space below its normal), `box`, `capsule`,
 //! `cylinder`; in the plane (the x-y plane of the body frame): `point`, `circle`, `line`
-//! (half-plane behind its normal), `polygon`. Normal contact is always Signorini's law
+//! (half-plane behind its normal), `polygon`, and the parametric contours `ellipse`, `spline`,
+//! `cam`, `gear`. Normal contact is always Signorini's law
 //! (g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0); friction is none, Coulomb with a static and a sliding
 //! coefficient, or a Stribeck curve; impacts follow Newton's or Poisson's law.
 
@@ -213,6 +214,50 @@ pub enum ContourDescription {
         #[serde(default = "one")]
         direction: f64,
     },
+    /// An external involute spur gear (a parametric contour, section 2.2.7.1).
+    Gear(GearDescription),
+}
+
+/// An external involute spur gear in the body's x-y plane (see `geometry::gear`); lengths in m,
+/// angles in rad. Give `module` or `base_radius` (`r_b = m z cos α / 2`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GearDescription {
+    /// Module (pitch diameter / teeth), > 0.
+    #[serde(default)]
+    pub module: Option<f64>,
+    /// Base-circle radius instead of the module.
+    #[serde(default)]
+    pub base_radius: Option<f64>,
+    /// Number of teeth, 5 to 170.
+    pub teeth: usize,
+    /// Pressure angle on the pitch circle (rad), 20° if absent.
+    #[serde(default)]
+    pub pressure_angle: Option<f64>,
+    /// Profile shift coefficient x (the tool moved out by x m).
+    #[serde(default)]
+    pub shift: f64,
+    /// Tooth thinning on the pitch circle (arc length, m), ≥ 0.
+    #[serde(default)]
+    pub backlash: f64,
+    /// Tip circle above the shifted pitch circle (m); the module if absent.
+    #[serde(default)]
+    pub addendum: Option<f64>,
+    /// Root circle below the shifted pitch circle (m); 1.25 modules if absent.
+    #[serde(default)]
+    pub dedendum: Option<f64>,
+    /// Tip rounding radius (m); 0.05 modules (or what fits) if absent.
+    #[serde(default)]
+    pub tip_radius: Option<f64>,
+    /// Root fillet radius (m); 0.2 modules (or what fits) if absent.
+    #[serde(default)]
+    pub root_radius: Option<f64>,
+    /// Centre of the gear (z ignored).
+    #[serde(default)]
+    pub center: [f64; 3],
+    /// Direction of tooth 0's centre line from the body's x axis (rad).
+    #[serde(default)]
+    pub phase: f64,
 }
 
 /// Where a parametric contour's solid lies.

@@ -103,6 +103,58 @@ impl Roots {
     }
 }
 
+/// How a gear pair's roots are given candidate slots: `2 × colours` slots, the root's flank side
+/// (the lower or upper flank of a tooth of the colouring gear) and the colour of that tooth,
+/// `k mod colours`. A root keeps its slot while it persists, so each tooth flank in mesh stays
+/// the same candidate through the tooth changes (a slot holds its deepest root; roots that
+/// share a slot are teeth `colours` apart, never in contact together while the contact ratio is
+/// below `colours`). With one colour the slots are the drive and the coast side: every pair in
+/// involute action on one side has the same gap and line of action, so the closest pair of each
+/// side is the contact that side needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GearSlots {
+    colours: usize,
+    /// Colour the teeth of the pair's second gear (the first has `z mod colours = 1`).
+    second: bool,
+}
+
+impl GearSlots {
+    fn slot(&self, c1: &Curve, c2: &Curve, r: &Root) -> usize {
+        let (gear, s) = if self.second { (c2.as_gear(), r.s2) } else { (c1.as_gear(), r.s1) };
+        let (k, upper) = gear.expect("a gear pair").tooth_at(s);
+        2 * (k % self.colours) + upper as usize
+    }
+}
+
+/// The slots of a gear–gear pair with `count` candidates (`None`: not a gear pair, or one
+/// candidate); an error for an odd count or when neither gear's teeth can be coloured with
+/// `count / 2` colours so that neighbouring teeth differ (`z mod colours = 1` for both).
+pub(crate) fn gear_slots(c1: &Curve, c2: &Curve, count: usize) -> Option<Result<GearSlots, String>> {
+    let (g1, g2) = (c1.as_gear()?, c2.as_gear()?);
+    if count < 2 {
+        return None;
+    }
+    if count % 2 == 1 {
+        return Some(Err(format!(
+            "a gear pair takes an even number of points (one per flank side and tooth colour: 2, 4, 6 or 8), got {count}"
+        )));
+    }
+    let colours = count / 2;
+    let proper = |z: usize| colours == 1 || z % colours != 1;
+    Some(if proper(g1.teeth()) {
+        Ok(GearSlots { colours, second: false })
+    } else if proper(g2.teeth()) {
+        Ok(GearSlots { colours, second: true })
+    } else {
+        Err(format!(
+            "with {count} points the gear pair's teeth ({} and {}) cannot be told apart around the gear              (both leave 1 over when divided by {colours}); use {} points, or 2 (drive and coast side)",
+            g1.teeth(),
+            g2.teeth(),
+            2 * (colours + 1)
+        ))
+    })
+}
+
 /// Relative placement of body 1 in body 2's frame and the world data of both.
 struct Relative<'a> {
     x1: &'a Pose,
@@ -210,6 +262,16 @@ impl CurveGeometry {
                 *count = points;
                 *reach = if points > 1 { scale(curve) } else { 0.0 };
             }
+        }
+    }
+
+    /// A number of points this pair cannot take, with the reason (gear pairs, see [`GearSlots`]).
+    pub(crate) fn check_points(&self, points: usize) -> Result<(), String> {
+        match self {
+            CurveGeometry::OnCurve { first: First::Curve(c1), second, .. } => {
+                gear_slots(c1, second, points).unwrap_or(Ok(GearSlots { colours: 1, second: false })).map(|_| ())
+            }
+            _ => Ok(()),
         }
     }
 
@@ -605,7 +667,9 @@ fn curve_curve(
         let j2 = c2.eval(b);
         ([rel.point(&j1[0]), rel.dir(&j1[1]), rel.dir(&j1[2]), rel.dir(&j1[3])], j1, j2)
     };
-    let mut roots = Roots::new(count.max(1));
+    // gear pairs: one candidate per flank side and tooth colour (see `gear_slots`)
+    let slots = gear_slots(c1, c2, count).and_then(|r| r.ok());
+    let mut roots = Roots::new(if slots.is_some() { MAX_ROOTS } else { count.max(1) });
     let mut best = (f64::INFINITY, 0usize, 0usize);
     let cap1 = 2.0 * c1.step();
     let samples1 = (0..ch1.len()).filter(|&a| keep1[a]).flat_map(|a| ch1[a].first..ch1[a].first + ch1[a].count);
@@ -666,41 +730,55 @@ fn curve_curve(
         roots.push(Root { s1: s1[best.1].s, s2: s2[best.2].s, key: best.0 }, |_, _| false);
     }
     let (o1, o2) = (c1.offset(), c2.offset());
-    fill(&mut roots, count, |r| r.s1, |k, root| {
-        out[k] = match root {
-            None => unused(&rel, &c1.bound().0, c1.bound().1, &c2.bound().0, c2.bound().1, tw),
-            Some(root) => {
-                let (r1, j1, j2) = jets(root.s1, root.s2);
-                let d = r1[0] - j2[0];
-                let nu = c2.outward(&j2[1]);
-                let g = d.dot(&nu) - o1 - o2;
-                let n = rel.world2(&nu);
-                let pb = x1.point_to_parent(&lift(&j1[0]));
-                let p1 = pb - n * o1;
-                let mut r = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
-                if let Some(tw) = tw {
-                    let rhod = rel.point_rate(tw, &pb);
-                    let rho1d = rel.dir_rate(tw, &j1[1]);
-                    let jm = [
-                        [r1[1].dot(&j2[1]), -j2[1].norm_squared() + d.dot(&j2[2])],
-                        [cross(&r1[2], &j2[1]), cross(&r1[1], &j2[2])],
-                    ];
-                    let ft = [rhod.dot(&j2[1]), cross(&rho1d, &j2[1])];
-                    let det = jm[0][0] * jm[1][1] - jm[0][1] * jm[1][0];
-                    let (sd1, sd2) = if det.abs() > 0.0 && det.is_finite() {
-                        (-(jm[1][1] * ft[0] - jm[0][1] * ft[1]) / det, -(-jm[1][0] * ft[0] + jm[0][0] * ft[1]) / det)
-                    } else {
-                        (0.0, 0.0)
-                    };
-                    let nud = normal_rate(&nu, &j2) * sd2;
-                    let gd = (rhod + r1[1] * sd1 - j2[1] * sd2).dot(&nu) + d.dot(&nud);
-                    r.nd = tw.1.w.cross(&n) + rel.world2(&nud);
-                    r.p1d = vel(tw.0, &pb) + x1.a * lift(&j1[1]) * sd1 - r.nd * o1;
-                    r.p2d = r.p1d - n * gd - r.nd * g;
-                }
-                r
+    let make = |root: Option<&Root>| match root {
+        None => unused(&rel, &c1.bound().0, c1.bound().1, &c2.bound().0, c2.bound().1, tw),
+        Some(root) => {
+            let (r1, j1, j2) = jets(root.s1, root.s2);
+            let d = r1[0] - j2[0];
+            let nu = c2.outward(&j2[1]);
+            let g = d.dot(&nu) - o1 - o2;
+            let n = rel.world2(&nu);
+            let pb = x1.point_to_parent(&lift(&j1[0]));
+            let p1 = pb - n * o1;
+            let mut r = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
+            if let Some(tw) = tw {
+                let rhod = rel.point_rate(tw, &pb);
+                let rho1d = rel.dir_rate(tw, &j1[1]);
+                let jm = [
+                    [r1[1].dot(&j2[1]), -j2[1].norm_squared() + d.dot(&j2[2])],
+                    [cross(&r1[2], &j2[1]), cross(&r1[1], &j2[2])],
+                ];
+                let ft = [rhod.dot(&j2[1]), cross(&rho1d, &j2[1])];
+                let det = jm[0][0] * jm[1][1] - jm[0][1] * jm[1][0];
+                let (sd1, sd2) = if det.abs() > 0.0 && det.is_finite() {
+                    (-(jm[1][1] * ft[0] - jm[0][1] * ft[1]) / det, -(-jm[1][0] * ft[0] + jm[0][0] * ft[1]) / det)
+                } else {
+                    (0.0, 0.0)
+                };
+                let nud = normal_rate(&nu, &j2) * sd2;
+                let gd = (rhod + r1[1] * sd1 - j2[1] * sd2).dot(&nu) + d.dot(&nud);
+                r.nd = tw.1.w.cross(&n) + rel.world2(&nud);
+                r.p1d = vel(tw.0, &pb) + x1.a * lift(&j1[1]) * sd1 - r.nd * o1;
+                r.p2d = r.p1d - n * gd - r.nd * g;
             }
-        };
-    });
+            r
+        }
+    };
+    match slots {
+        Some(slots) => {
+            // the deepest root of each slot, in slot order
+            let mut best: [Option<Root>; MAX_POINTS] = [None; MAX_POINTS];
+            for r in &roots.list[..roots.len] {
+                let k = slots.slot(c1, c2, r);
+                if k < count && best[k].is_none_or(|b| r.key < b.key) {
+                    best[k] = Some(*r);
+                }
+            }
+            for (k, o) in out.iter_mut().enumerate().take(count) {
+                *o = make(best[k].as_ref());
+            }
+        }
+        None => fill(&mut roots, count, |r| r.s1, |k, root| out[k] = make(root)),
+    }
 }
 

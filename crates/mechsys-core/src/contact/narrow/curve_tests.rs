@@ -238,102 +238,180 @@ fn ellipsoid_on_a_plane_against_sampled_support_and_curvatures_at_the_axes() {
     assert!((k[0] - a / (c * c)).abs() < 1e-12 && (k[1] - a / (b * b)).abs() < 1e-12, "{k:?}");
 }
 
-/// Two involute gears in mesh, z1 = 17 and z2 = 31, m = 2 mm, backlash on both, at the standard
-/// centre distance; gear 2 follows gear 1 at the speed ratio -z1/z2 with the drive flanks a gap
-/// `delta` apart. Reference (the involutes' own geometry, not the search): a flank pair meets the
-/// line of action (the common tangent of the base circles, tangent points T1, T2) at distances
-/// `r_b φ` (roll angles) from T1 and T2, so its gap along it is `a sin α - r_b1 φ1 - r_b2 φ2`, the
-/// same for every pair in mesh; drive and coast gaps add up to the normal backlash
+/// Two involute gears in mesh at the standard centre distance, m = 2 mm, backlash on both; gear 2
+/// follows gear 1 at the speed ratio -z1/z2 with the drive flanks a gap `delta` apart.
+/// Reference (the involutes' own geometry, not the search): a flank pair meets the line of action
+/// (the common tangent of the base circles, tangent points T1, T2) at distances `r_b φ` (roll
+/// angles) from T1 and T2, so its gap along it is `a sin α - r_b1 φ1 - r_b2 φ2`, the same for every
+/// pair in mesh; drive and coast gaps add up to the normal backlash
 /// `p_b - s_b1 - s_b2 + 2 (r_b1 + r_b2) inv α`.
-#[test]
-fn gear_pair_gaps_and_normals_follow_the_lines_of_action() {
-    use crate::geometry::gear::{involute_function, GearSpec};
-    let (m, z1, z2) = (0.002, 17usize, 31usize);
-    let alpha = 20f64.to_radians();
-    let j = 0.05 * m;
-    let g1 = Curve::gear(&GearSpec { backlash: j, ..GearSpec::new(m, z1) }, "pinion").unwrap();
-    let g2 = Curve::gear(&GearSpec { backlash: j, ..GearSpec::new(m, z2) }, "wheel").unwrap();
-    let (q1, q2) = (g1.as_gear().unwrap().clone(), g2.as_gear().unwrap().clone());
-    let (rb1, rb2) = (q1.base_radius(), q2.base_radius());
-    let a = 0.5 * m * (z1 + z2) as f64;
-    let (psi1, psi2) = (q1.base_half_angle(), q2.base_half_angle());
-    let pb = TAU * rb1 / z1 as f64;
-    let jn = pb - 2.0 * rb1 * psi1 - 2.0 * rb2 * psi2 + 2.0 * (rb1 + rb2) * involute_function(alpha);
-    assert!((jn - 2.0 * j * alpha.cos()).abs() < 1e-15, "normal backlash {jn}");
-    let delta = 0.3 * jn;
-    let pair = ContactPair::new("mesh", Contour::Curve(Box::new(g1)), Contour::Curve(Box::new(g2)))
-        .unwrap()
-        .with_points(4)
-        .unwrap();
-    let wrap = |x: f64| x.rem_euclid(TAU);
-    let (lo1, hi1) = q1.roll_range();
-    let (lo2, hi2) = q2.roll_range();
-    // gear 2's angle for gear 1 at 0: tooth 0 of both on the drive line of action at gap delta
-    let phi1 = psi1 + alpha;
-    let phi2 = (a * alpha.sin() - delta - rb1 * phi1) / rb2;
-    let c = PI - alpha + phi2 - psi2;
-    // drive: gear 1's upper flanks (unwound clockwise from θ1 + 2πk/z1 + ψ_b1) against gear 2's
-    // upper flanks, line of action T1 = r_b1 (cos α, -sin α) → T2, direction e = (sin α, cos α);
-    // coast: the lower flanks, mirrored about the centre line
-    let pairs_in_mesh = |t1: f64, t2: f64, coast: bool| {
-        let mut gaps = Vec::new();
+struct Mesh {
+    z: (usize, usize),
+    pair2: ContactPair,
+    pair4: Option<ContactPair>,
+    alpha: f64,
+    a: f64,
+    rb: (f64, f64),
+    psi: (f64, f64),
+    roll: ((f64, f64), (f64, f64)),
+    pb: f64,
+    jn: f64,
+    delta: f64,
+    /// gear 2's angle for gear 1 at 0
+    c: f64,
+}
+
+impl Mesh {
+    fn new(z1: usize, z2: usize) -> Mesh {
+        use crate::geometry::gear::{involute_function, GearSpec};
+        let (m, alpha) = (0.002, 20f64.to_radians());
+        let j = 0.05 * m;
+        let g1 = Curve::gear(&GearSpec { backlash: j, ..GearSpec::new(m, z1) }, "pinion").unwrap();
+        let g2 = Curve::gear(&GearSpec { backlash: j, ..GearSpec::new(m, z2) }, "wheel").unwrap();
+        let (q1, q2) = (g1.as_gear().unwrap().clone(), g2.as_gear().unwrap().clone());
+        let (rb1, rb2) = (q1.base_radius(), q2.base_radius());
+        let a = 0.5 * m * (z1 + z2) as f64;
+        let (psi1, psi2) = (q1.base_half_angle(), q2.base_half_angle());
+        let pb = TAU * rb1 / z1 as f64;
+        let jn = pb - 2.0 * rb1 * psi1 - 2.0 * rb2 * psi2 + 2.0 * (rb1 + rb2) * involute_function(alpha);
+        assert!((jn - 2.0 * j * alpha.cos()).abs() < 1e-15, "normal backlash {jn}");
+        let delta = 0.3 * jn;
+        let pair = ContactPair::new("mesh", Contour::Curve(Box::new(g1)), Contour::Curve(Box::new(g2))).unwrap();
+        let pair4 = pair.clone().with_points(4).ok();
+        // tooth 0 of both on the drive line of action at gap delta
+        let phi1 = psi1 + alpha;
+        let phi2 = (a * alpha.sin() - delta - rb1 * phi1) / rb2;
+        Mesh {
+            z: (z1, z2),
+            pair2: pair.with_points(2).unwrap(),
+            pair4,
+            alpha,
+            a,
+            rb: (rb1, rb2),
+            psi: (psi1, psi2),
+            roll: (q1.roll_range(), q2.roll_range()),
+            pb,
+            jn,
+            delta,
+            c: PI - alpha + phi2 - psi2,
+        }
+    }
+
+    /// Gaps of the flank pairs in involute action: drive (gear 1's upper flanks, unwound
+    /// clockwise from θ1 + 2πk/z1 + ψ_b1, against gear 2's upper flanks; line of action from
+    /// T1 = r_b1 (cos α, -sin α) along e = (sin α, cos α)) or coast (the lower flanks, mirrored).
+    fn in_mesh(&self, t1: f64, coast: bool) -> Vec<f64> {
+        let (z1, z2) = self.z;
+        let t2 = self.t2(t1);
+        let wrap = |x: f64| x.rem_euclid(TAU);
         let sgn = if coast { -1.0 } else { 1.0 };
+        let ((lo1, hi1), (lo2, hi2)) = self.roll;
+        let mut gaps = Vec::new();
         for k in 0..z1 {
-            let b1 = t1 + TAU * k as f64 / z1 as f64 + sgn * psi1;
-            let f1 = wrap(sgn * b1 + alpha);
-            for jj in 0..z2 {
-                let b2 = t2 + TAU * jj as f64 / z2 as f64 + sgn * psi2;
-                let f2 = wrap(sgn * (b2 - PI) + alpha);
+            let f1 = wrap(sgn * (t1 + TAU * k as f64 / z1 as f64 + sgn * self.psi.0) + self.alpha);
+            for j in 0..z2 {
+                let f2 = wrap(sgn * (t2 + TAU * j as f64 / z2 as f64 + sgn * self.psi.1 - PI) + self.alpha);
+                let g = self.a * self.alpha.sin() - self.rb.0 * f1 - self.rb.1 * f2;
                 let margin = 1e-6;
-                let g = a * alpha.sin() - rb1 * f1 - rb2 * f2;
-                // facing flanks (the others are a base pitch or more apart along the line)
                 let inside = f1 > lo1 + margin && f1 < hi1 - margin && f2 > lo2 + margin && f2 < hi2 - margin;
-                if inside && g.abs() < 0.5 * pb {
+                // facing flanks (the others are a base pitch or more apart along the line)
+                if inside && g.abs() < 0.5 * self.pb {
                     gaps.push(g);
                 }
             }
         }
         gaps
-    };
-    let x2 = |t2: f64| planar_pose(t2, a, 0.0);
-    let n = 60;
-    let (mut two, mut worst) = (0, 0.0f64);
+    }
+
+    fn t2(&self, t1: f64) -> f64 {
+        self.c - (self.z.0 as f64 / self.z.1 as f64) * t1
+    }
+
+    fn eval(&self, pair: &ContactPair, t1: f64) -> Vec<ContactPoint> {
+        eval(pair, &planar_pose(t1, 0.0, 0.0), &planar_pose(self.t2(t1), self.a, 0.0))
+    }
+}
+
+#[test]
+fn gear_pair_gaps_and_normals_follow_the_lines_of_action() {
+    let mesh = Mesh::new(17, 31);
+    let (delta, jn) = (mesh.delta, mesh.jn);
+    let e_drive = Vec3::new(mesh.alpha.sin(), mesh.alpha.cos(), 0.0);
+    let e_coast = Vec3::new(mesh.alpha.sin(), -mesh.alpha.cos(), 0.0);
+    let n = 150;
+    let mut two = 0;
+    // three tooth pitches of gear 1: through tooth changes and past gear 1's parameter origin
     for i in 0..n {
-        let t1 = 2.0 * TAU / z1 as f64 * i as f64 / n as f64 + 1e-3;
-        let t2 = c - (z1 as f64 / z2 as f64) * t1;
-        let (drive, coast) = (pairs_in_mesh(t1, t2, false), pairs_in_mesh(t1, t2, true));
+        let t1 = 3.0 * TAU / 17.0 * i as f64 / n as f64 + 1e-3;
+        let (drive, coast) = (mesh.in_mesh(t1, false), mesh.in_mesh(t1, true));
         assert!(!drive.is_empty() && !coast.is_empty(), "contact ratio > 1: always a pair in mesh");
-        for g in drive.iter() {
+        for g in &drive {
             assert!((g - delta).abs() < 1e-15, "conjugate: every drive pair at delta, {g}");
         }
-        for g in coast.iter() {
+        for g in &coast {
             assert!((g - (jn - delta)).abs() < 1e-15);
         }
         two += (drive.len() == 2) as usize;
-        let pts = eval(&pair, &planar_pose(t1, 0.0, 0.0), &x2(t2));
-        let e_drive = Vec3::new(alpha.sin(), alpha.cos(), 0.0);
-        let e_coast = Vec3::new(alpha.sin(), -alpha.cos(), 0.0);
-        let near = |p: &ContactPoint, g: f64| (p.g_n - g).abs() < 1e-12;
-        let (mut nd, mut nc) = (0, 0);
-        for p in &pts {
-            if near(p, delta) {
-                nd += 1;
-                // n points from body 2's contour towards body 1: against the drive direction
-                assert!((p.n + e_drive).norm() < 1e-10, "t1 = {t1}: drive normal {:?}", p.n);
-            } else if near(p, jn - delta) {
-                nc += 1;
-                assert!((p.n + e_coast).norm() < 1e-10, "t1 = {t1}: coast normal {:?}", p.n);
-            }
-            let err = (p.g_n - delta).abs().min((p.g_n - jn + delta).abs());
-            if err < 1e-9 {
-                worst = worst.max(err);
-            }
-        }
-        let least = pts.iter().map(|p| p.g_n).fold(f64::INFINITY, f64::min);
-        assert!((least - delta).abs() < 1e-12, "t1 = {t1}: least gap {least} vs {delta}");
-        assert_eq!(nd, drive.len(), "t1 = {t1}: drive pairs found {nd}, in mesh {}", drive.len());
-        assert!(nc >= 1 && nc <= coast.len(), "t1 = {t1}: coast pairs found {nc}, in mesh {}", coast.len());
+        // two points: the drive side (slot 1: gear 1's upper flanks) and the coast side
+        let pts = mesh.eval(&mesh.pair2, t1);
+        assert!((pts[1].g_n - delta).abs() < 1e-12, "t1 = {t1}: drive gap {} vs {delta}", pts[1].g_n);
+        assert!((pts[0].g_n - (jn - delta)).abs() < 1e-12, "t1 = {t1}: coast gap {} vs {}", pts[0].g_n, jn - delta);
+        // n points from body 2's contour towards body 1: against the drive direction
+        assert!((pts[1].n + e_drive).norm() < 1e-10, "t1 = {t1}: drive normal {:?}", pts[1].n);
+        assert!((pts[0].n + e_coast).norm() < 1e-10, "t1 = {t1}: coast normal {:?}", pts[0].n);
     }
     assert!(two > n / 4 && two < n, "two pairs in mesh part of the time: {two} of {n}");
-    eprintln!("gear pair: worst gap error {worst:e}");
+}
+
+#[test]
+fn gear_pair_flanks_keep_their_candidates_through_the_tooth_changes() {
+    // z1 = 18: gear 1's teeth alternate in two colours; 4 points = 2 flank sides × 2 colours
+    let mesh = Mesh::new(18, 31);
+    let pair = mesh.pair4.as_ref().unwrap();
+    let n = 400;
+    let step = 3.0 * TAU / 18.0 / n as f64;
+    let mut prev: Option<Vec<ContactPoint>> = None;
+    let (mut seen, mut handovers) = ([0usize; 4], 0);
+    for i in 0..n {
+        let t1 = step * i as f64 + 1e-3;
+        let pts = mesh.eval(pair, t1);
+        let (drive, coast) = (mesh.in_mesh(t1, false), mesh.in_mesh(t1, true));
+        let at = |g: f64| pts.iter().filter(|p| (p.g_n - g).abs() < 1e-12).count();
+        // every flank pair in involute action is a candidate of its own
+        assert_eq!(at(mesh.delta), drive.len(), "t1 = {t1}: drive candidates");
+        assert_eq!(at(mesh.jn - mesh.delta), coast.len(), "t1 = {t1}: coast candidates");
+        // a candidate in action now and before is the same flank: its point on gear 1 moved by
+        // no more than the step (the flank rolls along the line of action)
+        if let Some(prev) = &prev {
+            let x1 = |t: f64, p: &Vec3| local(&planar_pose(t, 0.0, 0.0), p);
+            for k in 0..4 {
+                let now = [mesh.delta, mesh.jn - mesh.delta].iter().any(|g| (pts[k].g_n - g).abs() < 1e-12);
+                let before = [mesh.delta, mesh.jn - mesh.delta].iter().any(|g| (prev[k].g_n - g).abs() < 1e-12);
+                if now && before {
+                    let moved = (x1(t1, &pts[k].p1) - x1(t1 - step, &prev[k].p1)).norm();
+                    assert!(moved < 0.05 * mesh.pb, "t1 = {t1}: candidate {k} jumped by {moved}");
+                    seen[k] += 1;
+                } else if now != before {
+                    handovers += 1;
+                }
+            }
+        }
+        prev = Some(pts);
+    }
+    assert!(seen.iter().all(|&c| c > n / 10), "every slot carries a flank in action: {seen:?}");
+    assert!(handovers >= 10, "flank pairs enter and leave action: {handovers}");
+}
+
+#[test]
+fn gear_pairs_refuse_points_that_cannot_keep_their_flanks_apart() {
+    let mesh = Mesh::new(17, 31);
+    assert!(mesh.pair4.is_none());
+    let pair = || mesh.pair2.clone();
+    let e = pair().with_points(4).unwrap_err().to_string();
+    assert!(e.contains("17 and 31") && e.contains("use 6 points"), "{e}");
+    let e = pair().with_points(3).unwrap_err().to_string();
+    assert!(e.contains("even number of points"), "{e}");
+    assert!(pair().with_points(6).is_ok() && pair().with_points(1).is_ok());
+    // 4 points colour the second gear's teeth when only the first leaves 1 over
+    assert!(Mesh::new(17, 30).pair4.is_some());
 }
