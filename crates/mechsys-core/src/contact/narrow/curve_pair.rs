@@ -28,7 +28,9 @@
 //!
 //! **Several points.** With `count > 1` the `count` deepest roots are kept, ordered by their
 //! parameter on the curve (so a candidate keeps its index while its root persists); slots
-//! without a root are *unused* candidates whose gap exceeds any real one.
+//! without a root are *unused* candidates whose gap exceeds any real one. Gear pairs, whose
+//! roots come and go with every tooth change, give each root the slot of its flank side and
+//! tooth colour instead (`GearSlots`).
 
 use crate::geometry::curve::{cross, Curve, Jet2, Vec2, CHUNK, MAX_SAMPLES};
 use crate::math::{Mat3, Vec3};
@@ -152,7 +154,7 @@ pub(crate) fn gear_slots(c1: &Curve, c2: &Curve, count: usize) -> Option<Result<
         Ok(GearSlots { colours, second: true })
     } else {
         Err(format!(
-            "with {count} points the gear pair's teeth ({} and {}) cannot be told apart around the gear              (both leave 1 over when divided by {colours}); use {} points, or 2 (drive and coast side)",
+            "with {count} points the gear pair's teeth ({} and {}) cannot be told apart around the gear (both leave 1 over when divided by {colours}); use {} points, or 2 (drive and coast side)",
             g1.teeth(),
             g2.teeth(),
             2 * (colours + 1)
@@ -419,8 +421,7 @@ fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
             let prev = if i > 0 { dist(i - 1) } else if curve.is_closed() { dist(n - 1) } else { f64::INFINITY };
             let next = if i + 1 < n { dist(i + 1) } else if curve.is_closed() { dist(0) } else { f64::INFINITY };
             if di <= prev && di <= next {
-                if let Some(s) = newton_foot(curve, y, samples[i].s) {
-                    let j = curve.eval(s);
+                if let Some((s, j)) = newton_foot(curve, y, samples[i].s) {
                     let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
                     roots.push(Root { s1: 0.0, s2: curve.wrap(s), key }, |a, b| same_param(curve, a.s2, b.s2));
                 }
@@ -473,8 +474,8 @@ impl Bracket {
 
 /// Newton on `F(s) = (y - r(s))·r'(s)` from `s`, steps limited to two sample spacings and kept
 /// within the sign change of `F` once one is known; `None` unless it converges to a distance
-/// minimum.
-fn newton_foot(curve: &Curve, y: &Vec2, mut s: f64) -> Option<f64> {
+/// minimum, else the foot point's parameter and the jet there.
+fn newton_foot(curve: &Curve, y: &Vec2, mut s: f64) -> Option<(f64, Jet2)> {
     let cap = 2.0 * curve.step();
     let mut bracket = Bracket::new();
     for _ in 0..NEWTON_ITERATIONS {
@@ -496,7 +497,7 @@ fn newton_foot(curve: &Curve, y: &Vec2, mut s: f64) -> Option<f64> {
         if ds.abs() <= CONVERGED * curve.step() {
             let j = curve.eval(s);
             let fs = -j[1].norm_squared() + (y - j[0]).dot(&j[2]);
-            return (fs < 0.0).then_some(s);
+            return (fs < 0.0).then_some((s, j));
         }
     }
     None
@@ -730,10 +731,11 @@ fn curve_curve(
         v
     };
     let handed = rel.handed();
+    let map1 = |j1: &Jet2| [rel.point(&j1[0]), rel.dir(&j1[1]), rel.dir(&j1[2]), rel.dir(&j1[3])];
+    let jet1 = |a: f64| map1(&c1.eval(a));
     let jets = |a: f64, b: f64| {
         let j1 = c1.eval(a);
-        let j2 = c2.eval(b);
-        ([rel.point(&j1[0]), rel.dir(&j1[1]), rel.dir(&j1[2]), rel.dir(&j1[3])], j1, j2)
+        (map1(&j1), j1, c2.eval(b))
     };
     // gear pairs: one candidate per flank side and tooth colour (see `gear_slots`)
     let slots = gear_slots(c1, c2, count).and_then(|r| r.ok());
@@ -757,10 +759,9 @@ fn curve_curve(
         let mut ok = false;
         let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
-            let r1 = jets(a, b).0;
-            let Some(foot) = newton_foot(c2, &r1[0], b) else { break };
+            let r1 = jet1(a);
+            let Some((foot, j2)) = newton_foot(c2, &r1[0], b) else { break };
             b = foot;
-            let j2 = c2.eval(b);
             let d = r1[0] - j2[0];
             let nu2 = c2.outward(&j2[1]);
             let fp = nu2.dot(&r1[1]);
@@ -773,7 +774,7 @@ fn curve_curve(
             a += da;
             b += db_da * da;
             if da.abs() <= CONVERGED * c1.step() {
-                ok = newton_foot(c2, &jets(a, b).0[0], b).map(|f| b = f).is_some() && fpp > 0.0;
+                ok = newton_foot(c2, &jet1(a)[0], b).map(|f| b = f.0).is_some() && fpp > 0.0;
                 break;
             }
         }
