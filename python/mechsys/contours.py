@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import math
+import operator
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -403,9 +404,14 @@ class Cam(Contour):
 
 
 def _teeth(z, what: str) -> int:
-    if isinstance(z, bool) or not isinstance(z, (int,)) and not (isinstance(z, float) and z.is_integer()):
+    if isinstance(z, bool):
         raise ModelError(f"{what}: expected a whole number of teeth, got {z!r}")
-    return int(z)
+    try:
+        return operator.index(z)
+    except TypeError:
+        if isinstance(z, float) and z.is_integer():
+            return int(z)
+        raise ModelError(f"{what}: expected a whole number of teeth, got {z!r}") from None
 
 
 def _optional(x, what: str):
@@ -427,7 +433,8 @@ class Gear(Contour):
     tooth 0's centre line). The flanks are exact involutes of the base circle, joined G1 to the
     roundings; the contour's parameter is the arc length along the outline, counter-clockwise
     from the middle of the gap before tooth 0 (see docs/contours.md). Pair two gears with
-    ``ms.Contact(..., points=4)``: drive and coast flanks of up to two tooth pairs."""
+    ``ms.Contact(..., points=2)``: one candidate for the drive flanks and one for the coast flanks
+    (the closest tooth pair on each side; 4, 6 or 8 points give every flank in mesh its own)."""
 
     module: float | None = None
     teeth: int = 0

@@ -20,10 +20,10 @@
 //! - `narrow_curve/<pair>_evaluate/100`, `narrow_curve/<pair>_kinematics/100`: planar
 //!   parametric pairs (roller–cam, circle–ellipse, ellipse–line, ellipse–ellipse) at random
 //!   placements near contact, both bodies turning, beside the closed-form circle–circle pair;
-//! - `narrow_curve/gears_<z1>_<z2>_evaluate/100`, `..._kinematics/100`: two involute gears in mesh
-//!   (m = 2 mm, backlash 0.05 m each, standard centre distance, 4 points per pair: drive and
-//!   coast flanks), gear 1 at random angles and gear 2 at the conjugate angle with the drive
-//!   flanks 10 µm apart, both turning;
+//! - `narrow_curve/gears_<z1>_<z2>_<points>_evaluate/100`, `..._kinematics/100`: two involute
+//!   gears in mesh (m = 2 mm, backlash 0.05 m each, standard centre distance; 2 points: the drive
+//!   and the coast side, 4: each tooth flank), gear 1 at random angles and gear 2 at the
+//!   conjugate angle with the drive flanks 10 µm apart, both turning;
 //!
 //! Run with `cargo bench -p mechsys-core --bench contact` (about a minute; `-- --quick` for a
 //! rough figure).
@@ -130,7 +130,7 @@ fn bench_gears(c: &mut Criterion) {
     let mut rng = Rng(0x9ea2_5eed_0000_0017);
     let mut g = c.benchmark_group("narrow_curve");
     g.throughput(Throughput::Elements(n as u64));
-    for (z1, z2) in [(17usize, 31usize), (40, 97)] {
+    for (z1, z2, points) in [(17usize, 31usize, 2usize), (18, 31, 4), (40, 97, 2)] {
         let m = 0.002;
         let gear = |z| {
             let spec = GearSpec { backlash: 0.05 * m, ..GearSpec::new(m, z) };
@@ -146,8 +146,8 @@ fn bench_gears(c: &mut Criterion) {
         let c0 = std::f64::consts::PI - alpha + phi2 - q2.base_half_angle();
         let pair = ContactPair::new("mesh", Contour::Curve(Box::new(g1)), Contour::Curve(Box::new(g2)))
             .expect("valid pair")
-            .with_points(4)
-            .expect("4 points");
+            .with_points(points)
+            .expect("points");
         let rz = |t: f64| nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), t).into_inner();
         let bodies: Vec<(BodyMotion, BodyMotion)> = (0..n)
             .map(|_| {
@@ -166,20 +166,20 @@ fn bench_gears(c: &mut Criterion) {
                 (b1, b2)
             })
             .collect();
-        let mut points = vec![ContactPoint::default(); 4 * n];
-        g.bench_with_input(BenchmarkId::new(format!("gears_{z1}_{z2}_evaluate"), n), &n, |b, _| {
+        let mut out = vec![ContactPoint::default(); points * n];
+        g.bench_with_input(BenchmarkId::new(format!("gears_{z1}_{z2}_{points}_evaluate"), n), &n, |b, _| {
             b.iter(|| {
-                for ((b1, b2), out) in bodies.iter().zip(points.chunks_mut(4)) {
-                    evaluate(&pair, &b1.pose, &b2.pose, out).expect("room for 4");
+                for ((b1, b2), o) in bodies.iter().zip(out.chunks_mut(points)) {
+                    evaluate(&pair, &b1.pose, &b2.pose, o).expect("room for the points");
                 }
-                black_box(&points);
+                black_box(&out);
             })
         });
-        let mut kin = vec![ContactKinematics::default(); 4 * n];
-        g.bench_with_input(BenchmarkId::new(format!("gears_{z1}_{z2}_kinematics"), n), &n, |b, _| {
+        let mut kin = vec![ContactKinematics::default(); points * n];
+        g.bench_with_input(BenchmarkId::new(format!("gears_{z1}_{z2}_{points}_kinematics"), n), &n, |b, _| {
             b.iter(|| {
-                for ((b1, b2), out) in bodies.iter().zip(kin.chunks_mut(4)) {
-                    contact_kinematics(&pair, b1, b2, out).expect("room for 4");
+                for ((b1, b2), o) in bodies.iter().zip(kin.chunks_mut(points)) {
+                    contact_kinematics(&pair, b1, b2, o).expect("room for the points");
                 }
                 black_box(&kin);
             })

@@ -299,7 +299,8 @@ impl ContactPair {
 
     /// Asks a pair with a parametric contour (other than a polygon's vertices, which have one
     /// candidate each) for up to `points` contact points (1 to 8): the deepest local minima of
-    /// the distance, ordered along the curve. An error for other pairs or out of range.
+    /// the distance, ordered along the curve (gear pairs: one per flank side and tooth colour,
+    /// an even number, see `curve_pair::GearSlots`). An error for other pairs or out of range.
     pub fn with_points(mut self, points: usize) -> Result<Self> {
         let name = format!("{}–{}", self.kinds.0, self.kinds.1);
         let Geometry::Curve(g) = &mut self.geometry else {

@@ -717,8 +717,9 @@ impl Curve {
     /// The foot point of `y` (body frame) on the base curve by Newton on `F(s) = (y - r)·r'` from
     /// `s`, steps limited to two sample spacings and kept within the sign change of `F` once one
     /// is known ([`Bracket`]); `None` unless it converges to a distance minimum (a maximum — the
-    /// far side of a hollow arc — is refused). No allocation.
-    pub fn foot(&self, y: &Vec2, mut s: f64) -> Option<f64> {
+    /// far side of a hollow arc — is refused), else the foot point's parameter and the jet there.
+    /// No allocation.
+    pub fn foot(&self, y: &Vec2, mut s: f64) -> Option<(f64, Jet2)> {
         let cap = 2.0 * self.step;
         let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
@@ -740,7 +741,7 @@ impl Curve {
             if ds.abs() <= CONVERGED * self.step {
                 let j = self.eval(s);
                 let fs = -j[1].norm_squared() + (y - j[0]).dot(&j[2]);
-                return (fs < 0.0).then_some(s);
+                return (fs < 0.0).then_some((s, j));
             }
         }
         None
@@ -756,7 +757,7 @@ impl Curve {
             .min_by(|a, b| (y - a.r).norm_squared().total_cmp(&(y - b.r).norm_squared()))
             .map(|smp| smp.s)
             .unwrap_or(self.lo);
-        self.foot(y, best).map(|s| self.wrap(s)).unwrap_or(best)
+        self.foot(y, best).map(|(s, _)| self.wrap(s)).unwrap_or(best)
     }
 
     /// Parameter range `[lo, hi]` (the period for closed curves).

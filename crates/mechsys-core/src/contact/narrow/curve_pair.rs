@@ -28,7 +28,9 @@
 //!
 //! **Several points.** With `count > 1` the `count` deepest roots are kept, ordered by their
 //! parameter on the curve (so a candidate keeps its index while its root persists); slots
-//! without a root are *unused* candidates whose gap exceeds any real one.
+//! without a root are *unused* candidates whose gap exceeds any real one. Gear pairs, whose
+//! roots come and go with every tooth change, give each root the slot of its flank side and
+//! tooth colour instead (`GearSlots`).
 
 use crate::geometry::curve::{cross, Bracket, Chunk, Curve, Jet2, Vec2, CHUNK, CONVERGED, MAX_SAMPLES, NEWTON_ITERATIONS};
 use crate::math::{Mat3, Vec3};
@@ -147,7 +149,7 @@ pub(crate) fn gear_slots(c1: &Curve, c2: &Curve, count: usize) -> Option<Result<
         Ok(GearSlots { colours, second: true })
     } else {
         Err(format!(
-            "with {count} points the gear pair's teeth ({} and {}) cannot be told apart around the gear              (both leave 1 over when divided by {colours}); use {} points, or 2 (drive and coast side)",
+            "with {count} points the gear pair's teeth ({} and {}) cannot be told apart around the gear (both leave 1 over when divided by {colours}); use {} points, or 2 (drive and coast side)",
             g1.teeth(),
             g2.teeth(),
             2 * (colours + 1)
@@ -432,8 +434,7 @@ fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
         |ch| (y - ch.center).norm() - ch.radius <= ub + reach,
         |i| (y - samples[i].r).norm(),
         |i| {
-            if let Some(s) = curve.foot(y, samples[i].s) {
-                let j = curve.eval(s);
+            if let Some((s, j)) = curve.foot(y, samples[i].s) {
                 let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
                 roots.push(Root { s1: 0.0, s2: curve.wrap(s), key }, |a, b| same_param(curve, a.s2, b.s2));
             }
@@ -662,10 +663,11 @@ fn curve_curve(
         v
     };
     let handed = rel.handed();
+    let map1 = |j1: &Jet2| [rel.point(&j1[0]), rel.dir(&j1[1]), rel.dir(&j1[2]), rel.dir(&j1[3])];
+    let jet1 = |a: f64| map1(&c1.eval(a));
     let jets = |a: f64, b: f64| {
         let j1 = c1.eval(a);
-        let j2 = c2.eval(b);
-        ([rel.point(&j1[0]), rel.dir(&j1[1]), rel.dir(&j1[2]), rel.dir(&j1[3])], j1, j2)
+        (map1(&j1), j1, c2.eval(b))
     };
     // gear pairs: one candidate per flank side and tooth colour (see `gear_slots`)
     let slots = gear_slots(c1, c2, count).and_then(|r| r.ok());
@@ -689,10 +691,9 @@ fn curve_curve(
         let mut ok = false;
         let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
-            let r1 = jets(a, b).0;
-            let Some(foot) = c2.foot(&r1[0], b) else { break };
+            let r1 = jet1(a);
+            let Some((foot, j2)) = c2.foot(&r1[0], b) else { break };
             b = foot;
-            let j2 = c2.eval(b);
             let d = r1[0] - j2[0];
             let nu2 = c2.outward(&j2[1]);
             let fp = nu2.dot(&r1[1]);
@@ -705,7 +706,7 @@ fn curve_curve(
             a += da;
             b += db_da * da;
             if da.abs() <= CONVERGED * c1.step() {
-                ok = c2.foot(&jets(a, b).0[0], b).map(|f| b = f).is_some() && fpp > 0.0;
+                ok = c2.foot(&jet1(a)[0], b).map(|f| b = f.0).is_some() && fpp > 0.0;
                 break;
             }
         }
