@@ -126,15 +126,22 @@ def test_a_ball_dropped_on_an_ellipsoidal_dome_bounces_off_its_surface_normal():
     impacts = [e for e in res.events if e["event"] == "impact"]
     assert impacts
     t_hit = impacts[0]["t"]
-    # reference: the height where the vertical line through (x0, y0) meets the surface offset by r,
-    # by bisection on the distance to the ellipsoid (dense-sampling check in the engine's tests)
+    # reference, independent of the engine's search: the height where the ball's centre is r from
+    # the ellipsoid, the distance by a dense grid of the surface's angles refined by scipy
+    from scipy.optimize import brentq, minimize
+
+    def distance(z):
+        p = np.array([x0, y0, z])
+        pt = lambda w: np.array([a * np.cos(w[0]) * np.cos(w[1]), b * np.sin(w[0]) * np.cos(w[1]), c * np.sin(w[1])])
+        uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 181), np.linspace(-np.pi / 2, np.pi / 2, 91))
+        d = (x0 - a * np.cos(uu) * np.cos(vv)) ** 2 + (y0 - b * np.sin(uu) * np.cos(vv)) ** 2 + (z - c * np.sin(vv)) ** 2
+        k = np.unravel_index(np.argmin(d), d.shape)
+        res = minimize(lambda w: np.sum((p - pt(w)) ** 2), [uu[k], vv[k]], method="Nelder-Mead",
+                       options={"xatol": 1e-14, "fatol": 1e-30, "maxiter": 4000})
+        return math.sqrt(res.fun)
+
+    z_hit = brentq(lambda z: distance(z) - r, c + 1e-6, 0.5, xtol=1e-13)
     g = ms.dynamics.contact_geometry
-    lo, hi = 0.0, 0.5
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        gap = g(m, [x0, y0, mid, 1.0, 0.0, 0.0, 0.0])["gap"][0]
-        lo, hi = (mid, hi) if gap < 0 else (lo, mid)
-    z_hit = 0.5 * (lo + hi)
     assert 0.5 - 0.5 * G * t_hit**2 == pytest.approx(z_hit, abs=1e-9)
     # the geometry at the hit: normal along the ellipsoid's gradient at the foot point
     geo = g(m, [x0, y0, z_hit, 1.0, 0.0, 0.0, 0.0])

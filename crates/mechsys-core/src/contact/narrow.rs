@@ -1001,6 +1001,19 @@ pub(crate) fn ellipsoid_foot(y: &Vec3, a: &Vec3) -> (Vec3, f64) {
         }
         t = next;
     }
+    let k = a2.imin();
+    if f(t).0 < -1e-12 && (t - lo).abs() <= 1e-12 * (1.0 + amin2) {
+        // no root above -a_k²: the point lies on the smallest axis' plane (y_k = 0) within the
+        // medial region (the ellipsoid's centre included); the foot points are off that plane at
+        // t = -a_k², x_k = ±a_k √(1 - Σ_{i≠k} (x_i / a_i)²), the + side taken (or y_k's sign)
+        let mut x = Vec3::zeros();
+        for i in (0..3).filter(|&i| i != k) {
+            x[i] = if a2[i] > amin2 { a2[i] * y[i] / (a2[i] - amin2) } else { 0.0 };
+        }
+        let rest: f64 = (0..3).filter(|&i| i != k).map(|i| (x[i] / a[i]).powi(2)).sum();
+        x[k] = if y[k] < 0.0 { -a[k] } else { a[k] } * (1.0 - rest).max(0.0).sqrt();
+        return (x, -amin2);
+    }
     (Vec3::from_fn(|i, _| a2[i] * y[i] / (a2[i] + t)), t)
 }
 

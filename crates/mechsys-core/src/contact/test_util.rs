@@ -400,7 +400,7 @@ pub(crate) fn ellipsoid_sdf(y: &Vec3, a: &Vec3) -> f64 {
     let (mut best, mut bu, mut bv) = (f64::INFINITY, 0.0, 0.0);
     for i in 0..360 {
         for j in 0..=180 {
-            let (u, v) = (std::f64::consts::TAU * i as f64 / 360.0, -1.5707963267948966 + std::f64::consts::PI * j as f64 / 180.0);
+            let (u, v) = (std::f64::consts::TAU * i as f64 / 360.0, -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 180.0);
             let d = d2(u, v);
             if d < best {
                 (best, bu, bv) = (d, u, v);

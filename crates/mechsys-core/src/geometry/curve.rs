@@ -400,7 +400,7 @@ impl Curve {
         let curve = Curve::build(shape, -radius, -direction, 0.0, tau, true, per, what)?;
         for smp in &curve.samples {
             let j = curve.eval(smp.s);
-            let k = curve.base_curvature(&j);
+            let k = curve.curvature_of(&j);
             if flat {
                 ensure!(
                     base_radius + curve.lift(smp.s)[0] + curve.lift(smp.s)[2] > 0.0,
@@ -676,12 +676,6 @@ impl Curve {
     #[inline]
     pub fn curvature_of(&self, j: &Jet2) -> f64 {
         self.sigma * cross(&j[1], &j[2]) / j[1].norm().powi(3)
-    }
-
-    /// Signed curvature of the base curve at `s` (without the offset; see [`Self::curvature`]).
-    #[inline]
-    fn base_curvature(&self, j: &Jet2) -> f64 {
-        self.curvature_of(j)
     }
 
     /// Signed curvature of the contour (offset included) at `s`: `κ / (1 + o κ)`.

@@ -209,7 +209,7 @@ fn ellipsoid_on_a_plane_against_sampled_support_and_curvatures_at_the_axes() {
         let (mut best, mut bu, mut bv) = (f64::INFINITY, 0.0, 0.0);
         for i in 0..720 {
             for j in 0..=360 {
-                let (u, v) = (TAU * i as f64 / 720.0, -1.5707963 + std::f64::consts::PI * j as f64 / 360.0);
+                let (u, v) = (TAU * i as f64 / 720.0, -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 360.0);
                 let h = height(u, v);
                 if h < best {
                     (best, bu, bv) = (h, u, v);
@@ -414,4 +414,20 @@ fn gear_pairs_refuse_points_that_cannot_keep_their_flanks_apart() {
     assert!(pair().with_points(6).is_ok() && pair().with_points(1).is_ok());
     // 4 points colour the second gear's teeth when only the first leaves 1 over
     assert!(Mesh::new(17, 30).pair4.is_some());
+}
+
+#[test]
+fn sphere_at_an_ellipsoids_centre_or_on_its_minor_plane_gets_the_nearest_wall() {
+    use crate::contact::test_util::ellipsoid_sdf;
+    let semi = Vec3::new(0.4, 0.3, 0.2);
+    let e = Contour::Ellipsoid { center: Vec3::zeros(), rotation: Mat3::identity(), semi_axes: semi };
+    let pair = ContactPair::new("core", Contour::Point { p: Vec3::zeros() }, e).unwrap();
+    // the centre and points on the smallest axis' plane inside (no root of the foot equation
+    // above -c²): the gap against an independent sampled distance, the normal finite and unit
+    for y in [Vec3::zeros(), Vec3::new(0.05, -0.03, 0.0), Vec3::new(0.1, 0.0, 0.0)] {
+        let c = eval(&pair, &Pose::new(Mat3::identity(), y), &Pose::IDENTITY)[0];
+        assert!(c.g_n.is_finite() && (c.n.norm() - 1.0).abs() < 1e-12, "{y}: {c:?}");
+        let reference = ellipsoid_sdf(&y, &semi);
+        assert!((c.g_n - reference).abs() < 1e-9, "{y}: gap {} vs sampled {reference}", c.g_n);
+    }
 }
