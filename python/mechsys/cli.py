@@ -479,9 +479,12 @@ def _frequency_grid(modes: Any, fmin: float | None, fmax: float | None, n: int) 
               help="Campbell diagram: re-linearize with the spin joint's velocity at N speeds START..STOP (rad/s).")
 @click.option("--whirl", metavar="X,Y", help="Coordinates of the whirl plane (x then y, right-handed with the spin axis) "
               "to tell forward from backward whirl.")
+@click.option("--contacts", "contacts", type=click.Choice(["refuse", "hold", "roll"]), default="refuse", show_default=True,
+              help="What a contact closed at the point becomes: refused, held closed sliding frictionlessly, or held "
+              "closed rolling without slip.")
 def linear(model_file: Path, at: str, free: str | None, coordinates: str | None, check: bool, sweep: str | None,
            out_dir: Path, frf: str | None, fmin: float | None, fmax: float | None, n_freq: int, campbell: str | None,
-           whirl: str | None) -> None:
+           whirl: str | None, contacts: str) -> None:
     """Linear vibration analysis of a model file about an equilibrium or a steady motion: modes,
     a Bode plot, a Campbell diagram, eigenvalues over a speed, a check against the nonlinear model.
 
@@ -502,9 +505,10 @@ def linear(model_file: Path, at: str, free: str | None, coordinates: str | None,
         try:
             if at == "steady":
                 point_at = lin_mod.steady_motion(model, free=[c.strip() for c in (free or "").split(",") if c.strip()])
-            lin = lin_mod.linearize(model, at=point_at, coordinates=names)
+            lin = lin_mod.linearize(model, at=point_at, coordinates=names, contacts=contacts)
         except (SettingsError, SolverError) as e:
-            option = "--coordinates" if "coordinates" in str(e) else "--free" if "steady_motion" in str(e) else "--at"
+            option = ("--contacts" if "contact" in str(e) else "--coordinates" if "coordinates" in str(e)
+                      else "--free" if "steady_motion" in str(e) else "--at")
             raise CliError(f"{option}: {e}") from None
     if lin.n == 0:
         raise CliError(f"{model_file}: the model has no degree of freedom to analyse")

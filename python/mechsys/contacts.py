@@ -1,5 +1,6 @@
-"""Unilateral contacts (section 2.5): a contour on each of two bodies, with the normal law
-(Signorini), a friction law and an impact law from :mod:`mechsys.laws`.
+"""Contacts (section 2.5): a contour on each of two bodies, with the normal law (Signorini's
+unilateral law, or ``laws.Bilateral`` to hold it closed), a friction law and an impact law from
+:mod:`mechsys.laws`.
 
 >>> c = Contact("tip", arm.contour(contours.Circle(radius=0.02, center=(0.4, 0, 0))),
 ...             m.ground.contour(contours.Line(point=(0.3, -0.5, 0), normal=(-1, 0, 0))),
@@ -35,8 +36,13 @@ class Contact:
         for k, side in (("first", self.first), ("second", self.second)):
             if not isinstance(side, OnBody):
                 raise ModelError(f"{what}.{k}: expected a contour on a body (body.contour(ms.contours.X(...))), got {type(side).__name__}")
-        if not isinstance(self.normal, laws.Signorini):
-            raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini(), got {type(self.normal).__name__}")
+        if not isinstance(self.normal, (laws.Signorini, laws.Bilateral)):
+            raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini() or Bilateral(), got {type(self.normal).__name__}")
+        if isinstance(self.normal, laws.Bilateral):
+            for key in ("friction", "impact"):
+                if getattr(self, key) is not None:
+                    raise ModelError(f"{what}.{key}: a bilateral contact is held closed and takes no {key} law "
+                                     "(laws.Bilateral(rolling=True) holds it without slip)")
         d = {
             "name": self.name,
             "body1": self.first.body,
@@ -44,6 +50,8 @@ class Contact:
             "body2": self.second.body,
             "contour2": self.second.contour.describe(f"{what}.contour2"),
         }
+        if isinstance(self.normal, laws.Bilateral):
+            d["normal"] = self.normal.describe(f"{what}.normal")
         if self.friction is not None:
             if not isinstance(self.friction, (laws.Coulomb, laws.Stribeck, laws.FrictionTable)):
                 raise ModelError(f"{what}.friction: expected a mechsys.laws friction law, got {type(self.friction).__name__}")

@@ -1,8 +1,12 @@
 """Contact laws (section 2.5.3): the normal law, friction laws and impact laws of a
 :class:`mechsys.Contact`.
 
-- :class:`Signorini`: the normal corner law g_N >= 0, lambda_N >= 0, g_N lambda_N = 0 (the only
-  normal law; contacts are rigid and unilateral).
+- :class:`Signorini`: the normal corner law g_N >= 0, lambda_N >= 0, g_N lambda_N = 0 (rigid and
+  unilateral: the default).
+- :class:`Bilateral`: the contact is held closed, g_N = 0, by a bilateral constraint whose force
+  may pull (MBSim's bilateral constraint law); ``rolling=True`` also holds the tangential relative
+  velocity at zero (rolling without slip). The contact is then a constraint: its force is the
+  signal ``constraint/<name>/lambda`` (columns normal, t1, t2).
 - :class:`Coulomb`: the double-corner law (2.200) with sliding coefficient ``mu`` and static
   coefficient ``mu0`` (equal to mu if omitted; below mu it is accepted with a warning and the
   contact sticks up to mu).
@@ -35,6 +39,19 @@ class Signorini:
 
     def describe(self, what: str) -> None:
         return None
+
+
+@dataclass
+class Bilateral:
+    """The contact stays closed (g_N = 0, the normal force may be negative: pulling); with
+    ``rolling``, it also rolls without slipping. No friction or impact law goes with it."""
+
+    rolling: bool = False
+
+    def describe(self, what: str) -> dict:
+        if not isinstance(self.rolling, (bool,)):
+            raise ModelError(f"{what}.rolling: expected True or False, got {self.rolling!r}")
+        return {"type": "bilateral", "rolling": bool(self.rolling)}
 
 
 @dataclass
@@ -98,4 +115,4 @@ class Poisson:
         return {"type": "poisson", "eps": _num(self.eps, f"{what}.eps"), "eps_t": _num(self.eps_t, f"{what}.eps_t")}
 
 
-__all__ = ["Signorini", "Coulomb", "Stribeck", "FrictionTable", "Newton", "Poisson"]
+__all__ = ["Signorini", "Bilateral", "Coulomb", "Stribeck", "FrictionTable", "Newton", "Poisson"]

@@ -496,7 +496,7 @@ def _names(model: Model, n_u: int) -> list[str]:
 
 
 def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: bool = False, at=None,
-              method: str = "auto", coordinates=None) -> LinearModel:
+              method: str = "auto", coordinates=None, contacts: str = "refuse") -> LinearModel:
     """Linearizes ``model`` at (``q``, ``u``, ``t``) (the model's q0, u0 by default): about an
     equilibrium or about a steady motion (a relative equilibrium: straight or circular rolling, a
     precessing top, a spinning rotor), also with non-holonomic constraints.
@@ -522,8 +522,17 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
     At a point that is neither an equilibrium nor a steady motion (``lin.steady`` False: the
     non-cyclic states change along the reference) a ``UserWarning`` says so, unless
     ``operating_point=True`` says the point is meant as it is. A point that violates a
-    constraint is a ModelError naming it; a contact closed at the point, or a friction element
-    sticking there, is refused (their force laws are not smooth there).
+    constraint is a ModelError naming it; a friction element sticking there is refused (its law
+    is not smooth there).
+
+    ``contacts`` says what a unilateral contact closed at the point becomes: ``"refuse"`` (the
+    default: a SettingsError naming it, since it may open or slip under any perturbation),
+    ``"hold"`` (held closed, g_N = 0, as a bilateral constraint that slides frictionlessly: a cam
+    follower that stays on its cam, a wheel on its rail) or ``"roll"`` (held closed and rolling
+    without slip: ġ_T = 0 too). A held contact must press at the point (normal force > 0, from
+    the constrained dynamics there), and a rolling one must stay inside its static friction cone;
+    otherwise a SettingsError names it and its force. Open contacts exert nothing and are left
+    out. ``lin.model`` is then the model with the held contacts (``laws.Bilateral``).
 
     ``at`` chooses the point instead of ``q``/``u``: ``None`` or ``"q0"`` (the model's q0, u0),
     ``"equilibrium"`` (:func:`mechsys.analysis.static_equilibrium` from ``q``, at rest unless
@@ -536,7 +545,16 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
         raise SettingsError(f"linearize: expected a mechsys.Model, got {type(model).__name__}")
     if isinstance(at, SteadyMotion):
         t = at.t
-    q, u = _point(model, q, u, float(t), at)
+    if contacts != "refuse":
+        # which contacts are closed is read where the search starts (q, or q0); an equilibrium is
+        # then found with them held
+        start = at if not (isinstance(at, str) and at == "equilibrium") else None
+        q0_, u0_ = _point(model, q, u, float(t), start)
+        model, held = _held_model(model, q0_, u0_, float(t), contacts)
+        q, u = (q0_, u0_) if start is at else _point(model, q, u, float(t), at)
+        _check_held(model, held, q, u, float(t), contacts)
+    else:
+        q, u = _point(model, q, u, float(t), at)
     _refuse_nonsmooth(model, q, u, float(t))
     coords = _names(model, model.nu)
     nonholonomic = _nonholonomic(model) if model.engine()[0].constraints() else False
@@ -655,6 +673,85 @@ def _check_constraints(model: Model, q: np.ndarray, u: np.ndarray, t: float) -> 
                              f"{vel.max():.3g}); give velocities the constraint admits")
 
 
+def _static_mu(friction) -> float | None:
+    """The static friction coefficient of a described friction law (None: frictionless)."""
+    if not isinstance(friction, dict):
+        return None
+    kind = friction.get("type")
+    if kind == "coulomb":
+        mu = float(friction["mu"])
+        return max(mu, float(friction.get("mu0") if friction.get("mu0") is not None else mu))
+    if kind == "stribeck":
+        return float(friction["mu0"])
+    if kind == "table":
+        return float(friction["mu"][0])
+    return None
+
+
+def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str) -> tuple[Model, dict]:
+    """``model`` with its contacts closed at (q, u, t) held by the bilateral law (rolling for
+    ``mode == "roll"``), and the held contacts' static friction coefficients by name."""
+    from .dynamics import contact_matrices
+
+    if mode not in ("hold", "roll"):
+        raise SettingsError(f"linearize: contacts: expected 'refuse', 'hold' or 'roll', got {mode!r}")
+    if not model._contacts:
+        return model, {}
+    cm = contact_matrices(model, q, u, t)
+    scale = 1e-9 * (1.0 + float(np.abs(q).max(initial=0.0)))
+    closed: dict[str, int] = {}
+    for name, g in zip(cm["contact"], cm["gap"]):
+        if g <= scale:
+            closed[name] = closed.get(name, 0) + 1
+    if not closed:
+        return model, {}
+    desc, callbacks = model.describe()
+    held = {}
+    for c in desc["contacts"]:
+        if c["name"] not in closed:
+            continue
+        what = f"linearize: contact '{c['name']}'"
+        if c.get("points", 1) != 1:
+            raise SettingsError(f"{what} looks for {c['points']} contact points; only a single-point contact "
+                                "(points=1) can be held closed")
+        mu = _static_mu(c.get("friction"))
+        if mode == "roll" and mu is None:
+            raise SettingsError(f"{what} is frictionless, so it cannot roll without slip; use contacts='hold'")
+        held[c["name"]] = mu
+        c["normal"] = {"type": "bilateral", "rolling": mode == "roll"}
+        c.pop("friction", None)
+        c.pop("impact", None)
+    return Model.from_dict(desc, callbacks), held
+
+
+def _check_held(derived: Model, held: dict, q: np.ndarray, u: np.ndarray, t: float, mode: str) -> None:
+    """A SettingsError naming a held contact that pulls at the point (or, rolling, would slip)."""
+    from .dynamics import mass_matrix, nonlinear_effects
+
+    if not held:
+        return
+    # the multipliers at the point: M u' = h + G^T lambda, G u' = gamma
+    core, cbs = derived.engine()
+    _, g_mat, _ = _core.constraint_jacobian(core, q, t, cbs)
+    gamma = _core.constraint_gamma(core, q, u, t, cbs)
+    m_inv_h = np.linalg.solve(mass_matrix(derived, q, t), np.column_stack([nonlinear_effects(derived, q, u, t), g_mat.T]))
+    lam = np.linalg.lstsq(g_mat @ m_inv_h[:, 1:], gamma - g_mat @ m_inv_h[:, 0], rcond=None)[0]
+    for info in derived.engine()[0].constraints():
+        if info["name"] not in held:
+            continue
+        r0, lam_n = info["row"], float(lam[info["row"]])
+        if lam_n <= 0.0:
+            raise SettingsError(f"linearize: contact '{info['name']}' does not press at the point (normal force "
+                                f"{lam_n:.4g} N): held closed it would have to pull, so it opens there")
+        mu = held[info["name"]]
+        if mode == "roll":
+            lam_t = float(np.linalg.norm(lam[r0 + 1:r0 + info["rows"]]))
+            if lam_t > mu * lam_n * (1.0 + 1e-12):
+                raise SettingsError(f"linearize: contact '{info['name']}' cannot roll at the point: it needs a friction "
+                                    f"force {lam_t:.4g} N, more than mu0 times its normal force ({mu:.3g} x {lam_n:.4g} N); "
+                                    "it slips (use contacts='hold' for frictionless sliding)")
+
+
 def _refuse_nonsmooth(model: Model, q: np.ndarray, u: np.ndarray, t: float) -> None:
     """SettingsError where a force law is not smooth at the point, so no linear form exists:
     a unilateral contact touching there (its force may jump on or off with any perturbation),
@@ -672,8 +769,8 @@ def _refuse_nonsmooth(model: Model, q: np.ndarray, u: np.ndarray, t: float) -> N
                 raise SettingsError(
                     f"linearize: contact '{cm['contact'][k]}' is closed at the point (gap {g:.3g} m): a unilateral "
                     "contact switches between touching and open (and stick and slip) under any perturbation, so the "
-                    "linear form does not apply there; linearize where it is open, replace it by a bilateral "
-                    "constraint, or simulate")
+                    "linear form does not apply there; linearize where it is open, hold it closed (contacts='hold' "
+                    "or 'roll'), or simulate")
     joints = {j["name"]: j for j in model.joint_info()}
     for f in model._forces:
         if isinstance(f, Jenkins):

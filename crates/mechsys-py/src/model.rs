@@ -211,6 +211,7 @@ impl PyModel {
                 // non-holonomic rows have no position violation (recorded as 0)
                 K::KnifeEdge { .. } => ("knife_edge", ("N", "m")),
                 K::RollingDisc { .. } => ("rolling_disc", ("N", "m")),
+                K::Contact { .. } => ("contact", ("N", "m")),
             };
             d.set_item("name", &c.name)?;
             d.set_item("type", t)?;
@@ -224,6 +225,12 @@ impl PyModel {
                     sel.names[..sel.n].iter().map(|n| if *n == "rz" { ("N m", "rad") } else { ("N", "m") }).collect();
                 d.set_item("column_units", units.iter().map(|u| u.0).collect::<Vec<_>>())?;
                 d.set_item("column_violation_units", units.iter().map(|u| u.1).collect::<Vec<_>>())?;
+            }
+            if let K::Contact { .. } = &c.kind {
+                // a held contact: its normal force, then the rolling rows' tangential forces
+                d.set_item("columns", ["normal", "t1", "t2"][..c.rows()].to_vec())?;
+                d.set_item("column_units", vec!["N"; c.rows()])?;
+                d.set_item("column_violation_units", vec!["m"; c.rows()])?;
             }
             d.set_item("unit", unit)?;
             d.set_item("violation_unit", vunit)?;

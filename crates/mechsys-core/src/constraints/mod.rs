@@ -625,6 +625,29 @@ fn rotation_from_vee(phi: &Vec3) -> Mat3 {
     Mat3::identity() * c + phi.cross_matrix() + phi * phi.transpose() / (1.0 + c)
 }
 
+/// Geometry of a held-closed contact at the placements in `data`: its first candidate (gap,
+/// normal, world points) and tangents; an error naming the constraint where the narrow phase
+/// gives no finite answer.
+fn held_contact(
+    c: &Constraint,
+    data: &Data,
+    t: f64,
+    body1: usize,
+    body2: usize,
+    pair: &crate::contact::ContactPair,
+) -> Result<(crate::contact::narrow::Raw, [Vec3; 2])> {
+    let (x1, x2) = (data.x_abs[body1], data.x_abs[body2]);
+    let k = pair.candidate(0, &x1, &x2, None);
+    if !(k.g.is_finite() && k.n.iter().all(|v| v.is_finite())) {
+        return Err(Error::Solver(format!(
+            "constraint '{}' (bilateral contact): the contact geometry is undefined at t = {t} s (gap {})",
+            c.name, k.g
+        )));
+    }
+    let tg = pair.tangents(&x2, &k.n, None);
+    Ok((k, [tg.t1, tg.t2]))
+}
+
 /// Position stage of the constraints: `phi` (m) and `G` (m × nu) at the last
 /// [`crate::kinematics::positions`]; `b` (m) receives the velocity right-hand side `G u = b`.
 pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Callbacks) -> Result<()> {
@@ -681,6 +704,17 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 data.b[r] = 0.0;
                 add_point_rows(model, &data.s, *body1, &w1, 1.0, Some(&e), &mut data.g, r);
                 add_point_rows(model, &data.s, *body2, &w2, -1.0, Some(&e), &mut data.g, r);
+            }
+            ConstraintKind::Contact { body1, body2, pair, .. } => {
+                // g_N = 0 (holonomic), then ġ_T = 0 along each friction direction (rolling)
+                let (k, tg) = held_contact(c, data, t, *body1, *body2, pair)?;
+                let rows = c.kind.rows();
+                for (j, e) in std::iter::once(&k.n).chain(tg.iter()).take(rows).enumerate() {
+                    data.phi[r + j] = if j == 0 { k.g } else { 0.0 };
+                    data.b[r + j] = 0.0;
+                    add_point_rows(model, &data.s, *body1, &k.p1, 1.0, Some(e), &mut data.g, r + j);
+                    add_point_rows(model, &data.s, *body2, &k.p2, -1.0, Some(e), &mut data.g, r + j);
+                }
             }
             ConstraintKind::Coupler { iq_a, iu_a, iq_b, iu_b, ratio, offset } => {
                 data.phi[r] = q[*iq_a] - ratio * q[*iq_b] - offset;
@@ -771,6 +805,20 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64
                 // d²|d|/dt² = e·a + (|v|² - (e·v)²)/|d|
                 data.gamma[r] = -(e.dot(&a) + (v.norm_squared() - e.dot(&v).powi(2)) / l);
             }
+            ConstraintKind::Contact { body1, body2, pair, .. } => {
+                // the velocity-product parts w̄_N, w̄_T of the contact kinematics (eqs. 2.114,
+                // 2.115): data.a holds the tree's accelerations at u̇ = 0 here
+                use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
+                let (b1, b2) = (BodyMotion::from_data(data, *body1), BodyMotion::from_data(data, *body2));
+                let mut k = [ContactKinematics::default(); 1];
+                contact_kinematics(pair, &b1, &b2, &mut k)
+                    .map_err(|e| Error::Solver(format!("constraint '{}' (bilateral contact): {e}", c.name)))?;
+                let rows = c.kind.rows();
+                data.gamma[r] = -k[0].wbar_n;
+                for j in 1..rows {
+                    data.gamma[r + j] = -k[0].wbar_t[j - 1];
+                }
+            }
             ConstraintKind::Coupler { .. } => data.gamma[r] = 0.0,
             ConstraintKind::Prescribed { function, .. } => {
                 data.gamma[r] = function_derivatives(function, t, cb).map_err(in_constraint(c, "function"))?.2;
@@ -835,6 +883,19 @@ fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
                 let f = d / d.norm() * data.lambda[r];
                 add_point_force(data, *body1, p1, &f);
                 add_point_force(data, *body2, p2, &(-f));
+            }
+            ConstraintKind::Contact { body1, body2, pair, .. } => {
+                let (k, tg) = held_contact(c, data, f64::NAN, *body1, *body2, pair)?;
+                let mut f = k.n * data.lambda[r];
+                for j in 1..c.kind.rows() {
+                    f += tg[j - 1] * data.lambda[r + j];
+                }
+                if *body1 != 0 {
+                    data.f_ext[*body1] += Force::new(k.p1.cross(&f), f);
+                }
+                if *body2 != 0 {
+                    data.f_ext[*body2] += Force::new(k.p2.cross(&(-f)), -f);
+                }
             }
             ConstraintKind::Coupler { iu_a, iu_b, ratio, .. } => {
                 data.tau_applied[*iu_a] += data.lambda[r];

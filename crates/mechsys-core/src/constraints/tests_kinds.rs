@@ -766,3 +766,72 @@ fn user_velocity_errors_name_the_constraint() {
 fn first_kinds_apply_forces_equal_g_transpose_lambda_on_the_planned_pattern() {
     check_apply_forces(&super::tests::model_with_all_kinds(), &NoCallbacks, 0.0);
 }
+
+/// The tree of [`model_with_new_kinds`] with its constraints replaced by contacts held closed
+/// (the bilateral normal law), rolling or not, between moving bodies and against the ground, on
+/// primitive and curved contours, at generic (not assembled) configurations.
+fn model_with_held_contacts() -> Model {
+    use crate::model::contact_description::{
+        ContactDescription, ContourDescription, FrictionDescription, ImpactDescription, NormalDescription,
+    };
+    let base = model_with_new_kinds();
+    let mut desc = base.description.clone();
+    desc.constraints.clear();
+    let held = |name: &str, b1: &str, c1: ContourDescription, b2: &str, c2: ContourDescription, rolling| {
+        ContactDescription {
+            name: name.into(),
+            body1: b1.into(),
+            contour1: c1,
+            body2: b2.into(),
+            contour2: c2,
+            normal: NormalDescription::Bilateral { rolling },
+            friction: FrictionDescription::None,
+            impact: ImpactDescription::default(),
+            points: None,
+        }
+    };
+    let sphere = |c: [f64; 3], r| ContourDescription::Sphere { center: c, radius: r };
+    desc.contacts = vec![
+        held(
+            "ball_on_plate",
+            "c",
+            sphere([0.05, -0.02, 0.1], 0.2),
+            "b",
+            ContourDescription::Plane { point: [0.1, 0.0, -0.3], normal: [0.2, 0.1, 1.0], surface_velocity: None },
+            true,
+        ),
+        held(
+            "egg_on_ground",
+            "disc",
+            ContourDescription::Ellipsoid { center: [0.01, 0.02, 0.0], rotation: None, semi_axes: [0.3, 0.2, 0.15] },
+            "ground",
+            ContourDescription::Plane { point: [0.0; 3], normal: [0.0, 0.0, 1.0], surface_velocity: None },
+            true,
+        ),
+        held("balls", "d", sphere([0.0, 0.1, 0.0], 0.1), "c", sphere([0.1, 0.0, 0.05], 0.15), false),
+    ];
+    Model::from_description(desc).unwrap()
+}
+
+#[test]
+fn held_contacts_have_their_row_counts() {
+    let model = model_with_held_contacts();
+    assert!(model.contacts.is_empty(), "held contacts are constraints");
+    let rows: Vec<(usize, usize)> = model.constraints.iter().map(|c| (c.kind.rows(), c.kind.holonomic_rows())).collect();
+    assert_eq!(rows, [(3, 1), (3, 1), (1, 1)]);
+}
+
+#[test]
+fn held_contacts_velocity_rows_are_the_time_derivative_of_the_gap() {
+    check_velocity_rows(&model_with_held_contacts(), &NoCallbacks, 0.2, 1e-8);
+}
+
+#[test]
+fn held_contacts_acceleration_rows_are_the_derivative_of_the_velocity_rows() {
+    check_acceleration_rows(&model_with_held_contacts(), &NoCallbacks, 0.3, 1e-7);
+}
+
+#[test]
+fn held_contacts_apply_forces_equal_g_transpose_lambda() {
+    check_apply_forces(&model_with_held_contacts(), &NoCallbacks, 0.0);
+}

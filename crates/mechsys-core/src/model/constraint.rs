@@ -1,6 +1,7 @@
 //! Bilateral constraints as model elements: what each constraint holds, its rows and which
 //! velocities they may involve. The constraint stage ([`crate::constraints`]) evaluates them.
 
+use crate::contact::ContactPair;
 use crate::math::Vec3;
 use crate::spatial::Pose;
 
@@ -154,6 +155,21 @@ pub enum ConstraintKind {
         /// Radius (m), > 0.
         radius: f64,
     },
+    /// A contact held closed (a contact with the bilateral normal law, MBSim's bilateral
+    /// constraint): the gap `g_N` of the pair's first candidate stays zero (1 holonomic row, λ the
+    /// normal force on body1 along the contact normal, N, negative when it pulls) and, when
+    /// `rolling`, its tangential relative velocity too (1 non-holonomic row per friction
+    /// direction: 1 for a planar pair, 2 in space; λ the tangential forces on body1 along t1, t2).
+    Contact {
+        /// Body carrying contour 1.
+        body1: usize,
+        /// Body carrying contour 2.
+        body2: usize,
+        /// The pair (one candidate), boxed: the other kinds are small.
+        pair: Box<ContactPair>,
+        /// Whether the contact also rolls without slipping.
+        rolling: bool,
+    },
 }
 
 /// Which loop-closing joint a [`ConstraintKind::Loop`] is. The joint axis is the z-axis of the
@@ -243,6 +259,9 @@ impl ConstraintKind {
             ConstraintKind::PointOnLine { .. } => 2,
             ConstraintKind::PrescribedBody { orientation, .. } => 3 + 3 * usize::from(orientation.is_some()),
             ConstraintKind::Velocity { rows, .. } => *rows,
+            ConstraintKind::Contact { pair, rolling, .. } => {
+                1 + usize::from(*rolling) * if pair.is_planar() { 1 } else { 2 }
+            }
             ConstraintKind::Loop { joint, .. } => match joint {
                 LoopJoint::Spherical | LoopJoint::Planar => 3,
                 LoopJoint::Cylindrical | LoopJoint::Universal => 4,
@@ -259,6 +278,7 @@ impl ConstraintKind {
             | ConstraintKind::Distance { body1, body2, .. }
             | ConstraintKind::PointOnLine { body1, body2, .. }
             | ConstraintKind::PointOnPlane { body1, body2, .. }
+            | ConstraintKind::Contact { body1, body2, .. }
             | ConstraintKind::Loop { body1, body2, .. } => Reach::Bodies(*body1, *body2),
             ConstraintKind::KnifeEdge { body, .. }
             | ConstraintKind::RollingDisc { body, .. }
@@ -273,7 +293,7 @@ impl ConstraintKind {
     pub fn holonomic_rows(&self) -> usize {
         match self {
             ConstraintKind::KnifeEdge { .. } | ConstraintKind::Velocity { .. } => 0,
-            ConstraintKind::RollingDisc { .. } => 1,
+            ConstraintKind::RollingDisc { .. } | ConstraintKind::Contact { .. } => 1,
             k => k.rows(),
         }
     }

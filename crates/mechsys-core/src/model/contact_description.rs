@@ -26,6 +26,9 @@ pub struct ContactDescription {
     pub body2: String,
     /// Contour on body2, body-frame data.
     pub contour2: ContourDescription,
+    /// Normal law (Signorini's unilateral law if absent).
+    #[serde(default)]
+    pub normal: NormalDescription,
     /// Tangential law (frictionless if absent).
     #[serde(default)]
     pub friction: FrictionDescription,
@@ -276,6 +279,23 @@ pub enum SolidSide {
 
 fn one() -> f64 {
     1.0
+}
+
+/// Normal contact law.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum NormalDescription {
+    /// Signorini's corner law: g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0 (a unilateral contact).
+    #[default]
+    Signorini,
+    /// The contact is held closed, g_N = 0, by a bilateral constraint whose force may pull (a
+    /// follower that never lifts off, a wheel held on its rail); with `rolling`, it also rolls
+    /// without slipping (ġ_T = 0). No friction or impact law applies.
+    Bilateral {
+        /// Whether the tangential relative velocity is held at zero too.
+        #[serde(default)]
+        rolling: bool,
+    },
 }
 
 /// Tangential contact law.

@@ -8,6 +8,7 @@ use nalgebra::SymmetricEigen;
 use super::description::*;
 use super::*;
 use crate::error::{Error, Result};
+use super::contact_description::{FrictionDescription, NormalDescription};
 
 fn err(msg: String) -> Error {
     Error::Model(msg)
@@ -1174,6 +1175,36 @@ impl Model {
                 d.name
             );
             let c = super::contact::validate(d, i, n_contact_points, body, rotation)?;
+            if let NormalDescription::Bilateral { rolling } = d.normal {
+                // held closed: a constraint, not a unilateral contact
+                let what = format!("contacts[{i}] '{}'", d.name);
+                crate::ensure!(
+                    matches!(d.friction, FrictionDescription::None),
+                    Model,
+                    "{what}.friction: a bilateral contact takes no friction law (rolling = true holds it without slip)"
+                );
+                crate::ensure!(
+                    c.points() == 1,
+                    Model,
+                    "{what}.points: a bilateral contact holds one contact point, the pair has {}",
+                    c.points()
+                );
+                crate::ensure!(
+                    c.pair.surface_velocity().iter().all(|v| v.norm() == 0.0),
+                    Model,
+                    "{what}: a bilateral contact on a moving surface is not supported; use the unilateral law"
+                );
+                crate::ensure!(
+                    constraint_names.insert(d.name.clone()),
+                    Model,
+                    "{what}: a constraint has the same name (a bilateral contact is a constraint)"
+                );
+                let kind = ConstraintKind::Contact { body1: c.body1, body2: c.body2, pair: Box::new(c.pair), rolling };
+                let rows = kind.rows();
+                constraints.push(Constraint { name: d.name.clone(), kind, row, select: None });
+                row += rows;
+                continue;
+            }
             n_contact_points += c.points();
             contacts.push(c);
         }
