@@ -17,7 +17,7 @@ from .errors import (
     SingularityError,
     SolverError,
 )
-from .contacts import Contact, ContactGroup
+from .contacts import Contact, ContactGroup, GapContact
 from .integrators import DOPRI5, RK4, EventDriven, Lemke, MoreauJean, Newton, NSGS, Radau5
 from .joints import Frame
 from .model import Body, Model
@@ -53,6 +53,7 @@ __all__ = [
     "constraints",
     "Contact",
     "ContactGroup",
+    "GapContact",
     "contours",
     "laws",
     "mechanisms",

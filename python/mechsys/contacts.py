@@ -12,7 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from . import laws
+from ._pathsample import _Taylor2
 from .contours import OnBody
 from .errors import ModelError
 
@@ -133,4 +136,128 @@ class ContactGroup:
         return out
 
 
-__all__ = ["Contact", "ContactGroup"]
+@dataclass
+class GapContact:
+    """A unilateral contact given directly by its normal distance g_N(q, t) — open where it is
+    positive — instead of by contours: a stop on a joint, a wall a linkage's point must not pass,
+    a clearance written in the coordinates (section 2.2.7, the relative kinematics written by
+    hand). Optional ``tangents`` (at most 2) are tangential coordinates g_T(q, t) whose rates are
+    the sliding velocities the friction law acts against. Works in both contact schemes.
+
+    Each function is either
+
+    - an expression of the joint coordinates (a joint's name, or ``name[k]`` for coordinate k
+      of a multi-coordinate joint) and the time ``t``, with ``+ - * / ^``, ``pi``, ``e`` and
+      ``sin cos tan asin acos atan sinh cosh tanh exp ln sqrt abs atan2 hypot min max``:
+      evaluated by the engine, with exact derivatives (dual numbers), at full speed; or
+    - a Python callable ``g(q, t)`` of the whole coordinate vector, called back from the step
+      loop (slow); its derivatives come from forward-mode Taylor arithmetic when it computes with
+      operators and numpy functions (``np.sin``, not ``math.sin``), else from central
+      differences.
+
+    The coordinates a gap reads must have their velocities as rates (no free or spherical joint).
+    Its contact frame is fixed (n = z, t1 = x, t2 = y at the origin), so the signals
+    ``contact/<name>/g_n``, ``gd_n``, ``lambda_n`` (the generalized force along ∂g/∂q, N for a
+    gap in m), ``lambda_t`` and the events mean what they mean for any contact, while ``normal``
+    and ``point`` are those fixed values.
+
+    >>> stop = GapContact("stop", gap="0.3 - L * sin(swing)".replace("L", "0.5"), impact=laws.Newton(eps=0.5))
+    """
+
+    name: str
+    gap: Any
+    tangents: Any = ()
+    friction: Any = None
+    impact: Any = None
+
+    def describe(self, callbacks: list) -> dict:
+        what = f"gap contact '{self.name}'"
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise ModelError(f"gap contact: name must be a non-empty string, got {self.name!r}")
+        tangents = [self.tangents] if isinstance(self.tangents, str) or callable(self.tangents) else list(self.tangents)
+        d = {"name": self.name, "gap": _gap_term(self.gap, f"{what}.gap", callbacks)}
+        if tangents:
+            d["tangents"] = [_gap_term(f, f"{what}.tangents[{k}]", callbacks) for k, f in enumerate(tangents)]
+        d.update(_law_fields(what, self.friction, self.impact))
+        return d
+
+
+def _gap_term(f, what: str, callbacks: list):
+    """An expression as it is, a callable as a callback id of its derivative wrapper."""
+    if isinstance(f, str):
+        return f
+    if callable(f):
+        callbacks.append(_GapCallback(f, what))
+        return {"callback": len(callbacks) - 1}
+    raise ModelError(f"{what}: expected an expression (a string) or a callable g(q, t), got {type(f).__name__}")
+
+
+class _GapCallback:
+    """The engine's side of a Python gap function g(q, t): called with (t, q, u), returns
+    (g, g', w_bar, dg/dq) — g' the rate along q' = u (with dg/dt), w_bar the second derivative
+    along (u, 1) at u' = 0 — by Taylor arithmetic, or central differences when g does not take
+    Taylor numbers."""
+
+    def __init__(self, f, what: str):
+        self.f, self.what, self.taylor = f, what, True
+
+    def _call(self, q, t):
+        try:
+            v = self.f(q, t)
+        except Exception as e:  # the user's code: say which contact's function failed
+            if self.taylor and isinstance(e, (TypeError, AttributeError)) and any(
+                    isinstance(x, _Taylor2) for x in list(q) + [t]):
+                raise _NoTaylor from None
+            raise ModelError(f"{self.what}: the function raised {type(e).__name__}: {e}") from e
+        if isinstance(v, np.ndarray) and v.size == 1:
+            v = v.reshape(-1)[0]
+        return v
+
+    def __call__(self, t, q, u):
+        q, u = np.asarray(q, dtype=float), np.asarray(u, dtype=float)
+        if self.taylor:
+            try:
+                return self._by_taylor(t, q, u)
+            except _NoTaylor:
+                self.taylor = False
+        return self._by_differences(t, q, u)
+
+    def _scalar(self, v, kind=float):
+        if isinstance(v, _Taylor2):
+            return v
+        try:
+            return float(v)
+        except (TypeError, ValueError):
+            raise ModelError(f"{self.what}: expected the function to return a number, got {v!r}") from None
+
+    def _by_taylor(self, t, q, u):
+        r = self._scalar(self._call(np.array([_Taylor2(x, v) for x, v in zip(q, u)], dtype=object), _Taylor2(t, 1.0)))
+        r = _Taylor2.lift(r)
+        grad = np.empty(q.size)
+        for i in range(q.size):
+            qi = np.array([_Taylor2(x, 1.0 if k == i else 0.0) for k, x in enumerate(q)], dtype=object)
+            grad[i] = _Taylor2.lift(self._scalar(self._call(qi, t))).d
+        return r.v, r.d, r.dd, grad
+
+    def _by_differences(self, t, q, u):
+        def g(qq, tt):
+            return self._scalar(self._call(qq, tt))
+
+        g0 = g(q, t)
+        grad = np.empty(q.size)
+        for i in range(q.size):
+            h = 1e-6 * max(1.0, abs(q[i]))
+            e = np.zeros(q.size)
+            e[i] = h
+            grad[i] = (g(q + e, t) - g(q - e, t)) / (2 * h)
+        # along the motion (q + u s, t + s): first and second derivatives at s = 0
+        s = 1e-4 / max(1.0, float(np.abs(u).max(initial=0.0)))
+        gp, gm = g(q + u * s, t + s), g(q - u * s, t - s)
+        return g0, (gp - gm) / (2 * s), (gp - 2 * g0 + gm) / (s * s), grad
+
+
+class _NoTaylor(Exception):
+    """The user's function does not compute with Taylor numbers."""
+
+
+__all__ = ["Contact", "ContactGroup", "GapContact"]

@@ -186,8 +186,8 @@ class Model:
         return constraint
 
     def add_contact(self, contact) -> Any:
-        """Adds a unilateral contact (see :class:`mechsys.Contact`) or a contact group
-        (:class:`mechsys.ContactGroup`)."""
+        """Adds a unilateral contact (see :class:`mechsys.Contact`), a contact given by a gap
+        function (:class:`mechsys.GapContact`) or a contact group (:class:`mechsys.ContactGroup`)."""
         from .contacts import ContactGroup
 
         if isinstance(contact, ContactGroup):
@@ -238,9 +238,14 @@ class Model:
             desc["planar"] = True
         if constraints:
             desc["constraints"] = constraints
-        contacts = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._contacts]
+        described_contacts = [c if isinstance(c, dict) else c.describe(callbacks) for c in self._contacts]
+        # a gap contact (a user gap function, mechsys.GapContact) has a "gap" instead of contours
+        contacts = [c for c in described_contacts if not (isinstance(c, dict) and "gap" in c)]
+        gaps = [c for c in described_contacts if isinstance(c, dict) and "gap" in c]
         if contacts:
             desc["contacts"] = contacts
+        if gaps:
+            desc["gap_contacts"] = gaps
         groups = [g if isinstance(g, dict) else g.describe(callbacks) for g in self._contact_groups]
         if groups:
             desc["contact_groups"] = groups
@@ -297,6 +302,11 @@ class Model:
         m._ground_markers = seq("ground_markers")
         m._constraints = seq("constraints")
         m._contacts = seq("contacts")
+        gaps = seq("gap_contacts")
+        if isinstance(gaps, list) and isinstance(m._contacts, list):
+            m._contacts += gaps
+        elif gaps:
+            raise ModelError(f"model.gap_contacts: expected a list of tables, got {type(gaps).__name__}")
         m._contact_groups = seq("contact_groups")
         known = {"name", "gravity", "planar", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts", "contact_groups"}
         extra = set(desc) - known

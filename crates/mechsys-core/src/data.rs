@@ -127,6 +127,8 @@ pub struct Data {
     pub element_force: Vec<f64>,
     /// forces: each element's deflection at the last evaluation (n_force_outputs).
     pub element_deflection: Vec<f64>,
+    /// contacts: the user gap functions' scratch and their rows at the last evaluation.
+    pub gap: crate::contact::gap::GapWork,
 }
 
 impl Data {
@@ -185,6 +187,10 @@ impl Data {
             slider_force: vec![0.0; model.n_sliders],
             element_force: vec![0.0; model.n_force_outputs],
             element_deflection: vec![0.0; model.n_force_outputs],
+            gap: {
+                let f: Vec<_> = model.contacts.iter().filter_map(|c| c.gap().map(|g| g.0)).collect();
+                crate::contact::gap::GapWork::new(f.len(), model.nq, model.nu, &f)
+            },
         }
     }
 }

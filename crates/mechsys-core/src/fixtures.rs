@@ -51,6 +51,7 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        gap_contacts: vec![],
         planar: false,
         constraints: vec![],
     }

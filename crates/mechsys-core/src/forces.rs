@@ -59,6 +59,13 @@ pub trait Callbacks {
         let _ = (t, q, u, rows, out);
         Err(Error::Callback(format!("{} callback {id} was not provided", which.label())))
     }
+    /// A user gap function's term `id` at (t, q, u): returns `[g, ġ, w̄]` (value, rate along
+    /// `q̇ = u` including `∂g/∂t`, and the velocity-product part of `g̈`) and writes `∂g/∂q`
+    /// into `grad` (nq). An implementation checks that every value is finite.
+    fn gap_function(&self, id: usize, t: f64, q: &[f64], u: &[f64], grad: &mut [f64]) -> Result<[f64; 3]> {
+        let _ = (t, q, u, grad);
+        Err(Error::Callback(format!("gap function callback {id} was not provided")))
+    }
 }
 
 /// No callbacks: any model referring to one fails when built into a simulation.

@@ -1376,7 +1376,7 @@ fn time_stepping(
         crate::kinematics::accelerations(model, &mut data, &ud);
         data.udot = ud;
         record(model, &data, &ws.saddle, t_rec, &y, &mut rec);
-        stepper.measure(model, &data)?;
+        stepper.measure(model, &mut data, t_rec, q, u, cb)?;
         for (pt, kk) in stepper.kinematics().iter().enumerate() {
             let r = &stepper.results[pt];
             // over the interval since the last sample (one step at the first sample)

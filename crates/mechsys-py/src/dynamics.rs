@@ -467,7 +467,7 @@ pub fn register_contact_matrices(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact_geometry, m)?)
 }
 
-/// The contact geometry at q for every candidate point of the explicit contacts: gap, the
+/// The contact geometry at q for every candidate point of the explicit contour contacts: gap, the
 /// witness points on each contour, the normal and tangents, and each contour's principal
 /// curvatures at its witness point (planar contours: [κ, 0]; ∞ at points, vertices, edges).
 #[pyfunction]
@@ -482,9 +482,11 @@ fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>
     let (mut p1, mut p2, mut n, mut t1, mut t2, mut k1, mut k2) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for con in &m.contacts {
-        let mut pts = vec![ContactPoint::default(); con.pair.candidates()];
+        // gap contacts have no contours (their gap and rows: contact_matrices)
+        let (Some(pair), Some(contours)) = (con.pair(), con.contours()) else { continue };
+        let mut pts = vec![ContactPoint::default(); pair.candidates()];
         let (x1, x2) = (data.x_abs[con.body1], data.x_abs[con.body2]);
-        evaluate(&con.pair, &x1, &x2, &mut pts).map_err(PyMechsysError::from)?;
+        evaluate(pair, &x1, &x2, &mut pts).map_err(PyMechsysError::from)?;
         for c in &pts {
             names.push(con.name.clone());
             gap.push(c.g_n);
@@ -493,8 +495,8 @@ fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>
             n.extend_from_slice(c.n.as_slice());
             t1.extend_from_slice(c.t1.as_slice());
             t2.extend_from_slice(c.t2.as_slice());
-            k1.extend_from_slice(&con.contours[0].curvatures_at(&x1, &c.p1));
-            k2.extend_from_slice(&con.contours[1].curvatures_at(&x2, &c.p2));
+            k1.extend_from_slice(&contours[0].curvatures_at(&x1, &c.p1));
+            k2.extend_from_slice(&contours[1].curvatures_at(&x2, &c.p2));
         }
     }
     let np = gap.len();

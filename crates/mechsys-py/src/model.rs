@@ -133,7 +133,8 @@ impl PyModel {
             d.set_item("body2", &self.model.bodies[c.body2].name)?;
             d.set_item("first", c.first)?;
             d.set_item("points", c.points())?;
-            d.set_item("tangents", c.pair.tangent_dim())?;
+            d.set_item("tangents", c.tangent_dim())?;
+            d.set_item("kind", if c.gap().is_some() { "gap" } else { "contours" })?;
             out.push(d);
         }
         Ok(out)

@@ -95,6 +95,25 @@ impl Callbacks for PyCallbacks {
             Ok(())
         })
     }
+    fn gap_function(&self, id: usize, t: f64, q: &[f64], u: &[f64], grad: &mut [f64]) -> Result<[f64; 3], Error> {
+        // the Python side (mechsys.contacts) returns (g, ġ, w̄, ∂g/∂q) from the user's g(q, t)
+        let f = self.get(id)?;
+        Python::with_gil(|py| {
+            let qa = PyArray1::from_slice(py, q);
+            let ua = PyArray1::from_slice(py, u);
+            let r = f.call1(py, (t, qa, ua)).map_err(py_err)?;
+            let (g, gd, wbar, jac): (f64, f64, f64, Vec<f64>) = r.extract(py).map_err(py_err)?;
+            if jac.len() != grad.len() {
+                return Err(Error::Callback(format!(
+                    "gap function callback {id} gave {} derivatives, expected nq = {}",
+                    jac.len(),
+                    grad.len()
+                )));
+            }
+            grad.copy_from_slice(&jac);
+            Ok([g, gd, wbar])
+        })
+    }
     fn velocity_constraint(
         &self,
         id: usize,

@@ -60,6 +60,7 @@ pub(super) fn model_with_all_kinds() -> Model {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        gap_contacts: vec![],
         planar: false,
         constraints: vec![
             ConstraintDescription::Point {
@@ -212,6 +213,7 @@ fn drift_control_choices() {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        gap_contacts: vec![],
         planar: false,
         constraints: vec![ConstraintDescription::Distance {
             name: "rod".into(),

@@ -59,6 +59,7 @@ fn model_with_new_kinds() -> Model {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        gap_contacts: vec![],
         planar: false,
         constraints: vec![
             ConstraintDescription::PointOnLine {
@@ -625,6 +626,7 @@ fn model_with_user_rows(rate: bool, offset: bool) -> Model {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        gap_contacts: vec![],
         planar: false,
         constraints: vec![
             ConstraintDescription::Velocity {

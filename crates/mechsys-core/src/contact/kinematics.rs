@@ -36,8 +36,10 @@
 //! face and the crossing slides along it (see [`super::narrow::box_box`]).
 
 use crate::data::Data;
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::forces::Callbacks;
 use crate::math::Vec3;
+use crate::model::contact::Contact;
 use crate::spatial::{Motion, Pose};
 
 use super::narrow::{ContactPair, ContactPoint};
@@ -93,9 +95,10 @@ pub struct ContactKinematics {
     /// Relative angular velocity `ω1 - ω2` in the contact frame: `[n·Δω` (spin, drilling),
     /// `t1·Δω, t2·Δω]` (rolling); rad/s.
     pub omega_rel: [f64; 3],
-    /// The part of `ġ_T` that the contours' moving surfaces add (a conveyor belt's speed), the
-    /// rheonomic `w̃_T` of eq. 2.112: `ġ_T = W_Tᵀ u + w̃_T` (zero without moving surfaces).
-    pub gd_t_surface: [f64; 2],
+    /// The rheonomic parts `w̃ = [w̃_N, w̃_T1, w̃_T2]` of eq. 2.112, `ġ = Wᵀ u + w̃`: a moving
+    /// surface's speed (a conveyor belt) in the tangential entries, a time-dependent user gap
+    /// function's `∂g/∂t`; zero for contours at rest on their bodies.
+    pub w_tilde: [f64; 3],
 }
 
 /// Fills `out[..pair.candidates()]` for body 1 in state `b1` and body 2 in `b2`. No allocation;
@@ -159,11 +162,60 @@ pub fn contact_kinematics(
                 t.t1d.dot(&(dv + dws)) + t.t1.dot(&(da + dws_dt)),
                 t.t2d.dot(&(dv + dws)) + t.t2.dot(&(da + dws_dt)),
             ],
-            gd_t_surface: surf,
+            w_tilde: [0.0, surf[0], surf[1]],
             omega_rel: [r.n.dot(&dw), t.t1.dot(&dw), t.t2.dot(&dw)],
         };
     });
     Ok(())
+}
+
+/// The kinematics of every point of `con` into `out[..con.points()]`: from the bodies' motion in
+/// `data` (the tree's kinematics at (q, u) done, `data.a` as the caller set it) for a pair of
+/// contours; from the gap function at (t, q, u) for a gap contact, whose `w̄` is always the
+/// velocity-product part and whose rows land in `data.gap`. Errors name the contact.
+#[allow(clippy::too_many_arguments)]
+pub fn contact_point_kinematics(
+    con: &Contact,
+    data: &mut Data,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    out: &mut [ContactKinematics],
+) -> Result<()> {
+    match con.gap() {
+        None => {
+            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
+            contact_kinematics(con.pair().expect("a contour contact"), &b1, &b2, out)
+        }
+        Some((f, slot)) => f.evaluate(t, q, u, cb, &mut data.gap, slot, &mut out[0]).map_err(|e| match e {
+            Error::Callback(m) => Error::Callback(format!("gap contact '{}': {m}", con.name)),
+            other => other,
+        }),
+    }
+}
+
+/// An error of contact `name`'s kinematics at time `t` as the integrators report it: a solver
+/// error naming the contact and time, a callback's error (a Python gap function's, possibly an
+/// interrupt) passed on as it is.
+pub fn at_contact(e: Error, name: &str, t: f64) -> Error {
+    match e {
+        Error::Callback(_) => e,
+        other => Error::Solver(format!("contact '{name}' at t = {t:.6} s: {other}")),
+    }
+}
+
+/// `k` of a gap contact with its full accelerations: `w̄ + W u̇` from its rows in `data.gap`
+/// (the contour contacts get theirs from the full body accelerations instead).
+pub fn gap_with_accelerations(con: &Contact, data: &Data, udot: &[f64], k: &mut ContactKinematics) {
+    if let Some((_, slot)) = con.gap() {
+        let nu = udot.len();
+        let rows = &data.gap.rows[3 * slot * nu..3 * (slot + 1) * nu];
+        let dot = |r: usize| rows[r * nu..(r + 1) * nu].iter().zip(udot).map(|(a, b)| a * b).sum::<f64>();
+        k.wbar_n += dot(0);
+        k.wbar_t[0] += dot(1);
+        k.wbar_t[1] += dot(2);
+    }
 }
 
 #[cfg(test)]

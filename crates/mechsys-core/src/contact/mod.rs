@@ -30,6 +30,7 @@
 
 pub mod broad;
 pub mod contour;
+pub mod gap;
 pub mod group;
 pub mod kinematics;
 pub mod narrow;
@@ -40,5 +41,7 @@ pub(crate) mod test_util;
 pub use broad::{Aabb, SweepAndPrune};
 pub use contour::{Contour, ContourKind, Vec2};
 pub use group::GroupPhase;
-pub use kinematics::{contact_kinematics, BodyMotion, ContactKinematics};
+pub use kinematics::{
+    at_contact, contact_kinematics, contact_point_kinematics, gap_with_accelerations, BodyMotion, ContactKinematics,
+};
 pub use narrow::{candidates, evaluate, ContactPair, ContactPoint};

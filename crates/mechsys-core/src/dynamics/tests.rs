@@ -73,6 +73,7 @@ fn mixed_tree() -> Model {
         ground_markers: vec![],
         contacts: vec![],
         contact_groups: vec![],
+        gap_contacts: vec![],
         planar: false,
         constraints: vec![],
     })

@@ -35,7 +35,9 @@
 
 use nalgebra::DMatrix;
 
-use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics, ContactPoint, GroupPhase};
+use crate::contact::{
+    at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase,
+};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -208,7 +210,7 @@ impl MoreauJean {
     pub fn with_assembly(model: &Model, h: f64, method: Method, assembly: Assembly) -> Result<Self> {
         crate::ensure!(h.is_finite() && h > 0.0, Settings, "integrator.dt: must be > 0, got {h}");
         let (nu, np) = (model.nu, model.n_contact_points);
-        let planar = model.contacts.iter().all(|c| c.pair.is_planar()) && model.contact_groups.iter().all(|g| g.planar);
+        let planar = model.contacts.iter().all(|c| c.is_planar()) && model.contact_groups.iter().all(|g| g.planar);
         let dim = if planar { 2 } else { 3 };
         crate::ensure!(
             !(assembly == Assembly::Sparse && model.nc > 0),
@@ -216,7 +218,14 @@ impl MoreauJean {
             "integrator: the sparse contact assembly needs a model without bilateral constraints (this one has {})",
             model.nc
         );
-        let use_sparse = model.nc == 0 && assembly != Assembly::Dense;
+        let gaps = model.contacts.iter().any(|c| c.gap().is_some());
+        crate::ensure!(
+            !(assembly == Assembly::Sparse && gaps),
+            Settings,
+            "integrator: the sparse contact assembly works on contours; this model has gap contacts (use the dense one)"
+        );
+        // the sparse path builds rows from body points; a gap function brings its own
+        let use_sparse = model.nc == 0 && !gaps && assembly != Assembly::Dense;
         let problem = FrictionContact {
             dim,
             w: if use_sparse {
@@ -377,10 +386,9 @@ impl MoreauJean {
         let (d, np) = (self.dim, model.n_contact_points);
         self.act.clear();
         for con in &model.contacts {
-            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
             let k = &mut self.kin[con.first..con.first + con.points()];
-            contact_kinematics(&con.pair, &b1, &b2, k)
-                .map_err(|e| Error::Solver(format!("contact '{}' at t = {tm:.6} s: {e}", con.name)))?;
+            // a gap function reads the step's start velocities (its w̃ does not depend on them)
+            contact_point_kinematics(con, data, tm, &self.q_mid, u, cb, k).map_err(|e| at_contact(e, &con.name, tm))?;
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
                 if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
@@ -485,13 +493,14 @@ impl MoreauJean {
                     self.gd_before[a] = s0;
                 }
             }
-            // moving surfaces: ġ_T = W_Tᵀ u + w̃_T (eq. 2.112), the belt's speed at the midpoint
+            // rheonomic terms: ġ = Wᵀ u + w̃ (eq. 2.112), a belt's speed or a user gap's ∂g/∂t at
+            // the midpoint
             for (ai, a) in self.act.iter().enumerate() {
                 if let Source::Point(pt) = a.source {
-                    let s = self.kin[pt].gd_t_surface;
-                    for k in 1..d {
-                        self.problem.q[ai * d + k] += s[k - 1];
-                        self.gd_before[ai * d + k] += s[k - 1];
+                    let s = self.kin[pt].w_tilde;
+                    for k in 0..d {
+                        self.problem.q[ai * d + k] += s[k];
+                        self.gd_before[ai * d + k] += s[k];
                     }
                 }
             }
@@ -682,12 +691,13 @@ impl MoreauJean {
                         *af = (0..nu).map(|i| self.w_rows[(a, i)] * u[i]).sum();
                     }
                 }
-                // a moving surface: ġ_T⁺ includes its speed, and it works on the system by -Λ_Tᵀ w̃_T
+                // a moving surface or a time-dependent gap: ġ⁺ includes w̃, and the motion that
+                // drives it works on the system by -Λᵀ w̃
                 if let Source::Point(pt) = self.act[ai].source {
-                    let w = self.kin[pt].gd_t_surface;
-                    for row in 1..d {
-                        after[row] += w[row - 1];
-                        self.surface_work -= self.r[ai * d + row] * w[row - 1];
+                    let w = self.kin[pt].w_tilde;
+                    for row in 0..d {
+                        after[row] += w[row];
+                        self.surface_work -= self.r[ai * d + row] * w[row];
                     }
                 }
                 let mut e_point = 0.0;
@@ -764,6 +774,21 @@ impl MoreauJean {
         }
         for (ai, a) in self.act.iter().enumerate() {
             let k = &a.point;
+            let gap = match a.source {
+                Source::Point(pt) => model.contact_of_point(pt).gap().map(|g| g.1),
+                Source::Group { .. } => None,
+            };
+            if let Some(slot) = gap {
+                // a gap function's own rows W_N, W_T1, W_T2
+                let nu = model.nu;
+                for row in 0..d {
+                    let w = &data.gap.rows[(3 * slot + row) * nu..(3 * slot + row + 1) * nu];
+                    for (i, v) in w.iter().enumerate() {
+                        self.w_rows[(ai * d + row, i)] = *v;
+                    }
+                }
+                continue;
+            }
             let dirs = [k.n, k.t1, k.t2];
             for (row, dir) in dirs.iter().enumerate().take(d) {
                 let r = ai * d + row;
@@ -790,10 +815,10 @@ impl MoreauJean {
 
     /// Contact geometry and relative velocities of every candidate at the state in `data`
     /// (after a kinematics pass), for the records.
-    pub fn measure(&mut self, model: &Model, data: &Data) -> Result<()> {
+    pub fn measure(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
         for con in &model.contacts {
-            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
-            contact_kinematics(&con.pair, &b1, &b2, &mut self.kin[con.first..con.first + con.points()])?;
+            contact_point_kinematics(con, data, t, q, u, cb, &mut self.kin[con.first..con.first + con.points()])
+                .map_err(|e| at_contact(e, &con.name, t))?;
         }
         Ok(())
     }

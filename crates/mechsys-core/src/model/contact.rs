@@ -1,12 +1,15 @@
 //! Validated unilateral contacts: the pair of contours (prepared once for the narrow phase), the
 //! friction law (eqs. 2.200, 2.201) and the impact law (eqs. 2.202, 2.203).
 
+use crate::contact::gap::{GapFunction, GapTerm};
 use crate::contact::{ContactPair, Contour, Vec2};
+use crate::math::expr::Expr;
 use crate::error::{Error, Result};
 use crate::math::Vec3;
 
 use super::contact_description::{
-    ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, GearDescription,
+    ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, GapContactDescription,
+    GapTermDescription, GearDescription,
     ImpactDescription, SolidSide,
 };
 use crate::geometry::curve::{Curve, Follower, Solid};
@@ -111,14 +114,12 @@ impl ImpactLaw {
 pub struct Contact {
     /// Unique name.
     pub name: String,
-    /// Body carrying contour 1.
+    /// Body carrying contour 1 (0, the ground, for a gap function).
     pub body1: usize,
-    /// Body carrying contour 2.
+    /// Body carrying contour 2 (0 for a gap function).
     pub body2: usize,
-    /// The prepared pair of contours.
-    pub pair: ContactPair,
-    /// The two contours (body-frame data, normalized), for queries and reports.
-    pub contours: [Contour; 2],
+    /// What the contact's kinematics come from.
+    pub geometry: ContactGeometry,
     /// Friction law.
     pub friction: FrictionLaw,
     /// Impact law.
@@ -156,10 +157,70 @@ pub struct ContactGroup {
     pub planar: bool,
 }
 
+/// Where a contact's kinematics come from.
+#[derive(Debug, Clone)]
+pub enum ContactGeometry {
+    /// A contour on each body, searched by the narrow phase.
+    Contours {
+        /// The prepared pair of contours.
+        pair: ContactPair,
+        /// The two contours (body-frame data, normalized), for queries and reports.
+        contours: [Contour; 2],
+    },
+    /// A user gap function of the coordinates and time ([`crate::contact::gap`]).
+    Gap {
+        /// The function.
+        function: GapFunction,
+        /// Its index among the model's gap contacts (its rows in `GapWork::rows`).
+        slot: usize,
+    },
+}
+
 impl Contact {
     /// Number of candidate points.
     pub fn points(&self) -> usize {
-        self.pair.candidates()
+        match &self.geometry {
+            ContactGeometry::Contours { pair, .. } => pair.candidates(),
+            ContactGeometry::Gap { .. } => 1,
+        }
+    }
+
+    /// The pair of contours (None for a gap function).
+    pub fn pair(&self) -> Option<&ContactPair> {
+        match &self.geometry {
+            ContactGeometry::Contours { pair, .. } => Some(pair),
+            ContactGeometry::Gap { .. } => None,
+        }
+    }
+
+    /// The two contours (None for a gap function).
+    pub fn contours(&self) -> Option<&[Contour; 2]> {
+        match &self.geometry {
+            ContactGeometry::Contours { contours, .. } => Some(contours),
+            ContactGeometry::Gap { .. } => None,
+        }
+    }
+
+    /// Friction directions per point: 1 for planar pairs, 2 in space; a gap function's number
+    /// of tangential coordinates (at least 1, so a frictionless one fits a planar model).
+    pub fn tangent_dim(&self) -> usize {
+        match &self.geometry {
+            ContactGeometry::Contours { pair, .. } => pair.tangent_dim(),
+            ContactGeometry::Gap { function, .. } => function.tangents().max(1),
+        }
+    }
+
+    /// Whether the contact has one friction direction (it fits a planar contact problem).
+    pub fn is_planar(&self) -> bool {
+        self.tangent_dim() == 1
+    }
+
+    /// The gap function and its slot (None for contours).
+    pub fn gap(&self) -> Option<(&GapFunction, usize)> {
+        match &self.geometry {
+            ContactGeometry::Gap { function, slot } => Some((function, *slot)),
+            ContactGeometry::Contours { .. } => None,
+        }
     }
 }
 
@@ -427,7 +488,81 @@ pub(super) fn validate(
     };
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
-    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, pair, contours, friction, impact, first })
+    let geometry = ContactGeometry::Contours { pair, contours };
+    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, geometry, friction, impact, first })
+}
+
+/// Validates one gap contact (`index` among the gap contacts, `first` its point index): its
+/// functions parsed against the joints' coordinates, callbacks counted into `n_callbacks`.
+pub(super) fn validate_gap(
+    d: &GapContactDescription,
+    index: usize,
+    first: usize,
+    joints: &[super::Joint],
+    n_callbacks: &mut usize,
+) -> Result<Contact> {
+    let what = format!("gap_contacts[{index}] '{}'", d.name);
+    super::validate::check_name(&d.name, &format!("gap_contacts[{index}]"))?;
+    crate::ensure!(
+        d.tangents.len() <= 2,
+        Model,
+        "{what}.tangents: at most 2 tangential coordinates, got {}",
+        d.tangents.len()
+    );
+    crate::ensure!(
+        !d.tangents.is_empty() || matches!(d.friction, FrictionDescription::None),
+        Model,
+        "{what}.friction: a friction law needs a tangential coordinate to act along (give tangents)"
+    );
+    let mut coordinates: Vec<(usize, usize)> = Vec::new();
+    let mut terms = Vec::with_capacity(1 + d.tangents.len());
+    for (k, term) in std::iter::once(&d.gap).chain(&d.tangents).enumerate() {
+        let key = if k == 0 { "gap".to_string() } else { format!("tangents[{}]", k - 1) };
+        match term {
+            GapTermDescription::Expression(text) => {
+                let resolve = |name: &str, index: Option<usize>| -> std::result::Result<usize, String> {
+                    let j = joints.iter().find(|j| j.name == name).ok_or_else(|| {
+                        let known: Vec<&str> = joints.iter().filter(|j| j.nq() > 0).map(|j| j.name.as_str()).collect();
+                        format!("unknown name '{name}' (joint coordinates: {}; and t)", known.join(", "))
+                    })?;
+                    if j.kind.has_quaternion() {
+                        return Err(format!(
+                            "joint '{name}' turns by a quaternion; a gap function reads coordinates whose rates are                              velocities (revolute, prismatic, cylindrical, universal, planar, path joints)"
+                        ));
+                    }
+                    let k = match (index, j.nq()) {
+                        (None, 1) => 0,
+                        (None, n) => return Err(format!("joint '{name}' has {n} coordinates; write {name}[0] .. {name}[{}]", n.max(1) - 1)),
+                        (Some(k), n) if k < n => k,
+                        (Some(k), n) => return Err(format!("joint '{name}' has {n} coordinate(s), [{k}] is out of range")),
+                    };
+                    let c = (j.iq + k, j.iu + k);
+                    Ok(coordinates.iter().position(|x| *x == c).unwrap_or_else(|| {
+                        coordinates.push(c);
+                        coordinates.len() - 1
+                    }))
+                };
+                let e = Expr::parse(text, resolve).map_err(|m| Error::Model(format!("{what}.{key}: {m} in \"{text}\"")))?;
+                terms.push(GapTerm::Expr(e));
+            }
+            GapTermDescription::Callback { callback } => {
+                crate::ensure!(*callback < 1 << 32, Model, "{what}.{key}: callback index {callback} is out of range");
+                if let Some(j) = joints.iter().find(|j| j.kind.has_quaternion()) {
+                    return Err(Error::Model(format!(
+                        "{what}.{key}: a Python gap function needs every coordinate's rate to be its velocity, but joint \
+                         '{}' turns by a quaternion; write the gap as an expression of the other joints' coordinates",
+                        j.name
+                    )));
+                }
+                *n_callbacks = (*n_callbacks).max(callback + 1);
+                terms.push(GapTerm::Callback(*callback));
+            }
+        }
+    }
+    let friction = friction_law(&d.friction, &what)?;
+    let impact = impact_law(&d.impact, &what)?;
+    let geometry = ContactGeometry::Gap { function: GapFunction::new(terms, coordinates), slot: index };
+    Ok(Contact { name: d.name.clone(), body1: 0, body2: 0, geometry, friction, impact, first })
 }
 
 /// Validates one contact group (body indices resolved by `body`): names, contours, that every

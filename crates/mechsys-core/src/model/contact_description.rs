@@ -281,6 +281,40 @@ fn one() -> f64 {
     1.0
 }
 
+/// A unilateral contact given by its normal distance `g_N(q, t)` (and optional tangential
+/// coordinates whose rates are the sliding velocities), with the laws of any contact.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GapContactDescription {
+    /// Unique contact name (shared with the contacts and groups).
+    pub name: String,
+    /// `g_N(q, t)` (m or the unit of the coordinates it reads): open where > 0.
+    pub gap: GapTermDescription,
+    /// Tangential coordinates `g_T,k(q, t)` (at most 2): the friction law acts against their rates.
+    #[serde(default)]
+    pub tangents: Vec<GapTermDescription>,
+    /// Tangential law (frictionless if absent; needs at least one tangent).
+    #[serde(default)]
+    pub friction: FrictionDescription,
+    /// Impact law (a fully plastic Newton impact, ε = 0, if absent).
+    #[serde(default)]
+    pub impact: ImpactDescription,
+}
+
+/// One function of a gap contact: an expression of the joint coordinates (by joint name, or
+/// `name[k]` for coordinate k of a multi-coordinate joint) and the time `t`, or a Python callable.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum GapTermDescription {
+    /// A closed-form expression (`math::expr` grammar).
+    Expression(String),
+    /// A callable by its callback id (given by the Python builder).
+    Callback {
+        /// Callback id.
+        callback: usize,
+    },
+}
+
 /// Normal contact law.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]

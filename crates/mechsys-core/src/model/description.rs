@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
-use super::contact_description::{ContactDescription, ContactGroupDescription};
+use super::contact_description::{ContactDescription, ContactGroupDescription, GapContactDescription};
 pub use super::rotation_description::{AnglesDescription, RotationDescription};
 
 /// A whole model as written in a model file.
@@ -42,6 +42,9 @@ pub struct ModelDescription {
     /// other contours, with one friction and one impact law (pairs found by a broad phase).
     #[serde(default)]
     pub contact_groups: Vec<ContactGroupDescription>,
+    /// Unilateral contacts given by user gap functions of the coordinates and time.
+    #[serde(default)]
+    pub gap_contacts: Vec<GapContactDescription>,
     /// A planar model: every body moves in the world x-y plane (revolute joints about z,
     /// prismatic and planar joints in the plane), loop closures keep only their in-plane rows.
     #[serde(default)]

@@ -1189,8 +1189,9 @@ impl Model {
                     "{what}.points: a bilateral contact holds one contact point, the pair has {}",
                     c.points()
                 );
+                let pair = c.pair().expect("a contour contact").clone();
                 crate::ensure!(
-                    c.pair.surface_velocity().iter().all(|v| v.norm() == 0.0),
+                    pair.surface_velocity().iter().all(|v| v.norm() == 0.0),
                     Model,
                     "{what}: a bilateral contact on a moving surface is not supported; use the unilateral law"
                 );
@@ -1199,12 +1200,25 @@ impl Model {
                     Model,
                     "{what}: a constraint has the same name (a bilateral contact is a constraint)"
                 );
-                let kind = ConstraintKind::Contact { body1: c.body1, body2: c.body2, pair: Box::new(c.pair), rolling };
+                let kind = ConstraintKind::Contact { body1: c.body1, body2: c.body2, pair: Box::new(pair), rolling };
                 let rows = kind.rows();
                 constraints.push(Constraint { name: d.name.clone(), kind, row, select: None });
                 row += rows;
                 continue;
             }
+            n_contact_points += c.points();
+            contacts.push(c);
+        }
+
+        // gap contacts come after the contour contacts (their points last)
+        for (i, d) in desc.gap_contacts.iter().enumerate() {
+            crate::ensure!(
+                contact_names.insert(d.name.clone()),
+                Model,
+                "gap_contacts[{i}] '{}': duplicate contact name (contacts and gap contacts share one namespace)",
+                d.name
+            );
+            let c = super::contact::validate_gap(d, i, n_contact_points, &joints, &mut n_callbacks)?;
             n_contact_points += c.points();
             contacts.push(c);
         }

@@ -446,7 +446,7 @@ fn moving_surface_adds_its_speed_to_the_tangential_velocity() {
             for k in 0..2 {
                 let t = [m.point.t1, m.point.t2][k];
                 assert!((m.gd_t[k] - (p.gd_t[k] - t.dot(&w))).abs() < 1e-14, "ġ_T[{k}]");
-                assert!((m.gd_t_surface[k] + t.dot(&w)).abs() < 1e-14);
+                assert!((m.w_tilde[k + 1] + t.dot(&w)).abs() < 1e-14);
                 let h = 1e-5;
                 let fd = (kin(&moving, &tr1.at(h), &tr2.at(h))[0].gd_t[k] - kin(&moving, &tr1.at(-h), &tr2.at(-h))[0].gd_t[k])
                     / (2.0 * h);

@@ -197,14 +197,10 @@ impl Phase<'_> {
     }
 
     /// The rheonomic part `w̃` of relative velocity `k` (0 normal, 1–2 tangential) of point `pt`:
-    /// a moving surface's speed (eq. 2.112); zero otherwise.
+    /// a moving surface's speed or a user gap's `∂g/∂t` (eq. 2.112); zero otherwise.
     #[inline]
     fn surface_rate(&self, pt: usize, k: usize) -> f64 {
-        if k == 0 {
-            0.0
-        } else {
-            self.kin[pt].gd_t_surface[k - 1]
-        }
+        self.kin[pt].w_tilde[k]
     }
 
     /// Closed points keep the relative velocities the transition took as zero (up to

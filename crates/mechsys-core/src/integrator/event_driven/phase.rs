@@ -3,7 +3,9 @@
 use nalgebra::DMatrix;
 
 use super::{EventWork, Options, Phase, JAM, PYRAMID};
-use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
+use crate::contact::{
+    at_contact, contact_kinematics, contact_point_kinematics, gap_with_accelerations, BodyMotion, ContactKinematics,
+};
 use crate::data::Data;
 use crate::dynamics::sparse::Saddle;
 use crate::error::{Error, Result};
@@ -23,7 +25,7 @@ impl<'a> Phase<'a> {
     pub fn new(model: &'a Model, cb: &'a dyn Callbacks, opts: Options) -> Result<Self> {
         opts.validate()?;
         let (nu, np) = (model.nu, model.n_contact_points);
-        let d = if model.contacts.iter().all(|c| c.pair.is_planar()) { 2 } else { 3 };
+        let d = if model.contacts.iter().all(|c| c.is_planar()) { 2 } else { 3 };
         // the LCP has at most np (1 + K + 1) unknowns
         let k = if d == 2 { 2 } else { PYRAMID };
         let rmax = (np * (k + 1)).max(d * np).max(1);
@@ -151,9 +153,8 @@ impl<'a> Phase<'a> {
         }
         self.a_free = c;
         for con in &model.contacts {
-            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
-            contact_kinematics(&con.pair, &b1, &b2, &mut self.kin[con.first..con.first + con.points()])
-                .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.6} s: {e}", con.name)))?;
+            contact_point_kinematics(con, data, t, q, u, self.cb, &mut self.kin[con.first..con.first + con.points()])
+                .map_err(|e| at_contact(e, &con.name, t))?;
         }
         Ok(p)
     }
@@ -195,6 +196,17 @@ impl<'a> Phase<'a> {
             m[(r, i)] = 0.0;
         }
         let con = model.contact_of_point(pt);
+        if let Some((_, slot)) = con.gap() {
+            // a gap function's rows, combined along the direction's parts in its fixed frame
+            let nu = model.nu;
+            let rows = &data.gap.rows[3 * slot * nu..3 * (slot + 1) * nu];
+            for (k, c) in [dir.z, dir.x, dir.y].into_iter().enumerate() {
+                for i in 0..nu {
+                    m[(r, i)] += c * rows[k * nu + i];
+                }
+            }
+            return;
+        }
         let k = &kin[pt].point;
         crate::constraints::add_point_rows(model, &data.s, con.body1, &k.p1, 1.0, Some(dir), m, r);
         crate::constraints::add_point_rows(model, &data.s, con.body2, &k.p2, -1.0, Some(dir), m, r);
@@ -520,9 +532,15 @@ impl<'a> Phase<'a> {
             }
             // (every contact's points, not a fixed-size buffer: none may be skipped)
             let k = &mut self.ev.apex;
-            let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
             let n = con.points();
-            contact_kinematics(&con.pair, &b1, &b2, &mut k[..n])?;
+            if con.gap().is_some() {
+                // the last evaluation's velocity-product part and rows, with its accelerations
+                k[0] = self.kin[con.first];
+                gap_with_accelerations(con, &self.data, &self.data.udot, &mut k[0]);
+            } else {
+                let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
+                contact_kinematics(con.pair().expect("a contour contact"), &b1, &b2, &mut k[..n])?;
+            }
             for (j, kk) in k[..n].iter().enumerate() {
                 let pt = con.first + j;
                 if self.status[pt] != OPEN {
@@ -570,11 +588,12 @@ impl OdeSystem for Phase<'_> {
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
         let e = nq + nu;
         dy[e] = p.dissipated;
-        // a moving surface (conveyor) works on the system through the friction force: -λ_Tᵀ w̃_T
+        // a moving surface (conveyor) or a time-dependent gap works on the system through the
+        // contact forces: -λᵀ w̃
         let belt: f64 = (0..np)
             .map(|pt| {
-                let w = self.kin[pt].gd_t_surface;
-                -(self.lam_t[pt][0] * w[0] + self.lam_t[pt][1] * w[1])
+                let w = self.kin[pt].w_tilde;
+                -(self.lam_n[pt] * w[0] + self.lam_t[pt][0] * w[1] + self.lam_t[pt][1] * w[2])
             })
             .sum();
         dy[e + 1] = p.external + belt;

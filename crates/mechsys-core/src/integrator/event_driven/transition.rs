@@ -1,7 +1,7 @@
 //! The transition problem at acceleration level (section 2.5.2): which touching points stay closed and which stick.
 
 use super::{Dissipation, Phase, PYRAMID};
-use crate::contact::{contact_kinematics, BodyMotion};
+use crate::contact::{contact_kinematics, gap_with_accelerations, BodyMotion};
 use crate::error::{Error, Result};
 use crate::integrator::events::{EventKind, Painleve};
 use crate::integrator::moreau_jean::{OPEN, SLIP, STICK};
@@ -452,9 +452,14 @@ impl Phase<'_> {
     fn relative_acceleration(&mut self, t: f64, pt: usize) -> Result<(f64, [f64; 2])> {
         let con = self.model.contact_of_point(pt);
         let n = con.points();
-        let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
-        contact_kinematics(&con.pair, &b1, &b2, &mut self.ev.apex[..n])
-            .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.9} s: {e}", con.name)))?;
+        if con.gap().is_some() {
+            self.ev.apex[0] = self.kin[con.first];
+            gap_with_accelerations(con, &self.data, &self.data.udot, &mut self.ev.apex[0]);
+        } else {
+            let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
+            contact_kinematics(con.pair().expect("a contour contact"), &b1, &b2, &mut self.ev.apex[..n])
+                .map_err(|e| Error::Solver(format!("contact '{}' at t = {t:.9} s: {e}", con.name)))?;
+        }
         let k = &self.ev.apex[pt - con.first];
         Ok((k.wbar_n, if self.d == 3 { k.wbar_t } else { [k.wbar_t[0], 0.0] }))
     }

@@ -1,0 +1,204 @@
+"""Contacts given by user gap functions (mechsys.GapContact): expressions and Python callables,
+in both contact schemes, against closed forms of impacts, lift-off and friction."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.special import ellipkinc, ellipk
+
+import mechsys as ms
+from mechsys.errors import CallbackError, ModelError
+
+G, L, D, A0 = 9.81, 1.0, 0.3, 0.5  # gravity, pendulum length, wall distance, release angle
+
+
+def pendulum(gap, eps: float = 0.5, friction=None, tangents=()) -> ms.Model:
+    """A point-mass pendulum (length L, angle 'swing' from hanging, counter-clockwise) released
+    from rest at -A0 towards a wall at x = D given by ``gap``."""
+    m = ms.Model("pendulum", gravity=(0.0, -G, 0.0), planar=True)
+    bob = m.add_body("bob", 1.0, np.zeros((3, 3)), com=(0.0, -L, 0.0))
+    m.add_joint(ms.joints.Revolute("swing", m.ground, bob, axis=(0, 0, 1), q0=-A0))
+    m.add_contact(ms.GapContact("wall", gap=gap, tangents=tangents, friction=friction, impact=ms.laws.Newton(eps=eps)))
+    return m
+
+
+def impact_time_and_rate() -> tuple[float, float]:
+    """First impact of the pendulum on the wall: time from release (complete and incomplete
+    elliptic integrals of the first kind) and angular rate just before it (energy)."""
+    k = np.sin(A0 / 2)
+    theta = np.arcsin(D / L)
+    phi = np.arcsin(np.sin(theta / 2) / k)
+    m = k * k  # scipy's parameter m = k^2
+    t = (ellipkinc(phi, m) + ellipk(m)) / np.sqrt(G / L)
+    return float(t), float(np.sqrt(2 * G / L * (np.cos(theta) - np.cos(A0))))
+
+
+def first_impact(res) -> dict:
+    ev = [e for e in res.events if e["event"] == "impact" and e["contact"] == "wall"]
+    assert ev, "no impact on the wall"
+    return ev[0]
+
+
+@pytest.mark.parametrize("gap", ["0.3 - 1.0 * sin(swing)", lambda q, t: 0.3 - np.sin(q[0]),
+                                  lambda q, t: 0.3 - __import__("math").sin(q[0])],
+                         ids=["expression", "callable-taylor", "callable-differences"])
+def test_a_pendulum_hits_a_wall_given_by_its_gap_at_the_closed_form_time_and_rebounds_by_newton(gap):
+    t_star, rate = impact_time_and_rate()
+    res = ms.simulate(pendulum(gap), t_end=t_star + 0.3, integrator=ms.EventDriven(rtol=1e-10, atol=1e-12),
+                      output_dt=1e-3)
+    ev = first_impact(res)
+    tol = 1e-7 if not callable(gap) or "math" not in gap.__code__.co_names else 1e-5
+    assert abs(ev["t"] - t_star) < tol
+    np.testing.assert_allclose(ev["u_before"], [rate], rtol=1e-6)
+    np.testing.assert_allclose(ev["u_after"], [-0.5 * rate], rtol=1e-6)
+    # the impulse is the generalized one along dg/dq = -L cos(theta): m L^2 (1 + e) theta' / (L cos(theta))
+    theta = np.arcsin(D / L)
+    np.testing.assert_allclose(ev["impulse_n"], L * L * 1.5 * rate / (L * np.cos(theta)), rtol=1e-6)
+    assert res["contact/wall/g_n"].min() > -1e-9
+
+
+def test_the_moreau_jean_scheme_keeps_the_pendulum_out_of_the_wall_and_rebounds_by_newton():
+    t_star, rate = impact_time_and_rate()
+    res = ms.simulate(pendulum("0.3 - sin(swing)", eps=0.5), t_end=t_star + 0.2, integrator=ms.MoreauJean(dt=1e-4),
+                      output_dt=1e-4)
+    q, u = res["joint/swing/q"], res["joint/swing/u"]
+    assert q.max() < np.arcsin(D / L) + 1e-3
+    k = int(np.argmax(u < 0))  # first sample moving back
+    assert abs(res.t[k] - t_star) < 2e-4
+    np.testing.assert_allclose(u[k], -0.5 * rate, rtol=2e-3)
+
+
+def test_rows_and_velocity_product_terms_of_a_time_dependent_gap_match_finite_differences():
+    # a planar body (x, y, angle) and a gap with every kind of term: coordinates, products, time
+    m = ms.Model("rows", gravity=(0.0, -G, 0.0), planar=True)
+    b = m.add_body("b", 1.0, np.eye(3) * 0.01)
+    m.add_joint(ms.joints.Planar("p", m.ground, b, q0=[0.1, 0.2, 0.3]))
+    expr = "p[1] - 0.1 * sin(3 * t) * cos(p[2]) + 0.05 * p[0]^2 * exp(-t)"
+    tan = "p[0] + 0.2 * p[2] * t"
+    m.add_contact(ms.GapContact("g", gap=expr, tangents=[tan], friction=ms.laws.Coulomb(mu=0.3)))
+
+    def g(q, t):
+        return q[1] - 0.1 * np.sin(3 * t) * np.cos(q[2]) + 0.05 * q[0] ** 2 * np.exp(-t)
+
+    def s(q, t):
+        return q[0] + 0.2 * q[2] * t
+
+    q, u, t = np.array([0.1, 0.2, 0.3]), np.array([0.7, -0.4, 1.1]), 0.37
+    cm = ms.dynamics.contact_matrices(m, q, u, t)
+    h = 1e-6
+    for k, f in enumerate([g, s]):
+        row = 0 if k == 0 else 1
+        grad = np.array([(f(q + h * e, t) - f(q - h * e, t)) / (2 * h) for e in np.eye(3)])
+        np.testing.assert_allclose(cm["w"][0, row], grad, atol=1e-8)
+        # along the motion (q + u s, t + s): g' and its velocity-product part g'' (u' = 0)
+        hs = 1e-4
+        fp, f0, fm = f(q + u * hs, t + hs), f(q, t), f(q - u * hs, t - hs)
+        np.testing.assert_allclose(cm["velocity"][0, row], (fp - fm) / (2 * hs), atol=1e-8)
+        np.testing.assert_allclose(cm["wbar"][0, row], (fp - 2 * f0 + fm) / hs**2, atol=1e-5)
+    assert cm["gap"][0] == pytest.approx(g(q, t), abs=1e-15)
+    assert cm["contact"] == ["g"]
+
+
+def shaker(amplitude: float, omega: float) -> ms.Model:
+    """A block resting on a table that moves up and down as A sin(omega t): gap = y - A sin(omega t)."""
+    m = ms.Model("shaker", gravity=(0.0, -G, 0.0), planar=True)
+    b = m.add_body("block", 2.0, np.eye(3) * 0.01)
+    m.add_joint(ms.joints.Prismatic("lift", m.ground, b, axis=(0, 1, 0), q0=0.0, u0=amplitude * omega))
+    m.add_contact(ms.GapContact("table", gap=f"lift - {amplitude} * sin({omega} * t)"))
+    return m
+
+
+def test_a_block_on_a_shaker_table_lifts_off_where_the_table_falls_faster_than_gravity():
+    amplitude, omega = 0.01, 40.0  # A omega^2 = 16 m/s^2 > g
+    t_off = np.arcsin(G / (amplitude * omega**2)) / omega
+    res = ms.simulate(shaker(amplitude, omega), t_end=t_off + 0.01, integrator=ms.EventDriven(rtol=1e-10, atol=1e-12),
+                      output_dt=1e-4)
+    ev = [e for e in res.events if e["contact"] == "table" and e["event"] == "open"]
+    assert ev, [e["event"] for e in res.events]
+    assert abs(ev[0]["t"] - t_off) < 1e-7
+    before = res.t < t_off - 1e-3
+    # riding on the table: y = A sin(omega t), and the table carries m (g + y'')
+    np.testing.assert_allclose(res["joint/lift/q"][before], amplitude * np.sin(omega * res.t[before]), atol=1e-9)
+    lam = 2.0 * (G - amplitude * omega**2 * np.sin(omega * res.t[before]))
+    np.testing.assert_allclose(res["contact/table/lambda_n"][before][1:], lam[1:], rtol=1e-6)
+    # the table's motion does work on the block through the contact force: the energy balance holds
+    e = res["energy/total"] - res["energy/external_work"]
+    assert np.abs(e - e[0]).max() < 1e-6
+
+
+def test_a_block_sliding_on_a_gap_floor_stops_where_coulomb_friction_says():
+    mu, v0 = 0.4, 2.0
+    for integrator, tol in ((ms.EventDriven(rtol=1e-10, atol=1e-12), 1e-7), (ms.MoreauJean(dt=1e-4), 2e-3)):
+        m = ms.Model("slide", gravity=(0.0, -G, 0.0), planar=True)
+        b = m.add_body("block", 1.5, np.eye(3) * 0.01)
+        m.add_joint(ms.joints.Planar("p", m.ground, b, q0=[0.0, 0.0, 0.0], u0=[v0, 0.0, 0.0]))
+        m.add_contact(ms.GapContact("floor", gap="p[1]", tangents=["p[0]"], friction=ms.laws.Coulomb(mu=mu)))
+        res = ms.simulate(m, t_end=1.0, integrator=integrator, output_dt=1e-3)
+        x = res["joint/p/q"][:, 0]
+        np.testing.assert_allclose(x[-1], v0**2 / (2 * mu * G), rtol=tol * 10)
+        t_stop = v0 / (mu * G)
+        sliding = res.t < t_stop - 0.01
+        np.testing.assert_allclose(res["contact/floor/lambda_t"][sliding][2:], -mu * 1.5 * G, rtol=tol * 10)
+        np.testing.assert_allclose(res["contact/floor/lambda_n"][2:], 1.5 * G, rtol=tol * 10)
+
+
+def test_bad_gap_functions_are_refused_naming_the_contact():
+    with pytest.raises(ModelError, match=r"gap_contacts\[0\] 'wall'.gap: unknown name 'swang' \(joint coordinates: swing; and t\)"):
+        pendulum("0.3 - sin(swang)").build()
+    with pytest.raises(ModelError, match=r"'wall'.gap: expected a number, a name or '\(', found the end"):
+        pendulum("0.3 - ").build()
+    with pytest.raises(ModelError, match="'wall'.friction: a friction law needs a tangential coordinate"):
+        pendulum("0.3 - sin(swing)", friction=ms.laws.Coulomb(mu=0.3)).build()
+    with pytest.raises(ModelError, match="'wall'.tangents: at most 2 tangential coordinates"):
+        pendulum("0.3 - sin(swing)", tangents=["swing"] * 3).build()
+    m = ms.Model("free", gravity=(0, 0, -G))
+    b = m.add_body("ball", 1.0, np.eye(3) * 0.1)
+    m.add_joint(ms.joints.Free("fly", m.ground, b))
+    m.add_contact(ms.GapContact("floor", gap="fly[2]"))
+    with pytest.raises(ModelError, match="joint 'fly' turns by a quaternion"):
+        m.build()
+    with pytest.raises(ModelError, match="expected an expression .* or a callable"):
+        pendulum(3.0).build()
+    # a function that raises or returns NaN stops the run with the contact named
+    bad = pendulum(lambda q, t: 0.3 - np.sin(q[0]) + (1 / 0 if t > 0.1 else 0.0))
+    with pytest.raises(CallbackError, match="gap contact 'wall'.gap: the function raised ZeroDivisionError"):
+        ms.simulate(bad, t_end=0.5, integrator=ms.EventDriven())
+    nan = pendulum(lambda q, t: 0.3 - np.sin(q[0]) + (np.nan if t > 0.1 else 0.0))
+    with pytest.raises(CallbackError, match="gap contact 'wall': gap is not finite"):
+        ms.simulate(nan, t_end=0.5, integrator=ms.MoreauJean(dt=1e-3))
+
+
+def test_a_gap_contact_in_a_model_file_runs_from_the_command_line(tmp_path):
+    path = tmp_path / "stop.toml"
+    path.write_text(f"""
+name = "stop"
+gravity = [0.0, -9.81, 0.0]
+planar = true
+[[bodies]]
+name = "bob"
+mass = 1.0
+inertia = [0.0, 0.0, 0.0]
+com = [0.0, -1.0, 0.0]
+[[joints]]
+name = "swing"
+type = "revolute"
+parent = "ground"
+child = "bob"
+axis = [0.0, 0.0, 1.0]
+q0 = [-{A0}]
+[[gap_contacts]]
+name = "wall"
+gap = "{D} - sin(swing)"
+impact = {{ type = "newton", eps = 0.5 }}
+[simulation]
+t_end = 1.0
+integrator = "event_driven"
+""")
+    out = tmp_path / "stop.h5"
+    run = subprocess.run([sys.executable, "-m", "mechsys", "run", str(path), "--out", str(out), "--quiet"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    res = ms.load(out)
+    assert abs(first_impact(res)["t"] - impact_time_and_rate()[0]) < 1e-6
