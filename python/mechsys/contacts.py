@@ -156,6 +156,9 @@ class GapContact:
       differences.
 
     The coordinates a gap reads must have their velocities as rates (no free or spherical joint).
+    With ``normal=laws.Bilateral()`` the gap is held at zero (a constraint g(q, t) = 0 written
+    by hand; ``rolling=True`` holds the tangential coordinates' rates at zero too).
+
     Its contact frame is fixed (n = z, t1 = x, t2 = y at the origin), so the signals
     ``contact/<name>/g_n``, ``gd_n``, ``lambda_n`` (the generalized force along ∂g/∂q, N for a
     gap in m), ``lambda_t`` and the events mean what they mean for any contact, while ``normal``
@@ -167,6 +170,7 @@ class GapContact:
     name: str
     gap: Any
     tangents: Any = ()
+    normal: Any = field(default_factory=laws.Signorini)
     friction: Any = None
     impact: Any = None
 
@@ -178,6 +182,14 @@ class GapContact:
         d = {"name": self.name, "gap": _gap_term(self.gap, f"{what}.gap", callbacks)}
         if tangents:
             d["tangents"] = [_gap_term(f, f"{what}.tangents[{k}]", callbacks) for k, f in enumerate(tangents)]
+        if not isinstance(self.normal, (laws.Signorini, laws.Bilateral)):
+            raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini() or Bilateral(), got {type(self.normal).__name__}")
+        if isinstance(self.normal, laws.Bilateral):
+            for key in ("friction", "impact"):
+                if getattr(self, key) is not None:
+                    raise ModelError(f"{what}.{key}: a bilateral contact is held closed and takes no {key} law "
+                                     "(laws.Bilateral(rolling=True) holds its tangential coordinates)")
+            d["normal"] = self.normal.describe(f"{what}.normal")
         d.update(_law_fields(what, self.friction, self.impact))
         return d
 

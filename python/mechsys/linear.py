@@ -707,10 +707,12 @@ def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str)
         return model, {}
     desc, callbacks = model.describe()
     held = {}
-    for c in desc["contacts"]:
+    for c in desc.get("contacts", []) + desc.get("gap_contacts", []):
         if c["name"] not in closed:
             continue
         what = f"linearize: contact '{c['name']}'"
+        if "gap" in c and mode == "roll" and not c.get("tangents"):
+            raise SettingsError(f"{what} has no tangential coordinate, so it cannot roll; use contacts='hold'")
         if c.get("points", 1) != 1:
             raise SettingsError(f"{what} looks for {c['points']} contact points; only a single-point contact "
                                 "(points=1) can be held closed")

@@ -188,8 +188,16 @@ impl Data {
             element_force: vec![0.0; model.n_force_outputs],
             element_deflection: vec![0.0; model.n_force_outputs],
             gap: {
-                let f: Vec<_> = model.contacts.iter().filter_map(|c| c.gap().map(|g| g.0)).collect();
-                crate::contact::gap::GapWork::new(f.len(), model.nq, model.nu, &f)
+                // the gap functions of contacts and of contacts held closed, by slot
+                let mut f: Vec<(usize, &crate::contact::gap::GapFunction)> =
+                    model.contacts.iter().filter_map(|c| c.gap().map(|(g, s)| (s, g))).collect();
+                f.extend(model.constraints.iter().filter_map(|c| match &c.kind {
+                    constraint::ConstraintKind::Gap { function, slot, .. } => Some((*slot, &**function)),
+                    _ => None,
+                }));
+                let slots = f.iter().map(|(s, _)| s + 1).max().unwrap_or(0);
+                let functions: Vec<_> = f.iter().map(|(_, g)| *g).collect();
+                crate::contact::gap::GapWork::new(slots, model.nq, model.nu, &functions)
             },
         }
     }

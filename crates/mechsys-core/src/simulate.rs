@@ -1462,12 +1462,17 @@ fn event_driven(
     let e = nq + nu;
     // integrals of the forces at the previous sample, and the energy taken by impacts so far
     let mut prev = vec![0.0; 3 * np];
-    let (mut e_impact, mut e_impulsive_friction) = (0.0, 0.0);
+    let (mut e_impact, mut e_impulsive_friction, mut w_impulsive) = (0.0, 0.0, 0.0);
     let mut warnings = Vec::new();
     let mut sample = |ph: &mut Phase, t: f64, y: &[f64], imp: &[f64], d: event_driven::Dissipation| -> Result<()> {
         record(model, &ph.data, &ph.dynamics.saddle, t, y, &mut rec);
         e_impact += d.impact;
         e_impulsive_friction += d.friction;
+        // a moving surface or time-dependent gap works through the impulses too
+        w_impulsive += d.external;
+        if let Some(w) = rec.external_work.last_mut() {
+            *w += w_impulsive;
+        }
         for pt in 0..np {
             let kk = &ph.kin[pt];
             let now_n = y[e + 3 + pt];

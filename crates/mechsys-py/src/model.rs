@@ -213,6 +213,8 @@ impl PyModel {
                 K::KnifeEdge { .. } => ("knife_edge", ("N", "m")),
                 K::RollingDisc { .. } => ("rolling_disc", ("N", "m")),
                 K::Contact { .. } => ("contact", ("N", "m")),
+                // a gap in m gives a force in N; in other units the user's scaling decides
+                K::Gap { .. } => ("gap", ("", "")),
             };
             d.set_item("name", &c.name)?;
             d.set_item("type", t)?;

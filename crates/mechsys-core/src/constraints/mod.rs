@@ -716,6 +716,24 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     add_point_rows(model, &data.s, *body2, &k.p2, -1.0, Some(e), &mut data.g, r + j);
                 }
             }
+            ConstraintKind::Gap { function, slot, .. } => {
+                // the gap's rows at (q, t) (its rates need u: evaluated at u = 0 here, the rows
+                // and ∂g/∂t do not depend on it)
+                let nu = model.nu;
+                let mut k = crate::contact::ContactKinematics::default();
+                let zero = std::mem::take(&mut data.zero_u);
+                let res = function.evaluate(t, q, &zero, cb, &mut data.gap, *slot, &mut k);
+                data.zero_u = zero;
+                res.map_err(in_constraint(c, ""))?;
+                for j in 0..c.kind.rows() {
+                    data.phi[r + j] = if j == 0 { k.point.g_n } else { 0.0 };
+                    // G u = b: W_jᵀ u + w̃_j = 0
+                    data.b[r + j] = -k.w_tilde[j];
+                    for i in 0..nu {
+                        data.g[(r + j, i)] += data.gap.rows[(3 * slot + j) * nu + i];
+                    }
+                }
+            }
             ConstraintKind::Coupler { iq_a, iu_a, iq_b, iu_b, ratio, offset } => {
                 data.phi[r] = q[*iq_a] - ratio * q[*iq_b] - offset;
                 data.b[r] = 0.0;
@@ -819,6 +837,14 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64
                     data.gamma[r + j] = -k[0].wbar_t[j - 1];
                 }
             }
+            ConstraintKind::Gap { function, slot, .. } => {
+                let mut k = crate::contact::ContactKinematics::default();
+                function.evaluate(t, q, u, cb, &mut data.gap, *slot, &mut k).map_err(in_constraint(c, ""))?;
+                data.gamma[r] = -k.wbar_n;
+                for j in 1..c.kind.rows() {
+                    data.gamma[r + j] = -k.wbar_t[j - 1];
+                }
+            }
             ConstraintKind::Coupler { .. } => data.gamma[r] = 0.0,
             ConstraintKind::Prescribed { function, .. } => {
                 data.gamma[r] = function_derivatives(function, t, cb).map_err(in_constraint(c, "function"))?.2;
@@ -902,9 +928,9 @@ fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
                 data.tau_applied[*iu_b] -= ratio * data.lambda[r];
             }
             ConstraintKind::Prescribed { iu, .. } => data.tau_applied[*iu] += data.lambda[r],
-            ConstraintKind::Velocity { rows, .. } => {
+            ConstraintKind::Gap { .. } | ConstraintKind::Velocity { .. } => {
                 // W λ, with W from the last position stage
-                for k in r..r + rows {
+                for k in r..r + c.kind.rows() {
                     for i in 0..model.nu {
                         data.tau_applied[i] += data.g[(k, i)] * data.lambda[k];
                     }

@@ -1,6 +1,7 @@
 //! Bilateral constraints as model elements: what each constraint holds, its rows and which
 //! velocities they may involve. The constraint stage ([`crate::constraints`]) evaluates them.
 
+use crate::contact::gap::GapFunction;
 use crate::contact::ContactPair;
 use crate::math::Vec3;
 use crate::spatial::Pose;
@@ -170,6 +171,17 @@ pub enum ConstraintKind {
         /// Whether the contact also rolls without slipping.
         rolling: bool,
     },
+    /// A gap contact held closed: its gap function `g_N(q, t) = 0` (1 holonomic row, λ the
+    /// generalized force along `∂g/∂q`) and, when `rolling`, the rates of its tangential
+    /// coordinates (1 non-holonomic row each).
+    Gap {
+        /// The function (its rows in `GapWork::rows` at `slot`).
+        function: Box<GapFunction>,
+        /// Its index among the model's gap functions.
+        slot: usize,
+        /// Whether the tangential coordinates are held too.
+        rolling: bool,
+    },
 }
 
 /// Which loop-closing joint a [`ConstraintKind::Loop`] is. The joint axis is the z-axis of the
@@ -262,6 +274,7 @@ impl ConstraintKind {
             ConstraintKind::Contact { pair, rolling, .. } => {
                 1 + usize::from(*rolling) * if pair.is_planar() { 1 } else { 2 }
             }
+            ConstraintKind::Gap { function, rolling, .. } => 1 + usize::from(*rolling) * function.tangents(),
             ConstraintKind::Loop { joint, .. } => match joint {
                 LoopJoint::Spherical | LoopJoint::Planar => 3,
                 LoopJoint::Cylindrical | LoopJoint::Universal => 4,
@@ -285,7 +298,7 @@ impl ConstraintKind {
             | ConstraintKind::PrescribedBody { body, .. } => Reach::Bodies(*body, 0),
             ConstraintKind::Coupler { iu_a, iu_b, .. } => Reach::Velocities(*iu_a, *iu_b),
             ConstraintKind::Prescribed { iu, .. } => Reach::Velocities(*iu, *iu),
-            ConstraintKind::Velocity { .. } => Reach::All,
+            ConstraintKind::Velocity { .. } | ConstraintKind::Gap { .. } => Reach::All,
         }
     }
     /// Number of holonomic rows (they come first; the rest are non-holonomic velocity rows with
@@ -293,7 +306,7 @@ impl ConstraintKind {
     pub fn holonomic_rows(&self) -> usize {
         match self {
             ConstraintKind::KnifeEdge { .. } | ConstraintKind::Velocity { .. } => 0,
-            ConstraintKind::RollingDisc { .. } | ConstraintKind::Contact { .. } => 1,
+            ConstraintKind::RollingDisc { .. } | ConstraintKind::Contact { .. } | ConstraintKind::Gap { .. } => 1,
             k => k.rows(),
         }
     }

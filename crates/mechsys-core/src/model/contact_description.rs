@@ -293,6 +293,10 @@ pub struct GapContactDescription {
     /// Tangential coordinates `g_T,k(q, t)` (at most 2): the friction law acts against their rates.
     #[serde(default)]
     pub tangents: Vec<GapTermDescription>,
+    /// Normal law (Signorini's if absent; bilateral: g_N = 0 held as a constraint, and with
+    /// `rolling` the tangential coordinates' rates too).
+    #[serde(default)]
+    pub normal: NormalDescription,
     /// Tangential law (frictionless if absent; needs at least one tangent).
     #[serde(default)]
     pub friction: FrictionDescription,

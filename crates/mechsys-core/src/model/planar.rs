@@ -138,6 +138,7 @@ fn selection(model: &Model, data: &Data, ci: usize) -> Result<Option<Selection>>
         | ConstraintKind::Prescribed { .. }
         | ConstraintKind::Velocity { .. }
         | ConstraintKind::Contact { .. }
+        | ConstraintKind::Gap { .. }
         | ConstraintKind::KnifeEdge { .. } => return Ok(None),
         ConstraintKind::RollingDisc { .. } => {
             return Err(err(format!("{what} (rolling disc) rolls out of the plane; it has no planar form")))

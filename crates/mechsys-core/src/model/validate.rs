@@ -1219,6 +1219,25 @@ impl Model {
                 d.name
             );
             let c = super::contact::validate_gap(d, i, n_contact_points, &joints, &mut n_callbacks)?;
+            if let NormalDescription::Bilateral { rolling } = d.normal {
+                let what = format!("gap_contacts[{i}] '{}'", d.name);
+                crate::ensure!(
+                    matches!(d.friction, FrictionDescription::None),
+                    Model,
+                    "{what}.friction: a bilateral contact takes no friction law (rolling = true holds its tangents)"
+                );
+                crate::ensure!(
+                    constraint_names.insert(d.name.clone()),
+                    Model,
+                    "{what}: a constraint has the same name (a bilateral contact is a constraint)"
+                );
+                let (function, slot) = c.gap().map(|(f, s)| (Box::new(f.clone()), s)).expect("a gap contact");
+                let kind = ConstraintKind::Gap { function, slot, rolling };
+                let rows = kind.rows();
+                constraints.push(Constraint { name: d.name.clone(), kind, row, select: None });
+                row += rows;
+                continue;
+            }
             n_contact_points += c.points();
             contacts.push(c);
         }

@@ -161,7 +161,10 @@ impl Phase<'_> {
             ev.point_energy[pt] = 0.0;
         }
         for a in 0..dm {
-            let after: f64 = (0..nu).map(|i| self.rows[(a, i)] * u[i]).sum();
+            // ġ⁺ with the rheonomic part, as ġ⁻; what drives that part works by -Λ w̃
+            let w = self.surface_rate(pts[a / d], a % d);
+            let after: f64 = (0..nu).map(|i| self.rows[(a, i)] * u[i]).sum::<f64>() + w;
+            diss.external -= total[a] * w;
             let e = -total[a] * 0.5 * (after + before[a]);
             ev.point_energy[pts[a / d]] += e;
             if a % d == 0 {
@@ -266,7 +269,9 @@ impl Phase<'_> {
             let l = self.rhs[j];
             let (pt, k) = self.unk[j];
             imp[3 * pt + k] += l;
-            let after: f64 = (0..nu).map(|c| self.rows[(j, c)] * u[c]).sum::<f64>() + self.surface_rate(pt, k);
+            let w = self.surface_rate(pt, k);
+            let after: f64 = (0..nu).map(|c| self.rows[(j, c)] * u[c]).sum::<f64>() + w;
+            diss.external -= l * w;
             let e = -l * 0.5 * (before[j] + after);
             self.ev.point_energy[pt] += e;
             if k == 0 {

@@ -227,6 +227,9 @@ pub struct Dissipation {
     pub impact: f64,
     /// Kinetic energy taken by tangential impulses (J).
     pub friction: f64,
+    /// Work done on the system through the impulses by what drives the contacts' rheonomic terms
+    /// (a conveyor belt, a time-dependent gap): `-Λᵀ w̃` (J).
+    pub external: f64,
 }
 
 /// Observer of the driver: called at each output time with the phase freshly evaluated at
@@ -268,6 +271,7 @@ pub fn integrate<'a>(
     let d = timed_transition(phase, t, &mut y, (&mut imp, warnings), &triggered, &mut stats)?;
     diss.impact += d.impact;
     diss.friction += d.friction;
+    diss.external += d.external;
     phase.rhs(t, &y, &mut st.k[0])?;
     phase.event_values(&mut e_start);
     let mut cap = phase.after_step()?;
@@ -373,6 +377,7 @@ pub fn integrate<'a>(
             let d = timed_transition(phase, t, &mut y, (&mut imp, warnings), &triggered, &mut stats)?;
             diss.impact += d.impact;
             diss.friction += d.friction;
+            diss.external += d.external;
             phase.rhs(t, &y, &mut st.k[0])?;
             stats.evaluations += 1;
             phase.event_values(&mut e_start);

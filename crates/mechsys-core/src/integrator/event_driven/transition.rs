@@ -261,6 +261,7 @@ impl Phase<'_> {
             let d = r?;
             diss.impact += d.impact;
             diss.friction += d.friction;
+            diss.external += d.external;
             self.free_motion(t, q, u)?;
             // after an impulse the forces are new: nothing is decided by the old ones
             self.ev.leaving.fill(false);
@@ -324,6 +325,7 @@ impl Phase<'_> {
             self.ev.hit = culprits;
             diss.impact += d.impact;
             diss.friction += d.friction;
+            diss.external += d.external;
             self.free_motion(t, q, u)?;
             closing.retain(|&pt| self.kin[pt].gd_n.abs() <= vtol);
             if !self.transition_lcp(closing)? {
@@ -364,6 +366,7 @@ impl Phase<'_> {
         let d = self.settle(u, imp);
         diss.impact += d.impact;
         diss.friction += d.friction;
+        diss.external += d.external;
         self.check_switches(t, q, u, old)?;
         // the sliding points' starting coefficients, for the jam indicator
         self.evaluate(t, q, u)?;
