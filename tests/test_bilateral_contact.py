@@ -227,3 +227,24 @@ t_end = 0.5
                           "hold", "--at", "equilibrium", "--out-dir", str(tmp_path)], capture_output=True, text=True)
     assert lin.returncode == 0, lin.stderr
     assert "13.1838" in lin.stdout
+
+
+def test_static_equilibrium_with_contacts_held_gives_the_contact_forces():
+    # the disc in the elliptical hole, started beside the bottom: it rolls down to the bottom,
+    # where the hole carries its weight (normal force m g, no friction needed)
+    a, b, r = 1.2, 1.0, 0.1
+    s = -np.pi / 2 + 0.2
+    p = np.array([a * np.cos(s), b * np.sin(s)])
+    n = -np.array([np.cos(s) / a, np.sin(s) / b])
+    c = p + r * n / np.linalg.norm(n)
+    m = _disc_in_hole(a, b, r)
+    eq = ms.analysis.static_equilibrium(m, q=(c[0], c[1], 0.3), contacts="roll")
+    np.testing.assert_allclose(eq["q"][:2], [0.0, -b + r], atol=1e-9)
+    np.testing.assert_allclose(eq["lambda"]["hole"], [G, 0.0], atol=1e-9)
+    # without the contacts held the disc has no equilibrium at all (it would fall)
+    with pytest.raises(ms.errors.SolverError):
+        ms.analysis.static_equilibrium(m, q=(c[0], c[1], 0.3))
+    # gravity pointing up: the disc would have to be pulled onto the hole
+    up = _disc_in_hole(a, b, r, gravity=G)
+    with pytest.raises(ms.errors.SolverError, match="contact 'hole' would have to pull"):
+        ms.analysis.static_equilibrium(up, q=(0.0, -b + r, 0.0), contacts="hold")

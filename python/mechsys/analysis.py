@@ -13,7 +13,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from . import _core
-from .errors import ModelError, SolverError
+from .errors import ModelError, SettingsError, SolverError
 from .model import Model
 
 
@@ -97,11 +97,26 @@ def kinematic_analysis(model: Model, t: Sequence[float], q=None) -> dict[str, np
     return {"t": ts, "q": np.array(out_q), "u": np.array(out_u), "udot": np.array(out_a)}
 
 
-def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10, max_iter: int = 50) -> dict:
+def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10, max_iter: int = 50,
+                       contacts: str = "ignore") -> dict:
     """Static equilibrium of a constrained model at time t: h(q, 0, t) + G(q)^T lambda = 0 with
     Phi(q, t) = 0, by Newton with a finite-difference stiffness in the velocity coordinates.
     Returns ``{"q", "lambda": {constraint: multipliers}, "residual"}``; the multiplier of a
-    driving constraint is the force or torque the drive must supply (virtual work)."""
+    driving constraint is the force or torque the drive must supply (virtual work).
+
+    ``contacts``: ``"ignore"`` (unilateral contacts exert nothing), or ``"hold"``/``"roll"``: the
+    contacts closed at the start q are held closed (sliding freely, or rolling without slip) and
+    their forces come back in ``lambda`` under their names (normal, then tangential); a held
+    contact that would have to pull in the equilibrium found (it opens there) or, rolling, slip
+    is a SolverError naming it."""
+    held = {}
+    if contacts != "ignore":
+        if contacts not in ("hold", "roll"):
+            raise SettingsError(f"static equilibrium: contacts: expected 'ignore', 'hold' or 'roll', got {contacts!r}")
+        from .linear import _held_model
+
+        q_start, _ = assemble(model, q, None, t)
+        model, held = _held_model(model, q_start, np.zeros(model.nu), t, contacts)
     core, callbacks = model.engine()
     qk, _ = assemble(model, q, None, t)
     nu, nc = core.nu, core.nc
@@ -134,6 +149,15 @@ def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10,
     else:
         raise SolverError(f"static equilibrium: Newton did not converge (residual {np.abs(f).max():.3e})")
     names = {c["name"]: lam[c["row"] : c["row"] + c["rows"]].copy() for c in core.constraints()}
+    for name, mu in held.items():
+        lam_c = names[name]
+        if lam_c[0] <= 0.0:
+            raise SolverError(f"static equilibrium: contact '{name}' would have to pull (normal force {lam_c[0]:.4g} N) "
+                              "in the equilibrium found: it opens there")
+        if contacts == "roll" and np.linalg.norm(lam_c[1:]) > mu * lam_c[0] * (1 + 1e-12):
+            raise SolverError(f"static equilibrium: contact '{name}' would need a friction force "
+                              f"{np.linalg.norm(lam_c[1:]):.4g} N, more than mu0 x normal force ({mu:.3g} x {lam_c[0]:.4g} N): "
+                              "it slips")
     return {"q": qk, "lambda": names, "residual": float(np.abs(f).max())}
 
 
