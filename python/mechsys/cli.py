@@ -370,7 +370,8 @@ def info(model_file: Path) -> None:
     if contacts:
         click.echo("")
         click.echo(f"contacts ({len(contacts)}; simulate with --integrator moreau_jean or event_driven):")
-        rows = [(c["name"], f"{c['body1']} / {c['body2']}", str(c["points"]), "planar" if c["tangents"] == 1 else "spatial")
+        rows = [(c["name"], "gap function" if c.get("kind") == "gap" else f"{c['body1']} / {c['body2']}", str(c["points"]),
+                 "planar" if c["tangents"] == 1 else "spatial")
                 for c in contacts]
         click.echo(_table(["name", "bodies", "points", "kind"], rows))
     groups = core.contact_groups() if hasattr(core, "contact_groups") else []

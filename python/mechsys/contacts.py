@@ -234,7 +234,7 @@ class _GapCallback:
                 self.taylor = False
         return self._by_differences(t, q, u)
 
-    def _scalar(self, v, kind=float):
+    def _scalar(self, v):
         if isinstance(v, _Taylor2):
             return v
         try:
