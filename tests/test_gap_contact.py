@@ -277,3 +277,33 @@ def test_the_hopping_part_of_the_shaker_example_balances_its_energy_in_both_sche
         ends.append(res["joint/lift/q"][-1])
     # the two schemes land the part at the same place after some 60 hops
     assert abs(ends[0] - ends[1]) < 1e-5
+
+
+def _arm(kind: str) -> ms.Model:
+    """An arm falling about a horizontal hinge onto a stop at 0.2 rad (gravity presses it on)."""
+    m = ms.Model("arm", gravity=(0.0, 0.0, -G))
+    arm = m.add_body("arm", 1.0, np.eye(3) * 0.01, com=(0.5, 0.0, 0.0))
+    m.add_joint(ms.joints.Revolute("hinge", m.ground, arm, axis=(0, 1, 0), q0=-0.3))
+    if kind == "gap":
+        m.add_contact(ms.GapContact("stop", gap="sin(0.2 - hinge)", impact=ms.laws.Newton(eps=0.5)))
+    else:  # the same stop as a point on the arm against a plane through the hinge: n . tip = sin(0.2 - q)
+        m.add_contact(ms.Contact("stop", arm.contour(ms.contours.Point(position=(1.0, 0.0, 0.0))),
+                                 m.ground.contour(ms.contours.Plane(normal=(np.sin(0.2), 0.0, np.cos(0.2)))),
+                                 impact=ms.laws.Newton(eps=0.5)))
+    return m
+
+
+def test_an_accumulation_of_impacts_on_a_gap_stop_ends_closed_as_on_the_same_contour_stop():
+    runs = {}
+    for kind in ("gap", "contour"):
+        res = ms.simulate(_arm(kind), t_end=1.5, integrator=ms.EventDriven(), output_dt=1e-3)
+        impacts = [e["t"] for e in res.events if e["event"] == "impact"]
+        close = [e["t"] for e in res.events if e["event"] == "close"]
+        runs[kind] = (impacts, close, res["joint/hinge/q"], res["contact/stop/state"][-1], res["contact/stop/lambda_n"][-1])
+    gap, contour = runs["gap"], runs["contour"]
+    assert len(gap[0]) == len(contour[0]) > 10
+    np.testing.assert_allclose(gap[0], contour[0], atol=1e-9)
+    assert len(gap[1]) == 1 and abs(gap[1][0] - contour[1][0]) < 1e-9
+    assert gap[3] == 1 and gap[2].max() <= 0.2 + 1e-12
+    # resting on the stop: the gap's force along d(sin(0.2 - q))/dq = -1 holds the gravity moment m g x_c cos(0.2)
+    np.testing.assert_allclose(gap[4], 1.0 * G * 0.5 * np.cos(0.2), rtol=1e-9)

@@ -83,10 +83,14 @@ impl Phase<'_> {
             let acc: f64 = (0..nu).map(|i| self.rows[(a * d, i)] * self.a_free[i]).sum::<f64>() + self.kin[pt].wbar_n;
             let con = model.contact_of_point(pt);
             let kp = &self.kin[pt].point;
-            let scale =
+            // (a gap function's gap is a function of the coordinates: its round-off is about ε)
+            let scale = if con.gap().is_some() {
+                1.0
+            } else {
                 [kp.p1.amax(), kp.p2.amax(), self.data.x_abs[con.body1].r.amax(), self.data.x_abs[con.body2].r.amax()]
                     .iter()
-                    .fold(1e-300f64, |a, b| a.max(*b));
+                    .fold(1e-300f64, |a, b| a.max(*b))
+            };
             unresolved[a] = acc < 0.0 && v * v / (-2.0 * acc) < 64.0 * f64::EPSILON * scale;
         }
         let eps_of = |a: usize, e: f64| if unresolved[a] { 0.0 } else { e };
