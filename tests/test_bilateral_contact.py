@@ -121,6 +121,13 @@ def test_the_nonlinear_cam_shaft_oscillates_at_the_linearized_frequency():
     np.testing.assert_allclose(1.0 / ex.period(res), ex.OMEGA / (2 * np.pi), rtol=1e-4)
 
 
+def _touching(a: float, b: float, r: float, s: float) -> np.ndarray:
+    """The centre of a disc of radius r touching the inside of the ellipse (a, b) at angle s."""
+    p = np.array([a * np.cos(s), b * np.sin(s)])
+    n = -np.array([np.cos(s) / a, np.sin(s) / b])
+    return p + r * n / np.linalg.norm(n)
+
+
 def _disc_in_hole(a: float, b: float, r: float, friction=True, x0: float = 0.0, gravity=-G) -> ms.Model:
     """A disc resting at the bottom of an elliptical hole with semi-axes a (x), b (y)."""
     m = ms.Model("disc", gravity=(0.0, gravity, 0.0), planar=True)
@@ -147,10 +154,7 @@ def test_a_disc_in_an_elliptical_hole_rolls_and_slides_at_the_closed_form_freque
 def test_the_held_linearization_finds_the_equilibrium_from_a_point_on_the_contour():
     a, b, r = 1.2, 1.0, 0.1
     # a start beside the bottom, touching: the centre on the offset curve at ellipse angle -pi/2 + 0.1
-    s = -np.pi / 2 + 0.1
-    p = np.array([a * np.cos(s), b * np.sin(s)])
-    n = -np.array([np.cos(s) / a, np.sin(s) / b])
-    c = p + r * n / np.linalg.norm(n)
+    c = _touching(a, b, r, -np.pi / 2 + 0.1)
     m = _disc_in_hole(a, b, r)
     lin = ms.linear.linearize(m, q=(c[0], c[1], 0.0), at="equilibrium", contacts="roll")
     np.testing.assert_allclose(lin.q[:2], [0.0, -b + r], atol=1e-9)
@@ -233,10 +237,7 @@ def test_static_equilibrium_with_contacts_held_gives_the_contact_forces():
     # the disc in the elliptical hole, started beside the bottom: it rolls down to the bottom,
     # where the hole carries its weight (normal force m g, no friction needed)
     a, b, r = 1.2, 1.0, 0.1
-    s = -np.pi / 2 + 0.2
-    p = np.array([a * np.cos(s), b * np.sin(s)])
-    n = -np.array([np.cos(s) / a, np.sin(s) / b])
-    c = p + r * n / np.linalg.norm(n)
+    c = _touching(a, b, r, -np.pi / 2 + 0.2)
     m = _disc_in_hole(a, b, r)
     eq = ms.analysis.static_equilibrium(m, q=(c[0], c[1], 0.3), contacts="roll")
     np.testing.assert_allclose(eq["q"][:2], [0.0, -b + r], atol=1e-9)

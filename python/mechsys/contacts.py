@@ -39,13 +39,7 @@ class Contact:
         for k, side in (("first", self.first), ("second", self.second)):
             if not isinstance(side, OnBody):
                 raise ModelError(f"{what}.{k}: expected a contour on a body (body.contour(ms.contours.X(...))), got {type(side).__name__}")
-        if not isinstance(self.normal, (laws.Signorini, laws.Bilateral)):
-            raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini() or Bilateral(), got {type(self.normal).__name__}")
-        if isinstance(self.normal, laws.Bilateral):
-            for key in ("friction", "impact"):
-                if getattr(self, key) is not None:
-                    raise ModelError(f"{what}.{key}: a bilateral contact is held closed and takes no {key} law "
-                                     "(laws.Bilateral(rolling=True) holds it without slip)")
+        normal = _normal_law(what, self.normal, self.friction, self.impact)
         d = {
             "name": self.name,
             "body1": self.first.body,
@@ -53,8 +47,8 @@ class Contact:
             "body2": self.second.body,
             "contour2": self.second.contour.describe(f"{what}.contour2"),
         }
-        if isinstance(self.normal, laws.Bilateral):
-            d["normal"] = self.normal.describe(f"{what}.normal")
+        if normal is not None:
+            d["normal"] = normal
         if self.friction is not None:
             if not isinstance(self.friction, (laws.Coulomb, laws.Stribeck, laws.FrictionTable)):
                 raise ModelError(f"{what}.friction: expected a mechsys.laws friction law, got {type(self.friction).__name__}")
@@ -68,6 +62,20 @@ class Contact:
                 raise ModelError(f"{what}.points: expected a whole number from 1 to 8, got {self.points!r}")
             d["points"] = int(self.points)
         return d
+
+
+def _normal_law(what: str, normal, friction, impact) -> dict | None:
+    """The description of a contact's normal law (None for Signorini's, the default); a bilateral
+    contact takes no friction or impact law."""
+    if not isinstance(normal, (laws.Signorini, laws.Bilateral)):
+        raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini() or Bilateral(), got {type(normal).__name__}")
+    if isinstance(normal, laws.Signorini):
+        return None
+    for key, law in (("friction", friction), ("impact", impact)):
+        if law is not None:
+            raise ModelError(f"{what}.{key}: a bilateral contact is held closed and takes no {key} law "
+                             "(laws.Bilateral(rolling=True) holds it without slip)")
+    return normal.describe(f"{what}.normal")
 
 
 def _law_fields(what: str, friction, impact) -> dict:
@@ -182,14 +190,9 @@ class GapContact:
         d = {"name": self.name, "gap": _gap_term(self.gap, f"{what}.gap", callbacks)}
         if tangents:
             d["tangents"] = [_gap_term(f, f"{what}.tangents[{k}]", callbacks) for k, f in enumerate(tangents)]
-        if not isinstance(self.normal, (laws.Signorini, laws.Bilateral)):
-            raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini() or Bilateral(), got {type(self.normal).__name__}")
-        if isinstance(self.normal, laws.Bilateral):
-            for key in ("friction", "impact"):
-                if getattr(self, key) is not None:
-                    raise ModelError(f"{what}.{key}: a bilateral contact is held closed and takes no {key} law "
-                                     "(laws.Bilateral(rolling=True) holds its tangential coordinates)")
-            d["normal"] = self.normal.describe(f"{what}.normal")
+        normal = _normal_law(what, self.normal, self.friction, self.impact)
+        if normal is not None:
+            d["normal"] = normal
         d.update(_law_fields(what, self.friction, self.impact))
         return d
 

@@ -5,10 +5,10 @@ use std::collections::{HashMap, HashSet};
 
 use nalgebra::SymmetricEigen;
 
+use super::contact_description::{FrictionDescription, NormalDescription};
 use super::description::*;
 use super::*;
 use crate::error::{Error, Result};
-use super::contact_description::{FrictionDescription, NormalDescription};
 
 fn err(msg: String) -> Error {
     Error::Model(msg)
@@ -1195,15 +1195,8 @@ impl Model {
                     Model,
                     "{what}: a bilateral contact on a moving surface is not supported; use the unilateral law"
                 );
-                crate::ensure!(
-                    constraint_names.insert(d.name.clone()),
-                    Model,
-                    "{what}: a constraint has the same name (a bilateral contact is a constraint)"
-                );
                 let kind = ConstraintKind::Contact { body1: c.body1, body2: c.body2, pair: Box::new(pair), rolling };
-                let rows = kind.rows();
-                constraints.push(Constraint { name: d.name.clone(), kind, row, select: None });
-                row += rows;
+                hold(&what, &d.name, kind, &mut constraint_names, &mut constraints, &mut row)?;
                 continue;
             }
             n_contact_points += c.points();
@@ -1226,16 +1219,15 @@ impl Model {
                     Model,
                     "{what}.friction: a bilateral contact takes no friction law (rolling = true holds its tangents)"
                 );
-                crate::ensure!(
-                    constraint_names.insert(d.name.clone()),
-                    Model,
-                    "{what}: a constraint has the same name (a bilateral contact is a constraint)"
-                );
                 let (function, slot) = c.gap().map(|(f, s)| (Box::new(f.clone()), s)).expect("a gap contact");
-                let kind = ConstraintKind::Gap { function, slot, rolling };
-                let rows = kind.rows();
-                constraints.push(Constraint { name: d.name.clone(), kind, row, select: None });
-                row += rows;
+                hold(
+                    &what,
+                    &d.name,
+                    ConstraintKind::Gap { function, slot, rolling },
+                    &mut constraint_names,
+                    &mut constraints,
+                    &mut row,
+                )?;
                 continue;
             }
             n_contact_points += c.points();
@@ -1299,6 +1291,27 @@ impl Model {
         }
         Ok(model)
     }
+}
+
+/// A contact held closed (the bilateral normal law) becomes constraint `kind` named `name`, its
+/// rows from `row` on.
+fn hold(
+    what: &str,
+    name: &str,
+    kind: ConstraintKind,
+    names: &mut HashSet<String>,
+    constraints: &mut Vec<Constraint>,
+    row: &mut usize,
+) -> Result<()> {
+    crate::ensure!(
+        names.insert(name.to_string()),
+        Model,
+        "{what}: a constraint has the same name (a bilateral contact is a constraint)"
+    );
+    let rows = kind.rows();
+    constraints.push(Constraint { name: name.to_string(), kind, row: *row, select: None });
+    *row += rows;
+    Ok(())
 }
 
 fn markers(list: &[MarkerDescription], what: &str) -> Result<Vec<Marker>> {
