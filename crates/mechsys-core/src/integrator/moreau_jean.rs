@@ -48,6 +48,7 @@ use crate::model::Model;
 use crate::solver::{self, BlockDelassus, ContactState, Delassus, FrictionContact, Method, Workspace};
 use crate::spatial::Motion;
 
+mod projection;
 mod sparse;
 #[cfg(test)]
 mod tests;
@@ -197,6 +198,8 @@ pub struct MoreauJean {
     sparse: Option<SparseRows>,
     /// Steps taken (for the validity of the groups' warm starts).
     steps: u64,
+    /// The closed contacts' position projection after each step.
+    projection: projection::Projection,
 }
 
 impl MoreauJean {
@@ -274,6 +277,7 @@ impl MoreauJean {
             act: Vec::with_capacity(np),
             sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
             steps: 0,
+            projection: projection::Projection::new(model),
         })
     }
 
@@ -737,6 +741,9 @@ impl MoreauJean {
         model.integrate(&self.q_mid, u, 0.5 * h, q);
         model.normalize(q);
         self.reframe(&self.q_mid, q, u);
+        // closed contacts that the velocity-level step let sink into a curved contour
+        let (proj, results) = (&mut self.projection, &self.results);
+        proj.project(model, data, ws, t + h, q, u, cb, |pt| results[pt].state != OPEN)?;
         if nc > 0 {
             crate::dynamics::constrained::project(model, data, ws, t + h, q, u, cb)?;
         }
