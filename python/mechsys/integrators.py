@@ -127,10 +127,14 @@ class MoreauJean:
     dt: float
     solver: NSGS | Newton | Lemke = NSGS()
     continue_on_painleve: bool = True
+    #: project the contacts that stay closed back onto their contours after each step: stops
+    #: the O(dt) sinking of a contact rolling or sliding along a curved contour (a ball in a
+    #: track); positions move without a force, so the energy balance carries that small work
+    project: bool = False
 
     def describe(self) -> dict:
         return {"type": "moreau_jean", "dt": float(self.dt), "solver": self.solver.describe(),
-                "continue_on_painleve": bool(self.continue_on_painleve)}
+                "continue_on_painleve": bool(self.continue_on_painleve), "project": bool(self.project)}
 
 
 @dataclass(frozen=True)

@@ -63,7 +63,7 @@ INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
     "rk4": ("dt",),
     "dopri5": ("rtol", "atol", "max_step", "first_step"),
     "radau5": ("dt", "rtol", "atol", "newton_tol", "max_step", "first_step"),
-    "moreau_jean": ("dt", "solver", "continue_on_painleve"),
+    "moreau_jean": ("dt", "solver", "continue_on_painleve", "project"),
     "event_driven": ("rtol", "atol", "max_step", "gap_tol", "velocity_tol", "max_events", "continue_on_painleve"),
 }
 
@@ -74,7 +74,7 @@ _INTEGRATOR_OBJECTS = "mechsys.RK4, DOPRI5, Radau5, MoreauJean or EventDriven"
 #: Parameters of integrators and solvers: integers (with their least value), booleans, and numbers
 #: that must be > 0; all other parameters are numbers >= 0.
 _INTEGER_KEYS = {"max_events": 1, "max_iter": 1, "facets": 3}
-_BOOLEAN_KEYS = ("continue_on_painleve",)
+_BOOLEAN_KEYS = ("continue_on_painleve", "project")
 _POSITIVE_KEYS = ("dt", "rtol", "newton_tol", "tol", "pivot_tol", "relaxation")
 #: Keys of a solver table, per solver type (besides ``type``).
 SOLVER_KEYS: dict[str, tuple[str, ...]] = {"nsgs": ("tol", "max_iter", "relaxation"), "newton": ("tol", "max_iter"),

@@ -1086,7 +1086,7 @@ pub fn simulate(
         _ => {}
     }
     let contacts = !model.contacts.is_empty();
-    if let IntegratorKind::MoreauJean { dt, solver, continue_on_painleve } = settings.integrator {
+    if let IntegratorKind::MoreauJean { dt, solver, continue_on_painleve, project } = settings.integrator {
         // Poisson's law (2.203) relates the impulses of an impact's compression and expansion
         // phases; a time step's impulse mixes the impact with the step's smooth forces, so the
         // scheme cannot apply it: refused rather than replaced by Newton's law unseen
@@ -1104,7 +1104,7 @@ pub fn simulate(
                 g.name
             )));
         }
-        return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve), rec);
+        return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve, project), rec);
     }
     crate::ensure!(
         model.contact_groups.is_empty() || matches!(settings.integrator, IntegratorKind::MoreauJean { .. }),
@@ -1272,7 +1272,7 @@ fn time_stepping(
     progress: Option<&Progress>,
     t_out: &[f64],
     y0: Vec<f64>,
-    (dt, solver, continue_on_painleve): (f64, crate::solver::Method, bool),
+    (dt, solver, continue_on_painleve, project): (f64, crate::solver::Method, bool, bool),
     mut rec: Recording,
 ) -> Result<Recording> {
     let budget = Budget::new(settings);
@@ -1281,6 +1281,7 @@ fn time_stepping(
     // (prepare() checked that output_dt is a whole multiple of dt)
     let every = (settings.output_dt / dt).round() as u64;
     let mut stepper = MoreauJean::new(model, dt, solver)?;
+    stepper.project = project;
     let mut group_stats = vec![crate::integrator::moreau_jean::GroupStats::default(); model.contact_groups.len()];
     let (mut data, mut ws) = (Data::new(model), dynamics::Workspace::new(model));
     let mut y = y0;

@@ -71,3 +71,36 @@ fn group_steps_do_not_allocate_after_warm_up() {
     assert_eq!(contacts2, contacts, "the repeated run is the same run");
     assert_eq!(second, 0, "{second} allocations in 400 steps after warm-up");
 }
+
+/// A ball rolling in a spherical bowl (an explicit curved contact, dense assembly) with the
+/// position projection on: every step projects, and none allocates after the first.
+#[test]
+fn projected_steps_do_not_allocate() {
+    let json = r#"{
+        "name": "bowl",
+        "gravity": [0.0, 0.0, -9.81],
+        "bodies": [{"name": "ball", "mass": 1.0, "inertia": [0.004, 0.004, 0.004]}],
+        "joints": [{"name": "free", "type": "free", "parent": "ground", "child": "ball",
+                    "q0": [0.05, 0.0, -0.39686269665968863, 1.0, 0.0, 0.0, 0.0]}],
+        "contacts": [{"name": "bowl", "body1": "ball", "contour1": {"type": "sphere", "radius": 0.1},
+                      "body2": "ground", "contour2": {"type": "bowl", "radius": 0.5},
+                      "friction": {"type": "coulomb", "mu": 0.8}}]
+    }"#;
+    let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
+    let h = 1e-3;
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0 });
+    let mut st = MoreauJean::new(&model, h, method).unwrap();
+    st.project = true;
+    let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
+    let (mut q, mut u) = (model.q0(), model.u0());
+    for k in 0..50 {
+        st.step(&model, &mut data, &mut ws, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
+    }
+    let before = allocations();
+    for k in 50..400 {
+        st.step(&model, &mut data, &mut ws, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
+    }
+    let n = allocations() - before;
+    assert!(st.projections() > 300, "only {} projected steps", st.projections());
+    assert_eq!(n, 0, "{n} allocations in 350 projected steps");
+}

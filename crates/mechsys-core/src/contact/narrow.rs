@@ -388,6 +388,12 @@ impl ContactPair {
         self.planar
     }
 
+    /// Whether its candidates are a clipped face manifold (box–box): points that slide over
+    /// both bodies' faces rather than material points of one of them.
+    pub fn is_clipped_manifold(&self) -> bool {
+        matches!(self.geometry, Geometry::BoxBox { .. })
+    }
+
     pub(crate) fn check_len(&self, len: usize) -> Result<()> {
         ensure!(
             len >= self.count,

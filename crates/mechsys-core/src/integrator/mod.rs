@@ -109,6 +109,12 @@ pub enum IntegratorKind {
         /// a `painleve` event and a warning) instead of raising.
         #[serde(default = "default_true")]
         continue_on_painleve: bool,
+        /// Project the contacts that stay closed back onto their contours after each step
+        /// ([`moreau_jean`]'s position projection): stops the O(h) sinking of contacts rolling
+        /// or sliding along curved contours; it moves positions without a force, so the energy
+        /// balance then carries the projection's (small) work.
+        #[serde(default)]
+        project: bool,
     },
     /// Event-driven integration of contact models ([`event_driven`]).
     EventDriven(event_driven::Options),

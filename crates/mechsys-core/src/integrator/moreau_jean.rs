@@ -198,8 +198,14 @@ pub struct MoreauJean {
     sparse: Option<SparseRows>,
     /// Steps taken (for the validity of the groups' warm starts).
     steps: u64,
+    /// Whether the contacts that stay closed are projected onto their contours after each step.
+    pub project: bool,
     /// The closed contacts' position projection after each step.
     projection: projection::Projection,
+    /// Per explicit point: it was in the last step's contact problem and closed before it.
+    in_step: Vec<bool>,
+    /// Per explicit point: closed (stick or slip) at the start of the step.
+    closed_before: Vec<bool>,
 }
 
 impl MoreauJean {
@@ -277,7 +283,10 @@ impl MoreauJean {
             act: Vec::with_capacity(np),
             sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
             steps: 0,
+            project: false,
             projection: projection::Projection::new(model),
+            in_step: vec![false; np],
+            closed_before: vec![false; np],
         })
     }
 
@@ -313,6 +322,9 @@ impl MoreauJean {
     ) -> Result<(f64, f64)> {
         let (nu, nc, h) = (model.nu, model.nc, self.h);
         let tm = t + 0.5 * h;
+        for (c, r) in self.closed_before.iter_mut().zip(&self.results) {
+            *c = r.state != OPEN;
+        }
         model.integrate(q, u, 0.5 * h, &mut self.q_mid);
         model.normalize(&mut self.q_mid);
         // ---- smooth part at the midpoint: u_free = u + h M⁻¹ (τ - c(ū)), with the velocity-
@@ -728,6 +740,9 @@ impl MoreauJean {
         let mut next = 0;
         for pt in 0..np {
             let hit = self.act[next..].first().is_some_and(|a| matches!(a.source, Source::Point(p) if p == pt));
+            // held: in this step's problem and closed before it (an impact's penetration is the
+            // scheme's own and stays)
+            self.in_step[pt] = hit && self.closed_before[pt];
             if hit {
                 next += 1;
             } else {
@@ -741,13 +756,22 @@ impl MoreauJean {
         model.integrate(&self.q_mid, u, 0.5 * h, q);
         model.normalize(q);
         self.reframe(&self.q_mid, q, u);
-        // closed contacts that the velocity-level step let sink into a curved contour
-        let (proj, results) = (&mut self.projection, &self.results);
-        proj.project(model, data, ws, t + h, q, u, cb, |pt| results[pt].state != OPEN)?;
+        // contacts that the velocity-level step let sink into a curved contour: every point of
+        // the step's problem that was closed before it (a redundant twin of a closed point
+        // too, so a symmetric resting configuration stays symmetric)
+        if self.project {
+            let (proj, in_step) = (&mut self.projection, &self.in_step);
+            proj.project(model, data, ws, t + h, q, u, cb, |pt| in_step[pt])?;
+        }
         if nc > 0 {
             crate::dynamics::constrained::project(model, data, ws, t + h, q, u, cb)?;
         }
         Ok((p.external * h, p.dissipated * h))
+    }
+
+    /// Steps in which the position projection moved a contact back onto its contour.
+    pub fn projections(&self) -> usize {
+        self.projection.count
     }
 
     /// Re-expresses the child-frame velocity blocks of `u`, given in the joint frames of `q_from`,

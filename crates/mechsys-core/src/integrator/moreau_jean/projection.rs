@@ -4,20 +4,22 @@
 //! On a curved contour a contact that rolls or slides along it therefore drifts into it by
 //! O(h²) per step — the midpoint's normal turns within the step — and the drift adds up: a ball
 //! rolling in a curved track sinks steadily. After the step, every explicit contact point that
-//! closed in it and now penetrates is moved back onto its contour by Newton steps on
+//! was in its contact problem and now penetrates is moved back onto its contour by Newton steps on
 //! `g_N(q) = 0` with the smallest correction in the kinetic metric,
 //! `Δu = M̃⁻¹ W μ`, `Wᵀ M̃⁻¹ W μ = -g` (M̃⁻¹ restricted to the bilateral constraints' tangent
 //! space, as in the step), and `q ← q ⊕ Δu` — the direct projection of the closed contacts onto
 //! their admissible set. Velocities are not changed. Points whose multiplier comes out negative
-//! (the others' correction lifts them off) are left to the next iteration.
+//! (the others' correction lifts them off) are left to the next iteration. Box–box pairs are
+//! left out: flat on flat, they do not drift, and their clipped manifold points slide over both
+//! faces.
 
 use nalgebra::DMatrix;
 
 use crate::contact::{contact_point_kinematics, ContactKinematics};
 use crate::data::Data;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::forces::Callbacks;
-use crate::math::linalg::{lu_factor, lu_solve};
+use crate::math::linalg::solve_min_norm;
 use crate::model::Model;
 
 /// Penetration (m) above which a closed point is projected: below the scheme's activation
@@ -35,7 +37,9 @@ pub(super) struct Projection {
     rows: DMatrix<f64>,
     cols: Vec<f64>,
     a: Vec<f64>,
+    aat: Vec<f64>,
     piv: Vec<usize>,
+    work: Vec<f64>,
     mu: Vec<f64>,
     du: Vec<f64>,
     q_tmp: Vec<f64>,
@@ -52,7 +56,9 @@ impl Projection {
             rows: DMatrix::zeros(np, nu),
             cols: vec![0.0; np * nu],
             a: vec![0.0; np * np],
+            aat: vec![0.0; np * np],
             piv: vec![0; np],
+            work: vec![0.0; np],
             mu: vec![0.0; np],
             du: vec![0.0; nu],
             q_tmp: vec![0.0; model.nq],
@@ -61,7 +67,7 @@ impl Projection {
     }
 
     /// Projects `q` (at time `t`, velocities `u` only for the gap functions' evaluation) so that
-    /// no point with `closed(pt)` penetrates by more than [`TOLERANCE`]. `ws` holds the step's
+    /// no point with `closed(pt)` (in the step's problem) penetrates by more than [`TOLERANCE`]. `ws` holds the step's
     /// factor of M (and of the bilateral constraints' Schur complement when `model.nc > 0`).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn project(
@@ -82,7 +88,9 @@ impl Projection {
             self.points.clear();
             for con in &model.contacts {
                 let range = con.first..con.first + con.points();
-                if !range.clone().any(&closed) {
+                // a box–box manifold rests on flat faces (no drift to undo), and its clipped
+                // points are no material points a correction could be computed for
+                if !range.clone().any(&closed) || con.pair().is_some_and(|p| p.is_clipped_manifold()) {
                     continue;
                 }
                 // (the rates come from stale velocities and are not used: only g, n and points)
@@ -139,15 +147,10 @@ impl Projection {
                 }
                 self.mu[i] = -self.kin[self.points[i]].point.g_n;
             }
-            // points that cannot move independently (two candidates on one rigid pair) make A
-            // singular: a tiny diagonal shift picks the least-norm-like answer
-            let scale = (0..m).fold(0.0f64, |s, i| s.max(self.a[i * m + i]));
-            for i in 0..m {
-                self.a[i * m + i] += 1e-12 * scale.max(f64::MIN_POSITIVE);
-            }
-            lu_factor(&mut self.a[..m * m], m, &mut self.piv[..m])
-                .map_err(|e| Error::Solver(format!("contact projection at t = {t:.6} s: {e}")))?;
-            lu_solve(&self.a[..m * m], m, &self.piv[..m], &mut self.mu[..m]);
+            // points that cannot move independently (a box's four corners on a face) make A
+            // singular: the minimum-norm multipliers share the correction evenly (and keep a
+            // symmetric configuration symmetric)
+            solve_min_norm(&self.a[..m * m], m, &mut self.mu[..m], &mut self.aat[..m * m], &mut self.piv[..m], &mut self.work[..m], 1e-12);
             self.du.fill(0.0);
             for j in 0..m {
                 // a negative multiplier would pull a contact shut: left to the next iteration
