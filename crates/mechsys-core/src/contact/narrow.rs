@@ -1148,3 +1148,6 @@ mod tests;
 
 #[cfg(test)]
 mod curve_tests;
+
+#[cfg(test)]
+mod mesh_tests;
