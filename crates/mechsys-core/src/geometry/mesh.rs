@@ -331,7 +331,13 @@ impl TriMesh {
             let nd = &self.nodes[node];
             if nd.count > 0 {
                 for &t in &self.order[nd.index as usize..(nd.index + nd.count) as usize] {
-                    let (point, feature) = closest_on_triangle(y, &self.corners(t as usize));
+                    let corners = self.corners(t as usize);
+                    // the distance to the triangle's plane bounds it from below: a cheap rejection
+                    let h = self.normals[t as usize].dot(&(y - corners[0]));
+                    if h * h >= best.dist2 {
+                        continue;
+                    }
+                    let (point, feature) = closest_on_triangle(y, &corners);
                     let d2 = (y - point).norm_squared();
                     if d2 < best.dist2 {
                         best = Closest { triangle: t, feature, point, dist2: d2 };
