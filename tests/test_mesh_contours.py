@@ -315,3 +315,9 @@ def test_model_files_take_a_mesh_file_or_inline_triangles(tmp_path):
     for contour, message in bad.items():
         with pytest.raises(ms.ModelError, match=message):
             load_model(_write_model(tmp_path, contour))
+    # a description that reaches the engine with a file (not through the loader) is refused clearly
+    import tomllib
+
+    desc = tomllib.loads(MODEL.replace("CONTOUR", '{ type = "mesh", file = "meshes/sq.obj" }'))
+    with pytest.raises(ms.ModelError, match=r"contour2.file: mesh files are read by the Python model loader"):
+        ms.Model.from_dict(desc).build()
