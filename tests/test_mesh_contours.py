@@ -135,6 +135,23 @@ def test_a_box_resting_on_a_mesh_floor_carries_its_weight_on_four_corners(integr
     assert res["joint/free/q"][-1, 2] == pytest.approx(0.05, abs=tol)
 
 
+def test_a_capsule_lying_on_a_mesh_floor_rests_on_its_end_spheres():
+    # a rod of length L and radius r across the grid: each end sphere carries half its weight
+    mass, L, r = 1.5, 0.4, 0.03
+    v, t = floor(1.0, 7, z=0.0)
+    m = ms.Model("rod", gravity=(0.0, 0.0, -G))
+    rod = m.add_body("rod", mass, ms.inertia.cylinder(mass, r, L, axis="x"))
+    qz = 0.6
+    m.add_joint(ms.joints.Free("free", m.ground, rod, q0=[0.1, 0.05, r + 1e-4, math.cos(qz / 2), 0.0, 0.0, math.sin(qz / 2)]))
+    m.add_contact(ms.Contact("floor", rod.contour(ms.contours.Capsule(a=(-L / 2, 0, 0), b=(L / 2, 0, 0), radius=r)),
+                             m.ground.contour(ms.contours.Mesh(v, t)), friction=ms.laws.Coulomb(mu=0.5)))
+    res = ms.simulate(m, t_end=0.5, integrator=ms.EventDriven(), output_dt=1e-2)
+    lam = res["contact/floor/lambda_n"][-1]
+    assert lam == pytest.approx([mass * G / 2] * 2, rel=1e-6)
+    assert res["contact/floor/g_n"][-1] == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert res["joint/free/q"][-1, 2] == pytest.approx(r, abs=1e-9)
+
+
 def test_spheres_in_a_mesh_container_as_a_group_equal_the_explicit_contacts():
     # the group's pairs go through the same narrow phase: the same motion as the declared pairs
     def model(group: bool):

@@ -64,11 +64,16 @@ fn mesh_evaluation_does_not_allocate() {
         ContactPair::new("s", Contour::Sphere { center: Vec3::zeros(), radius: 0.05 }, terrain.clone()).unwrap(),
         ContactPair::new(
             "b",
-            Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.1, 0.05, 0.03) },
+            Contour::Box {
+                center: Vec3::zeros(),
+                rotation: Mat3::identity(),
+                half_extents: Vec3::new(0.1, 0.05, 0.03),
+            },
             terrain.clone(),
         )
         .unwrap(),
-        ContactPair::new("c", terrain, Contour::Capsule { a: -Vec3::x() * 0.1, b: Vec3::x() * 0.1, radius: 0.02 }).unwrap(),
+        ContactPair::new("c", terrain, Contour::Capsule { a: -Vec3::x() * 0.1, b: Vec3::x() * 0.1, radius: 0.02 })
+            .unwrap(),
     ];
     let mut out = [ContactPoint::default(); 8];
     let mut kin = [ContactKinematics::default(); 8];

@@ -43,7 +43,9 @@ fn sphere_and_point_on_a_tessellated_plane_match_the_plane() {
     let mut rng = Rng::new(21);
     let floor = grid(8, 1.0, 0.1);
     let plane = Contour::Plane { point: Vec3::new(0.0, 0.0, 0.1), normal: Vec3::z() };
-    for first in [Contour::Sphere { center: Vec3::new(0.02, 0.0, 0.01), radius: 0.15 }, Contour::Point { p: Vec3::zeros() }] {
+    for first in
+        [Contour::Sphere { center: Vec3::new(0.02, 0.0, 0.01), radius: 0.15 }, Contour::Point { p: Vec3::zeros() }]
+    {
         let mesh_pair = ContactPair::new("m", first.clone(), floor.clone()).unwrap();
         let plane_pair = ContactPair::new("p", first.clone(), plane.clone()).unwrap();
         for it in 0..200 {
@@ -53,7 +55,10 @@ fn sphere_and_point_on_a_tessellated_plane_match_the_plane() {
             let x1 = Pose::new(rng.rotation(), x2.point_to_parent(&local));
             let (m, p) = (eval(&mesh_pair, &x1, &x2)[0], eval(&plane_pair, &x1, &x2)[0]);
             assert!((m.g_n - p.g_n).abs() < 1e-12, "#{it}: {} vs {}", m.g_n, p.g_n);
-            assert!((m.n - p.n).norm() < 1e-12 && (m.p1 - p.p1).norm() < 1e-12 && (m.p2 - p.p2).norm() < 1e-12, "#{it}");
+            assert!(
+                (m.n - p.n).norm() < 1e-12 && (m.p1 - p.p1).norm() < 1e-12 && (m.p2 - p.p2).norm() < 1e-12,
+                "#{it}"
+            );
         }
     }
 }
@@ -112,7 +117,8 @@ fn ball_in_a_tessellated_cavity_converges_to_the_bowl_at_second_order() {
 #[test]
 fn box_on_a_mesh_floor_touches_at_four_corners() {
     let floor = grid(6, 1.0, 0.0);
-    let cube = Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.1, 0.15, 0.05) };
+    let cube =
+        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.1, 0.15, 0.05) };
     let pair = ContactPair::new("box", cube.clone(), floor).unwrap();
     assert_eq!(pair.candidates(), 8);
     for (k, angle) in [0.0, 0.3, 1.1].iter().enumerate() {
@@ -136,7 +142,13 @@ fn box_on_a_mesh_floor_touches_at_four_corners() {
 #[test]
 fn normal_is_continuous_across_edges_and_vertices() {
     let v: Vec<Vec3> = (0..8)
-        .map(|i| Vec3::new(if i & 1 == 0 { -0.5 } else { 0.5 }, if i & 2 == 0 { -0.5 } else { 0.5 }, if i & 4 == 0 { -0.5 } else { 0.5 }))
+        .map(|i| {
+            Vec3::new(
+                if i & 1 == 0 { -0.5 } else { 0.5 },
+                if i & 2 == 0 { -0.5 } else { 0.5 },
+                if i & 4 == 0 { -0.5 } else { 0.5 },
+            )
+        })
         .collect();
     // two triangles per face, counter-clockwise seen from outside
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
