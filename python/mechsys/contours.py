@@ -245,7 +245,8 @@ class Mesh(Contour):
     triangle (turns a closed solid into a cavity). ``scale`` multiplies the vertices.
 
     Pairs with a point, a sphere, a box (its 8 corners) and a capsule (its 2 end spheres); see
-    docs/contours.md for the cost and the limits.
+    docs/contours.md for the cost and the limits. Beyond an open mesh's boundary there is no
+    material: a body that gets around the rim of an open bowl is outside it.
 
     >>> bowl = ms.contours.Mesh.from_file("bowl.obj", scale=0.001)  # doctest: +SKIP
     """

@@ -11,9 +11,12 @@
 //! of a face, on an edge or at a vertex. The distance is signed by the side of `y`: the face
 //! normal for a face, else the angle-weighted pseudo-normal of the feature (Bærentzen and
 //! Aanæs, 2005: the sum of the adjacent face normals for an edge, weighted by the faces' angles
-//! at a vertex), which classifies inside and outside correctly for a closed mesh. The contact
-//! normal is the unit direction `±(y - X)`, which equals the face normal on a face and turns
-//! continuously across edges and vertices.
+//! at a vertex), which classifies inside and outside correctly for a closed mesh. Beyond the
+//! boundary of an open mesh (the closest feature a boundary edge or vertex) there is no material:
+//! the solid behind an open mesh is the region whose nearest point lies inside it, so a body
+//! passing around the rim of an open bowl is outside. The contact normal is the unit direction
+//! `±(y - X)`, which equals the face normal on a face and turns continuously across edges and
+//! vertices.
 //!
 //! **Bounding-volume hierarchy.** A binary tree of axis-aligned boxes over the triangles, built
 //! once by splitting at the median of the triangle centroids along the box's longest axis (up to
@@ -79,6 +82,10 @@ pub struct TriMesh {
     edge_normals: Vec<[Vec3; 3]>,
     /// Angle-weighted vertex pseudo-normals (unit; zero for a vertex of no triangle).
     vertex_normals: Vec<Vec3>,
+    /// Bit k set: edge k of the triangle is a boundary edge (one triangle only).
+    boundary_edges: Vec<u8>,
+    /// Whether a vertex lies on a boundary edge.
+    boundary_vertices: Vec<bool>,
     nodes: Vec<Node>,
     /// Triangle indices in leaf order.
     order: Vec<u32>,
@@ -182,6 +189,8 @@ impl TriMesh {
         }
         let mut closed = true;
         let mut edge_normals = vec![[Vec3::zeros(); 3]; tris.len()];
+        let mut boundary_edges = vec![0u8; tris.len()];
+        let mut boundary_vertices = vec![false; nv];
         for (t, tri) in tris.iter().enumerate() {
             for k in 0..3 {
                 let (i, j) = (tri[k], tri[(k + 1) % 3]);
@@ -189,6 +198,9 @@ impl TriMesh {
                     Some(&(o, _)) => normals[t] + normals[o as usize],
                     None => {
                         closed = false;
+                        boundary_edges[t] |= 1 << k;
+                        boundary_vertices[i as usize] = true;
+                        boundary_vertices[j as usize] = true;
                         normals[t]
                     }
                 };
@@ -230,6 +242,8 @@ impl TriMesh {
             normals,
             edge_normals,
             vertex_normals,
+            boundary_edges,
+            boundary_vertices,
             nodes: Vec::new(),
             order: Vec::new(),
             closed,
@@ -298,6 +312,25 @@ impl TriMesh {
             Feature::Edge(k) => self.edge_normals[t][k as usize],
             Feature::Vertex(k) => self.vertex_normals[self.triangles[t][k as usize] as usize],
         }
+    }
+
+    /// Whether a feature of triangle `t` lies on the boundary of an open mesh (an edge of one
+    /// triangle only, or a vertex of such an edge).
+    #[inline]
+    pub fn on_boundary(&self, t: usize, f: Feature) -> bool {
+        match f {
+            Feature::Face => false,
+            Feature::Edge(k) => self.boundary_edges[t] & (1 << k) != 0,
+            Feature::Vertex(k) => self.boundary_vertices[self.triangles[t][k as usize] as usize],
+        }
+    }
+
+    /// Whether `y`, whose closest feature is `f` of triangle `t` at `x`, lies in the solid: behind
+    /// the feature's pseudo-normal, except beyond the boundary of an open mesh, where there is no
+    /// material (the solid behind an open mesh is the region whose nearest point lies inside it).
+    #[inline]
+    pub fn behind(&self, t: usize, f: Feature, y: &Vec3, x: &Vec3) -> bool {
+        !self.on_boundary(t, f) && (y - x).dot(&self.pseudo_normal(t, f)) < 0.0
     }
 
     fn build_hierarchy(&mut self) {
@@ -376,7 +409,7 @@ impl TriMesh {
     pub fn signed_distance(&self, y: &Vec3) -> f64 {
         let c = self.closest(y);
         let d = c.dist2.sqrt();
-        if (y - c.point).dot(&self.pseudo_normal(c.triangle as usize, c.feature)) < 0.0 {
+        if self.behind(c.triangle as usize, c.feature, y, &c.point) {
             -d
         } else {
             d

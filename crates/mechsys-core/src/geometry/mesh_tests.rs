@@ -134,7 +134,15 @@ fn inward_winding_makes_a_cavity() {
     let open = TriMesh::new(&f, &ft, "floor").unwrap();
     assert!(!open.is_closed());
     assert!((open.signed_distance(&Vec3::new(0.5, 0.2, -0.1)) + 0.1).abs() < 1e-15);
-    // beyond the edge x = 1 the floor's edge gives the distance and the side
+    // beyond the edge x = 1 the floor's edge gives the distance; there is no material there, above
+    // or below the floor's plane
     let d = open.signed_distance(&Vec3::new(1.3, 0.5, 0.4));
     assert!((d - 0.5).abs() < 1e-15, "{d}");
+    let d = open.signed_distance(&Vec3::new(1.3, 0.5, -0.4));
+    assert!((d - 0.5).abs() < 1e-15, "{d}");
+    // beyond the corner (1, 1): the corner vertex, also free
+    let d = open.signed_distance(&Vec3::new(1.3, 1.4, -0.6));
+    assert!((d - 0.61f64.sqrt()).abs() < 1e-15, "{d}");
+    // under the floor, within it: inside
+    assert!((open.signed_distance(&Vec3::new(0.9, 0.5, -0.4)) + 0.4).abs() < 1e-15);
 }

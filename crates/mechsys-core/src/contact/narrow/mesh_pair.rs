@@ -7,7 +7,7 @@
 //! - on a face with outward normal `m`: the half-space of that face, `n = m`,
 //!   `g_N = m·(c - a) - r` (signed: negative when `c` lies behind the face);
 //! - on an edge or at a vertex: `n = σ (c - X)/|c - X|` with `σ = ±1` the side of the feature's
-//!   pseudo-normal, `g_N = σ |c - X| - r`. The normal is continuous across the face/edge/vertex
+//!   pseudo-normal (`+1` on an open mesh's boundary), `g_N = σ |c - X| - r`. The normal is continuous across the face/edge/vertex
 //!   regions (on their borders `c - X` is along the face normal).
 //!
 //! `P1 = c - r n`, `P2 = X`, so `P1 - P2 = g_N n`. Rates for a fixed feature: the face normal
@@ -65,7 +65,8 @@ impl MeshGeometry {
         let e = c - x;
         let len = e.norm();
         let pn = x2.a * self.mesh.pseudo_normal(t, hit.feature);
-        let sigma = if e.dot(&pn) < 0.0 { -1.0 } else { 1.0 };
+        // beyond an open mesh's boundary there is no material (see `TriMesh::behind`)
+        let sigma = if e.dot(&pn) < 0.0 && !self.mesh.on_boundary(t, hit.feature) { -1.0 } else { 1.0 };
         // on the feature itself (a centre exactly on an edge or vertex): its pseudo-normal
         let degenerate = !(len > 1e-12 * (1.0 + r));
         let n = if degenerate { pn } else { e * (sigma / len) };

@@ -175,3 +175,16 @@ fn normal_is_continuous_across_edges_and_vertices() {
     let c = eval(&pair, &Pose::new(Mat3::identity(), Vec3::repeat(0.6)), &Pose::IDENTITY)[0];
     assert!((c.n - Vec3::repeat(1.0).normalize()).norm() < 1e-14 && (c.g_n - 0.1 * 3f64.sqrt()).abs() < 1e-14);
 }
+
+/// Beyond an open mesh's boundary there is no material: a ball beside a floor's edge, below its
+/// plane, is open by its distance to the edge; under the floor it penetrates.
+#[test]
+fn beyond_an_open_mesh_boundary_is_free() {
+    let floor = grid(4, 1.0, 0.0);
+    let pair = ContactPair::new("f", Contour::Sphere { center: Vec3::zeros(), radius: 0.1 }, floor).unwrap();
+    let c = eval(&pair, &Pose::new(Mat3::identity(), Vec3::new(1.3, 0.2, -0.4)), &Pose::IDENTITY)[0];
+    assert!((c.g_n - (0.5 - 0.1)).abs() < 1e-14 && (c.n - Vec3::new(0.6, 0.0, -0.8)).norm() < 1e-14, "{c:?}");
+    assert!((c.p2 - Vec3::new(1.0, 0.2, 0.0)).norm() < 1e-14);
+    let c = eval(&pair, &Pose::new(Mat3::identity(), Vec3::new(0.9, 0.2, -0.05)), &Pose::IDENTITY)[0];
+    assert!((c.g_n + 0.15).abs() < 1e-14 && c.n == Vec3::z(), "{c:?}");
+}
