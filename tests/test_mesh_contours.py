@@ -152,6 +152,21 @@ def test_a_capsule_lying_on_a_mesh_floor_rests_on_its_end_spheres():
     assert res["joint/free/q"][-1, 2] == pytest.approx(r, abs=1e-9)
 
 
+def test_a_ball_beside_an_open_bowl_falls_freely():
+    # beyond an open mesh's boundary there is no material: a ball beside the bowl's rim, below it,
+    # falls as in free space (g_N > 0 throughout, no force)
+    v, t = cap(0.5, 0.12, 24)
+    m = ms.Model("outside", gravity=(0.0, 0.0, -G))
+    ball = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, 0.05))
+    m.add_joint(ms.joints.Free("free", m.ground, ball, q0=[0.25, 0.0, -0.5, 1.0, 0.0, 0.0, 0.0]))
+    m.add_contact(ms.Contact("bowl", ball.contour(ms.contours.Sphere(radius=0.05)), m.ground.contour(ms.contours.Mesh(v, t))))
+    for integrator in (ms.MoreauJean(1e-3), ms.EventDriven()):
+        res = ms.simulate(m, t_end=0.3, integrator=integrator, output_dt=1e-2)
+        assert res["contact/bowl/g_n"].min() > 0.05
+        assert np.all(res["contact/bowl/lambda_n"] == 0)
+        assert res["joint/free/q"][:, 2] == pytest.approx(-0.5 - 0.5 * G * res.t**2, abs=1e-9)
+
+
 def test_spheres_in_a_mesh_container_as_a_group_equal_the_explicit_contacts():
     # the group's pairs go through the same narrow phase: the same motion as the declared pairs
     def model(group: bool):
