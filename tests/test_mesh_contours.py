@@ -353,3 +353,41 @@ def test_model_files_take_a_mesh_file_or_inline_triangles(tmp_path):
     desc = tomllib.loads(MODEL.replace("CONTOUR", '{ type = "mesh", file = "meshes/sq.obj" }'))
     with pytest.raises(ms.ModelError, match=r"contour2.file: mesh files are read by the Python model loader"):
         ms.Model.from_dict(desc).build()
+
+
+GROUP_MODEL = """
+name = "group"
+gravity = [0, 0, -9.81]
+
+[[bodies]]
+name = "ball"
+mass = 1.0
+inertia = [0.001, 0.001, 0.001]
+
+[[joints]]
+name = "free"
+type = "free"
+parent = "ground"
+child = "ball"
+q0 = [0.6, 0.3, 0.1, 1, 0, 0, 0]
+
+[[contact_groups]]
+name = "balls"
+members = [{ body = "ball", contour = { type = "sphere", radius = 0.05 } }]
+against = [{ body = "ground", contour = { type = "mesh", file = "sq.obj", scale = 2.0 } }]
+"""
+
+
+def test_a_contact_group_in_a_model_file_takes_a_mesh_file(tmp_path):
+    from mechsys.modelfile import load_model
+
+    (tmp_path / "sq.obj").write_text(OBJ)
+    (tmp_path / "group.toml").write_text(GROUP_MODEL)
+    model, _ = load_model(tmp_path / "group.toml")
+    res = ms.simulate(model, t_end=0.5, integrator=ms.MoreauJean(1e-3), output_dt=1e-2)
+    # dropped 5 cm onto the floor, at rest on it (within the plastic impact step's v dt)
+    assert res["joint/free/q"][-1, 2] == pytest.approx(0.05, abs=1e-3)
+    assert np.abs(res["u"][-1]).max() < 1e-9
+    (tmp_path / "group.toml").write_text(GROUP_MODEL.replace('file = "sq.obj"', 'file = "missing.obj"'))
+    with pytest.raises(ms.ModelError, match=r"contact_groups\[0\] 'balls'.against\[0\].contour.file: no such mesh file"):
+        load_model(tmp_path / "group.toml")
