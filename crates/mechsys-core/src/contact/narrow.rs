@@ -31,7 +31,8 @@
 //! Degenerate configurations give defined values, never NaN: coincident centres (sphere–sphere,
 //! circle–circle) or intersecting capsule axes give the true (negative) gap with a normal fixed
 //! in body 2 (`d1 × d2` for crossing capsule axes); a sphere centre inside a box uses the nearest
-//! face; a cylinder standing exactly upright on the plane uses a fixed rim point.
+//! face; a cylinder standing exactly upright on the plane uses a fixed rim point; a centre exactly
+//! on a mesh's edge or vertex takes that feature's pseudo-normal.
 //!
 //! Capsule–plane: the lowest points of the two end spheres. When the capsule is tilted, the
 //! upper end's point lies inside the capsule (its gap exceeds the lower end's, so it never closes
