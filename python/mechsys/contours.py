@@ -4,7 +4,9 @@ Attach one to a body with ``body.contour(ms.contours.Sphere(radius=0.02))`` and 
 :class:`mechsys.Contact`. All data are in the body frame (m).
 
 In space: :class:`Point`, :class:`Sphere`, :class:`Plane` (half-space below its normal),
-:class:`Box`, :class:`Capsule`, :class:`Cylinder`. In the plane (the body's x-y plane):
+:class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Torus`, :class:`Ellipsoid`, the
+cavities :class:`Bowl` and :class:`Bore`, and triangle meshes :class:`Mesh` (from arrays or
+from STL/OBJ files). In the plane (the body's x-y plane):
 :class:`Point`, :class:`Circle`, :class:`Line` (half-plane behind its normal), :class:`Polygon`
 (convex, vertices counter-clockwise), and the parametric contours of section 2.2.7.1 —
 :class:`Ellipse`, :class:`Spline` (through points, or sampled from a function with
@@ -230,6 +232,114 @@ class Bore(Contour):
     def describe(self, what: str) -> dict:
         return {"type": "bore", "center": _vec3(self.center, f"{what}.center"), "axis": _vec3(self.axis, f"{what}.axis"),
                 "radius": _radius(self.radius, f"{what}.radius")}
+
+
+class Mesh(Contour):
+    """A triangle mesh (a bowl, a track, a container, uneven ground), rigid on its body.
+
+    ``vertices``: (n, 3) points in the body frame (m); ``triangles``: (m, 3) vertex indices (from
+    0), each counter-clockwise seen from outside the solid, so that its normal
+    ``(b - a) × (c - a)`` points out of the material. The solid lies behind the triangles: below
+    an open mesh (a terrain, a bowl's shell with its normals up and in), inside a closed mesh
+    wound outward, outside a closed mesh wound inward (a cavity). ``flip=True`` reverses every
+    triangle (turns a closed solid into a cavity). ``scale`` multiplies the vertices.
+
+    Pairs with a point, a sphere, a box (its 8 corners) and a capsule (its 2 end spheres); see
+    docs/contours.md for the cost and the limits. Beyond an open mesh's boundary there is no
+    material: a body that gets around the rim of an open bowl is outside it.
+
+    >>> bowl = ms.contours.Mesh.from_file("bowl.obj", scale=0.001)  # doctest: +SKIP
+    """
+
+    kind = "mesh"
+
+    def __init__(self, vertices, triangles, *, scale: float = 1.0, flip: bool = False, source: str | None = None):
+        what = f"Mesh({source!r})" if source else "Mesh"
+        self.vertices, self.triangles = _mesh_arrays(vertices, triangles, scale, flip, what)
+        self.source = source
+
+    @classmethod
+    def from_file(cls, path, scale: float = 1.0, flip: bool = False) -> "Mesh":
+        """Reads an STL (ASCII or binary), OBJ, PLY, OFF, ... file through the ``trimesh``
+        library (vertices with equal coordinates merged, so neighbouring triangles share their
+        edges).
+        ``scale`` converts the file's units to metres (0.001 for millimetres)."""
+        v, t = _read_mesh_file(path, f"Mesh.from_file({str(path)!r})")
+        return cls(v, t, scale=scale, flip=flip, source=str(path))
+
+    def __repr__(self) -> str:
+        src = f", source={self.source!r}" if self.source else ""
+        return f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles{src})"
+
+    def describe(self, what: str) -> dict:
+        return {"type": "mesh", "vertices": self.vertices.tolist(), "triangles": self.triangles.tolist()}
+
+
+def _mesh_arrays(vertices, triangles, scale, flip, what: str):
+    """Checked (n, 3) float vertices (scaled) and (m, 3) int64 triangles (reversed if ``flip``);
+    errors name ``what``. The engine checks the rest (degenerate triangles, orientation)."""
+    import numpy as np
+
+    try:
+        v = np.asarray(vertices, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what}.vertices: expected an (n, 3) array of numbers") from None
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ModelError(f"{what}.vertices: expected an (n, 3) array, got shape {v.shape}")
+    try:
+        t_raw = np.asarray(triangles)
+        if t_raw.size and not np.issubdtype(t_raw.dtype, np.integer):
+            if not np.issubdtype(t_raw.dtype, np.floating) or not np.all(t_raw == np.round(t_raw)):
+                raise TypeError
+        t = t_raw.astype(np.int64)
+    except (TypeError, ValueError, OverflowError):
+        raise ModelError(f"{what}.triangles: expected an (m, 3) array of whole vertex indices") from None
+    if t.size == 0:
+        raise ModelError(f"{what}: the mesh has no triangles")
+    if t.ndim != 2 or t.shape[1] != 3:
+        raise ModelError(f"{what}.triangles: expected an (m, 3) array, got shape {t.shape}")
+    if not isinstance(flip, bool):
+        raise ModelError(f"{what}.flip: expected true or false, got {flip!r}")
+    scale = _radius(scale, f"{what}.scale")
+    if not (math.isfinite(scale) and scale > 0):
+        raise ModelError(f"{what}.scale: must be > 0 and finite, got {scale}")
+    bad = np.argwhere(~np.isfinite(v))
+    if len(bad):
+        raise ModelError(f"{what}: vertex {int(bad[0][0])} must be finite, got {v[bad[0][0]].tolist()}")
+    out = np.argwhere((t < 0) | (t >= len(v)))
+    if len(out):
+        i, j = (int(x) for x in out[0])
+        raise ModelError(f"{what}: triangle {i} vertex {j} is index {int(t[i, j])}, out of range "
+                         f"(the mesh has {len(v)} vertices)")
+    return v * scale, (t[:, ::-1].copy() if flip else t)
+
+
+def _read_mesh_file(path, what: str):
+    """(vertices, triangles) of a mesh file, through trimesh; errors name ``what`` and the file."""
+    from pathlib import Path
+
+    try:
+        import trimesh
+    except ImportError:
+        raise ModelError(f"{what}: reading mesh files needs the 'trimesh' package (pip install trimesh)") from None
+    p = Path(path)
+    if not p.is_file():
+        raise ModelError(f"{what}: no such mesh file '{p}'")
+    import numpy as np
+
+    try:
+        # unprocessed: the merge below is ours, the same for every format
+        mesh = trimesh.load(str(p), force="mesh", process=False)
+        faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
+        vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=float)
+    except Exception as e:  # noqa: BLE001 - any reader failure is the file's fault
+        raise ModelError(f"{what}: cannot read mesh file '{p}': {e}") from None
+    if faces.ndim != 2 or len(faces) == 0:
+        raise ModelError(f"{what}: mesh file '{p}' contains no triangles")
+    # STL repeats each vertex per triangle: merge equal coordinates, so neighbours share edges
+    # (the engine's orientation check and the solid side at edges need that)
+    merged, inverse = np.unique(vertices, axis=0, return_inverse=True)
+    return merged, inverse.reshape(-1)[faces]
 
 
 _SOLIDS = ("left", "right", "inside", "outside")
@@ -642,6 +752,7 @@ __all__ = [
     "Ellipsoid",
     "Bowl",
     "Bore",
+    "Mesh",
     "Ellipse",
     "Spline",
     "Cam",

@@ -210,7 +210,53 @@ def _load_toml(path: Path) -> tuple[Model, Any]:
         # load instead of at the run ("the model refers to 1 callbacks, 0 given")
         raise ModelError(f"{where}: a callback needs a Python callable, which a TOML file cannot hold; "
                          "use a function given by values (constant, ramp, harmonic, table) or a .py model file")
+    _resolve_meshes(data, path.parent)
     return Model.from_dict(data), sim
+
+
+def _resolve_meshes(data: dict, folder: Path) -> None:
+    """Mesh contours (``type = "mesh"``) in place: a ``file`` (relative to the model file) read
+    through trimesh, ``scale`` and ``flip`` applied, leaving the ``vertices`` and ``triangles``
+    the engine reads. Errors name the contour's key path and the file."""
+    from .contours import _mesh_arrays, _read_mesh_file
+
+    def fix(table, where: str) -> None:
+        if not isinstance(table, dict) or table.get("type") != "mesh":
+            return
+        extra = set(table) - {"type", "file", "vertices", "triangles", "scale", "flip"}
+        if extra:
+            raise ModelError(f"{where}: unknown key(s) {', '.join(sorted(extra))} for a mesh "
+                             "(expected file or vertices and triangles, scale, flip)")
+        file = table.pop("file", None)
+        if file is not None:
+            if not isinstance(file, str):
+                raise ModelError(f"{where}.file: expected a file name, got {_tname(file)}")
+            if "vertices" in table or "triangles" in table:
+                raise ModelError(f"{where}: give a mesh file or vertices and triangles, not both")
+            v, t = _read_mesh_file(folder / file, f"{where}.file")
+        else:
+            if "vertices" not in table or "triangles" not in table:
+                raise ModelError(f"{where}: a mesh needs a file or both vertices and triangles")
+            v, t = table.pop("vertices"), table.pop("triangles")
+        v, t = _mesh_arrays(v, t, table.pop("scale", 1.0), table.pop("flip", False), where)
+        table["vertices"], table["triangles"] = v.tolist(), t.tolist()
+
+    def label(item, key: str, i: int) -> str:
+        name = item.get("name") if isinstance(item, dict) else None
+        return f"{key}[{i}]" + (f" '{name}'" if isinstance(name, str) else "")
+
+    for i, c in enumerate(data.get("contacts", []) if isinstance(data.get("contacts"), list) else []):
+        if isinstance(c, dict):
+            for k in ("contour1", "contour2"):
+                fix(c.get(k), f"{label(c, 'contacts', i)}.{k}")
+    groups = data.get("contact_groups", [])
+    for i, g in enumerate(groups if isinstance(groups, list) else []):
+        if isinstance(g, dict):
+            for key in ("members", "against"):
+                items = g.get(key, [])
+                for k, m in enumerate(items if isinstance(items, list) else []):
+                    if isinstance(m, dict):
+                        fix(m.get("contour"), f"{label(g, 'contact_groups', i)}.{key}[{k}].contour")
 
 
 def _callback_in(node, path: str = "") -> str | None:

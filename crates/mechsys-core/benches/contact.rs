@@ -25,6 +25,10 @@
 //!   and the coast side, 4: each tooth flank), gear 1 at random angles and gear 2 at the
 //!   conjugate angle with the drive flanks 10 µm apart, both turning;
 //!
+//! - `mesh/<pair>_evaluate/100`, `mesh/<pair>_kinematics/100`: sphere–mesh and box–mesh (8
+//!   corner queries) on wavy terrains of 98, 10 082 and 100 352 triangles, beside sphere–plane
+//!   (`-- mesh` runs them alone);
+//!
 //! Run with `cargo bench -p mechsys-core --bench contact` (about a minute; `-- --quick` for a
 //! rough figure).
 
@@ -119,6 +123,92 @@ fn bench_narrow(c: &mut Criterion) {
     bench_box_box(c);
     bench_curves(c);
     bench_gears(c);
+    bench_mesh(c);
+}
+
+/// A wavy terrain over [-1, 1]² (z = 0.05 sin 3x cos 2y), `k × k` cells of two triangles each.
+fn terrain(k: usize) -> Contour {
+    use mechsys_core::geometry::mesh::TriMesh;
+    let h = |x: f64, y: f64| 0.05 * (3.0 * x).sin() * (2.0 * y).cos();
+    let s = |i: usize| -1.0 + 2.0 * i as f64 / k as f64;
+    let mut v = Vec::with_capacity((k + 1) * (k + 1));
+    for j in 0..=k {
+        for i in 0..=k {
+            v.push(Vec3::new(s(i), s(j), h(s(i), s(j))));
+        }
+    }
+    let id = |i: usize, j: usize| j * (k + 1) + i;
+    let mut t = Vec::with_capacity(2 * k * k);
+    for j in 0..k {
+        for i in 0..k {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Contour::Mesh(std::sync::Arc::new(TriMesh::new(&v, &t, "terrain").expect("valid mesh")))
+}
+
+/// Spheres (radius 0.05) and boxes (0.1 × 0.08 × 0.06) on terrains of about 100, 10 000 and
+/// 100 000 triangles: [`evaluate`] and [`contact_kinematics`] for 100 pairs at random places
+/// over the terrain, 0 to 2 cm above its surface, turned at random and moving (the box's 8
+/// corners are 8 closest-point queries); sphere–plane beside them.
+fn bench_mesh(c: &mut Criterion) {
+    let n = 100;
+    let mut rng = Rng(0x6d65_7368_0000_0001);
+    let mut g = c.benchmark_group("mesh");
+    g.throughput(Throughput::Elements(n as u64));
+    let bodies: Vec<BodyMotion> = (0..n)
+        .map(|_| {
+            let a = nalgebra::Rotation3::from_euler_angles(
+                rng.uniform(-3.0, 3.0),
+                rng.uniform(-1.5, 1.5),
+                rng.uniform(-3.0, 3.0),
+            )
+            .into_inner();
+            let (x, y) = (rng.uniform(-0.9, 0.9), rng.uniform(-0.9, 0.9));
+            let r = Vec3::new(x, y, 0.05 * (3.0 * x).sin() * (2.0 * y).cos() + 0.05 + rng.uniform(0.0, 0.02));
+            let w = Vec3::new(rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0));
+            let v = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)) - w.cross(&r);
+            BodyMotion {
+                pose: Pose::new(a, r),
+                twist: Motion::new(w, v),
+                acc: Motion::new(Vec3::zeros(), Vec3::new(0.0, 0.0, -9.81)),
+            }
+        })
+        .collect();
+    let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.05 };
+    let cube =
+        Contour::Box { center: Vec3::zeros(), rotation: Mat3::identity(), half_extents: Vec3::new(0.05, 0.04, 0.03) };
+    let plane = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
+    let mut cases = vec![("sphere_plane".to_string(), ball.clone(), plane)];
+    for k in [7usize, 71, 224] {
+        let t = terrain(k);
+        cases.push((format!("sphere_mesh_{}", 2 * k * k), ball.clone(), t.clone()));
+        cases.push((format!("box_mesh_{}", 2 * k * k), cube.clone(), t));
+    }
+    for (name, first, second) in cases {
+        let pair = ContactPair::new("p", first, second).expect("valid pair");
+        let m = pair.candidates();
+        let mut points = vec![ContactPoint::default(); m];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_evaluate"), n), &n, |b, _| {
+            b.iter(|| {
+                for body in &bodies {
+                    evaluate(&pair, &body.pose, &Pose::IDENTITY, &mut points).expect("room");
+                    black_box(&points);
+                }
+            })
+        });
+        let mut kin = vec![ContactKinematics::default(); m];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_kinematics"), n), &n, |b, _| {
+            b.iter(|| {
+                for body in &bodies {
+                    contact_kinematics(&pair, body, &BodyMotion::GROUND, &mut kin).expect("room");
+                    black_box(&kin);
+                }
+            })
+        });
+    }
+    g.finish();
 }
 
 /// Gear pairs in mesh: [`evaluate`] and [`contact_kinematics`] with 4 candidates per pair.

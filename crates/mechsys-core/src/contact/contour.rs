@@ -12,6 +12,8 @@ use crate::spatial::Pose;
 
 use super::broad::Aabb;
 use crate::geometry::curve::Curve;
+use crate::geometry::mesh::TriMesh;
+use std::sync::Arc;
 
 /// 2-vector of `f64` (the coordinates of planar contours in the body's x-y plane).
 pub type Vec2 = nalgebra::Vector2<f64>;
@@ -134,6 +136,10 @@ pub enum Contour {
     /// Planar: a parametric contour (ellipse, spline, cam; see [`crate::geometry::curve`]),
     /// validated when it was built.
     Curve(Box<Curve>),
+    /// A triangle mesh, solid behind its triangles' outward normals (see
+    /// [`crate::geometry::mesh`]), validated with its bounding-volume hierarchy when it was
+    /// built; shared, so the pairs of a contact group do not copy it.
+    Mesh(Arc<TriMesh>),
 }
 
 /// The kind of a contour, for dispatch tables and messages.
@@ -169,6 +175,8 @@ pub enum ContourKind {
     Polygon,
     /// [`Contour::Curve`]
     Curve,
+    /// [`Contour::Mesh`]
+    Mesh,
 }
 
 impl ContourKind {
@@ -190,6 +198,7 @@ impl ContourKind {
             ContourKind::Line => "line",
             ContourKind::Polygon => "polygon",
             ContourKind::Curve => "curve",
+            ContourKind::Mesh => "mesh",
         }
     }
 
@@ -276,6 +285,7 @@ impl Contour {
             Contour::Line { .. } => ContourKind::Line,
             Contour::Polygon { .. } => ContourKind::Polygon,
             Contour::Curve(_) => ContourKind::Curve,
+            Contour::Mesh(_) => ContourKind::Mesh,
         }
     }
 
@@ -365,8 +375,8 @@ impl Contour {
                 Ok(())
             }
             Contour::Polygon { vertices } => validate_polygon(vertices, what),
-            // checked by its constructor
-            Contour::Curve(_) => Ok(()),
+            // checked by their constructors
+            Contour::Curve(_) | Contour::Mesh(_) => Ok(()),
         }
     }
 
@@ -468,6 +478,13 @@ impl Contour {
             }
             // an open curve continues along its end tangents
             Contour::Curve(_) => Aabb::EVERYTHING,
+            Contour::Mesh(m) => {
+                // the extent along world axis k is Σ_j |A_kj| h_j about the box centre
+                let b = m.bounds();
+                let c = pose.point_to_parent(&((b.min + b.max) * 0.5));
+                let e = pose.a.abs() * ((b.max - b.min) * 0.5);
+                Aabb { min: c - e, max: c + e }
+            }
         }
     }
 }
@@ -575,6 +592,11 @@ impl Contour {
                 let s = c.closest_parameter(&Vec2::new(l.x, l.y));
                 [c.curvature(s), 0.0]
             }
+            // flat faces; no curvature defined on an edge or at a vertex
+            Contour::Mesh(m) => match m.closest(&l).feature {
+                crate::geometry::mesh::Feature::Face => [0.0, 0.0],
+                _ => [inf, inf],
+            },
         }
     }
 }

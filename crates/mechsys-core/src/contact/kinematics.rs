@@ -26,8 +26,9 @@
 //! returns `g̈_N` and `d ġ_T/dt` themselves.
 //!
 //! Exactness: the rates are the time derivatives of the narrow phase's closed forms wherever
-//! those are smooth (a fixed face/edge/corner region of a box, fixed clamping of capsule segment
-//! parameters). Not exact: at the degenerate configurations listed in [`super::narrow`] (the
+//! those are smooth (a fixed face/edge/corner region of a box or of a mesh's nearest triangle,
+//! fixed clamping of capsule segment parameters). Where a mesh's nearest face changes over a
+//! concave edge the normal jumps, and so does `ġ_N`. Not exact: at the degenerate configurations listed in [`super::narrow`] (the
 //! normal is then taken as turning with body 2) and for exactly parallel capsule axes, where the
 //! overlap-midpoint rule fixes the parameter on segment 1. Box–box: every candidate has
 //! `ġ_N = d g_N/dt` but a crossing of the clipped manifold (an incident edge crossing a side plane

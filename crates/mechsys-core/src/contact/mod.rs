@@ -1,7 +1,8 @@
 //! Contact geometry and relative contact kinematics (section 2.2.7, notation of section 2.5).
 //!
 //! - [`contour`]: the contours a body carries ([`Contour`]), in the body frame, with validation
-//!   and world bounding boxes.
+//!   and world bounding boxes (a triangle mesh, [`Contour::Mesh`], has its own hierarchy of boxes
+//!   over its triangles, [`crate::geometry::mesh`]).
 //! - [`broad`]: sweep and prune over bounding boxes ([`SweepAndPrune`]).
 //! - [`narrow`]: a [`ContactPair`] of two contours, prepared once, and [`evaluate`], which gives
 //!   a fixed number of candidate [`ContactPoint`]s per pair (gap, normal, points, tangents).

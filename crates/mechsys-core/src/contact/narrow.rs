@@ -18,6 +18,7 @@
 //! | box – box | 8 | separating axes; the clipped incident face (each vertex a point against a face), or one edge–edge point ([`box_box`]) |
 //! | point2, circle, polygon – line | 1, 1, vertices | as the spatial point/sphere – plane |
 //! | point2, circle – circle | 1 | along the centre line in the x-y plane |
+//! | point, sphere, box, capsule – mesh | 1, 1, 8, 2 | each centre (corner, end sphere) against the closest point of the mesh ([`mesh_pair`]) |
 //!
 //! Planar pairs are evaluated in body 2's x-y plane: contours are extruded along body 2's z axis
 //! `e_z`, `n ⟂ e_z`, and `t1 = e_z × n / |e_z × n|` (the one friction direction; `t2 = n × t1` is
@@ -30,7 +31,8 @@
 //! Degenerate configurations give defined values, never NaN: coincident centres (sphere–sphere,
 //! circle–circle) or intersecting capsule axes give the true (negative) gap with a normal fixed
 //! in body 2 (`d1 × d2` for crossing capsule axes); a sphere centre inside a box uses the nearest
-//! face; a cylinder standing exactly upright on the plane uses a fixed rim point.
+//! face; a cylinder standing exactly upright on the plane uses a fixed rim point; a centre exactly
+//! on a mesh's edge or vertex takes that feature's pseudo-normal.
 //!
 //! Capsule–plane: the lowest points of the two end spheres. When the capsule is tilted, the
 //! upper end's point lies inside the capsule (its gap exceeds the lower end's, so it never closes
@@ -49,9 +51,11 @@ use crate::spatial::{Motion, Pose};
 use super::contour::{lift, Contour, ContourKind};
 use box_box::BoxShape;
 use curve_pair::{CurveGeometry, First};
+use mesh_pair::MeshGeometry;
 
 pub mod box_box;
 pub mod curve_pair;
+pub mod mesh_pair;
 
 /// One candidate contact: gap, frame and the two surface points, world components.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -108,6 +112,8 @@ enum Geometry {
     /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
     /// cavity of body 2.
     Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
+    /// Centres of body 1 against a triangle mesh of body 2 ([`mesh_pair`]).
+    Mesh(MeshGeometry),
 }
 
 /// A contour pair prepared for per-step evaluation.
@@ -188,6 +194,7 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
         K::Box => matches!(a, K::Point | K::Sphere | K::Box),
         K::Circle => matches!(a, K::Point2 | K::Circle),
         K::Bowl | K::Bore | K::Ellipsoid => matches!(a, K::Point | K::Sphere),
+        K::Mesh => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule),
         _ => false,
     }
 }
@@ -202,7 +209,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid/torus–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, point/sphere/box/capsule–mesh, in either order)"
         )))
     }
 }
@@ -214,7 +221,8 @@ pub fn candidates(c1: &Contour, c2: &Contour) -> Result<usize> {
     c1.validate(&format!("contour 1 ({})", c1.kind()))?;
     c2.validate(&format!("contour 2 ({})", c2.kind()))?;
     let first = if swapped { c2 } else { c1 };
-    let against_plane = matches!(c1.kind(), ContourKind::Plane) || matches!(c2.kind(), ContourKind::Plane);
+    // end spheres and rim circles against a half-space, end spheres against a mesh
+    let against_plane = [c1.kind(), c2.kind()].iter().any(|k| matches!(k, ContourKind::Plane | ContourKind::Mesh));
     Ok(match first {
         // the clipped incident face has at most 8 vertices (one point for an edge–edge contact)
         Contour::Box { .. } if matches!((c1.kind(), c2.kind()), (ContourKind::Box, ContourKind::Box)) => {
@@ -565,6 +573,7 @@ impl ContactPair {
             Geometry::SphereEllipsoid { center, radius, e_center, e_rotation, semi } => {
                 sphere_ellipsoid(x1, x2, tw, center, *radius, e_center, e_rotation, semi)
             }
+            Geometry::Mesh(g) => g.one(k, x1, x2, tw),
         }
     }
 }
@@ -601,6 +610,16 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             return Geometry::Curve(CurveGeometry::OnCurve { first, second: (**second).clone(), count: 1, reach: 0.0 });
         }
         _ => {}
+    }
+    if let Contour::Mesh(mesh) = s {
+        let (centers, radius) = match f {
+            Contour::Point { p } => (vec![*p], 0.0),
+            Contour::Sphere { center, radius } => (vec![*center], *radius),
+            Contour::Box { center, rotation, half_extents } => (box_corners(center, rotation, half_extents), 0.0),
+            Contour::Capsule { a, b, radius } => (vec![*a, *b], *radius),
+            _ => unreachable!("excluded by the dispatch table"),
+        };
+        return Geometry::Mesh(MeshGeometry { centers, radius, mesh: mesh.clone() });
     }
     // the second contour's half-space (plane or line), body 2 frame
     let half_space = |s: &Contour| match s {
@@ -651,7 +670,8 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             | Contour::Curve(_)
             | Contour::Bowl { .. }
             | Contour::Bore { .. }
-            | Contour::Ellipsoid { .. } => {
+            | Contour::Ellipsoid { .. }
+            | Contour::Mesh(_) => {
                 unreachable!("excluded by the dispatch table")
             }
         };
@@ -1135,3 +1155,6 @@ mod tests;
 
 #[cfg(test)]
 mod curve_tests;
+
+#[cfg(test)]
+mod mesh_tests;

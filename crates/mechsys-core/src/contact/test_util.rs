@@ -201,6 +201,15 @@ pub(crate) fn sample(kind: &str) -> Contour {
         "spline_bore" => curve_sample("bore"),
         "gear" => curve_sample("gear"),
         "gear_b" => curve_sample("gear_b"),
+        // a closed, non-convex mesh: a once-subdivided icosahedron with jittered radii about 0.5
+        "mesh" => {
+            let (mut v, t) = icosphere(1, 1.0);
+            let mut rng = Rng::new(9);
+            for p in v.iter_mut() {
+                *p = *p * rng.uniform(0.4, 0.6) + Vec3::new(0.03, -0.02, 0.05);
+            }
+            mesh_contour(&v, &t)
+        }
         _ => unreachable!("unknown sample {kind}"),
     }
 }
@@ -284,7 +293,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 13] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 25] = [
+pub(crate) const PAIRS: [(&str, &str); 29] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -310,6 +319,10 @@ pub(crate) const PAIRS: [(&str, &str); 25] = [
     ("sphere", "bowl"),
     ("point", "bore"),
     ("sphere", "bore"),
+    ("point", "mesh"),
+    ("sphere_b", "mesh"),
+    ("box_b", "mesh"),
+    ("capsule_b", "mesh"),
 ];
 
 /// Random placements of two bodies near each other (plane motion: rotations about z, z = 0).
@@ -388,6 +401,109 @@ pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
             let y = xl - center;
             radius - (y - a * a.dot(&y)).norm()
         }
+        Contour::Mesh(m) => mesh_sdf(m, &xl),
+    }
+}
+
+/// An icosphere of `radius` about the origin: the icosahedron with each triangle split into four
+/// `levels` times, vertices pushed onto the sphere; triangles counter-clockwise seen from outside
+/// (20·4^levels triangles).
+pub(crate) fn icosphere(levels: usize, radius: f64) -> (Vec<Vec3>, Vec<[usize; 3]>) {
+    let p = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<Vec3> = [
+        (-1.0, p, 0.0),
+        (1.0, p, 0.0),
+        (-1.0, -p, 0.0),
+        (1.0, -p, 0.0),
+        (0.0, -1.0, p),
+        (0.0, 1.0, p),
+        (0.0, -1.0, -p),
+        (0.0, 1.0, -p),
+        (p, 0.0, -1.0),
+        (p, 0.0, 1.0),
+        (-p, 0.0, -1.0),
+        (-p, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
+    .collect();
+    let mut t: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut split = |a: usize, b: usize, v: &mut Vec<Vec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push(((v[a] + v[b]) * 0.5).normalize());
+                v.len() - 1
+            })
+        };
+        let mut next = Vec::with_capacity(4 * t.len());
+        for &[a, b, c] in &t {
+            let (ab, bc, ca) = (split(a, b, &mut v), split(b, c, &mut v), split(c, a, &mut v));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        t = next;
+    }
+    (v.into_iter().map(|x| x * radius).collect(), t)
+}
+
+/// A mesh contour from vertices and triangles (valid by construction in the tests).
+pub(crate) fn mesh_contour(v: &[Vec3], t: &[[usize; 3]]) -> Contour {
+    Contour::Mesh(std::sync::Arc::new(crate::geometry::mesh::TriMesh::new(v, t, "test mesh").expect("valid mesh")))
+}
+
+/// Brute-force signed distance to a closed mesh (body frame), independent of its hierarchy and
+/// pseudo-normals: the smallest distance to any triangle (the projection onto the face when it
+/// falls inside, else the nearest point of the three edges), negative where the winding number
+/// (the triangles' solid angles, van Oosterom–Strackee, over 4π) is 1 for an outward mesh or 0
+/// for an inward one (a cavity).
+pub(crate) fn mesh_sdf(m: &crate::geometry::mesh::TriMesh, y: &Vec3) -> f64 {
+    let seg = |p: &Vec3, q: &Vec3| {
+        let d = q - p;
+        let s = ((y - p).dot(&d) / d.dot(&d)).clamp(0.0, 1.0);
+        (y - p - d * s).norm()
+    };
+    let mut best = f64::INFINITY;
+    let mut omega = 0.0;
+    for k in 0..m.triangles().len() {
+        let [a, b, c] = m.corners(k);
+        let n = (b - a).cross(&(c - a)).normalize();
+        let q = y - n * n.dot(&(y - a));
+        let inside = [(a, b), (b, c), (c, a)].iter().all(|(p, r)| (r - p).cross(&(q - p)).dot(&n) >= 0.0);
+        let d = if inside { n.dot(&(y - a)).abs() } else { seg(&a, &b).min(seg(&b, &c)).min(seg(&c, &a)) };
+        best = best.min(d);
+        let (ra, rb, rc) = (a - y, b - y, c - y);
+        let (la, lb, lc) = (ra.norm(), rb.norm(), rc.norm());
+        let num = ra.dot(&rb.cross(&rc));
+        let den = la * lb * lc + ra.dot(&rb) * lc + rb.dot(&rc) * la + rc.dot(&ra) * lb;
+        omega += 2.0 * num.atan2(den);
+    }
+    let winding = omega / (4.0 * std::f64::consts::PI);
+    let solid = if m.volume() > 0.0 { winding > 0.5 } else { winding > -0.5 };
+    if solid {
+        -best
+    } else {
+        best
     }
 }
 
@@ -400,7 +516,10 @@ pub(crate) fn ellipsoid_sdf(y: &Vec3, a: &Vec3) -> f64 {
     let (mut best, mut bu, mut bv) = (f64::INFINITY, 0.0, 0.0);
     for i in 0..360 {
         for j in 0..=180 {
-            let (u, v) = (std::f64::consts::TAU * i as f64 / 360.0, -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 180.0);
+            let (u, v) = (
+                std::f64::consts::TAU * i as f64 / 360.0,
+                -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 180.0,
+            );
             let d = d2(u, v);
             if d < best {
                 (best, bu, bv) = (d, u, v);
@@ -410,7 +529,16 @@ pub(crate) fn ellipsoid_sdf(y: &Vec3, a: &Vec3) -> f64 {
     let mut step = 0.02;
     while step > 1e-13 {
         let mut moved = false;
-        for (du, dv) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step), (step, step), (-step, -step), (step, -step), (-step, step)] {
+        for (du, dv) in [
+            (step, 0.0),
+            (-step, 0.0),
+            (0.0, step),
+            (0.0, -step),
+            (step, step),
+            (-step, -step),
+            (step, -step),
+            (-step, step),
+        ] {
             let d = d2(bu + du, bv + dv);
             if d < best {
                 (best, bu, bv, moved) = (d, bu + du, bv + dv, true);

@@ -335,6 +335,25 @@ fn contour(
         ContourDescription::Bore { center, axis, radius } => {
             Contour::Bore { center: vec3(center), axis: vec3(axis), radius: *radius }
         }
+        ContourDescription::Mesh { vertices, triangles, file } => {
+            crate::ensure!(
+                file.is_none(),
+                Model,
+                "{what}.file: mesh files are read by the Python model loader (mechsys.load_model, `mechsys run`); \
+                 give vertices and triangles here"
+            );
+            let mut tris = Vec::with_capacity(triangles.len());
+            for (t, tri) in triangles.iter().enumerate() {
+                let mut out = [0usize; 3];
+                for (j, &i) in tri.iter().enumerate() {
+                    crate::ensure!(i >= 0, Model, "{what}.triangles[{t}][{j}]: vertex index must be ≥ 0, got {i}");
+                    out[j] = i as usize;
+                }
+                tris.push(out);
+            }
+            let v: Vec<Vec3> = vertices.iter().map(vec3).collect();
+            Contour::Mesh(std::sync::Arc::new(crate::geometry::mesh::TriMesh::new(&v, &tris, what)?))
+        }
         ContourDescription::Circle { center, radius } => {
             Contour::Circle { center: Vec2::new(center[0], center[1]), radius: *radius }
         }

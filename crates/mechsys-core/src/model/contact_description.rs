@@ -2,7 +2,8 @@
 //! friction law and the impact law, as written in model files and emitted by the Python builder.
 //!
 //! Contours in space: `point`, `sphere`, `plane` (half-space below its normal), `box`, `capsule`,
-//! `cylinder`; in the plane (the x-y plane of the body frame): `point`, `circle`, `line`
+//! `cylinder`, `torus`, `ellipsoid`, `bowl`, `bore`, `mesh` (triangles); in the plane (the x-y
+//! plane of the body frame): `point`, `circle`, `line`
 //! (half-plane behind its normal), `polygon`, and the parametric contours `ellipse`, `spline`,
 //! `cam`, `gear`. Normal contact is always Signorini's law
 //! (g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0); friction is none, Coulomb with a static and a sliding
@@ -144,6 +145,20 @@ pub enum ContourDescription {
         axis: [f64; 3],
         /// Radius, > 0.
         radius: f64,
+    },
+    /// A triangle mesh: the solid lies behind the triangles' outward normals (vertices
+    /// counter-clockwise seen from outside); a closed mesh wound inward is a cavity.
+    Mesh {
+        /// Vertices `[x, y, z]` (m, body frame).
+        #[serde(default)]
+        vertices: Vec<[f64; 3]>,
+        /// Triangles as three vertex indices (from 0).
+        #[serde(default)]
+        triangles: Vec<[i64; 3]>,
+        /// A mesh file, read by the Python loader (which replaces it by `vertices` and
+        /// `triangles`); the engine itself reads no files.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        file: Option<String>,
     },
     /// A circle in the body's x-y plane.
     Circle {

@@ -6,8 +6,8 @@ use nalgebra::{DMatrix, DVector};
 use super::*;
 use crate::contact::narrow::{evaluate, ContactPair};
 use crate::contact::test_util::{close, curve_joints, random_poses, rot, sample, Rng, Trajectory, CURVE_PAIRS, PAIRS};
+use crate::contact::{Contour, ContourKind};
 use crate::geometry::curve::Vec2;
-use crate::contact::Contour;
 use crate::math::Mat3;
 
 fn kin(pair: &ContactPair, b1: &BodyMotion, b2: &BodyMotion) -> Vec<ContactKinematics> {
@@ -39,6 +39,8 @@ fn check_smooth(pair: &ContactPair, tr1: &Trajectory, tr2: &Trajectory, joints: 
     let k0 = at(0.0);
     let (kp, km) = (at(h1), at(-h1));
     let (gp, gm, g0) = (g(h2), g(-h2), g(0.0));
+    let (gph, gmh) = (g(0.5 * h2), g(-0.5 * h2));
+    let mesh = matches!(pair.kinds(), (_, ContourKind::Mesh) | (ContourKind::Mesh, _));
     let (gp1, gm1) = (g(h1), g(-h1));
     let (m1, m2) = (tr1.at(0.0), tr2.at(0.0));
     let body = |tr: &Trajectory, t: f64, p: &Vec3| {
@@ -62,8 +64,21 @@ fn check_smooth(pair: &ContactPair, tr1: &Trajectory, tr2: &Trajectory, joints: 
         }
         let gd_fd = (gp1[k].g_n - gm1[k].g_n) / (2.0 * h1);
         assert!(close(c.gd_n, gd_fd, 1e-6), "{tag}: ġ_N {} vs difference {gd_fd}", c.gd_n);
-        let gdd_fd2 = (gp[k].g_n - 2.0 * g0[k].g_n + gm[k].g_n) / (h2 * h2);
-        assert!(close(c.wbar_n, gdd_fd2, 1e-6), "{tag}: g̈_N {} vs second difference {gdd_fd2} (g_N {})", c.wbar_n, c.point.g_n);
+        let d2 = |p: f64, m: f64, h: f64| (p - 2.0 * g0[k].g_n + m) / (h * h);
+        let gdd_fd2 = if mesh {
+            // Richardson-extrapolated (error O(h⁴)): a centre near a mesh edge or vertex has a
+            // contact curvature of 1/distance, large enough for the plain difference's O(h²)
+            // error to show; the mesh's closed forms have no solver noise for it to amplify
+            (4.0 * d2(gph[k].g_n, gmh[k].g_n, 0.5 * h2) - d2(gp[k].g_n, gm[k].g_n, h2)) / 3.0
+        } else {
+            d2(gp[k].g_n, gm[k].g_n, h2)
+        };
+        assert!(
+            close(c.wbar_n, gdd_fd2, 1e-6),
+            "{tag}: g̈_N {} vs second difference {gdd_fd2} (g_N {})",
+            c.wbar_n,
+            c.point.g_n
+        );
         let gdd_fd = (kp[k].gd_n - km[k].gd_n) / (2.0 * h1);
         assert!(close(c.wbar_n, gdd_fd, 1e-6), "{tag}: g̈_N {} vs difference of ġ_N {gdd_fd}", c.wbar_n);
         // material points at P1 and P2 frozen in their bodies

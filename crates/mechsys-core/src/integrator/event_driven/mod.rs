@@ -8,7 +8,9 @@
 //!   state (with the energy dissipated by sliding and the time integrals of the contact forces) is
 //!   integrated by Dormand–Prince with error control.
 //! - **Events** (roots located on the continuous extension of the step, Illinois' regula falsi):
-//!   an open point's gap `g_N` reaches zero; a closed point's normal force `λ_N` reaches zero;
+//!   an open point's gap `g_N` reaches zero; a closed point's normal force `λ_N` reaches zero,
+//!   or its `ġ_N` jumps below `−10 velocity_tol` (a contour whose normal jumps, a mesh's concave
+//!   edge: the point starts to approach its new face, an impact at the event);
 //!   a sticking point's friction reserve `µ0 λ_N − |λ_T|` reaches zero; a slipping point's
 //!   sliding velocity `ġ_T` reaches zero.
 //! - **At an event**, with positions frozen:

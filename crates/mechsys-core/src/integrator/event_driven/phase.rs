@@ -501,6 +501,10 @@ impl<'a> Phase<'a> {
             } else {
                 (self.lam_n[pt], 1.0)
             };
+            // a closed point whose normal jumps (a mesh's concave edge, where the nearest face
+            // changes) starts to approach: an event, which the impact step resolves like any
+            // touching approach; a closed point otherwise keeps ġ_N ≈ 0 (its g̈_N = 0)
+            let e0 = if self.status[pt] == OPEN { e0 } else { e0.min(self.kin[pt].gd_n + APPROACH * self.opts.velocity_tol) };
             out[3 * pt] = e0;
             out[3 * pt + 1] = e1;
         }
@@ -631,6 +635,10 @@ impl OdeSystem for Phase<'_> {
         Ok(())
     }
 }
+
+/// A closed point approaching faster than this many `velocity_tol` is an event (above the
+/// approach that closes a contact without impact, so the event's impact step takes it).
+const APPROACH: f64 = 10.0;
 
 /// The first time `t > 0` at which `g + v t + a t²/2` reaches `target` (< g), or infinity if it
 /// never does.
