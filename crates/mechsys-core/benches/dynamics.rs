@@ -156,6 +156,10 @@ fn bench_stepping(c: &mut Criterion) {
             q0: None,
             u0: None,
             stabilization: Default::default(),
+            on_singular: Default::default(),
+            max_steps: None,
+            max_wall: None,
+            record: Default::default(),
         };
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
