@@ -18,6 +18,7 @@
 //! | box – box | 8 | separating axes; the clipped incident face (each vertex a point against a face), or one edge–edge point ([`box_box`]) |
 //! | point2, circle, polygon – line | 1, 1, vertices | as the spatial point/sphere – plane |
 //! | point2, circle – circle | 1 | along the centre line in the x-y plane |
+//! | ellipsoid – ellipsoid | 1 | the common normal maximizing the support gap ([`convex_pair`]) |
 //!
 //! Planar pairs are evaluated in body 2's x-y plane: contours are extruded along body 2's z axis
 //! `e_z`, `n ⟂ e_z`, and `t1 = e_z × n / |e_z × n|` (the one friction direction; `t2 = n × t1` is
@@ -51,6 +52,7 @@ use box_box::BoxShape;
 use curve_pair::{CurveGeometry, First};
 
 pub mod box_box;
+pub mod convex_pair;
 pub mod curve_pair;
 
 /// One candidate contact: gap, frame and the two surface points, world components.
@@ -105,6 +107,9 @@ enum Geometry {
     EllipsoidHalfSpace { center: Vec3, shape: Mat3, point: Vec3, normal: Vec3 },
     /// A sphere (or point, radius 0) on body 1 against an ellipsoid on body 2.
     SphereEllipsoid { center: Vec3, radius: f64, e_center: Vec3, e_rotation: Mat3, semi: Vec3 },
+    /// Two ellipsoids, centres and shape matrices `S = R diag(a², b², c²) Rᵀ` in their body
+    /// frames ([`convex_pair`]).
+    EllipsoidEllipsoid { c1: Vec3, shape1: Mat3, c2: Vec3, shape2: Mat3 },
     /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
     /// cavity of body 2.
     Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
@@ -187,7 +192,8 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
         K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
         K::Box => matches!(a, K::Point | K::Sphere | K::Box),
         K::Circle => matches!(a, K::Point2 | K::Circle),
-        K::Bowl | K::Bore | K::Ellipsoid => matches!(a, K::Point | K::Sphere),
+        K::Bowl | K::Bore => matches!(a, K::Point | K::Sphere),
+        K::Ellipsoid => matches!(a, K::Point | K::Sphere | K::Ellipsoid),
         _ => false,
     }
 }
@@ -202,7 +208,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid/torus–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, ellipsoid–ellipsoid, in either order)"
         )))
     }
 }
@@ -559,6 +565,9 @@ impl ContactPair {
             Geometry::SphereEllipsoid { center, radius, e_center, e_rotation, semi } => {
                 sphere_ellipsoid(x1, x2, tw, center, *radius, e_center, e_rotation, semi)
             }
+            Geometry::EllipsoidEllipsoid { c1, shape1, c2, shape2 } => {
+                convex_pair::ellipsoid_ellipsoid(x1, x2, tw, c1, shape1, c2, shape2)
+            }
         }
     }
 }
@@ -650,6 +659,14 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             }
         };
         return Geometry::PointsHalfSpace { centers, radius, point, normal };
+    }
+    let shape = |rotation: &Mat3, semi: &Vec3| rotation * Mat3::from_diagonal(&semi.component_mul(semi)) * rotation.transpose();
+    if let (
+        Contour::Ellipsoid { center: c1, rotation: r1, semi_axes: a1 },
+        Contour::Ellipsoid { center: c2, rotation: r2, semi_axes: a2 },
+    ) = (f, s)
+    {
+        return Geometry::EllipsoidEllipsoid { c1: *c1, shape1: shape(r1, a1), c2: *c2, shape2: shape(r2, a2) };
     }
     if let Contour::Ellipsoid { center: ec, rotation, semi_axes } = s {
         let (center, radius) = match f {

@@ -191,6 +191,11 @@ pub(crate) fn sample(kind: &str) -> Contour {
             rotation: rot(&Vec3::new(0.3, -1.0, 0.6), 0.8),
             semi_axes: Vec3::new(0.4, 0.3, 0.25),
         },
+        "ellipsoid_b" => Contour::Ellipsoid {
+            center: Vec3::new(-0.04, 0.02, 0.05),
+            rotation: rot(&Vec3::new(1.0, 0.4, -0.2), -0.6),
+            semi_axes: Vec3::new(0.22, 0.35, 0.28),
+        },
         "torus" => Contour::Torus { center: Vec3::new(0.05, 0.1, -0.02), axis: Vec3::new(0.2, 1.0, 0.3), radius: 0.35, tube: 0.05 },
         "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
         "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
@@ -284,7 +289,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 13] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 25] = [
+pub(crate) const PAIRS: [(&str, &str); 26] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -306,6 +311,7 @@ pub(crate) const PAIRS: [(&str, &str); 25] = [
     ("torus", "plane"),
     ("point", "ellipsoid"),
     ("sphere_b", "ellipsoid"),
+    ("ellipsoid_b", "ellipsoid"),
     ("point", "bowl"),
     ("sphere", "bowl"),
     ("point", "bore"),
