@@ -12,6 +12,8 @@ use crate::spatial::Pose;
 
 use super::broad::Aabb;
 use crate::geometry::curve::Curve;
+use crate::geometry::revolution::Revolution;
+use crate::geometry::surface::Patch;
 
 /// 2-vector of `f64` (the coordinates of planar contours in the body's x-y plane).
 pub type Vec2 = nalgebra::Vector2<f64>;
@@ -134,6 +136,12 @@ pub enum Contour {
     /// Planar: a parametric contour (ellipse, spline, cam; see [`crate::geometry::curve`]),
     /// validated when it was built.
     Curve(Box<Curve>),
+    /// A surface of revolution: a planar profile turned about an axis
+    /// ([`crate::geometry::revolution`]), validated when it was built.
+    Revolution(Box<Revolution>),
+    /// A bicubic spline patch `r(s1, s2)` through a grid of points, solid below its normal
+    /// `r_1 × r_2` ([`crate::geometry::surface`]), validated when it was built.
+    Patch(Box<Patch>),
 }
 
 /// The kind of a contour, for dispatch tables and messages.
@@ -169,6 +177,10 @@ pub enum ContourKind {
     Polygon,
     /// [`Contour::Curve`]
     Curve,
+    /// [`Contour::Revolution`]
+    Revolution,
+    /// [`Contour::Patch`]
+    Patch,
 }
 
 impl ContourKind {
@@ -190,6 +202,8 @@ impl ContourKind {
             ContourKind::Line => "line",
             ContourKind::Polygon => "polygon",
             ContourKind::Curve => "curve",
+            ContourKind::Revolution => "revolution",
+            ContourKind::Patch => "patch",
         }
     }
 
@@ -276,6 +290,8 @@ impl Contour {
             Contour::Line { .. } => ContourKind::Line,
             Contour::Polygon { .. } => ContourKind::Polygon,
             Contour::Curve(_) => ContourKind::Curve,
+            Contour::Revolution(_) => ContourKind::Revolution,
+            Contour::Patch(_) => ContourKind::Patch,
         }
     }
 
@@ -365,8 +381,8 @@ impl Contour {
                 Ok(())
             }
             Contour::Polygon { vertices } => validate_polygon(vertices, what),
-            // checked by its constructor
-            Contour::Curve(_) => Ok(()),
+            // checked by their constructors
+            Contour::Curve(_) | Contour::Revolution(_) | Contour::Patch(_) => Ok(()),
         }
     }
 
@@ -468,6 +484,18 @@ impl Contour {
             }
             // an open curve continues along its end tangents
             Contour::Curve(_) => Aabb::EVERYTHING,
+            Contour::Revolution(r) => match r.bound() {
+                Some(radius) => Aabb::point(&pose.point_to_parent(&r.center)).inflated(radius),
+                // an open profile continues along its end tangents
+                None => Aabb::EVERYTHING,
+            },
+            Contour::Patch(p) => {
+                let mut b = Aabb::EMPTY;
+                for (c, r) in p.balls() {
+                    b = b.union(&Aabb::point(&pose.point_to_parent(c)).inflated(*r));
+                }
+                b
+            }
         }
     }
 }
@@ -575,6 +603,11 @@ impl Contour {
                 let s = c.closest_parameter(&Vec2::new(l.x, l.y));
                 [c.curvature(s), 0.0]
             }
+            Contour::Revolution(r) => {
+                let (w, _) = Revolution::meridian(&r.local(&l));
+                r.curvatures(r.foot(&w).0)
+            }
+            Contour::Patch(p) => Patch::curvatures(&p.eval(p.foot(&l))),
         }
     }
 }

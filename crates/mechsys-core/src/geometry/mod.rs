@@ -1,7 +1,10 @@
 //! Parametric contact geometry (section 2.2.7): planar contours `r(s)` with their moving
 //! trihedral and curvature ([`curve`]), built on C² cubic splines ([`spline`]) or on involute gear
-//! outlines ([`gear`]).
+//! outlines ([`gear`]); spatial surfaces of revolution ([`revolution`]) and bicubic spline
+//! patches ([`surface`]).
 
 pub mod curve;
 pub mod gear;
+pub mod revolution;
 pub mod spline;
+pub mod surface;

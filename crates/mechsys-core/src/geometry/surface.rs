@@ -319,8 +319,10 @@ impl Patch {
                 let t = self.clamp([s[0] + step.x, s[1] + step.y]);
                 let jt = self.eval(t);
                 let pt = 0.5 * (y - jt[0]).norm_squared();
-                if pt <= phi {
-                    moved = (t[0] - s[0]).abs() > 1e-13 * self.h[0] || (t[1] - s[1]).abs() > 1e-13 * self.h[1];
+                // rounding hides φ's decrease near the root (it changes with the square of the
+                // step); a step that raises φ by no more than that still approaches the root
+                if pt <= phi * (1.0 + 1e-13) + 1e-300 {
+                    moved = (t[0] - s[0]).abs() > 1e-15 * self.h[0] || (t[1] - s[1]).abs() > 1e-15 * self.h[1];
                     (s, j, phi) = (t, jt, pt);
                     break;
                 }
