@@ -1191,3 +1191,6 @@ mod tests;
 
 #[cfg(test)]
 mod curve_tests;
+
+#[cfg(test)]
+mod surface_tests;
