@@ -134,3 +134,149 @@ def test_overlapping_ellipsoids_satisfy_the_contact_conditions_at_30_digits_and_
         best = min(minimize(f, [u, v], method="Nelder-Mead", options={"xatol": 1e-13, "fatol": 1e-15, "maxiter": 4000}).fun
                    for u in np.linspace(-np.pi, np.pi, 8, endpoint=False) for v in (-1.0, 0.0, 1.0))
         assert gap == pytest.approx(-best, abs=1e-9)
+
+
+# ---- surfaces of revolution and spline patches ------------------------------------------------
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+
+
+def _on_ground(contour1, contour2, q0=(0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0), name="c") -> ms.Model:
+    m = ms.Model("s", gravity=(0.0, 0.0, -9.81))
+    b = m.add_body("b", 1.0, ms.inertia.sphere(1.0, 0.1))
+    m.add_joint(ms.joints.Free("f", m.ground, b, q0=list(q0)))
+    m.add_contact(ms.Contact(name, b.contour(contour1), m.ground.contour(contour2)))
+    return m
+
+
+def test_revolution_of_an_ellipse_is_the_ellipsoid_of_revolution_on_a_plane():
+    """An elliptical profile (a across, b along the axis) turned about the axis is a spheroid: on
+    a plane, tipped by t, its centre is √(b² cos² t + a² sin² t) above the contact, the support
+    point's curvatures are those of the spheroid there (closed forms of the ellipse)."""
+    a, b = 0.1, 0.25
+    egg = ms.contours.Revolution(profile=ms.contours.Ellipse(a=a, b=b))
+    floor = ms.contours.Plane(normal=(0, 0, 1))
+    for t in (0.0, 0.3, 1.0, math.pi / 2):
+        q = [0.0, 0.0, 0.7, math.cos(t / 2), math.sin(t / 2), 0.0, 0.0]
+        g = ms.dynamics.contact_geometry(_on_ground(egg, floor), q)
+        h = math.sqrt((b * math.cos(t)) ** 2 + (a * math.sin(t)) ** 2)
+        assert g["gap"][0] == pytest.approx(0.7 - h, abs=1e-12)
+        if t == 0.0:
+            # the pole: both curvatures b / a²
+            assert g["curvature1"][0] == pytest.approx([b / a**2, b / a**2], rel=1e-9)
+        if t == math.pi / 2:
+            # the equator: meridian a / b², parallel 1 / a
+            assert sorted(g["curvature1"][0]) == pytest.approx(sorted([a / b**2, 1 / a]), rel=1e-9)
+
+
+def test_ball_on_a_patch_sampled_from_a_sphere_reproduces_gap_and_curvature():
+    R = 0.8
+    cap = ms.contours.Patch.from_function(lambda x, y: (x, y, math.sqrt(R * R - x * x - y * y)), (-0.4, 0.4), (-0.4, 0.4), 33, 33)
+    ball = ms.contours.Sphere(radius=0.05)
+    q = [0.03, -0.02, 1.2, 1.0, 0.0, 0.0, 0.0]
+    g = ms.dynamics.contact_geometry(_on_ground(ball, cap), q)
+    c = np.array(q[:3])
+    assert g["gap"][0] == pytest.approx(np.linalg.norm(c) - R - 0.05, abs=1e-7)
+    assert np.allclose(g["normal"][0], c / np.linalg.norm(c), atol=1e-6)
+    assert g["curvature2"][0] == pytest.approx([1 / R, 1 / R], rel=1e-3)
+    # the ball rests on the cap's top: lambda_N = m g once it has settled
+    m = _on_ground(ball, cap, q0=(0.0, 0.0, R + 0.05 + 0.01, 1.0, 0.0, 0.0, 0.0))
+    res = ms.simulate(m, t_end=0.3, integrator=ms.EventDriven(), output_dt=1e-2)
+    assert res["contact/c/lambda_n"][-1] == pytest.approx(9.81, rel=1e-6)
+    assert np.all(np.isfinite(res["contact/c/spin"])) and res["contact/c/rolling"].shape[1] == 2
+
+
+def test_model_file_revolution_and_patch(tmp_path):
+    text = """
+name = "surfaces"
+gravity = [0.0, 0.0, -9.81]
+
+[[bodies]]
+name = "egg"
+mass = 1.0
+inertia = [0.01, 0.01, 0.01]
+
+[[bodies]]
+name = "ball"
+mass = 1.0
+inertia = [0.01, 0.01, 0.01]
+
+[[joints]]
+name = "egg"
+type = "free"
+parent = "ground"
+child = "egg"
+q0 = [0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0]
+
+[[joints]]
+name = "ball"
+type = "free"
+parent = "ground"
+child = "ball"
+q0 = [0.2, 0.3, 0.5, 1.0, 0.0, 0.0, 0.0]
+
+[[contacts]]
+name = "floor"
+body1 = "egg"
+body2 = "ground"
+contour1 = { type = "revolution", profile = { type = "ellipse", semi_axes = [0.1, 0.2] } }
+contour2 = { type = "plane", normal = [0.0, 0.0, 1.0] }
+
+[[contacts]]
+name = "terrain"
+body1 = "ball"
+body2 = "ground"
+contour1 = { type = "sphere", radius = 0.1 }
+contour2 = { type = "patch", range1 = [-1.0, 1.0], range2 = [-1.0, 1.0], points = [
+  [[-1.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, 1.0, 0.0]],
+  [[0.0, -1.0, 0.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+  [[1.0, -1.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]] ] }
+"""
+    p = tmp_path / "m.toml"
+    p.write_text(text)
+    from mechsys.modelfile import load_model
+
+    m, _ = load_model(p)
+    g = ms.dynamics.contact_geometry(m, [0.0, 0.0, 0.5, 1, 0, 0, 0, 0.2, 0.3, 0.5, 1, 0, 0, 0])
+    assert g["gap"] == pytest.approx([0.3, 0.4], abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    "contour, message",
+    [
+        (ms.contours.Revolution(profile=ms.contours.Ellipse(a=0.1, b=0.2, center=(0.05, 0.0, 0.0))), "revolution profile crosses the axis"),
+        (ms.contours.Revolution(profile=ms.contours.Ellipse(a=0.0, b=0.2)), "semi-axis a must be > 0"),
+        (ms.contours.Revolution(profile=ms.contours.Circle(radius=0.1)), "expected a mechsys.contours Ellipse, Spline or Cam"),
+        (ms.contours.Patch(points=[[(0, 0, 0), (0, 1, 0)], [(1, 0, 0), (1, 1, float("nan"))]]), r"points\[1\]\[1\]: must be finite"),
+        (ms.contours.Patch(points=[[(0, 0, 0), (0, 1, 0)], [(1, 0, 0)]]), "rectangular: row 1 has 1 points"),
+        (ms.contours.Patch(points=[[(0, 0, 0), (0, 1)], [(1, 0, 0), (1, 1, 0)]]), r"points\[0\]\[1\]: expected three numbers"),
+        (ms.contours.Patch(points=[[(0, 0, 0), (0, 1, 0)], [(1, 0, 0), (1, 1, 0)], [(2, 0, 0), (2, 1, 0)], [(3, 0, 0), (3, 1, 0)]],
+                           periodic=(True, False)), "last row does not repeat the first"),
+    ],
+)
+def test_bad_surfaces_name_the_contact_and_contour(contour, message):
+    m = _on_ground(ms.contours.Sphere(radius=0.1), contour, name="terrain")
+    with pytest.raises(ms.ModelError, match=rf"terrain.*contour2.*{message}|{message}"):
+        m.build()
+    # the message names the contact
+    with pytest.raises(ms.ModelError, match="terrain"):
+        m.build()
+
+
+def test_patch_from_function_errors_name_the_function_and_point():
+    with pytest.raises(ms.ModelError, match=r"surface function raised at \(s1, s2\) = \(0.0, 0.0\): ZeroDivisionError"):
+        ms.contours.Patch.from_function(lambda x, y: (x, y, 1 / (x * x + y * y)), (0, 1), (0, 1), 3, 3)
+    with pytest.raises(ms.ModelError, match="three finite numbers"):
+        ms.contours.Patch.from_function(lambda x, y: (x, y, float("nan")), (0, 1), (0, 1), 3, 3)
+    with pytest.raises(ms.ModelError, match="n1 must be a whole number"):
+        ms.contours.Patch.from_function(lambda x, y: (x, y, 0.0), (0, 1), (0, 1), 1, 3)
+
+
+def test_egg_and_bowl_example_rocks_and_rolls_at_the_closed_form_periods():
+    ns = __import__("runpy").run_path(str(ROOT / "examples" / "egg_and_bowl.py"))
+    res = ms.simulate(ns["model"], **ns["simulation"])
+    egg_t, ball_t = ns["expected_periods"]()
+    assert ns["period"](res.t, res["joint/egg/q"][:, 0]) == pytest.approx(egg_t, rel=5e-3)
+    assert ns["period"](res.t, res["joint/ball/q"][:, 0]) == pytest.approx(ball_t, rel=1e-3)
+    assert np.ptp(res["energy/total"]) < 1e-8
+    assert set(res["contact/floor/state"].tolist()) == {1} and set(res["contact/bowl/state"].tolist()) == {1}
