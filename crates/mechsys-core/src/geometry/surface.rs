@@ -16,11 +16,12 @@
 //! follows the Weingarten equations (eq. 2.125).
 //!
 //! **Foot point.** The nearest point of the patch to `y` minimizes `½|y - r(s)|²`. Each cell's
-//! Bézier control net (the power basis converted) bounds it by a ball; cells whose ball is
-//! farther than the nearest ball's far side cannot hold the minimum and are skipped, the rest
-//! are sampled on a 5 × 5 grid, and Newton (Hessian `I - h II`, `h = (y - r)·ν`; the metric `I`
-//! where that is not positive definite) refines the nearest sample, kept inside the parameter
-//! range of a natural direction and wrapped in a periodic one. On a natural patch's edge the
+//! Bézier control net (the power basis converted) bounds it by a ball, blocks of 4 × 4 cells by
+//! a ball around theirs; in the nearest block the cell whose ball has the nearest far side is
+//! sampled first (5 × 5), then every cell (of every block) whose ball is nearer than the best
+//! sample so far (the others cannot hold the minimum). Newton (Hessian `I - h II`,
+//! `h = (y - r)·ν`; the metric `I` where that is not positive definite) refines the nearest
+//! sample, kept inside the parameter range of a natural direction and wrapped in a periodic one. On a natural patch's edge the
 //! foot point may be a boundary point; the contact then takes the edge's tangent plane.
 
 use crate::ensure;
@@ -50,6 +51,19 @@ pub struct Patch {
     coef: Vec<[[Vec3; 4]; 4]>,
     /// Per cell a ball holding it (centre, radius).
     balls: Vec<(Vec3, f64)>,
+    /// Blocks of up to `BLOCK × BLOCK` cells with a ball holding theirs (the search's first level).
+    blocks: Vec<Block>,
+}
+
+/// Cells per side of a block of the search's bounding hierarchy.
+const BLOCK: usize = 4;
+
+/// A block of cells `i.0..i.1` × `j.0..j.1` and a ball holding their balls.
+#[derive(Debug, Clone, PartialEq)]
+struct Block {
+    i: (usize, usize),
+    j: (usize, usize),
+    ball: (Vec3, f64),
 }
 
 impl Patch {
@@ -179,7 +193,17 @@ impl Patch {
                 balls.push((center, radius));
             }
         }
-        Ok(Patch { cells, lo: [range1.0, range2.0], h, periodic, coef, balls })
+        let mut blocks = Vec::new();
+        for bi in (0..cells[0]).step_by(BLOCK) {
+            for bj in (0..cells[1]).step_by(BLOCK) {
+                let (i, j) = ((bi, (bi + BLOCK).min(cells[0])), (bj, (bj + BLOCK).min(cells[1])));
+                let ks: Vec<usize> = (i.0..i.1).flat_map(|a| (j.0..j.1).map(move |b| a * cells[1] + b)).collect();
+                let center = ks.iter().map(|&k| balls[k].0).sum::<Vec3>() / ks.len() as f64;
+                let radius = ks.iter().map(|&k| (balls[k].0 - center).norm() + balls[k].1).fold(0.0, f64::max);
+                blocks.push(Block { i, j, ball: (center, radius) });
+            }
+        }
+        Ok(Patch { cells, lo: [range1.0, range2.0], h, periodic, coef, balls, blocks })
     }
 
     /// Parameter range per direction.
@@ -256,27 +280,60 @@ impl Patch {
     /// The parameters of the point of the patch nearest to `y` (see the module docs). No
     /// allocation.
     pub fn foot(&self, y: &Vec3) -> [f64; 2] {
-        let far = self.balls.iter().map(|(c, r)| (y - c).norm() + r).fold(f64::INFINITY, f64::min);
+        // the nearest block, and in it the cell with the nearest far side, first: its samples
+        // bound the distance tightly
+        let lower = |(c, r): &(Vec3, f64)| (y - c).norm() - r;
+        let mut near = 0;
+        for (b, blk) in self.blocks.iter().enumerate() {
+            if lower(&blk.ball) < lower(&self.blocks[near].ball) {
+                near = b;
+            }
+        }
+        let (mut first, mut far) = (0, f64::INFINITY);
+        for k in self.block_cells(near) {
+            let (c, r) = &self.balls[k];
+            let ub = (y - c).norm() + r;
+            if ub < far {
+                (first, far) = (k, ub);
+            }
+        }
         let (mut best, mut sb) = (f64::INFINITY, [self.lo[0], self.lo[1]]);
-        for (k, (c, r)) in self.balls.iter().enumerate() {
-            if (y - c).norm() - r > far {
+        self.sample_cell(y, first, &mut best, &mut sb);
+        // a block or cell whose ball is farther than the best sample cannot hold the foot point
+        let beyond = |lb: f64, best: f64| lb > 0.0 && lb * lb > best;
+        for b in 0..self.blocks.len() {
+            if beyond(lower(&self.blocks[b].ball), best) {
                 continue;
             }
-            let (i, j) = (k / self.cells[1], k % self.cells[1]);
-            for a in 0..5 {
-                for b in 0..5 {
-                    let s = [
-                        self.lo[0] + self.h[0] * (i as f64 + a as f64 / 4.0),
-                        self.lo[1] + self.h[1] * (j as f64 + b as f64 / 4.0),
-                    ];
-                    let d = (y - self.value(&self.coef[k], a as f64 / 4.0, b as f64 / 4.0)).norm_squared();
-                    if d < best {
-                        (best, sb) = (d, s);
-                    }
+            for k in self.block_cells(b) {
+                if k != first && !beyond(lower(&self.balls[k]), best) {
+                    self.sample_cell(y, k, &mut best, &mut sb);
                 }
             }
         }
         self.newton(y, sb)
+    }
+
+    /// The cells of block `b` (indices into the cell arrays).
+    fn block_cells(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
+        let blk = &self.blocks[b];
+        let n2 = self.cells[1];
+        (blk.i.0..blk.i.1).flat_map(move |i| (blk.j.0..blk.j.1).map(move |j| i * n2 + j))
+    }
+
+    /// The nearest of a 5 × 5 grid of samples of cell `k`, if nearer than `best`.
+    fn sample_cell(&self, y: &Vec3, k: usize, best: &mut f64, sb: &mut [f64; 2]) {
+        let (i, j) = (k / self.cells[1], k % self.cells[1]);
+        for a in 0..5 {
+            for b in 0..5 {
+                let (t1, t2) = (a as f64 / 4.0, b as f64 / 4.0);
+                let d = (y - self.value(&self.coef[k], t1, t2)).norm_squared();
+                if d < *best {
+                    *best = d;
+                    *sb = [self.lo[0] + self.h[0] * (i as f64 + t1), self.lo[1] + self.h[1] * (j as f64 + t2)];
+                }
+            }
+        }
     }
 
     /// The value in cell `c` at `τ`.
