@@ -4,7 +4,10 @@ Attach one to a body with ``body.contour(ms.contours.Sphere(radius=0.02))`` and 
 :class:`mechsys.Contact`. All data are in the body frame (m).
 
 In space: :class:`Point`, :class:`Sphere`, :class:`Plane` (half-space below its normal),
-:class:`Box`, :class:`Capsule`, :class:`Cylinder`. In the plane (the body's x-y plane):
+:class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Torus`, :class:`Ellipsoid`, the cavities
+:class:`Bowl` and :class:`Bore`, and the parametric surfaces of section 2.2.7.2 — :class:`Revolution`
+(a planar profile turned about an axis) and :class:`Patch` (a bicubic spline through a grid of
+points, or sampled from a function with :meth:`Patch.from_function`). In the plane (the body's x-y plane):
 :class:`Point`, :class:`Circle`, :class:`Line` (half-plane behind its normal), :class:`Polygon`
 (convex, vertices counter-clockwise), and the parametric contours of section 2.2.7.1 —
 :class:`Ellipse`, :class:`Spline` (through points, or sampled from a function with
