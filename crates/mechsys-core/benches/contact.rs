@@ -25,7 +25,7 @@
 //!   and the coast side, 4: each tooth flank), gear 1 at random angles and gear 2 at the
 //!   conjugate angle with the drive flanks 10 µm apart, both turning;
 //! - `narrow_surface/<pair>_evaluate/100`, `..._kinematics/100`: spatial parametric pairs
-//!   (ellipsoid–ellipsoid, revolution–plane with an egg-shaped spline profile, sphere–revolution,
+//!   (ellipsoid–ellipsoid apart and overlapping, revolution–plane with an egg-shaped spline profile, sphere–revolution,
 //!   sphere–patch on a 33 × 33 terrain patch) at random placements near contact, both bodies
 //!   turning, beside the closed-form sphere–sphere and ellipsoid–plane pairs; every call searches
 //!   from scratch (there is no warm start);
@@ -303,7 +303,9 @@ fn bench_surfaces(c: &mut Criterion) {
     let cases = [
         ("sphere_sphere", ball.clone(), Contour::Sphere { center: Vec3::zeros(), radius: 0.3 }, 0.4),
         ("ellipsoid_plane", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), plane.clone(), 0.25),
-        ("ellipsoid_ellipsoid", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), ellipsoid(Vec3::new(0.25, 0.15, 0.2)), 0.42),
+        // always apart (extents at most 0.3 + 0.25) and always overlapping (at least 0.15 + 0.15)
+        ("ellipsoid_ellipsoid_apart", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), ellipsoid(Vec3::new(0.25, 0.15, 0.2)), 0.6),
+        ("ellipsoid_ellipsoid_overlap", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), ellipsoid(Vec3::new(0.25, 0.15, 0.2)), 0.25),
         ("revolution_plane", egg.clone(), plane, 0.3),
         ("sphere_revolution", ball.clone(), egg, 0.4),
         ("sphere_patch", ball, terrain, 0.1),

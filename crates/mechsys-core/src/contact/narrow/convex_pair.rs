@@ -16,10 +16,13 @@
 //! translation that separates them when they overlap. Maximizing `f` therefore never returns a
 //! non-minimum of the distance, and penetration needs no separate case.
 //!
-//! **Search.** `f` at a fixed set of directions spread over the sphere (cheap: two quadratic forms)
-//! gives the start; Newton on the sphere refines it with the Riemannian Hessian
-//! `-(K1 + K2) - g I` restricted to the tangent plane, safeguarded by an ascent test (a gradient
-//! step where that Hessian is not negative definite).
+//! **Search.** Newton from the centre line; when that ends at `f > 0` it is the global maximum
+//! (`f` extends to a concave, positively homogeneous function on ℝ³, so a local maximum with
+//! `f > 0` is the maximum over the unit ball). Otherwise `f` at a fixed set of directions spread
+//! over the sphere (cheap: two quadratic forms) gives a second start, and the larger root is
+//! kept. Newton on the sphere uses the Riemannian Hessian `-(K1 + K2) - g I` restricted to the
+//! tangent plane, safeguarded by an ascent test (a gradient step where that Hessian is not
+//! negative definite).
 //!
 //! **Rates** (the differentiated conditions, the spatial form of eq. 2.109). A rotating body turns
 //! its support point: `Ṗ1 = v1(P1) - K1 (ṅ - ω1 × n)`, `Ṗ2 = v2(P2) + K2 (ṅ - ω2 × n)`.
@@ -75,18 +78,38 @@ fn lattice(i: usize) -> Vec3 {
     Vec3::new(r * c, r * s, z)
 }
 
-/// The normal maximizing `f`: the best lattice direction (or the centre line), refined by Newton.
+/// The normal maximizing `f`. Newton from the centre line first: `F(v) = v·(c1 - c2) - h1(-v) -
+/// h2(v)` is concave and positively homogeneous on ℝ³, so a local maximum on the sphere with
+/// `f > 0` is one on the unit ball too, hence the global one (the solids are apart and this is
+/// their distance). Otherwise (overlap) the best lattice direction is refined as well and the
+/// larger root kept.
 fn common_normal(e1: &Quadric, e2: &Quadric) -> Vec3 {
     let d = e1.c - e2.c;
-    let mut n = if d.norm() > 0.0 { d.normalize() } else { Vec3::z() };
-    let mut f = support_gap(e1, e2, &n);
+    let start = if d.norm() > 0.0 { d.normalize() } else { Vec3::z() };
+    let (n, f) = refine(e1, e2, start);
+    if f > 0.0 {
+        return n;
+    }
+    let (mut best, mut fb) = (start, support_gap(e1, e2, &start));
     for i in 0..SAMPLES {
         let u = lattice(i);
         let fu = support_gap(e1, e2, &u);
-        if fu > f {
-            (n, f) = (u, fu);
+        if fu > fb {
+            (best, fb) = (u, fu);
         }
     }
+    let (m, fm) = refine(e1, e2, best);
+    if fm > f {
+        m
+    } else {
+        n
+    }
+}
+
+/// Newton on the sphere from `n` (ascent-safeguarded); the root and `f` there.
+fn refine(e1: &Quadric, e2: &Quadric, mut n: Vec3) -> (Vec3, f64) {
+    let d = e1.c - e2.c;
+    let mut f = support_gap(e1, e2, &n);
     let scale = e1.s.trace().sqrt() + e2.s.trace().sqrt() + d.norm();
     for _ in 0..ITERATIONS {
         let (k1, s1) = e1.k(&n);
@@ -133,7 +156,7 @@ fn common_normal(e1: &Quadric, e2: &Quadric) -> Vec3 {
             break;
         }
     }
-    n
+    (n, f)
 }
 
 /// Ellipsoid (body 1, centre and shape matrix in its body frame) against ellipsoid (body 2).
