@@ -280,3 +280,18 @@ def test_egg_and_bowl_example_rocks_and_rolls_at_the_closed_form_periods():
     assert ns["period"](res.t, res["joint/ball/q"][:, 0]) == pytest.approx(ball_t, rel=1e-3)
     assert np.ptp(res["energy/total"]) < 1e-8
     assert set(res["contact/floor/state"].tolist()) == {1} and set(res["contact/bowl/state"].tolist()) == {1}
+
+
+def test_patch_takes_a_numpy_grid_and_a_periodic_direction():
+    """A cylinder of radius R about z as an (n1, n2, 3) array, periodic around it: a ball's gap is
+    ρ − R − r to the spline's accuracy (16 cells around: about 5e-5)."""
+    R, n = 0.5, 17
+    t = np.linspace(0, 2 * np.pi, n)
+    z = np.linspace(-1, 1, 9)
+    grid = np.stack([R * np.cos(t)[:, None] + 0 * z, R * np.sin(t)[:, None] + 0 * z, 0 * t[:, None] + z], axis=-1)
+    grid[-1] = grid[0]  # close the period exactly
+    cyl = ms.contours.Patch(points=grid, range1=(0, 2 * np.pi), range2=(-1, 1), periodic=(True, False))
+    q = [0.4, 0.6, 0.1, 1.0, 0.0, 0.0, 0.0]
+    g = ms.dynamics.contact_geometry(_on_ground(ms.contours.Sphere(radius=0.05), cyl), q)
+    assert g["gap"][0] == pytest.approx(math.hypot(0.4, 0.6) - R - 0.05, abs=2e-4)
+    assert g["normal"][0] == pytest.approx([0.4 / math.hypot(0.4, 0.6), 0.6 / math.hypot(0.4, 0.6), 0.0], abs=1e-3)

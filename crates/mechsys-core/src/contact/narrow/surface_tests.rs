@@ -173,3 +173,28 @@ fn bad_patch_grids_are_refused() {
     let e = Patch::new(&ok, (1.0, 0.0), (0.0, 1.0), [false, false], what).unwrap_err().to_string();
     assert!(e.contains("range s1 must be finite and increasing"), "{e}");
 }
+
+/// Beyond a natural patch's edge the foot point is the nearest edge point and the edge's tangent
+/// plane continues the surface: finite values, `P1 - P2 = g n`, the gap the height over that
+/// plane (a flat patch: the plane itself); finite rates.
+#[test]
+fn beyond_a_patch_edge_the_tangent_plane_continues_it() {
+    use crate::contact::kinematics::{contact_kinematics, BodyMotion, ContactKinematics};
+    use crate::spatial::Motion;
+    let flat = grid(5, (0.0, 0.0), (1.0, 1.0), |x, y| Vec3::new(x, y, 0.1 * x));
+    let patch = Contour::Patch(Box::new(Patch::new(&flat, (0.0, 1.0), (0.0, 1.0), [false, false], "flat").unwrap()));
+    let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.05 };
+    for c in [Vec3::new(1.5, 0.5, 0.4), Vec3::new(-0.3, 1.2, 0.2), Vec3::new(0.5, -0.5, -0.1)] {
+        let x1 = Pose::new(Mat3::identity(), c);
+        let k = one(&ball, &x1, &patch, &Pose::IDENTITY);
+        let m = Vec3::new(-0.1, 0.0, 1.0).normalize();
+        assert!((k.n - m).norm() < 1e-9, "{}", k.n);
+        assert!((k.g_n - (m.dot(&c) - 0.05)).abs() < 1e-9, "{} vs {}", k.g_n, m.dot(&c) - 0.05);
+        assert!((k.p1 - k.p2 - k.n * k.g_n).norm() < 1e-12);
+        let pair = ContactPair::new("s", ball.clone(), patch.clone()).unwrap();
+        let b1 = BodyMotion { pose: x1, twist: Motion::new(Vec3::new(0.3, -1.0, 0.2), Vec3::new(0.5, 0.1, -0.2)), acc: Motion::ZERO };
+        let mut out = [ContactKinematics::default()];
+        contact_kinematics(&pair, &b1, &BodyMotion::GROUND, &mut out).unwrap();
+        assert!(out[0].gd_n.is_finite() && out[0].wbar_n.is_finite() && out[0].gd_t.iter().all(|v| v.is_finite()));
+    }
+}
