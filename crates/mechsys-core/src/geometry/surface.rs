@@ -33,7 +33,8 @@ use crate::math::Vec3;
 pub type Jet = [Vec3; 6];
 
 /// Cubic Hermite → power basis: `[p0, m0, p1, m1] ↦ [c0, c1, c2, c3]` (rows: coefficients).
-const HERMITE: [[f64; 4]; 4] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-3.0, -2.0, 3.0, -1.0], [2.0, 1.0, -2.0, 1.0]];
+const HERMITE: [[f64; 4]; 4] =
+    [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-3.0, -2.0, 3.0, -1.0], [2.0, 1.0, -2.0, 1.0]];
 /// Power → Bernstein (Bézier control points) for a cubic on [0, 1]: rows are control points.
 const BEZIER: [[f64; 4]; 4] =
     [[1.0, 0.0, 0.0, 0.0], [1.0, 1.0 / 3.0, 0.0, 0.0], [1.0, 2.0 / 3.0, 1.0 / 3.0, 0.0], [1.0, 1.0, 1.0, 1.0]];
@@ -70,7 +71,13 @@ impl Patch {
     /// The patch through `points[i][j]` (`n1 × n2`, at least 2 × 2; 4 along a periodic direction
     /// with the last line repeating the first) at `s_k = range_k.0 + i (range_k.1 - range_k.0) /
     /// (n_k - 1)`. `what` names the contact and contour in errors.
-    pub fn new(points: &[Vec<Vec3>], range1: (f64, f64), range2: (f64, f64), periodic: [bool; 2], what: &str) -> Result<Self> {
+    pub fn new(
+        points: &[Vec<Vec3>],
+        range1: (f64, f64),
+        range2: (f64, f64),
+        periodic: [bool; 2],
+        what: &str,
+    ) -> Result<Self> {
         let n1 = points.len();
         let n2 = points.first().map_or(0, |r| r.len());
         for (k, (n, p)) in [(n1, periodic[0]), (n2, periodic[1])].iter().enumerate() {
@@ -85,7 +92,12 @@ impl Patch {
                 row.len()
             );
             for (j, p) in row.iter().enumerate() {
-                ensure!(p.iter().all(|v| v.is_finite()), Model, "{what}: patch point [{i}][{j}] must be finite, got {:?}", p.as_slice());
+                ensure!(
+                    p.iter().all(|v| v.is_finite()),
+                    Model,
+                    "{what}: patch point [{i}][{j}] must be finite, got {:?}",
+                    p.as_slice()
+                );
             }
         }
         for (k, r) in [range1, range2].iter().enumerate() {

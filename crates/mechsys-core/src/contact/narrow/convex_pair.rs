@@ -187,12 +187,7 @@ pub(crate) fn ellipsoid_ellipsoid(
         let a = perpendicular(&n);
         let b = n.cross(&a);
         let kk = h1 + h2;
-        let m = nalgebra::Matrix2::new(
-            a.dot(&(kk * a)) + g,
-            a.dot(&(kk * b)),
-            b.dot(&(kk * a)),
-            b.dot(&(kk * b)) + g,
-        );
+        let m = nalgebra::Matrix2::new(a.dot(&(kk * a)) + g, a.dot(&(kk * b)), b.dot(&(kk * a)), b.dot(&(kk * b)) + g);
         let r = nalgebra::Vector2::new(a.dot(&rhs), b.dot(&rhs));
         let sol = m.lu().solve(&r).unwrap_or_else(nalgebra::Vector2::zeros);
         let nd = a * sol.x + b * sol.y;
@@ -261,7 +256,8 @@ mod tests {
     #[test]
     fn separated_gap_is_the_brute_force_minimum_distance() {
         let mut rng = Rng::new(31);
-        let surf = |a: &Vec3, u: f64, v: f64| Vec3::new(a.x * u.cos() * v.cos(), a.y * u.sin() * v.cos(), a.z * v.sin());
+        let surf =
+            |a: &Vec3, u: f64, v: f64| Vec3::new(a.x * u.cos() * v.cos(), a.y * u.sin() * v.cos(), a.z * v.sin());
         let mut checked = 0;
         while checked < 6 {
             let (a1, a2) = (
@@ -280,9 +276,8 @@ mod tests {
             };
             let (n, m) = (48, 24);
             let (mut best, mut bp) = (f64::INFINITY, [0.0; 4]);
-            let ang = |i: usize, j: usize| {
-                (std::f64::consts::TAU * i as f64 / n as f64, -1.5 + 3.0 * j as f64 / m as f64)
-            };
+            let ang =
+                |i: usize, j: usize| (std::f64::consts::TAU * i as f64 / n as f64, -1.5 + 3.0 * j as f64 / m as f64);
             for i in 0..n {
                 for j in 0..=m {
                     for k in 0..n {

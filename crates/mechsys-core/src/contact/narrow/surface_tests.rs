@@ -28,7 +28,8 @@ fn circle_profiles_are_spheres_and_tori() {
     let mut rng = Rng::new(17);
     let turn = rot(&Vec3::new(0.2, 1.0, 0.4), 0.9);
     let (big, r0, a) = (0.4, 0.5, 0.15);
-    let ball = revolution(Curve::ellipse(Vec2::zeros(), big, big, 0.3, "ball").unwrap(), Vec3::new(0.1, 0.0, 0.0), turn);
+    let ball =
+        revolution(Curve::ellipse(Vec2::zeros(), big, big, 0.3, "ball").unwrap(), Vec3::new(0.1, 0.0, 0.0), turn);
     let ring = revolution(Curve::ellipse(Vec2::new(r0, 0.0), a, a, 0.0, "ring").unwrap(), Vec3::zeros(), turn);
     let probe = Contour::Sphere { center: Vec3::zeros(), radius: 0.05 };
     let plane = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
@@ -74,7 +75,8 @@ fn paraboloid_on_a_tilted_plane_touches_where_the_slope_matches() {
     let expected = Vec3::new(-c * theta.tan(), 0.0, height + c * theta.tan().powi(2) / 2.0);
     let mut errors = Vec::new();
     for n in [21, 41, 81] {
-        let pts: Vec<Vec2> = (0..n).map(|i| -1.0 + 2.0 * i as f64 / (n - 1) as f64).map(|x| Vec2::new(x, x * x / (2.0 * c))).collect();
+        let pts: Vec<Vec2> =
+            (0..n).map(|i| -1.0 + 2.0 * i as f64 / (n - 1) as f64).map(|x| Vec2::new(x, x * x / (2.0 * c))).collect();
         let profile = Curve::spline(&pts, false, Solid::Left, "cup").unwrap();
         let cup = revolution(profile, Vec3::zeros(), Mat3::identity());
         let k = one(&cup, &x1, &plane, &Pose::IDENTITY);
@@ -94,7 +96,10 @@ fn paraboloid_on_a_tilted_plane_touches_where_the_slope_matches() {
 fn a_profile_crossing_the_axis_is_refused() {
     let off = Curve::ellipse(Vec2::new(0.1, 0.0), 0.3, 0.2, 0.0, "p").unwrap();
     let e = Revolution::new(Vec3::zeros(), Mat3::identity(), off, "contact 'egg': contour 2 (revolution)").unwrap_err();
-    assert!(e.to_string().contains("contact 'egg': contour 2 (revolution): revolution profile crosses the axis"), "{e}");
+    assert!(
+        e.to_string().contains("contact 'egg': contour 2 (revolution): revolution profile crosses the axis"),
+        "{e}"
+    );
     let centred = Curve::ellipse(Vec2::zeros(), 0.3, 0.2, 0.0, "p").unwrap();
     Revolution::new(Vec3::zeros(), Mat3::identity(), centred, "egg").unwrap();
 }
@@ -125,7 +130,8 @@ fn patches_sampled_from_a_sphere_and_a_cylinder_converge_to_the_closed_forms() {
     let (mut eg, mut ek) = (Vec::new(), Vec::new());
     for n in [9, 17, 33] {
         let cap = grid(n, (-0.6, -0.6), (0.6, 0.6), |x, y| centre + Vec3::new(x, y, (r * r - x * x - y * y).sqrt()));
-        let patch = Contour::Patch(Box::new(Patch::new(&cap, (-0.6, 0.6), (-0.6, 0.6), [false, false], "cap").unwrap()));
+        let patch =
+            Contour::Patch(Box::new(Patch::new(&cap, (-0.6, 0.6), (-0.6, 0.6), [false, false], "cap").unwrap()));
         let c = one(&ball, &x1, &patch, &Pose::IDENTITY);
         eg.push((c.g_n - ((x1.r - centre).norm() - r - 0.1)).abs());
         let k = patch.curvatures_at(&Pose::IDENTITY, &c.p2);
@@ -192,7 +198,11 @@ fn beyond_a_patch_edge_the_tangent_plane_continues_it() {
         assert!((k.g_n - (m.dot(&c) - 0.05)).abs() < 1e-9, "{} vs {}", k.g_n, m.dot(&c) - 0.05);
         assert!((k.p1 - k.p2 - k.n * k.g_n).norm() < 1e-12);
         let pair = ContactPair::new("s", ball.clone(), patch.clone()).unwrap();
-        let b1 = BodyMotion { pose: x1, twist: Motion::new(Vec3::new(0.3, -1.0, 0.2), Vec3::new(0.5, 0.1, -0.2)), acc: Motion::ZERO };
+        let b1 = BodyMotion {
+            pose: x1,
+            twist: Motion::new(Vec3::new(0.3, -1.0, 0.2), Vec3::new(0.5, 0.1, -0.2)),
+            acc: Motion::ZERO,
+        };
         let mut out = [ContactKinematics::default()];
         contact_kinematics(&pair, &b1, &BodyMotion::GROUND, &mut out).unwrap();
         assert!(out[0].gd_n.is_finite() && out[0].wbar_n.is_finite() && out[0].gd_t.iter().all(|v| v.is_finite()));
