@@ -296,7 +296,8 @@ fn bench_surfaces(c: &mut Criterion) {
                 .collect()
         })
         .collect();
-    let terrain = Contour::Patch(Box::new(Patch::new(&grid, (0.0, 1.0), (0.0, 1.0), [false, false], "terrain").expect("valid")));
+    let terrain =
+        Contour::Patch(Box::new(Patch::new(&grid, (0.0, 1.0), (0.0, 1.0), [false, false], "terrain").expect("valid")));
     let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.1 };
     let plane = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
     // (name, contour 1, contour 2, distance of body 1's origin from body 2's)
@@ -305,7 +306,12 @@ fn bench_surfaces(c: &mut Criterion) {
         ("ellipsoid_plane", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), plane.clone(), 0.25),
         // always apart (extents at most 0.3 + 0.25) and always overlapping (at least 0.15 + 0.15)
         ("ellipsoid_ellipsoid_apart", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), ellipsoid(Vec3::new(0.25, 0.15, 0.2)), 0.6),
-        ("ellipsoid_ellipsoid_overlap", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), ellipsoid(Vec3::new(0.25, 0.15, 0.2)), 0.25),
+        (
+            "ellipsoid_ellipsoid_overlap",
+            ellipsoid(Vec3::new(0.3, 0.2, 0.15)),
+            ellipsoid(Vec3::new(0.25, 0.15, 0.2)),
+            0.25,
+        ),
         ("revolution_plane", egg.clone(), plane, 0.3),
         ("sphere_revolution", ball.clone(), egg, 0.4),
         ("sphere_patch", ball, terrain, 0.1),
@@ -316,7 +322,8 @@ fn bench_surfaces(c: &mut Criterion) {
         let pair = ContactPair::new(name, c1, c2).expect("valid pair");
         let turn = |rng: &mut Rng| {
             let axis = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
-            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), rng.uniform(-3.0, 3.0)).into_inner()
+            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), rng.uniform(-3.0, 3.0))
+                .into_inner()
         };
         let ground = name.ends_with("plane") || name.ends_with("patch");
         let bodies: Vec<(BodyMotion, BodyMotion)> = (0..n)

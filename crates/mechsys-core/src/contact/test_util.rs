@@ -226,7 +226,12 @@ pub(crate) fn surface_sample(kind: &str) -> Contour {
                 .map(|t| Vec2::new(t.cos(), t.sin()) * (0.3 + 0.08 * (2.0 * t).cos()))
                 .collect();
             let profile = Curve::spline(&pts, true, Solid::Inside, "revolution").unwrap();
-            let r = Revolution::new(Vec3::new(0.03, -0.02, 0.05), rot(&Vec3::new(0.4, 1.0, -0.3), 0.7), profile, "revolution");
+            let r = Revolution::new(
+                Vec3::new(0.03, -0.02, 0.05),
+                rot(&Vec3::new(0.4, 1.0, -0.3), 0.7),
+                profile,
+                "revolution",
+            );
             Contour::Revolution(Box::new(r.unwrap()))
         }
         "patch" => {
@@ -235,7 +240,8 @@ pub(crate) fn surface_sample(kind: &str) -> Contour {
                 .map(|i| {
                     (0..n)
                         .map(|j| {
-                            let (x, y) = (-2.5 + 5.0 * i as f64 / (n - 1) as f64, -2.5 + 5.0 * j as f64 / (n - 1) as f64);
+                            let (x, y) =
+                                (-2.5 + 5.0 * i as f64 / (n - 1) as f64, -2.5 + 5.0 * j as f64 / (n - 1) as f64);
                             Vec3::new(x, y, 0.1 * (2.0 * x).sin() * (1.5 * y).cos() - 0.2)
                         })
                         .collect()
@@ -502,7 +508,9 @@ pub(crate) fn patch_sdf(p: &crate::geometry::surface::Patch, y: &Vec3) -> f64 {
     let mut step = (a1 - a0).max(b1 - b0) / n as f64;
     while step > 1e-15 {
         let mut moved = false;
-        for (u, v) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)] {
+        for (u, v) in
+            [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)]
+        {
             let s = p.clamp([sb[0] + u * step, sb[1] + v * step]);
             let d = d2(s);
             if d < best {

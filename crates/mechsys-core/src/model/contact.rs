@@ -337,7 +337,13 @@ fn contour(
         }
         ContourDescription::Patch { points, range1, range2, periodic } => {
             let grid: Vec<Vec<Vec3>> = points.iter().map(|row| row.iter().map(vec3).collect()).collect();
-            Contour::Patch(Box::new(Patch::new(&grid, (range1[0], range1[1]), (range2[0], range2[1]), *periodic, what)?))
+            Contour::Patch(Box::new(Patch::new(
+                &grid,
+                (range1[0], range1[1]),
+                (range2[0], range2[1]),
+                *periodic,
+                what,
+            )?))
         }
     })
 }
