@@ -295,3 +295,25 @@ def test_patch_takes_a_numpy_grid_and_a_periodic_direction():
     g = ms.dynamics.contact_geometry(_on_ground(ms.contours.Sphere(radius=0.05), cyl), q)
     assert g["gap"][0] == pytest.approx(math.hypot(0.4, 0.6) - R - 0.05, abs=2e-4)
     assert g["normal"][0] == pytest.approx([0.4 / math.hypot(0.4, 0.6), 0.6 / math.hypot(0.4, 0.6), 0.0], abs=1e-3)
+
+
+def test_ellipsoid_on_a_saddle_patch_touches_where_the_normals_oppose():
+    """An ellipsoid above a saddle z = (x² − y²) / 4: at the witness points the patch normal
+    (from the analytic saddle) and the ellipsoid's normal (from its quadric) are opposite and
+    along the connecting vector; the gap is the distance along it."""
+    saddle = ms.contours.Patch.from_function(lambda x, y: (x, y, (x * x - y * y) / 4), (-1, 1), (-1, 1), 41, 41)
+    egg = ms.contours.Ellipsoid(semi_axes=(0.2, 0.12, 0.1), cardan=(0.3, 0.2, 0.0))
+    q = [0.1, -0.05, 0.3, math.cos(0.2), 0.0, math.sin(0.2), 0.0]
+    g = ms.dynamics.contact_geometry(_on_ground(egg, saddle), q)
+    p1, p2, n, gap = g["point1"][0], g["point2"][0], g["normal"][0], g["gap"][0]
+    x, y = p2[0], p2[1]
+    assert p2[2] == pytest.approx((x * x - y * y) / 4, abs=1e-7)
+    ns = np.array([-x / 2, y / 2, 1.0]) / np.linalg.norm([-x / 2, y / 2, 1.0])
+    assert np.allclose(n, ns, atol=1e-6)
+    # the ellipsoid's outward normal at p1 is -n: the gradient of its quadric
+    R = _rot(q[3:7]) @ Rotation.from_euler("xyz", [0.3, 0.2, 0.0]).as_matrix()
+    yb = R.T @ (p1 - np.array(q[:3]))
+    assert np.sum((yb / [0.2, 0.12, 0.1]) ** 2) == pytest.approx(1.0, abs=1e-12)
+    grad = R @ (yb / np.array([0.2, 0.12, 0.1]) ** 2)
+    assert np.allclose(-grad / np.linalg.norm(grad), n, atol=1e-9)
+    assert np.allclose(p1 - p2, gap * n, atol=1e-12)

@@ -195,7 +195,8 @@ class Torus(Contour):
 class Ellipsoid(Contour):
     """A solid ellipsoid with ``semi_axes`` (a, b, c) about ``center``; ``cardan`` angles (x-y-z)
     turn its axes in the body. Pairs with a plane (the support point, closed form), a point or a
-    sphere (the foot point) and another ellipsoid (the common normal, separated or overlapping)."""
+    sphere (the foot point), another ellipsoid (the common normal, separated or overlapping) and a
+:class:`Patch`."""
 
     semi_axes: Sequence[float] = (0.0, 0.0, 0.0)
     center: Sequence[float] = (0.0, 0.0, 0.0)
@@ -268,7 +269,8 @@ class Patch(Contour):
     n1 x n2 x 3) at uniform parameters over ``range1``, ``range2``; ``periodic`` per direction
     (the last grid line must then repeat the first), natural ends otherwise. The solid lies below
     the normal ``r_1 x r_2`` (for a terrain z(x, y) sampled with s1 = x, s2 = y: below the
-    ground). Pairs with a point and a sphere (Newton on the two parameters from a sampled start)."""
+    ground). Pairs with a point and a sphere (Newton on the two parameters from a sampled start)
+and an ellipsoid (Newton from the foot point of its centre: a local search)."""
 
     points: Any = ()
     range1: Sequence[float] = (0.0, 1.0)

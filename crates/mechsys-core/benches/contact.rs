@@ -26,7 +26,7 @@
 //!   conjugate angle with the drive flanks 10 µm apart, both turning;
 //! - `narrow_surface/<pair>_evaluate/100`, `..._kinematics/100`: spatial parametric pairs
 //!   (ellipsoid–ellipsoid apart and overlapping, revolution–plane with an egg-shaped spline profile, sphere–revolution,
-//!   sphere–patch on a 33 × 33 terrain patch) at random placements near contact, both bodies
+//!   sphere–patch and ellipsoid–patch on a 33 × 33 terrain patch) at random placements near contact, both bodies
 //!   turning, beside the closed-form sphere–sphere and ellipsoid–plane pairs; every call searches
 //!   from scratch (there is no warm start);
 //!
@@ -314,7 +314,8 @@ fn bench_surfaces(c: &mut Criterion) {
         ),
         ("revolution_plane", egg.clone(), plane, 0.3),
         ("sphere_revolution", ball.clone(), egg, 0.4),
-        ("sphere_patch", ball, terrain, 0.1),
+        ("sphere_patch", ball, terrain.clone(), 0.1),
+        ("ellipsoid_patch", ellipsoid(Vec3::new(0.15, 0.1, 0.08)), terrain, 0.15),
     ];
     let mut g = c.benchmark_group("narrow_surface");
     g.throughput(Throughput::Elements(n as u64));

@@ -21,6 +21,7 @@
 //! | ellipsoid – ellipsoid | 1 | the common normal maximizing the support gap ([`convex_pair`]) |
 //! | revolution – plane | 1 | the profile's support point in the meridian opposite the normal ([`surface_pair`]) |
 //! | point, sphere – revolution, patch | 1 | the centre's foot point ([`surface_pair`]) |
+//! | ellipsoid – patch | 1 | Newton on the patch parameters with the ellipsoid's support point ([`surface_pair`]) |
 //!
 //! Planar pairs are evaluated in body 2's x-y plane: contours are extruded along body 2's z axis
 //! `e_z`, `n ⟂ e_z`, and `t1 = e_z × n / |e_z × n|` (the one friction direction; `t2 = n × t1` is
@@ -121,6 +122,8 @@ enum Geometry {
     SphereRevolution { center: Vec3, radius: f64, rev: Box<Revolution> },
     /// A sphere (or point, radius 0) on body 1 against a spline patch of body 2.
     SpherePatch { center: Vec3, radius: f64, patch: Box<Patch> },
+    /// An ellipsoid on body 1 (centre, shape matrix in its body frame) against a spline patch.
+    EllipsoidPatch { center: Vec3, shape: Mat3, patch: Box<Patch> },
     /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
     /// cavity of body 2.
     Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
@@ -200,7 +203,8 @@ fn canonical(a: ContourKind, b: ContourKind) -> bool {
             a,
             K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder | K::Ellipsoid | K::Torus | K::Revolution
         ),
-        K::Revolution | K::Patch => matches!(a, K::Point | K::Sphere),
+        K::Revolution => matches!(a, K::Point | K::Sphere),
+        K::Patch => matches!(a, K::Point | K::Sphere | K::Ellipsoid),
         K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Curve => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Sphere => matches!(a, K::Point | K::Sphere),
@@ -223,7 +227,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid/torus–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, ellipsoid–ellipsoid, revolution–plane, point/sphere–revolution/patch, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, ellipsoid–ellipsoid, revolution–plane, point/sphere–revolution/patch, ellipsoid–patch, in either order)"
         )))
     }
 }
@@ -596,6 +600,9 @@ impl ContactPair {
             Geometry::SpherePatch { center, radius, patch } => {
                 surface_pair::sphere_patch(x1, x2, tw, center, *radius, patch)
             }
+            Geometry::EllipsoidPatch { center, shape, patch } => {
+                surface_pair::ellipsoid_patch(x1, x2, tw, center, shape, patch)
+            }
         }
     }
 }
@@ -692,6 +699,10 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             }
         };
         return Geometry::PointsHalfSpace { centers, radius, point, normal };
+    }
+    if let (Contour::Ellipsoid { center, rotation, semi_axes }, Contour::Patch(patch)) = (f, s) {
+        let shape = rotation * Mat3::from_diagonal(&semi_axes.component_mul(semi_axes)) * rotation.transpose();
+        return Geometry::EllipsoidPatch { center: *center, shape, patch: patch.clone() };
     }
     if let Contour::Revolution(_) | Contour::Patch(_) = s {
         let (center, radius) = match f {

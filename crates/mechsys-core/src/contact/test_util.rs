@@ -332,7 +332,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 13] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 31] = [
+pub(crate) const PAIRS: [(&str, &str); 32] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -360,6 +360,7 @@ pub(crate) const PAIRS: [(&str, &str); 31] = [
     ("sphere_b", "revolution"),
     ("point", "patch"),
     ("sphere_b", "patch"),
+    ("ellipsoid_b", "patch"),
     ("point", "bowl"),
     ("sphere", "bowl"),
     ("point", "bore"),

@@ -192,3 +192,112 @@ pub(crate) fn sphere_patch(
     }
     out
 }
+
+/// An ellipsoid (body 1; centre and shape matrix `S = R diag(a², b², c²) Rᵀ` in its body frame)
+/// against a spline patch of body 2. The unknowns are the patch parameters `s`: the ellipsoid's
+/// point facing the patch is its support point along `-ν(s)`,
+/// `q1 = c - S̃ ν / √(νᵀ S̃ ν)` (`S̃` the shape matrix in body 2's frame), so the normals are
+/// opposed by construction and the conditions 2.120 reduce to `(q1 - r)·r_i = 0`. Newton on `s`
+/// (Jacobian `-(K ν_,j)·r_i - E_ij + (q1 - r)·r_ij`, `K` the support function's Hessian) from the
+/// foot point of the ellipsoid's centre, steps limited to a cell and damped on `|F|`. Rates: the
+/// same Jacobian times `ṡ` balances `q̇1·r_i` at fixed `ν`, where a turning body turns its
+/// support point (`ṗ1 = v1(p1) - K1 (ṅ - ω1 × n)`, see [`super::convex_pair`]).
+pub(crate) fn ellipsoid_patch(
+    x1: &Pose,
+    x2: &Pose,
+    tw: Option<(&Motion, &Motion)>,
+    center: &Vec3,
+    shape: &crate::math::Mat3,
+    patch: &Patch,
+) -> Raw {
+    use crate::math::Mat3;
+    let rel = x2.a.transpose() * x1.a;
+    let st = rel * shape * rel.transpose();
+    let yc = x2.a.transpose() * (x1.point_to_parent(center) - x2.r);
+    // support point along -ν, its Hessian K and the normal's derivatives at s
+    let at = |s: [f64; 2]| {
+        let j = patch.eval(s);
+        let nu = Patch::normal(&j);
+        let sn = st * nu;
+        let k = nu.dot(&sn).sqrt();
+        let q1 = yc - sn / k;
+        let kk: Mat3 = st / k - sn * sn.transpose() / (k * k * k);
+        let len = j[1].cross(&j[2]).norm();
+        let dn = |a: usize| {
+            let v = j[3 + a].cross(&j[2]) + j[1].cross(&j[4 + a]);
+            (v - nu * nu.dot(&v)) / len
+        };
+        let dnu = [dn(0), dn(1)];
+        (j, nu, q1, kk, dnu)
+    };
+    let residual = |j: &crate::geometry::surface::Jet, q1: &Vec3| {
+        let d = q1 - j[0];
+        nalgebra::Vector2::new(d.dot(&j[1]), d.dot(&j[2]))
+    };
+    let jacobian = |j: &crate::geometry::surface::Jet, q1: &Vec3, kk: &Mat3, dnu: &[Vec3; 2]| {
+        let d = q1 - j[0];
+        let m = |i: usize, c: usize| -(kk * dnu[c]).dot(&j[1 + i]) - j[1 + c].dot(&j[1 + i]) + d.dot(&j[3 + i + c]);
+        nalgebra::Matrix2::new(m(0, 0), m(0, 1), m(1, 0), m(1, 1))
+    };
+    let mut s = patch.foot(&yc);
+    let mut cur = at(s);
+    let mut fr = residual(&cur.0, &cur.2);
+    let [(a0, a1), (b0, b1)] = patch.range();
+    let cell = [(a1 - a0) / 8.0, (b1 - b0) / 8.0];
+    for _ in 0..60 {
+        let jm = jacobian(&cur.0, &cur.2, &cur.3, &cur.4);
+        let Some(ji) = jm.try_inverse() else { break };
+        let mut step = -(ji * fr);
+        let cap = (step.x.abs() / cell[0]).max(step.y.abs() / cell[1]);
+        if cap > 1.0 {
+            step /= cap;
+        }
+        let mut moved = false;
+        for _ in 0..30 {
+            let t = patch.clamp([s[0] + step.x, s[1] + step.y]);
+            let next = at(t);
+            let fn_ = residual(&next.0, &next.2);
+            if fn_.norm() <= fr.norm() * (1.0 + 1e-12) {
+                moved = (t[0] - s[0]).abs() > 1e-15 * cell[0] || (t[1] - s[1]).abs() > 1e-15 * cell[1];
+                (s, cur, fr) = (t, next, fn_);
+                break;
+            }
+            step *= 0.5;
+        }
+        if !moved {
+            break;
+        }
+    }
+    let (j, nu, q1, kk, dnu) = cur;
+    let g = (q1 - j[0]).dot(&nu);
+    let n = x2.a * nu;
+    let p1 = x2.point_to_parent(&q1);
+    let mut out = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
+    if let Some((t1, t2)) = tw {
+        // q̇1 at fixed ν (body 2 frame): the support point turned by the relative rotation
+        let kw = x2.a * kk * x2.a.transpose();
+        let p1_fixed = vel(t1, &p1) - kw * (t2.w - t1.w).cross(&n);
+        let q1d = x2.a.transpose() * (p1_fixed - vel(t2, &p1));
+        let free = patch.on_edge(s).map(|e| !e);
+        let jm = jacobian(&j, &q1, &kk, &dnu);
+        let r = -nalgebra::Vector2::new(q1d.dot(&j[1]), q1d.dot(&j[2]));
+        let sd = match free {
+            [true, true] => {
+                let v = jm.lu().solve(&r).unwrap_or_else(nalgebra::Vector2::zeros);
+                [v.x, v.y]
+            }
+            [true, false] => [r[0] / jm[(0, 0)], 0.0],
+            [false, true] => [0.0, r[1] / jm[(1, 1)]],
+            [false, false] => [0.0, 0.0],
+        };
+        let nud = dnu[0] * sd[0] + dnu[1] * sd[1];
+        let nd = t2.w.cross(&n) + x2.a * nud;
+        let p1d = vel(t1, &p1) - kw * (nd - t1.w.cross(&n));
+        let gd = n.dot(&(p1d - vel(t2, &p1))) + (x2.a * (q1 - j[0])).dot(&nd)
+            - (x2.a * (j[1] * sd[0] + j[2] * sd[1])).dot(&n);
+        out.nd = nd;
+        out.p1d = p1d;
+        out.p2d = p1d - n * gd - nd * g;
+    }
+    out
+}

@@ -208,3 +208,29 @@ fn beyond_a_patch_edge_the_tangent_plane_continues_it() {
         assert!(out[0].gd_n.is_finite() && out[0].wbar_n.is_finite() && out[0].gd_t.iter().all(|v| v.is_finite()));
     }
 }
+
+/// An ellipsoid on a patch sampled from a tilted plane (which the spline reproduces exactly) has
+/// the closed-form ellipsoid–plane contact: gap, normal and contact point.
+#[test]
+fn ellipsoid_on_a_planar_patch_is_the_ellipsoid_plane_contact() {
+    let mut rng = Rng::new(23);
+    let m = Vec3::new(0.2, -0.1, 1.0).normalize();
+    // points of the plane m·x = 0 over a square
+    let flat = grid(9, (-2.0, -2.0), (2.0, 2.0), |x, y| Vec3::new(x, y, -(m.x * x + m.y * y) / m.z));
+    let patch = Contour::Patch(Box::new(Patch::new(&flat, (0.0, 1.0), (0.0, 1.0), [false, false], "flat").unwrap()));
+    let plane = Contour::Plane { point: Vec3::zeros(), normal: m };
+    let egg = Contour::Ellipsoid {
+        center: Vec3::new(0.02, 0.0, -0.03),
+        rotation: rot(&Vec3::new(1.0, 0.3, 0.2), 0.4),
+        semi_axes: Vec3::new(0.3, 0.2, 0.12),
+    };
+    for _ in 0..30 {
+        let x1 = Pose::new(
+            rng.rotation(),
+            Vec3::new(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(-0.1, 0.6)),
+        );
+        let (a, b) = (one(&egg, &x1, &patch, &Pose::IDENTITY), one(&egg, &x1, &plane, &Pose::IDENTITY));
+        assert!((a.g_n - b.g_n).abs() < 1e-12, "{} vs {}", a.g_n, b.g_n);
+        assert!((a.n - b.n).norm() < 1e-9 && (a.p1 - b.p1).norm() < 1e-9);
+    }
+}
