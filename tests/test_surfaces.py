@@ -311,7 +311,7 @@ def test_ellipsoid_on_a_saddle_patch_touches_where_the_normals_oppose():
     ns = np.array([-x / 2, y / 2, 1.0]) / np.linalg.norm([-x / 2, y / 2, 1.0])
     assert np.allclose(n, ns, atol=1e-6)
     # the ellipsoid's outward normal at p1 is -n: the gradient of its quadric
-    R = _rot(q[3:7]) @ Rotation.from_euler("xyz", [0.3, 0.2, 0.0]).as_matrix()
+    R = _rot(q[3:7]) @ Rotation.from_euler("XYZ", [0.3, 0.2, 0.0]).as_matrix()
     yb = R.T @ (p1 - np.array(q[:3]))
     assert np.sum((yb / [0.2, 0.12, 0.1]) ** 2) == pytest.approx(1.0, abs=1e-12)
     grad = R @ (yb / np.array([0.2, 0.12, 0.1]) ** 2)
