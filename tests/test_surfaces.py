@@ -250,6 +250,7 @@ contour2 = { type = "patch", range1 = [-1.0, 1.0], range2 = [-1.0, 1.0], points 
         (ms.contours.Patch(points=[[(0, 0, 0), (0, 1, 0)], [(1, 0, 0), (1, 1, float("nan"))]]), r"points\[1\]\[1\]: must be finite"),
         (ms.contours.Patch(points=[[(0, 0, 0), (0, 1, 0)], [(1, 0, 0)]]), "rectangular: row 1 has 1 points"),
         (ms.contours.Patch(points=[[(0, 0, 0), (0, 1)], [(1, 0, 0), (1, 1, 0)]]), r"points\[0\]\[1\]: expected three numbers"),
+        (ms.contours.Patch(points=[[(0, 0, 0), (0, 0, 0)], [(1, 0, 0), (1, 1, 0)]]), r"patch has no normal at \(s1, s2\) = \(0.0000"),
         (ms.contours.Patch(points=[[(0, 0, 0), (0, 1, 0)], [(1, 0, 0), (1, 1, 0)], [(2, 0, 0), (2, 1, 0)], [(3, 0, 0), (3, 1, 0)]],
                            periodic=(True, False)), "last row does not repeat the first"),
     ],

@@ -205,6 +205,23 @@ impl Patch {
                 balls.push((center, radius));
             }
         }
+        let patch = Patch { cells, lo: [range1.0, range2.0], h, periodic, coef, balls, blocks: Vec::new() };
+        // the normal r_1 × r_2 must exist everywhere: check the knots and the cell middles
+        for i in 0..2 * cells[0] + 1 {
+            for j in 0..2 * cells[1] + 1 {
+                let s = [range1.0 + 0.5 * h[0] * i as f64, range2.0 + 0.5 * h[1] * j as f64];
+                let jet = patch.eval(s);
+                let area = jet[1].cross(&jet[2]).norm();
+                ensure!(
+                    area > 1e-9 * jet[1].norm().max(1e-300) * jet[2].norm().max(1e-300) && area.is_finite(),
+                    Model,
+                    "{what}: patch has no normal at (s1, s2) = ({:.4}, {:.4}) (r_1 × r_2 = 0: repeated or collinear grid                      points, a pole)",
+                    s[0],
+                    s[1]
+                );
+            }
+        }
+        let Patch { coef, balls, .. } = patch;
         let mut blocks = Vec::new();
         for bi in (0..cells[0]).step_by(BLOCK) {
             for bj in (0..cells[1]).step_by(BLOCK) {

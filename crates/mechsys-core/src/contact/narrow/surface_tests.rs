@@ -176,6 +176,10 @@ fn bad_patch_grids_are_refused() {
     assert!(e.contains("periodic in s1 but its last row does not repeat the first"), "{e}");
     let e = Patch::new(&ok[..1], (0.0, 1.0), (0.0, 1.0), [false, false], what).unwrap_err().to_string();
     assert!(e.contains("at least 2 points along s1"), "{e}");
+    // a pole: the first row collapsed to one point
+    let pole = grid(5, (0.0, 0.0), (1.0, 1.0), |x, y| Vec3::new(x * y, x * (1.0 - y), x));
+    let e = Patch::new(&pole, (0.0, 1.0), (0.0, 1.0), [false, false], what).unwrap_err().to_string();
+    assert!(e.contains("patch has no normal at (s1, s2) = (0.0000"), "{e}");
     let e = Patch::new(&ok, (1.0, 0.0), (0.0, 1.0), [false, false], what).unwrap_err().to_string();
     assert!(e.contains("range s1 must be finite and increasing"), "{e}");
 }
