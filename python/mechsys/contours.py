@@ -4,9 +4,11 @@ Attach one to a body with ``body.contour(ms.contours.Sphere(radius=0.02))`` and 
 :class:`mechsys.Contact`. All data are in the body frame (m).
 
 In space: :class:`Point`, :class:`Sphere`, :class:`Plane` (half-space below its normal),
-:class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Torus`, :class:`Ellipsoid`, the
-cavities :class:`Bowl` and :class:`Bore`, and triangle meshes :class:`Mesh` (from arrays or
-from STL/OBJ files). In the plane (the body's x-y plane):
+:class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Torus`, :class:`Ellipsoid`, the cavities
+:class:`Bowl` and :class:`Bore`, the parametric surfaces of section 2.2.7.2 — :class:`Revolution`
+(a planar profile turned about an axis) and :class:`Patch` (a bicubic spline through a grid of
+points, or sampled from a function with :meth:`Patch.from_function`) — and triangle meshes
+:class:`Mesh` (from arrays or from STL/OBJ files). In the plane (the body's x-y plane):
 :class:`Point`, :class:`Circle`, :class:`Line` (half-plane behind its normal), :class:`Polygon`
 (convex, vertices counter-clockwise), and the parametric contours of section 2.2.7.1 —
 :class:`Ellipse`, :class:`Spline` (through points, or sampled from a function with
@@ -193,7 +195,9 @@ class Torus(Contour):
 @dataclass
 class Ellipsoid(Contour):
     """A solid ellipsoid with ``semi_axes`` (a, b, c) about ``center``; ``cardan`` angles (x-y-z)
-    turn its axes in the body. Pairs with a plane (the support point, closed form)."""
+    turn its axes in the body. Pairs with a plane (the support point, closed form), a point or a
+    sphere (the foot point), another ellipsoid (the common normal, separated or overlapping) and a
+:class:`Patch`."""
 
     semi_axes: Sequence[float] = (0.0, 0.0, 0.0)
     center: Sequence[float] = (0.0, 0.0, 0.0)
@@ -343,6 +347,100 @@ def _read_mesh_file(path, what: str):
 
 
 _SOLIDS = ("left", "right", "inside", "outside")
+
+
+@dataclass
+class Revolution(Contour):
+    """A surface of revolution: the planar ``profile`` (an :class:`Ellipse`, :class:`Spline` or
+    :class:`Cam`; its x is the distance from the axis, its y the height along it) turned about the
+    z axis of a frame at ``center``, turned in the body by ``cardan`` angles (x-y-z). The solid is
+    the profile's solid turned (inside a closed profile). The profile must keep x ≥ 0 or be its
+    own mirror image across the axis (an ellipse centred on it: an egg). Pairs with a plane, a
+    point and a sphere (searches in the meridian plane; docs/contours.md)."""
+
+    profile: Contour | None = None
+    center: Sequence[float] = (0.0, 0.0, 0.0)
+    cardan: Sequence[float] | None = None
+
+    def describe(self, what: str) -> dict:
+        if not isinstance(self.profile, (Ellipse, Spline, Cam)):
+            raise ModelError(f"{what}.profile: expected a mechsys.contours Ellipse, Spline or Cam, got {type(self.profile).__name__}")
+        d = {"type": "revolution", "center": _vec3(self.center, f"{what}.center"),
+             "profile": self.profile.describe(f"{what}.profile")}
+        if self.cardan is not None:
+            d["rotation"] = {"cardan": _vec3(self.cardan, f"{what}.cardan")}
+        return d
+
+
+@dataclass
+class Patch(Contour):
+    """A bicubic spline surface ``r(s1, s2)`` through a grid of body-frame ``points`` (shape
+    n1 x n2 x 3) at uniform parameters over ``range1``, ``range2``; ``periodic`` per direction
+    (the last grid line must then repeat the first), natural ends otherwise. The solid lies below
+    the normal ``r_1 x r_2`` (for a terrain z(x, y) sampled with s1 = x, s2 = y: below the
+    ground). Pairs with a point and a sphere (Newton on the two parameters from a sampled start)
+and an ellipsoid (Newton from the foot point of its centre: a local search)."""
+
+    points: Any = ()
+    range1: Sequence[float] = (0.0, 1.0)
+    range2: Sequence[float] = (0.0, 1.0)
+    periodic: Sequence[bool] = (False, False)
+
+    @classmethod
+    def from_function(cls, f, s1_range, s2_range, n1: int = 33, n2: int = 33, periodic=(False, False)) -> "Patch":
+        """Samples a surface ``f(s1, s2) -> (x, y, z)`` on an ``n1 x n2`` grid over the ranges
+        (both ends included; a periodic direction's end repeats its start). The interpolation
+        error falls with the fourth power of the spacing in the gap, the square in the curvature."""
+        what = "Patch.from_function"
+        ranges = []
+        for name, r in (("s1_range", s1_range), ("s2_range", s2_range)):
+            try:
+                lo, hi = (float(v) for v in r)
+            except (TypeError, ValueError):
+                raise ModelError(f"{what}: {name} must be two numbers (start, end), got {r!r}") from None
+            if not hi > lo:
+                raise ModelError(f"{what}: {name} must increase, got ({lo}, {hi})")
+            ranges.append((lo, hi))
+        for name, n in (("n1", n1), ("n2", n2)):
+            if isinstance(n, bool) or not isinstance(n, int) or n < 2:
+                raise ModelError(f"{what}: {name} must be a whole number ≥ 2, got {n!r}")
+        grid = []
+        for i in range(n1):
+            s1 = ranges[0][0] + (ranges[0][1] - ranges[0][0]) * i / (n1 - 1)
+            row = []
+            for j in range(n2):
+                s2 = ranges[1][0] + (ranges[1][1] - ranges[1][0]) * j / (n2 - 1)
+                try:
+                    v = [float(c) for c in f(s1, s2)]
+                except Exception as e:  # the user's function raised
+                    raise ModelError(f"{what}: the surface function raised at (s1, s2) = ({s1}, {s2}): {type(e).__name__}: {e}") from None
+                if len(v) != 3 or not all(math.isfinite(c) for c in v):
+                    raise ModelError(f"{what}: the surface function must return three finite numbers, got {v} at (s1, s2) = ({s1}, {s2})")
+                row.append(v)
+            grid.append(row)
+        if periodic[0]:
+            grid[-1] = [list(p) for p in grid[0]]
+        if periodic[1]:
+            for row in grid:
+                row[-1] = list(row[0])
+        return cls(points=grid, range1=ranges[0], range2=ranges[1], periodic=tuple(bool(p) for p in periodic))
+
+    def describe(self, what: str) -> dict:
+        try:
+            rows = [[[float(c) for c in p] for p in row] for row in self.points]
+        except (TypeError, ValueError):
+            raise ModelError(f"{what}.points: expected a grid of (x, y, z) points (shape n1 x n2 x 3)") from None
+        for i, row in enumerate(rows):
+            for j, p in enumerate(row):
+                if len(p) != 3:
+                    raise ModelError(f"{what}.points[{i}][{j}]: expected three numbers (x, y, z), got {len(p)}")
+                if not all(math.isfinite(c) for c in p):
+                    raise ModelError(f"{what}.points[{i}][{j}]: must be finite, got {p}")
+        per = [bool(p) for p in self.periodic]
+        if len(per) != 2:
+            raise ModelError(f"{what}.periodic: expected two flags (s1, s2), got {self.periodic!r}")
+        return {"type": "patch", "points": rows, "range1": _numbers(self.range1, f"{what}.range1"),
+                "range2": _numbers(self.range2, f"{what}.range2"), "periodic": per}
 
 
 def _solid(x, what: str, allowed=_SOLIDS):
@@ -750,6 +848,8 @@ __all__ = [
     "Polygon",
     "Torus",
     "Ellipsoid",
+    "Revolution",
+    "Patch",
     "Bowl",
     "Bore",
     "Mesh",

@@ -24,6 +24,11 @@
 //!   gears in mesh (m = 2 mm, backlash 0.05 m each, standard centre distance; 2 points: the drive
 //!   and the coast side, 4: each tooth flank), gear 1 at random angles and gear 2 at the
 //!   conjugate angle with the drive flanks 10 µm apart, both turning;
+//! - `narrow_surface/<pair>_evaluate/100`, `..._kinematics/100`: spatial parametric pairs
+//!   (ellipsoid–ellipsoid apart and overlapping, revolution–plane with an egg-shaped spline profile, sphere–revolution,
+//!   sphere–patch and ellipsoid–patch on a 33 × 33 terrain patch) at random placements near contact, both bodies
+//!   turning, beside the closed-form sphere–sphere and ellipsoid–plane pairs; every call searches
+//!   from scratch (there is no warm start);
 //!
 //! - `mesh/<pair>_evaluate/100`, `mesh/<pair>_kinematics/100`: sphere–mesh and box–mesh (8
 //!   corner queries) on wavy terrains of 98, 10 082 and 100 352 triangles, beside sphere–plane
@@ -124,6 +129,7 @@ fn bench_narrow(c: &mut Criterion) {
     bench_curves(c);
     bench_gears(c);
     bench_mesh(c);
+    bench_surfaces(c);
 }
 
 /// A wavy terrain over [-1, 1]² (z = 0.05 sin 3x cos 2y), `k × k` cells of two triangles each.
@@ -321,6 +327,119 @@ fn bench_curves(c: &mut Criterion) {
                     pose: Pose::new(rz(rng.uniform(-3.0, 3.0)), Vec3::zeros()),
                     twist: Motion::new(Vec3::new(0.0, 0.0, rng.uniform(-5.0, 5.0)), Vec3::zeros()),
                     acc: Motion::ZERO,
+                };
+                (b1, b2)
+            })
+            .collect();
+        let mut points = vec![ContactPoint::default(); n];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_evaluate"), n), &n, |b, _| {
+            b.iter(|| {
+                for ((b1, b2), out) in bodies.iter().zip(points.iter_mut()) {
+                    evaluate(&pair, &b1.pose, &b2.pose, std::slice::from_mut(out)).expect("room for 1");
+                }
+                black_box(&points);
+            })
+        });
+        let mut kin = vec![ContactKinematics::default(); n];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_kinematics"), n), &n, |b, _| {
+            b.iter(|| {
+                for ((b1, b2), out) in bodies.iter().zip(kin.iter_mut()) {
+                    contact_kinematics(&pair, b1, b2, std::slice::from_mut(out)).expect("room for 1");
+                }
+                black_box(&kin);
+            })
+        });
+    }
+    g.finish();
+}
+
+/// Spatial parametric pairs near contact, in general 3-D motion: [`evaluate`] and
+/// [`contact_kinematics`] per pair (a global start and Newton each call), next to closed forms.
+fn bench_surfaces(c: &mut Criterion) {
+    use mechsys_core::geometry::curve::{Curve, Solid, Vec2};
+    use mechsys_core::geometry::revolution::Revolution;
+    use mechsys_core::geometry::surface::Patch;
+    use std::f64::consts::TAU;
+    let n = 100;
+    let mut rng = Rng(0x5eed_5eed_0000_0002);
+    let ellipsoid = |a: Vec3| Contour::Ellipsoid { center: Vec3::zeros(), rotation: Mat3::identity(), semi_axes: a };
+    let egg_profile: Vec<Vec2> = (0..64)
+        .map(|i| TAU * i as f64 / 64.0)
+        .map(|t| Vec2::new(0.2 * t.cos(), 0.3 * t.sin() * (1.0 + 0.1 * t.sin())))
+        .collect();
+    let egg = Contour::Revolution(Box::new(
+        Revolution::new(
+            Vec3::zeros(),
+            Mat3::identity(),
+            Curve::spline(&egg_profile, true, Solid::Inside, "egg").expect("valid"),
+            "egg",
+        )
+        .expect("valid"),
+    ));
+    let grid: Vec<Vec<Vec3>> = (0..33)
+        .map(|i| {
+            (0..33)
+                .map(|j| {
+                    let (x, y) = (-1.0 + 2.0 * i as f64 / 32.0, -1.0 + 2.0 * j as f64 / 32.0);
+                    Vec3::new(x, y, 0.05 * (3.0 * x).sin() * (2.0 * y).cos())
+                })
+                .collect()
+        })
+        .collect();
+    let terrain =
+        Contour::Patch(Box::new(Patch::new(&grid, (0.0, 1.0), (0.0, 1.0), [false, false], "terrain").expect("valid")));
+    let ball = Contour::Sphere { center: Vec3::zeros(), radius: 0.1 };
+    let plane = Contour::Plane { point: Vec3::zeros(), normal: Vec3::z() };
+    // (name, contour 1, contour 2, distance of body 1's origin from body 2's)
+    let cases = [
+        ("sphere_sphere", ball.clone(), Contour::Sphere { center: Vec3::zeros(), radius: 0.3 }, 0.4),
+        ("ellipsoid_plane", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), plane.clone(), 0.25),
+        // always apart (extents at most 0.3 + 0.25) and always overlapping (at least 0.15 + 0.15)
+        ("ellipsoid_ellipsoid_apart", ellipsoid(Vec3::new(0.3, 0.2, 0.15)), ellipsoid(Vec3::new(0.25, 0.15, 0.2)), 0.6),
+        (
+            "ellipsoid_ellipsoid_overlap",
+            ellipsoid(Vec3::new(0.3, 0.2, 0.15)),
+            ellipsoid(Vec3::new(0.25, 0.15, 0.2)),
+            0.25,
+        ),
+        ("revolution_plane", egg.clone(), plane, 0.3),
+        ("sphere_revolution", ball.clone(), egg, 0.4),
+        ("sphere_patch", ball, terrain.clone(), 0.1),
+        ("ellipsoid_patch", ellipsoid(Vec3::new(0.15, 0.1, 0.08)), terrain, 0.15),
+    ];
+    let mut g = c.benchmark_group("narrow_surface");
+    g.throughput(Throughput::Elements(n as u64));
+    for (name, c1, c2, dist) in cases {
+        let pair = ContactPair::new(name, c1, c2).expect("valid pair");
+        let turn = |rng: &mut Rng| {
+            let axis = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), rng.uniform(-3.0, 3.0))
+                .into_inner()
+        };
+        let ground = name.ends_with("plane") || name.ends_with("patch");
+        let bodies: Vec<(BodyMotion, BodyMotion)> = (0..n)
+            .map(|_| {
+                // above a ground contour, anywhere around a body
+                let dir = if ground {
+                    Vec3::new(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), 1.0).normalize()
+                } else {
+                    Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)).normalize()
+                };
+                let r = dir * dist;
+                let w = Vec3::new(rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0));
+                let b1 = BodyMotion {
+                    pose: Pose::new(turn(&mut rng), r),
+                    twist: Motion::new(w, Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 0.0) - w.cross(&r)),
+                    acc: Motion::ZERO,
+                };
+                let b2 = if ground {
+                    BodyMotion::GROUND
+                } else {
+                    BodyMotion {
+                        pose: Pose::new(turn(&mut rng), Vec3::zeros()),
+                        twist: Motion::new(Vec3::new(rng.uniform(-5.0, 5.0), 0.0, 0.0), Vec3::zeros()),
+                        acc: Motion::ZERO,
+                    }
                 };
                 (b1, b2)
             })

@@ -14,6 +14,8 @@ use super::broad::Aabb;
 use crate::geometry::curve::Curve;
 use crate::geometry::mesh::TriMesh;
 use std::sync::Arc;
+use crate::geometry::revolution::Revolution;
+use crate::geometry::surface::Patch;
 
 /// 2-vector of `f64` (the coordinates of planar contours in the body's x-y plane).
 pub type Vec2 = nalgebra::Vector2<f64>;
@@ -140,6 +142,12 @@ pub enum Contour {
     /// [`crate::geometry::mesh`]), validated with its bounding-volume hierarchy when it was
     /// built; shared, so the pairs of a contact group do not copy it.
     Mesh(Arc<TriMesh>),
+    /// A surface of revolution: a planar profile turned about an axis
+    /// ([`crate::geometry::revolution`]), validated when it was built.
+    Revolution(Box<Revolution>),
+    /// A bicubic spline patch `r(s1, s2)` through a grid of points, solid below its normal
+    /// `r_1 × r_2` ([`crate::geometry::surface`]), validated when it was built.
+    Patch(Box<Patch>),
 }
 
 /// The kind of a contour, for dispatch tables and messages.
@@ -177,6 +185,10 @@ pub enum ContourKind {
     Curve,
     /// [`Contour::Mesh`]
     Mesh,
+    /// [`Contour::Revolution`]
+    Revolution,
+    /// [`Contour::Patch`]
+    Patch,
 }
 
 impl ContourKind {
@@ -199,6 +211,8 @@ impl ContourKind {
             ContourKind::Polygon => "polygon",
             ContourKind::Curve => "curve",
             ContourKind::Mesh => "mesh",
+            ContourKind::Revolution => "revolution",
+            ContourKind::Patch => "patch",
         }
     }
 
@@ -286,6 +300,8 @@ impl Contour {
             Contour::Polygon { .. } => ContourKind::Polygon,
             Contour::Curve(_) => ContourKind::Curve,
             Contour::Mesh(_) => ContourKind::Mesh,
+            Contour::Revolution(_) => ContourKind::Revolution,
+            Contour::Patch(_) => ContourKind::Patch,
         }
     }
 
@@ -376,7 +392,7 @@ impl Contour {
             }
             Contour::Polygon { vertices } => validate_polygon(vertices, what),
             // checked by their constructors
-            Contour::Curve(_) | Contour::Mesh(_) => Ok(()),
+            Contour::Curve(_) | Contour::Mesh(_) | Contour::Revolution(_) | Contour::Patch(_) => Ok(()),
         }
     }
 
@@ -484,6 +500,18 @@ impl Contour {
                 let c = pose.point_to_parent(&((b.min + b.max) * 0.5));
                 let e = pose.a.abs() * ((b.max - b.min) * 0.5);
                 Aabb { min: c - e, max: c + e }
+            }
+            Contour::Revolution(r) => match r.bound() {
+                Some(radius) => Aabb::point(&pose.point_to_parent(&r.center)).inflated(radius),
+                // an open profile continues along its end tangents
+                None => Aabb::EVERYTHING,
+            },
+            Contour::Patch(p) => {
+                let mut b = Aabb::EMPTY;
+                for (c, r) in p.balls() {
+                    b = b.union(&Aabb::point(&pose.point_to_parent(c)).inflated(*r));
+                }
+                b
             }
         }
     }
@@ -597,6 +625,11 @@ impl Contour {
                 crate::geometry::mesh::Feature::Face => [0.0, 0.0],
                 _ => [inf, inf],
             },
+            Contour::Revolution(r) => {
+                let (w, _) = Revolution::meridian(&r.local(&l));
+                r.curvatures(r.foot(&w).0)
+            }
+            Contour::Patch(p) => Patch::curvatures(&p.eval(p.foot(&l))),
         }
     }
 }

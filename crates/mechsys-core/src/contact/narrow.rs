@@ -19,6 +19,10 @@
 //! | point2, circle, polygon – line | 1, 1, vertices | as the spatial point/sphere – plane |
 //! | point2, circle – circle | 1 | along the centre line in the x-y plane |
 //! | point, sphere, box, capsule – mesh | 1, 1, 8, 2 | each centre (corner, end sphere) against the closest point of the mesh ([`mesh_pair`]) |
+//! | ellipsoid – ellipsoid | 1 | the common normal maximizing the support gap ([`convex_pair`]) |
+//! | revolution – plane | 1 | the profile's support point in the meridian opposite the normal ([`surface_pair`]) |
+//! | point, sphere – revolution, patch | 1 | the centre's foot point ([`surface_pair`]) |
+//! | ellipsoid – patch | 1 | Newton on the patch parameters with the ellipsoid's support point ([`surface_pair`]) |
 //!
 //! Planar pairs are evaluated in body 2's x-y plane: contours are extruded along body 2's z axis
 //! `e_z`, `n ⟂ e_z`, and `t1 = e_z × n / |e_z × n|` (the one friction direction; `t2 = n × t1` is
@@ -50,12 +54,16 @@ use crate::spatial::{Motion, Pose};
 
 use super::contour::{lift, Contour, ContourKind};
 use box_box::BoxShape;
+use crate::geometry::revolution::Revolution;
+use crate::geometry::surface::Patch;
 use curve_pair::{CurveGeometry, First};
 use mesh_pair::MeshGeometry;
 
 pub mod box_box;
+pub mod convex_pair;
 pub mod curve_pair;
 pub mod mesh_pair;
+pub mod surface_pair;
 
 /// One candidate contact: gap, frame and the two surface points, world components.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -109,6 +117,17 @@ enum Geometry {
     EllipsoidHalfSpace { center: Vec3, shape: Mat3, point: Vec3, normal: Vec3 },
     /// A sphere (or point, radius 0) on body 1 against an ellipsoid on body 2.
     SphereEllipsoid { center: Vec3, radius: f64, e_center: Vec3, e_rotation: Mat3, semi: Vec3 },
+    /// Two ellipsoids, centres and shape matrices `S = R diag(a², b², c²) Rᵀ` in their body
+    /// frames ([`convex_pair`]).
+    EllipsoidEllipsoid { c1: Vec3, shape1: Mat3, c2: Vec3, shape2: Mat3 },
+    /// A surface of revolution on body 1 against the half-space of body 2 ([`surface_pair`]).
+    RevolutionHalfSpace { rev: Box<Revolution>, point: Vec3, normal: Vec3 },
+    /// A sphere (or point, radius 0) on body 1 against a surface of revolution of body 2.
+    SphereRevolution { center: Vec3, radius: f64, rev: Box<Revolution> },
+    /// A sphere (or point, radius 0) on body 1 against a spline patch of body 2.
+    SpherePatch { center: Vec3, radius: f64, patch: Box<Patch> },
+    /// An ellipsoid on body 1 (centre, shape matrix in its body frame) against a spline patch.
+    EllipsoidPatch { center: Vec3, shape: Mat3, patch: Box<Patch> },
     /// A sphere (or point, radius 0) on body 1 inside a spherical (`axis = 0`) or cylindrical
     /// cavity of body 2.
     Cavity { c1: Vec3, r1: f64, c2: Vec3, axis: Vec3, r2: f64, across: Vec3 },
@@ -186,14 +205,20 @@ pub(crate) struct Tangents {
 fn canonical(a: ContourKind, b: ContourKind) -> bool {
     use ContourKind as K;
     match b {
-        K::Plane => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder | K::Ellipsoid | K::Torus),
+        K::Plane => matches!(
+            a,
+            K::Point | K::Sphere | K::Box | K::Capsule | K::Cylinder | K::Ellipsoid | K::Torus | K::Revolution
+        ),
+        K::Revolution => matches!(a, K::Point | K::Sphere),
+        K::Patch => matches!(a, K::Point | K::Sphere | K::Ellipsoid),
         K::Line => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Curve => matches!(a, K::Point2 | K::Circle | K::Polygon | K::Curve),
         K::Sphere => matches!(a, K::Point | K::Sphere),
         K::Capsule => matches!(a, K::Point | K::Sphere | K::Capsule),
         K::Box => matches!(a, K::Point | K::Sphere | K::Box),
         K::Circle => matches!(a, K::Point2 | K::Circle),
-        K::Bowl | K::Bore | K::Ellipsoid => matches!(a, K::Point | K::Sphere),
+        K::Bowl | K::Bore => matches!(a, K::Point | K::Sphere),
+        K::Ellipsoid => matches!(a, K::Point | K::Sphere | K::Ellipsoid),
         K::Mesh => matches!(a, K::Point | K::Sphere | K::Box | K::Capsule),
         _ => false,
     }
@@ -209,7 +234,7 @@ fn orientation(a: ContourKind, b: ContourKind) -> Result<bool> {
         Err(Error::Model(format!(
             "no contact geometry for the contour pair {a}–{b} (supported: point/sphere/box/capsule/cylinder/ellipsoid/torus–plane, \
              point2/circle/polygon–line, point/sphere–sphere, point/sphere/capsule–capsule, point/sphere/box–box, \
-             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, point/sphere/box/capsule–mesh, in either order)"
+             point2/circle–circle, point2/circle/polygon/curve–curve, curve–line, point/sphere–bowl/bore/ellipsoid, ellipsoid–ellipsoid, revolution–plane, point/sphere–revolution/patch, ellipsoid–patch, point/sphere/box/capsule–mesh, in either order)"
         )))
     }
 }
@@ -276,6 +301,10 @@ impl ContactPair {
             }
             Contour::Cylinder { axis, .. } | Contour::Bore { axis, .. } | Contour::Torus { axis, .. } => {
                 [*axis, perpendicular(axis)]
+            }
+            Contour::Revolution(r) => {
+                let axis = r.rotation.column(2).into_owned();
+                [axis, perpendicular(&axis)]
             }
             Contour::Box { rotation, .. } => [rotation.column(0).into_owned(), rotation.column(1).into_owned()],
             _ => [Vec3::x(), Vec3::y()],
@@ -574,6 +603,21 @@ impl ContactPair {
                 sphere_ellipsoid(x1, x2, tw, center, *radius, e_center, e_rotation, semi)
             }
             Geometry::Mesh(g) => g.one(k, x1, x2, tw),
+            Geometry::EllipsoidEllipsoid { c1, shape1, c2, shape2 } => {
+                convex_pair::ellipsoid_ellipsoid(x1, x2, tw, c1, shape1, c2, shape2)
+            }
+            Geometry::RevolutionHalfSpace { rev, point, normal } => {
+                surface_pair::revolution_half_space(x1, x2, tw, rev, point, normal)
+            }
+            Geometry::SphereRevolution { center, radius, rev } => {
+                surface_pair::sphere_revolution(x1, x2, tw, center, *radius, rev)
+            }
+            Geometry::SpherePatch { center, radius, patch } => {
+                surface_pair::sphere_patch(x1, x2, tw, center, *radius, patch)
+            }
+            Geometry::EllipsoidPatch { center, shape, patch } => {
+                surface_pair::ellipsoid_patch(x1, x2, tw, center, shape, patch)
+            }
         }
     }
 }
@@ -628,6 +672,9 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
         _ => None,
     };
     if let Some((point, normal)) = half_space(s) {
+        if let Contour::Revolution(rev) = f {
+            return Geometry::RevolutionHalfSpace { rev: rev.clone(), point, normal };
+        }
         if let Contour::Ellipsoid { center, rotation, semi_axes } = f {
             let d = Mat3::from_diagonal(&semi_axes.component_mul(semi_axes));
             return Geometry::EllipsoidHalfSpace { center: *center, shape: rotation * d * rotation.transpose(), point, normal };
@@ -671,11 +718,37 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             | Contour::Bowl { .. }
             | Contour::Bore { .. }
             | Contour::Ellipsoid { .. }
-            | Contour::Mesh(_) => {
+            | Contour::Mesh(_)
+            | Contour::Revolution(_)
+            | Contour::Patch(_) => {
                 unreachable!("excluded by the dispatch table")
             }
         };
         return Geometry::PointsHalfSpace { centers, radius, point, normal };
+    }
+    if let (Contour::Ellipsoid { center, rotation, semi_axes }, Contour::Patch(patch)) = (f, s) {
+        let shape = rotation * Mat3::from_diagonal(&semi_axes.component_mul(semi_axes)) * rotation.transpose();
+        return Geometry::EllipsoidPatch { center: *center, shape, patch: patch.clone() };
+    }
+    if let Contour::Revolution(_) | Contour::Patch(_) = s {
+        let (center, radius) = match f {
+            Contour::Point { p } => (*p, 0.0),
+            Contour::Sphere { center, radius } => (*center, *radius),
+            _ => unreachable!("excluded by the dispatch table"),
+        };
+        return match s {
+            Contour::Revolution(rev) => Geometry::SphereRevolution { center, radius, rev: rev.clone() },
+            Contour::Patch(patch) => Geometry::SpherePatch { center, radius, patch: patch.clone() },
+            _ => unreachable!(),
+        };
+    }
+    let shape = |rotation: &Mat3, semi: &Vec3| rotation * Mat3::from_diagonal(&semi.component_mul(semi)) * rotation.transpose();
+    if let (
+        Contour::Ellipsoid { center: c1, rotation: r1, semi_axes: a1 },
+        Contour::Ellipsoid { center: c2, rotation: r2, semi_axes: a2 },
+    ) = (f, s)
+    {
+        return Geometry::EllipsoidEllipsoid { c1: *c1, shape1: shape(r1, a1), c2: *c2, shape2: shape(r2, a2) };
     }
     if let Contour::Ellipsoid { center: ec, rotation, semi_axes } = s {
         let (center, radius) = match f {
@@ -1158,3 +1231,6 @@ mod curve_tests;
 
 #[cfg(test)]
 mod mesh_tests;
+
+#[cfg(test)]
+mod surface_tests;

@@ -191,9 +191,16 @@ pub(crate) fn sample(kind: &str) -> Contour {
             rotation: rot(&Vec3::new(0.3, -1.0, 0.6), 0.8),
             semi_axes: Vec3::new(0.4, 0.3, 0.25),
         },
+        "ellipsoid_b" => Contour::Ellipsoid {
+            center: Vec3::new(-0.04, 0.02, 0.05),
+            rotation: rot(&Vec3::new(1.0, 0.4, -0.2), -0.6),
+            semi_axes: Vec3::new(0.22, 0.35, 0.28),
+        },
         "torus" => Contour::Torus { center: Vec3::new(0.05, 0.1, -0.02), axis: Vec3::new(0.2, 1.0, 0.3), radius: 0.35, tube: 0.05 },
         "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
         "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
+        "revolution" => surface_sample("revolution"),
+        "patch" => surface_sample("patch"),
         "ellipse" => curve_sample("ellipse"),
         "ellipse_b" => curve_sample("ellipse_b"),
         "blob" => curve_sample("blob"),
@@ -211,6 +218,47 @@ pub(crate) fn sample(kind: &str) -> Contour {
             mesh_contour(&v, &t)
         }
         _ => unreachable!("unknown sample {kind}"),
+    }
+}
+
+/// Spatial parametric surfaces: a closed profile with dimples at its poles (mixed convexity,
+/// mirror-symmetric about its axis) turned about a tilted axis; a wavy terrain patch.
+pub(crate) fn surface_sample(kind: &str) -> Contour {
+    use crate::geometry::curve::{Curve, Solid};
+    use crate::geometry::revolution::Revolution;
+    use crate::geometry::surface::Patch;
+    use std::f64::consts::TAU;
+    match kind {
+        "revolution" => {
+            let pts: Vec<Vec2> = (0..48)
+                .map(|i| TAU * i as f64 / 48.0)
+                .map(|t| Vec2::new(t.cos(), t.sin()) * (0.3 + 0.08 * (2.0 * t).cos()))
+                .collect();
+            let profile = Curve::spline(&pts, true, Solid::Inside, "revolution").unwrap();
+            let r = Revolution::new(
+                Vec3::new(0.03, -0.02, 0.05),
+                rot(&Vec3::new(0.4, 1.0, -0.3), 0.7),
+                profile,
+                "revolution",
+            );
+            Contour::Revolution(Box::new(r.unwrap()))
+        }
+        "patch" => {
+            let n = 26;
+            let pts: Vec<Vec<Vec3>> = (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| {
+                            let (x, y) =
+                                (-2.5 + 5.0 * i as f64 / (n - 1) as f64, -2.5 + 5.0 * j as f64 / (n - 1) as f64);
+                            Vec3::new(x, y, 0.1 * (2.0 * x).sin() * (1.5 * y).cos() - 0.2)
+                        })
+                        .collect()
+                })
+                .collect();
+            Contour::Patch(Box::new(Patch::new(&pts, (0.0, 1.0), (0.0, 1.0), [false, false], "patch").unwrap()))
+        }
+        _ => unreachable!("unknown surface sample {kind}"),
     }
 }
 
@@ -293,7 +341,7 @@ pub(crate) const CURVE_PAIRS: [(&str, &str); 13] = [
 ];
 
 /// Every supported pair in canonical order (sample names).
-pub(crate) const PAIRS: [(&str, &str); 29] = [
+pub(crate) const PAIRS: [(&str, &str); 36] = [
     ("point", "plane"),
     ("sphere", "plane"),
     ("box", "plane"),
@@ -315,6 +363,13 @@ pub(crate) const PAIRS: [(&str, &str); 29] = [
     ("torus", "plane"),
     ("point", "ellipsoid"),
     ("sphere_b", "ellipsoid"),
+    ("ellipsoid_b", "ellipsoid"),
+    ("revolution", "plane"),
+    ("point", "revolution"),
+    ("sphere_b", "revolution"),
+    ("point", "patch"),
+    ("sphere_b", "patch"),
+    ("ellipsoid_b", "patch"),
     ("point", "bowl"),
     ("sphere", "bowl"),
     ("point", "bore"),
@@ -384,6 +439,12 @@ pub(crate) fn sdf(c: &Contour, pose: &Pose, x: &Vec3) -> f64 {
                 .fold(f64::NEG_INFINITY, f64::max)
         }
         Contour::Curve(c) => curve_sdf(c, &Vec2::new(xl.x, xl.y)).0,
+        Contour::Revolution(r) => {
+            // the meridian plane: the profile's sampled distance
+            let y = r.rotation.transpose() * (xl - r.center);
+            curve_sdf(&r.profile, &Vec2::new(y.x.hypot(y.y), y.z)).0
+        }
+        Contour::Patch(p) => patch_sdf(p, &xl),
         Contour::Torus { center, axis, radius, tube } => {
             let a = axis.normalize();
             let y = xl - center;
@@ -550,6 +611,48 @@ pub(crate) fn ellipsoid_sdf(y: &Vec3, a: &Vec3) -> f64 {
     }
     let inside = y.component_div(a).norm() < 1.0;
     if inside {
+        -best.sqrt()
+    } else {
+        best.sqrt()
+    }
+}
+
+/// Signed distance from a body-frame point to a spline patch (positive above its normal), by
+/// dense sampling of the parameters and a shrinking pattern search (independent of the foot
+/// point's Newton iteration).
+pub(crate) fn patch_sdf(p: &crate::geometry::surface::Patch, y: &Vec3) -> f64 {
+    let [(a0, a1), (b0, b1)] = p.range();
+    let n = 200;
+    let d2 = |s: [f64; 2]| (y - p.eval(s)[0]).norm_squared();
+    let (mut best, mut sb) = (f64::INFINITY, [a0, b0]);
+    for i in 0..=n {
+        for j in 0..=n {
+            let s = [a0 + (a1 - a0) * i as f64 / n as f64, b0 + (b1 - b0) * j as f64 / n as f64];
+            let v = d2(s);
+            if v < best {
+                (best, sb) = (v, s);
+            }
+        }
+    }
+    let mut step = (a1 - a0).max(b1 - b0) / n as f64;
+    while step > 1e-15 {
+        let mut moved = false;
+        for (u, v) in
+            [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)]
+        {
+            let s = p.clamp([sb[0] + u * step, sb[1] + v * step]);
+            let d = d2(s);
+            if d < best {
+                (best, sb, moved) = (d, s, true);
+            }
+        }
+        if !moved {
+            step *= 0.5;
+        }
+    }
+    let j = p.eval(sb);
+    let nu = j[1].cross(&j[2]).normalize();
+    if (y - j[0]).dot(&nu) < 0.0 {
         -best.sqrt()
     } else {
         best.sqrt()

@@ -14,6 +14,8 @@ use super::contact_description::{
 };
 use crate::geometry::curve::{Curve, Follower, Solid};
 use crate::geometry::gear::GearSpec;
+use crate::geometry::revolution::Revolution;
+use crate::geometry::surface::Patch;
 
 /// Tangential law with its coefficients.
 #[derive(Debug, Clone, PartialEq)]
@@ -402,7 +404,36 @@ fn contour(
             Contour::Curve(Box::new(Curve::cam(angles, lift, *base_radius, f, *direction, what)?))
         }
         ContourDescription::Gear(g) => Contour::Curve(Box::new(Curve::gear(&gear_spec(g, what)?, what)?)),
+        ContourDescription::Revolution { center, rotation: r, profile } => {
+            let w = format!("{what}.profile");
+            let Contour::Curve(c) = contour(profile, true, &w, no_rotation)? else {
+                return Err(Error::Model(format!(
+                    "{w}: a revolution profile is an ellipse, spline or cam, got {}",
+                    Contour::kind(&contour(profile, true, &w, no_rotation)?)
+                )));
+            };
+            let frame = rotation(r, &format!("{what}.rotation"))?;
+            Contour::Revolution(Box::new(Revolution::new(vec3(center), frame, *c, what)?))
+        }
+        ContourDescription::Patch { points, range1, range2, periodic } => {
+            let grid: Vec<Vec<Vec3>> = points.iter().map(|row| row.iter().map(vec3).collect()).collect();
+            Contour::Patch(Box::new(Patch::new(
+                &grid,
+                (range1[0], range1[1]),
+                (range2[0], range2[1]),
+                *periodic,
+                what,
+            )?))
+        }
     })
+}
+
+/// A profile (in its own plane) has no rotation of its own.
+fn no_rotation(r: &Option<super::description::RotationDescription>, what: &str) -> Result<crate::math::Mat3> {
+    match r {
+        None => Ok(crate::math::Mat3::identity()),
+        Some(_) => Err(Error::Model(format!("{what}: a revolution profile takes no rotation"))),
+    }
 }
 
 /// The validated friction law of a description; `what` names the owner in messages.

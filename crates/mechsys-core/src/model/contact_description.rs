@@ -5,7 +5,8 @@
 //! `cylinder`, `torus`, `ellipsoid`, `bowl`, `bore`, `mesh` (triangles); in the plane (the x-y
 //! plane of the body frame): `point`, `circle`, `line`
 //! (half-plane behind its normal), `polygon`, and the parametric contours `ellipse`, `spline`,
-//! `cam`, `gear`. Normal contact is always Signorini's law
+//! `cam`, `gear`; the spatial parametric surfaces `revolution` (a planar profile turned about an
+//! axis) and `patch` (a bicubic spline through a grid of points). Normal contact is always Signorini's law
 //! (g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0); friction is none, Coulomb with a static and a sliding
 //! coefficient, or a Stribeck curve; impacts follow Newton's or Poisson's law.
 
@@ -234,6 +235,38 @@ pub enum ContourDescription {
     },
     /// An external involute spur gear (a parametric contour, section 2.2.7.1).
     Gear(GearDescription),
+    /// A surface of revolution (section 2.2.7.2): a planar `profile` (an `ellipse`, `spline` or
+    /// `cam` table; its x is the radius, its y the height) turned about the z axis of the frame
+    /// at `center`, turned by `rotation` in the body.
+    Revolution {
+        /// Centre (a point of the axis).
+        #[serde(default)]
+        center: [f64; 3],
+        /// Orientation of the revolution frame (identity if absent: the axis is the body's z).
+        #[serde(default)]
+        rotation: Option<RotationDescription>,
+        /// The meridian profile.
+        profile: Box<ContourDescription>,
+    },
+    /// A bicubic spline patch `r(s1, s2)` through a grid of body-frame points, solid below its
+    /// normal `r_1 × r_2` (section 2.2.7.2).
+    Patch {
+        /// Grid `points[i][j]` at `s1_i`, `s2_j` (at least 2 × 2, rectangular).
+        points: Vec<Vec<[f64; 3]>>,
+        /// Parameter range of `s1` (`[0, 1]` if absent); the knots are uniform.
+        #[serde(default = "unit_range")]
+        range1: [f64; 2],
+        /// Parameter range of `s2`.
+        #[serde(default = "unit_range")]
+        range2: [f64; 2],
+        /// Periodic in `s1`, `s2` (the last grid line must then repeat the first).
+        #[serde(default)]
+        periodic: [bool; 2],
+    },
+}
+
+fn unit_range() -> [f64; 2] {
+    [0.0, 1.0]
 }
 
 /// An external involute spur gear in the body's x-y plane (see `geometry::gear`); lengths in m,
