@@ -1,8 +1,6 @@
 //! The mesh narrow phase (hierarchy walk on its fixed stack, closest features, rates) allocates
 //! nothing per evaluation (a counting global allocator, per thread).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::sync::Arc;
 
 use mechsys_core::contact::{
@@ -12,32 +10,11 @@ use mechsys_core::geometry::mesh::TriMesh;
 use mechsys_core::math::{Mat3, Vec3};
 use mechsys_core::spatial::{Motion, Pose};
 
-struct Counting;
-
-thread_local! {
-    static COUNT: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        COUNT.with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        COUNT.with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(p, l, n) }
-    }
-}
+mod common;
+use common::allocations;
 
 #[global_allocator]
-static A: Counting = Counting;
-
-fn allocations() -> usize {
-    COUNT.with(|c| c.get())
-}
+static A: common::Counting = common::Counting;
 
 /// A bumpy 40 × 40 terrain (3200 triangles) under a sphere, a box and a capsule at places over
 /// faces, edges and vertices, with and without rates: no allocation in 3000 evaluations.

@@ -1,8 +1,6 @@
 //! The Moreau–Jean step on a contact group allocates nothing once every pair has been met and
 //! every buffer has grown to the largest problem (a counting global allocator, per thread).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 
 use mechsys_core::contact::group::sphere_pile;
 use mechsys_core::data::Data;
@@ -12,32 +10,11 @@ use mechsys_core::integrator::moreau_jean::MoreauJean;
 use mechsys_core::model::{Model, ModelDescription};
 use mechsys_core::solver::{Method, NsgsOptions};
 
-struct Counting;
-
-thread_local! {
-    static COUNT: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        COUNT.with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        COUNT.with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(p, l, n) }
-    }
-}
+mod common;
+use common::allocations;
 
 #[global_allocator]
-static A: Counting = Counting;
-
-fn allocations() -> usize {
-    COUNT.with(|c| c.get())
-}
+static A: common::Counting = common::Counting;
 
 /// 27 spheres poured into a box: a first pass meets every pair and sizes every buffer; the same
 /// run repeated from the start (same stepper) then allocates nothing, in about 11 000 contact

@@ -405,3 +405,26 @@ pub fn project(
     }
     Ok(())
 }
+
+/// `x ← M̃⁻¹ x`: the accelerations a generalized force `x` causes under the bilateral
+/// constraints (`M⁻¹ x` restricted to their tangent space through the factored Schur complement
+/// in `sp`); `lambda`, if given, receives the multipliers it adds. `data.work2` is scratch.
+pub(crate) fn tangent_inverse_mass(data: &mut Data, sp: &mut Saddle, nc: usize, x: &mut [f64], lambda: Option<&mut [f64]>) {
+    sp.solve_mass(x);
+    if nc > 0 {
+        let mut y = std::mem::take(&mut data.work2);
+        y.resize(nc.max(y.len()), 0.0);
+        sp.g_times(x, &mut y[..nc]);
+        for v in y[..nc].iter_mut() {
+            *v = -*v;
+        }
+        sp.solve_schur(&mut y[..nc]);
+        sp.add_constraint_accelerations(&y[..nc], x);
+        if let Some(l) = lambda {
+            for k in 0..nc {
+                l[k] += y[k];
+            }
+        }
+        data.work2 = y;
+    }
+}

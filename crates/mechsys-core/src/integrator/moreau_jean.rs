@@ -466,17 +466,7 @@ impl MoreauJean {
                     for i in 0..nu {
                         x[i] = self.w_rows[(col, i)];
                     }
-                    ws.saddle.solve_mass(x);
-                    if nc > 0 {
-                        let mut y = std::mem::take(&mut data.lambda);
-                        ws.saddle.g_times(x, &mut y);
-                        for v in y.iter_mut() {
-                            *v = -*v;
-                        }
-                        ws.saddle.solve_schur(&mut y);
-                        ws.saddle.add_constraint_accelerations(&y, x);
-                        data.lambda = y;
-                    }
+                    crate::dynamics::constrained::tangent_inverse_mass(data, &mut ws.saddle, nc, x, None);
                 }
                 let Delassus::Dense(w) = &mut self.problem.w else { unreachable!("dense Delassus") };
                 w.clear();

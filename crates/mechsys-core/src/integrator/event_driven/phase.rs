@@ -162,23 +162,7 @@ impl<'a> Phase<'a> {
     /// `x ← M̃⁻¹ x`: the accelerations a generalized force `x` causes under the bilateral
     /// constraints; `lambda`, if given, receives the multipliers it adds.
     pub(super) fn inverse_mass(data: &mut Data, sp: &mut Saddle, nc: usize, x: &mut [f64], lambda: Option<&mut [f64]>) {
-        sp.solve_mass(x);
-        if nc > 0 {
-            let mut y = std::mem::take(&mut data.work2);
-            y.resize(nc.max(y.len()), 0.0);
-            sp.g_times(x, &mut y[..nc]);
-            for v in y[..nc].iter_mut() {
-                *v = -*v;
-            }
-            sp.solve_schur(&mut y[..nc]);
-            sp.add_constraint_accelerations(&y[..nc], x);
-            if let Some(l) = lambda {
-                for k in 0..nc {
-                    l[k] += y[k];
-                }
-            }
-            data.work2 = y;
-        }
+        crate::dynamics::constrained::tangent_inverse_mass(data, sp, nc, x, lambda);
     }
 
     /// Generalized direction of a force `dir` at point `pt` (body 1 pushed along `dir`, body 2
