@@ -52,6 +52,14 @@ pub struct Settings {
     /// What is recorded beyond the state, energies and momenta (default: everything).
     #[serde(default)]
     pub record: RecordSelection,
+    /// Warm-start the contact searches of planar parametric contours (default; the same roots as
+    /// cold searches, see [`crate::contact::SearchHint`]); `false`: every evaluation searches cold.
+    #[serde(default = "warm_search_default")]
+    pub warm_search: bool,
+}
+
+fn warm_search_default() -> bool {
+    true
 }
 
 /// Which groups of signals a run records. The state (t, q, u), energies, momenta and contact
@@ -97,7 +105,12 @@ pub struct Budget {
 impl Budget {
     /// Starts the clock.
     pub fn new(settings: &Settings) -> Self {
-        Budget { start: std::time::Instant::now(), max_steps: settings.max_steps, max_wall: settings.max_wall, steps: 0 }
+        Budget {
+            start: std::time::Instant::now(),
+            max_steps: settings.max_steps,
+            max_wall: settings.max_wall,
+            steps: 0,
+        }
     }
 
     /// An error once the wall-time budget is spent.
@@ -778,11 +791,28 @@ impl OdeSystem for MultibodySystem<'_> {
                 qs.extend_from_slice(q);
                 us.clear();
                 us.extend_from_slice(u);
-                if dynamics::constrained::project(self.model, &mut self.data, &mut self.ws, t, &mut qs, &mut us, self.cb)
-                    .is_ok()
+                if dynamics::constrained::project(
+                    self.model,
+                    &mut self.data,
+                    &mut self.ws,
+                    t,
+                    &mut qs,
+                    &mut us,
+                    self.cb,
+                )
+                .is_ok()
                 {
                     staged = true;
-                    p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, &qs, &us, None, self.cb)?;
+                    p = dynamics::forward_dynamics(
+                        self.model,
+                        &mut self.data,
+                        &mut self.ws,
+                        t,
+                        &qs,
+                        &us,
+                        None,
+                        self.cb,
+                    )?;
                     self.check_singular(t)?;
                 }
             }
@@ -893,7 +923,11 @@ pub fn check_inertia(model: &Model, t: f64, q: &[f64]) -> Result<()> {
     let big = (0..nu).map(|i| m[(i, i)].abs()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let name = |i: usize| {
         let j = model.joints.iter().find(|j| j.iu <= i && i < j.iu + j.nu()).expect("every velocity has a joint");
-        if j.nu() == 1 { format!("'{}'", j.name) } else { format!("'{}' (velocity {})", j.name, i - j.iu) }
+        if j.nu() == 1 {
+            format!("'{}'", j.name)
+        } else {
+            format!("'{}' (velocity {})", j.name, i - j.iu)
+        }
     };
     let light: Vec<String> = (0..nu).filter(|&i| !(m[(i, i)] > 1e-12 * big)).map(name).collect();
     let singular = !light.is_empty() || m.clone().cholesky().is_none();
@@ -1121,7 +1155,9 @@ pub fn simulate(
         "integrator: the model has unilateral contacts ('{}'); use MoreauJean (time-stepping) or EventDriven",
         model.contacts[0].name
     );
-    let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization).with_on_singular(settings.on_singular);
+    let mut sys = MultibodySystem::new(model, cb)
+        .with_stabilization(settings.stabilization)
+        .with_on_singular(settings.on_singular);
     // a consistent initial state: on the constraint manifolds (assembly from the given q0, u0)
     // (always by projection, whatever the drift control during the run)
     let mut y0 = y0;
@@ -1142,7 +1178,8 @@ pub fn simulate(
     // an explicit fixed step above its stability limit grows the energy geometrically: watched
     // for RK4 (the adaptive and implicit schemes control or damp it); variable-mass bodies carry
     // energy away with the ejected mass, so their balance is not checked
-    let guard = matches!(settings.integrator, IntegratorKind::Rk4 { .. }) && model.bodies.iter().all(|b| b.mass_rate == 0.0);
+    let guard =
+        matches!(settings.integrator, IntegratorKind::Rk4 { .. }) && model.bodies.iter().all(|b| b.mass_rate == 0.0);
     let mut divergence =
         Divergence { floor: 1e-6 * model.bodies.iter().skip(1).map(|b| b.mass).sum::<f64>(), ..Default::default() };
     sys.budget = Some(Budget::new(settings));
@@ -1155,7 +1192,8 @@ pub fn simulate(
             // the Jenkins sliders book their work when a step is committed; a sample inside or at
             // the end of a step (before the commit) adds the work they did since the last one
             let d = &sys.data;
-            let pending: f64 = (0..model.n_sliders).map(|i| d.slider_force[i] * (d.slider_trial[i] - d.slider[i])).sum();
+            let pending: f64 =
+                (0..model.n_sliders).map(|i| d.slider_force[i] * (d.slider_trial[i] - d.slider[i])).sum();
             if let Some(last) = rec.dissipated.last_mut() {
                 *last += pending;
             }
@@ -1281,6 +1319,7 @@ fn time_stepping(
     // (prepare() checked that output_dt is a whole multiple of dt)
     let every = (settings.output_dt / dt).round() as u64;
     let mut stepper = MoreauJean::new(model, dt, solver)?;
+    stepper.warm_search = settings.warm_search;
     let mut group_stats = vec![crate::integrator::moreau_jean::GroupStats::default(); model.contact_groups.len()];
     let (mut data, mut ws) = (Data::new(model), dynamics::Workspace::new(model));
     let mut y = y0;
@@ -1457,6 +1496,7 @@ fn event_driven(
     use crate::integrator::event_driven::{self, Phase};
     let (nq, nu, np) = (model.nq, model.nu, model.n_contact_points);
     let mut phase = Phase::new(model, cb, opts)?;
+    phase.warm_search = settings.warm_search;
     let mut y = vec![0.0; phase.state_len()];
     y[..nq + nu + 2].copy_from_slice(&y0);
     let e = nq + nu;
