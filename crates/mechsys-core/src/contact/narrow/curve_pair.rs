@@ -26,6 +26,11 @@
 //! it; roots that are not minima (the far side of a concave flank) are refused. When no seed
 //! converges, the best sample pair is used as it is (finite, approximate).
 //!
+//! **Warm start.** Given the state of the last evaluation ([`SearchHint`]), each search first
+//! tries Newton from the previous roots when the relative motion since the last full search is
+//! provably too small to change them (see [`super::warm`]); it records its basins and margin
+//! when it searches in full.
+//!
 //! **Several points.** With `count > 1` the `count` deepest roots are kept, ordered by their
 //! parameter on the curve (so a candidate keeps its index while its root persists); slots
 //! without a root are *unused* candidates whose gap exceeds any real one. Gear pairs, whose
