@@ -39,8 +39,8 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
 use mechsys_core::contact::{
-    contact_kinematics, contact_kinematics_warm, evaluate, Aabb, BodyMotion, ContactKinematics, ContactPair, ContactPoint, Contour,
-    SweepAndPrune,
+    contact_kinematics, contact_kinematics_warm, evaluate, Aabb, BodyMotion, ContactKinematics, ContactPair,
+    ContactPoint, Contour, SweepAndPrune,
 };
 use mechsys_core::math::{Mat3, Vec3};
 use mechsys_core::spatial::{Motion, Pose};
@@ -274,7 +274,11 @@ fn bench_sequences(c: &mut Criterion) {
     use mechsys_core::geometry::gear::GearSpec;
     let n = 100;
     let rz = |t: f64| nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), t).into_inner();
-    let at = |pose: Pose, w: f64| BodyMotion { pose, twist: Motion::new(Vec3::new(0.0, 0.0, w), Vec3::zeros()), acc: Motion::ZERO };
+    let at = |pose: Pose, w: f64| BodyMotion {
+        pose,
+        twist: Motion::new(Vec3::new(0.0, 0.0, w), Vec3::zeros()),
+        acc: Motion::ZERO,
+    };
     let ellipse = |a, b| Contour::Curve(Box::new(Curve::ellipse(Vec2::zeros(), a, b, 0.0, "e").expect("valid")));
     let ang: Vec<f64> = (0..=360).map(|i| std::f64::consts::TAU * i as f64 / 360.0).collect();
     let lift: Vec<f64> = ang.iter().map(|t| 0.004 * (1.0 - t.cos())).collect();
@@ -289,7 +293,8 @@ fn bench_sequences(c: &mut Criterion) {
         let mut d = 0.5;
         let mut k = vec![ContactKinematics::default(); pair.candidates()];
         for _ in 0..8 {
-            contact_kinematics(pair, &at(x1(d), 0.0), &at(Pose::new(rz(t2), Vec3::zeros()), 0.0), &mut k).expect("room");
+            contact_kinematics(pair, &at(x1(d), 0.0), &at(Pose::new(rz(t2), Vec3::zeros()), 0.0), &mut k)
+                .expect("room");
             d -= k[0].point.g_n - 1e-4;
         }
         (at(x1(d), 1.0), at(Pose::new(rz(t2), Vec3::zeros()), -2.0))

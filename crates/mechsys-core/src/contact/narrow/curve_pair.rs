@@ -410,7 +410,7 @@ fn leave(
     hints: &mut [SearchHint],
     sel: &[Option<Root>],
     warm: bool,
-    basins: &Basins<Root>,
+    basins: Option<&Basins<Root>>,
     searched: &Curve,
     param: impl Fn(&Root) -> f64,
     same: impl Fn(&Root, &Root) -> bool,
@@ -421,7 +421,7 @@ fn leave(
     if warm {
         hints[0].set_warm();
     } else {
-        let other = basins.margin(sel, &param, |r| r.key, same, period(searched), &mut windows);
+        let other = basins.and_then(|b| b.margin(sel, &param, |r| r.key, same, period(searched), &mut windows));
         let keys = sel.iter().flatten().map(|r| r.key);
         let (best, worst) = keys.fold((f64::INFINITY, f64::NEG_INFINITY), |(b, w), k| (b.min(k), w.max(k)));
         let margin = other.map_or(-1.0, |o| o.min(bound(best, worst)) - worst);
@@ -474,11 +474,13 @@ fn point_curve(
                 (y - ch.center).norm() - ch.radius <= roots.list[0].key + reach
             })
     });
-    let mut basins = Basins::new();
+    // (recorded for a later warm start only: a few kB to clear)
+    let mut basins = (hints.is_some() && !warm).then(Basins::new);
     let mut ub = 0.0;
     if !warm {
         roots = Roots::new(count.max(1));
-        ub = foot_points(curve, &y, reach, &mut roots, &mut basins);
+        // a band of a tenth of the curve's size beyond the pruning: the margin's reach
+        ub = foot_points(curve, &y, reach, &mut roots, basins.as_mut(), 0.1 * curve.bound().1);
     }
     let o2 = curve.offset();
     let c2d = Vec2::new(center.x, center.y);
@@ -516,10 +518,10 @@ fn point_curve(
         },
     );
     if let Some(h) = hints {
-        // pruned chunks are farther than ub + reach
-        let bound = |_, _| ub + reach;
+        // the chunks not looked at are farther than that
+        let bound = |_, _| ub;
         let same = |a: &Root, b: &Root| same_param(curve, a.s2, b.s2);
-        leave(h, &sel[..count], warm, &basins, curve, |r| r.s2, same, bound, placement);
+        leave(h, &sel[..count], warm, basins.as_ref(), curve, |r| r.s2, same, bound, placement);
     }
 }
 
@@ -563,30 +565,45 @@ fn sampled_minima(
     best
 }
 
-/// Local minima of the distance from `y` to the curve's samples, refined to foot points (each
-/// sampled minimum recorded in `basins`); returns the bound `ub` of the pruning.
-fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots, basins: &mut Basins<Root>) -> f64 {
-    let samples = curve.samples();
-    let ub = curve.chunks().iter().map(|c| (y - c.center).norm() + c.radius).fold(f64::INFINITY, f64::min);
+/// Local minima of the distance from `y` to the curve's samples, refined to foot points; returns
+/// the bound of the regions the search did not look at. Recording for a warm start (`basins`),
+/// it also looks `band` further, at competitors only (their minima go to `basins`, never to
+/// `roots`: the roots are those of the plain search), so that the margin is not limited by the
+/// pruning's upper bound.
+fn foot_points(
+    curve: &Curve,
+    y: &Vec2,
+    reach: f64,
+    roots: &mut Roots,
+    mut basins: Option<&mut Basins<Root>>,
+    band: f64,
+) -> f64 {
+    let (samples, chunks) = (curve.samples(), curve.chunks());
+    let ub = chunks.iter().map(|c| (y - c.center).norm() + c.radius).fold(f64::INFINITY, f64::min);
+    let band = if basins.is_some() { band } else { 0.0 };
+    let below = |ch: &Chunk| (y - ch.center).norm() - ch.radius;
     let best = sampled_minima(
         curve,
-        |ch| (y - ch.center).norm() - ch.radius <= ub + reach,
+        |ch| below(ch) <= ub + reach + band,
         |i| (y - samples[i].r).norm(),
         |i| {
+            let searched = chunks.get(i / CHUNK).is_some_and(|ch| below(ch) <= ub + reach);
             let root = curve.foot(y, samples[i].s).map(|(s, j)| {
                 let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
                 Root { s2: curve.wrap(s), key, ..Default::default() }
             });
-            if let Some(r) = root {
+            if let (Some(r), true) = (root, searched) {
                 roots.push(r, |a, b| same_param(curve, a.s2, b.s2));
             }
-            basins.push(samples[i].s, root);
+            if let Some(b) = basins.as_deref_mut() {
+                b.push(samples[i].s, root);
+            }
         },
     );
     if roots.len == 0 && best.0.is_finite() {
         roots.push(Root { s2: samples[best.1].s, key: best.0, ..Default::default() }, |_, _| false);
     }
-    ub
+    ub + reach + band
 }
 
 /// A curve on body 1 against the half-plane of body 2 (2-D `point`, unit `normal`).
@@ -647,7 +664,7 @@ fn curve_line(
                 m.dot(&(rel.point(&ch.center) - point)) - ch.radius <= roots.list[0].key + reach
             })
     });
-    let mut basins = Basins::new();
+    let mut basins = (hints.is_some() && !warm).then(Basins::new);
     let mut ub = 0.0;
     if !warm {
         roots = Roots::new(count.max(1));
@@ -661,7 +678,9 @@ fn curve_line(
                 if let Some(r) = root {
                     roots.push(r, same);
                 }
-                basins.push(samples[i].s, root);
+                if let Some(b) = basins.as_mut() {
+                    b.push(samples[i].s, root);
+                }
             },
         );
         if roots.len == 0 && best.0.is_finite() {
@@ -703,7 +722,7 @@ fn curve_line(
     if let Some(h) = hints {
         // pruned chunks are higher than ub + reach (keys: heights over the line's point)
         let bound = |_, _| ub + reach - m.dot(point);
-        leave(h, &sel[..count], warm, &basins, curve, |r| r.s1, same, bound, placement);
+        leave(h, &sel[..count], warm, basins.as_ref(), curve, |r| r.s1, same, bound, placement);
     }
 }
 
@@ -797,7 +816,7 @@ fn curve_curve(
                 })
             }
     });
-    let mut basins = Basins::new();
+    let mut basins = (hints.is_some() && !warm).then(Basins::new);
     let mut ub_out = 0.0;
     if !warm {
         roots = Roots::new(if slots.is_some() { MAX_ROOTS } else { count.max(1) });
@@ -958,7 +977,9 @@ fn curve_curve(
             if let Some((r, true)) = root {
                 roots.push(r, same);
             }
-            basins.push(s1[i].s, root.map(|r| r.0));
+            if let Some(b) = basins.as_mut() {
+                b.push(s1[i].s, root.map(|r| r.0));
+            }
         }
         if roots.len == 0 && best.0.is_finite() {
             roots.push(Root { s1: s1[best.1].s, s2: s2[best.2].s, key: best.0, ..Default::default() }, |_, _| false);
@@ -1036,6 +1057,6 @@ fn curve_curve(
         // family a warm start could follow; they always search cold
         let gears = c1.as_gear().is_some() || c2.as_gear().is_some();
         let bound = |best: f64, _| if -best < prune && !gears { prune } else { f64::NEG_INFINITY };
-        leave(h, &sel[..count], warm, &basins, c1, |r| r.s1, same, bound, placement);
+        leave(h, &sel[..count], warm, basins.as_ref(), c1, |r| r.s1, same, bound, placement);
     }
 }
