@@ -562,7 +562,8 @@ impl Contour {
             }
             Contour::Circle { radius, .. } => [1.0 / radius, 0.0],
             Contour::Polygon { vertices } => {
-                let on_vertex = vertices.iter().any(|v| (Vec2::new(l.x, l.y) - v).norm() <= 1e-9 * (1.0 + v.norm()));
+                let on_vertex =
+                    vertices.iter().any(|v| (Vec2::new(l.x, l.y) - v).norm() <= 1e-9 * (1.0 + v.norm()));
                 if on_vertex {
                     [inf, 0.0]
                 } else {

@@ -162,14 +162,7 @@ impl GapFunction {
             )));
         }
         *out = ContactKinematics {
-            point: ContactPoint {
-                g_n: value[0][0],
-                n: Vec3::z(),
-                p1: Vec3::zeros(),
-                p2: Vec3::zeros(),
-                t1: Vec3::x(),
-                t2: Vec3::y(),
-            },
+            point: ContactPoint { g_n: value[0][0], n: Vec3::z(), p1: Vec3::zeros(), p2: Vec3::zeros(), t1: Vec3::x(), t2: Vec3::y() },
             gd_n: value[0][1],
             gd_t: [value[1][1], value[2][1]],
             wbar_n: value[0][2],

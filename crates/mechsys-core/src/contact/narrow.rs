@@ -316,11 +316,7 @@ impl ContactPair {
             "contact pair {name}: points must be 1 to {}, got {points}",
             curve_pair::MAX_POINTS
         );
-        ensure!(
-            g.shared(),
-            Model,
-            "contact pair {name}: a polygon has one contact point per vertex; points does not apply"
-        );
+        ensure!(g.shared(), Model, "contact pair {name}: a polygon has one contact point per vertex; points does not apply");
         g.check_points(points).map_err(|m| Error::Model(format!("contact pair {name}: {m}")))?;
         g.set_points(points);
         self.count = points;
@@ -624,9 +620,7 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             let first = match f {
                 Contour::Point2 { p } => First::Points { centers: vec![lift(p)], radius: 0.0 },
                 Contour::Circle { center, radius } => First::Points { centers: vec![lift(center)], radius: *radius },
-                Contour::Polygon { vertices } => {
-                    First::Points { centers: vertices.iter().map(lift).collect(), radius: 0.0 }
-                }
+                Contour::Polygon { vertices } => First::Points { centers: vertices.iter().map(lift).collect(), radius: 0.0 },
                 Contour::Curve(c) => First::Curve((**c).clone()),
                 _ => unreachable!("excluded by the dispatch table"),
             };
@@ -643,12 +637,7 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
     if let Some((point, normal)) = half_space(s) {
         if let Contour::Ellipsoid { center, rotation, semi_axes } = f {
             let d = Mat3::from_diagonal(&semi_axes.component_mul(semi_axes));
-            return Geometry::EllipsoidHalfSpace {
-                center: *center,
-                shape: rotation * d * rotation.transpose(),
-                point,
-                normal,
-            };
+            return Geometry::EllipsoidHalfSpace { center: *center, shape: rotation * d * rotation.transpose(), point, normal };
         }
         let (centers, radius) = match f {
             Contour::Point { p } => (vec![*p], 0.0),

@@ -191,12 +191,7 @@ pub(crate) fn sample(kind: &str) -> Contour {
             rotation: rot(&Vec3::new(0.3, -1.0, 0.6), 0.8),
             semi_axes: Vec3::new(0.4, 0.3, 0.25),
         },
-        "torus" => Contour::Torus {
-            center: Vec3::new(0.05, 0.1, -0.02),
-            axis: Vec3::new(0.2, 1.0, 0.3),
-            radius: 0.35,
-            tube: 0.05,
-        },
+        "torus" => Contour::Torus { center: Vec3::new(0.05, 0.1, -0.02), axis: Vec3::new(0.2, 1.0, 0.3), radius: 0.35, tube: 0.05 },
         "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
         "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
         "ellipse" => curve_sample("ellipse"),
@@ -234,8 +229,7 @@ pub(crate) fn curve_sample(kind: &str) -> Contour {
         }
         // a circular bore of radius 0.9 (solid outside)
         "bore" => {
-            let pts: Vec<Vec2> =
-                (0..40).map(|i| TAU * i as f64 / 40.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.9).collect();
+            let pts: Vec<Vec2> = (0..40).map(|i| TAU * i as f64 / 40.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.9).collect();
             Curve::spline(&pts, true, Solid::Outside, "bore").unwrap()
         }
         // involute gears of about the samples' size, off their body origins
@@ -406,10 +400,7 @@ pub(crate) fn ellipsoid_sdf(y: &Vec3, a: &Vec3) -> f64 {
     let (mut best, mut bu, mut bv) = (f64::INFINITY, 0.0, 0.0);
     for i in 0..360 {
         for j in 0..=180 {
-            let (u, v) = (
-                std::f64::consts::TAU * i as f64 / 360.0,
-                -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 180.0,
-            );
+            let (u, v) = (std::f64::consts::TAU * i as f64 / 360.0, -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 180.0);
             let d = d2(u, v);
             if d < best {
                 (best, bu, bv) = (d, u, v);
@@ -419,16 +410,7 @@ pub(crate) fn ellipsoid_sdf(y: &Vec3, a: &Vec3) -> f64 {
     let mut step = 0.02;
     while step > 1e-13 {
         let mut moved = false;
-        for (du, dv) in [
-            (step, 0.0),
-            (-step, 0.0),
-            (0.0, step),
-            (0.0, -step),
-            (step, step),
-            (-step, -step),
-            (step, -step),
-            (-step, step),
-        ] {
+        for (du, dv) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step), (step, step), (-step, -step), (step, -step), (-step, step)] {
             let d = d2(bu + du, bv + dv);
             if d < best {
                 (best, bu, bv, moved) = (d, bu + du, bv + dv, true);

@@ -357,13 +357,12 @@ pub fn project(
         crate::kinematics::positions(model, data, q);
         constraints::positions(model, data, t, q, cb)?;
         let skip = &data.skip_rows;
-        worst = data.phi.iter().enumerate().filter(|(k, _)| !skip[*k]).fold((0.0, 0), |w, (k, v)| {
-            if v.abs() > w.0 {
-                (v.abs(), k)
-            } else {
-                w
-            }
-        });
+        worst = data
+            .phi
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| !skip[*k])
+            .fold((0.0, 0), |w, (k, v)| if v.abs() > w.0 { (v.abs(), k) } else { w });
         if worst.0 <= 1e-13 {
             converged = true;
             break;

@@ -35,7 +35,9 @@
 
 use nalgebra::DMatrix;
 
-use crate::contact::{at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase, SearchHint};
+use crate::contact::{
+    at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase, SearchHint,
+};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -822,15 +824,7 @@ impl MoreauJean {
 
     /// Contact geometry and relative velocities of every candidate at the state in `data`
     /// (after a kinematics pass), for the records.
-    pub fn measure(
-        &mut self,
-        model: &Model,
-        data: &mut Data,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        cb: &dyn Callbacks,
-    ) -> Result<()> {
+    pub fn measure(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
         for con in &model.contacts {
             let pts = con.first..con.first + con.points();
             let s = self.warm_search.then(|| &mut self.search[pts.clone()]);

@@ -266,12 +266,7 @@ impl<R: FnMut(&str, Option<usize>) -> Result<usize, String>> Parser<'_, R> {
                             self.bump()?;
                             let k = match self.tok {
                                 Token::Num(v) if v >= 0.0 && v.fract() == 0.0 && v < 1e6 => v as usize,
-                                _ => {
-                                    return Err(format!(
-                                        "expected a coordinate index after '{name}[', found {}",
-                                        self.describe()
-                                    ))
-                                }
+                                _ => return Err(format!("expected a coordinate index after '{name}[', found {}", self.describe())),
                             };
                             self.bump()?;
                             self.expect(']')?;
@@ -342,12 +337,8 @@ impl Expr {
     /// Parses `text`; `resolve(name, index)` turns a variable (`name` or `name[index]`) into a
     /// slot of the variable array that [`Expr::eval`] is given, or says why it cannot. The error
     /// says what is wrong and where (1-based character position).
-    pub fn parse(
-        text: &str,
-        resolve: impl FnMut(&str, Option<usize>) -> Result<usize, String>,
-    ) -> Result<Expr, String> {
-        let mut p =
-            Parser { lex: Lexer { s: text.as_bytes(), pos: 0 }, tok: Token::End, at: 0, ops: Vec::new(), resolve };
+    pub fn parse(text: &str, resolve: impl FnMut(&str, Option<usize>) -> Result<usize, String>) -> Result<Expr, String> {
+        let mut p = Parser { lex: Lexer { s: text.as_bytes(), pos: 0 }, tok: Token::End, at: 0, ops: Vec::new(), resolve };
         p.bump()?;
         if p.tok == Token::End {
             return Err("the expression is empty".to_string());
@@ -387,8 +378,7 @@ impl Expr {
 
     /// The variable slots it reads (ascending, each once).
     pub fn slots(&self) -> Vec<usize> {
-        let mut s: Vec<usize> =
-            self.ops.iter().filter_map(|o| if let Op::Var(k) = o { Some(*k) } else { None }).collect();
+        let mut s: Vec<usize> = self.ops.iter().filter_map(|o| if let Op::Var(k) = o { Some(*k) } else { None }).collect();
         s.sort_unstable();
         s.dedup();
         s
@@ -523,9 +513,7 @@ mod tests {
         let sdd = (-2.0 * a * b * y * y + 2.0 * x * b * b * y) / y.powi(4);
         let f = x * x * p.sin() + s.exp();
         let fd = 2.0 * x * a * p.sin() + x * x * p.cos() * pd + s.exp() * sd;
-        let fdd = 2.0 * a * a * p.sin()
-            + 4.0 * x * a * p.cos() * pd
-            + x * x * (-p.sin() * pd * pd + p.cos() * pdd)
+        let fdd = 2.0 * a * a * p.sin() + 4.0 * x * a * p.cos() * pd + x * x * (-p.sin() * pd * pd + p.cos() * pdd)
             + s.exp() * (sd * sd + sdd);
         assert!((r.re - f).abs() < 1e-14);
         assert!((r.v1 - fd).abs() < 1e-13, "{} vs {fd}", r.v1);

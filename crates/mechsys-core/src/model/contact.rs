@@ -3,13 +3,14 @@
 
 use crate::contact::gap::{GapFunction, GapTerm};
 use crate::contact::{ContactPair, Contour, Vec2};
-use crate::error::{Error, Result};
 use crate::math::expr::Expr;
+use crate::error::{Error, Result};
 use crate::math::Vec3;
 
 use super::contact_description::{
     ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, GapContactDescription,
-    GapTermDescription, GearDescription, ImpactDescription, SolidSide,
+    GapTermDescription, GearDescription,
+    ImpactDescription, SolidSide,
 };
 use crate::geometry::curve::{Curve, Follower, Solid};
 use crate::geometry::gear::GearSpec;
@@ -279,9 +280,7 @@ pub fn gear_spec(g: &GearDescription, what: &str) -> Result<GearSpec> {
         }
         (None, None) => return Err(Error::Model(format!("{what}: a gear needs its module (or base_radius)"))),
     };
-    for (k, v) in
-        [("shift", Some(g.shift)), ("backlash", Some(g.backlash)), ("addendum", g.addendum), ("dedendum", g.dedendum)]
-    {
+    for (k, v) in [("shift", Some(g.shift)), ("backlash", Some(g.backlash)), ("addendum", g.addendum), ("dedendum", g.dedendum)] {
         if let Some(v) = v {
             finite(v, &format!("{what}.{k}"))?;
         }
@@ -533,16 +532,9 @@ pub(super) fn validate_gap(
                     }
                     let k = match (index, j.nq()) {
                         (None, 1) => 0,
-                        (None, n) => {
-                            return Err(format!(
-                                "joint '{name}' has {n} coordinates; write {name}[0] .. {name}[{}]",
-                                n.max(1) - 1
-                            ))
-                        }
+                        (None, n) => return Err(format!("joint '{name}' has {n} coordinates; write {name}[0] .. {name}[{}]", n.max(1) - 1)),
                         (Some(k), n) if k < n => k,
-                        (Some(k), n) => {
-                            return Err(format!("joint '{name}' has {n} coordinate(s), [{k}] is out of range"))
-                        }
+                        (Some(k), n) => return Err(format!("joint '{name}' has {n} coordinate(s), [{k}] is out of range")),
                     };
                     let c = (j.iq + k, j.iu + k);
                     Ok(coordinates.iter().position(|x| *x == c).unwrap_or_else(|| {
@@ -550,8 +542,7 @@ pub(super) fn validate_gap(
                         coordinates.len() - 1
                     }))
                 };
-                let e =
-                    Expr::parse(text, resolve).map_err(|m| Error::Model(format!("{what}.{key}: {m} in \"{text}\"")))?;
+                let e = Expr::parse(text, resolve).map_err(|m| Error::Model(format!("{what}.{key}: {m} in \"{text}\"")))?;
                 terms.push(GapTerm::Expr(e));
             }
             GapTermDescription::Callback { callback } => {

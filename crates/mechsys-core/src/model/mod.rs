@@ -16,8 +16,8 @@ pub mod contact_description;
 pub mod description;
 pub mod jenkins;
 pub mod joint;
-mod planar;
 pub mod rotation_description;
+mod planar;
 pub mod validate;
 
 use std::collections::HashMap;

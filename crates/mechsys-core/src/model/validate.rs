@@ -5,10 +5,10 @@ use std::collections::{HashMap, HashSet};
 
 use nalgebra::SymmetricEigen;
 
-use super::contact_description::{FrictionDescription, NormalDescription};
 use super::description::*;
 use super::*;
 use crate::error::{Error, Result};
+use super::contact_description::{FrictionDescription, NormalDescription};
 
 fn err(msg: String) -> Error {
     Error::Model(msg)

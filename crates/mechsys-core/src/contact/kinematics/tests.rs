@@ -6,8 +6,8 @@ use nalgebra::{DMatrix, DVector};
 use super::*;
 use crate::contact::narrow::{evaluate, ContactPair};
 use crate::contact::test_util::{close, curve_joints, random_poses, rot, sample, Rng, Trajectory, CURVE_PAIRS, PAIRS};
-use crate::contact::Contour;
 use crate::geometry::curve::Vec2;
+use crate::contact::Contour;
 use crate::math::Mat3;
 
 fn kin(pair: &ContactPair, b1: &BodyMotion, b2: &BodyMotion) -> Vec<ContactKinematics> {
@@ -63,12 +63,7 @@ fn check_smooth(pair: &ContactPair, tr1: &Trajectory, tr2: &Trajectory, joints: 
         let gd_fd = (gp1[k].g_n - gm1[k].g_n) / (2.0 * h1);
         assert!(close(c.gd_n, gd_fd, 1e-6), "{tag}: ġ_N {} vs difference {gd_fd}", c.gd_n);
         let gdd_fd2 = (gp[k].g_n - 2.0 * g0[k].g_n + gm[k].g_n) / (h2 * h2);
-        assert!(
-            close(c.wbar_n, gdd_fd2, 1e-6),
-            "{tag}: g̈_N {} vs second difference {gdd_fd2} (g_N {})",
-            c.wbar_n,
-            c.point.g_n
-        );
+        assert!(close(c.wbar_n, gdd_fd2, 1e-6), "{tag}: g̈_N {} vs second difference {gdd_fd2} (g_N {})", c.wbar_n, c.point.g_n);
         let gdd_fd = (kp[k].gd_n - km[k].gd_n) / (2.0 * h1);
         assert!(close(c.wbar_n, gdd_fd, 1e-6), "{tag}: g̈_N {} vs difference of ġ_N {gdd_fd}", c.wbar_n);
         // material points at P1 and P2 frozen in their bodies
@@ -142,7 +137,9 @@ fn curve_pair_rates_match_finite_differences() {
                         )
                     } else {
                         // a small tilt: the curves are compared in body 2's plane
-                        let tilt = |x: &Pose, rng: &mut Rng| Pose::new(rot(&rng.unit(), 0.2) * x.a, x.r);
+                        let tilt = |x: &Pose, rng: &mut Rng| {
+                            Pose::new(rot(&rng.unit(), 0.2) * x.a, x.r)
+                        };
                         let (y1, y2) = (tilt(&x1, &mut rng), tilt(&x2, &mut rng));
                         (Trajectory::random(&mut rng, &y1, 0.5, 0.25), Trajectory::random(&mut rng, &y2, 0.5, 0.25))
                     };
@@ -411,6 +408,8 @@ fn degenerate_configurations_give_finite_rates() {
     }
 }
 
+
+
 /// A moving surface (conveyor belt) on a turning, moving body 2: `ġ_T` is the sliding velocity
 /// against the belt's material (the material points' relative velocity plus the belt's speed
 /// `w̃_T`), `ġ_N` is unchanged, and `d ġ_T/dt` matches differences of `ġ_T`.
@@ -449,8 +448,7 @@ fn moving_surface_adds_its_speed_to_the_tangential_velocity() {
                 assert!((m.gd_t[k] - (p.gd_t[k] - t.dot(&w))).abs() < 1e-14, "ġ_T[{k}]");
                 assert!((m.w_tilde[k + 1] + t.dot(&w)).abs() < 1e-14);
                 let h = 1e-5;
-                let fd = (kin(&moving, &tr1.at(h), &tr2.at(h))[0].gd_t[k]
-                    - kin(&moving, &tr1.at(-h), &tr2.at(-h))[0].gd_t[k])
+                let fd = (kin(&moving, &tr1.at(h), &tr2.at(h))[0].gd_t[k] - kin(&moving, &tr1.at(-h), &tr2.at(-h))[0].gd_t[k])
                     / (2.0 * h);
                 assert!(close(m.wbar_t[k], fd, 1e-6), "d ġ_T[{k}]/dt {} vs difference {fd}", m.wbar_t[k]);
             }

@@ -681,3 +681,4 @@ mod gap_time_tests {
         assert!(time_to_gap(0.1, 1.0, 2.0, -0.1).is_infinite());
     }
 }
+
