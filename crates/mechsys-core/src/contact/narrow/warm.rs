@@ -17,8 +17,14 @@
 //! basin's minimum), or the search runs cold. The assumption is the cold search's own: each
 //! sampled basin holds one minimum of `φ`, the one Newton finds from its sampled minimum.
 //!
+//! With several points (or a negative gap) a warm root must also keep its chunks within the
+//! pruning's reach of the closest point, else the cold search would not look there.
+//!
 //! Not warm-started (every evaluation cold): a search with a free candidate slot (any new root
-//! would fill it), or one whose basins did not all converge.
+//! would fill it), one whose basins did not all converge, contours overlapping deeper than the
+//! pruning's bound (a pruned region could then lie inside the other contour), and gear pairs
+//! (whether the cold search finds a root at a flank's end depends on its sampling, so the roots
+//! through a tooth handover are no family Newton could follow).
 
 use crate::geometry::curve::Vec2;
 
