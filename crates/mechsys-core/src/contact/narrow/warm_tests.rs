@@ -282,3 +282,46 @@ fn stale_hints_and_jumps_fall_back_to_the_cold_search() {
     contact_kinematics_warm(&pair, &b.0, &b.1, &mut k, Some(&mut g)).unwrap();
     assert!((k[0].point.g_n - cold(&b).point.g_n).abs() < 1e-12);
 }
+
+#[test]
+fn ellipse_on_a_line_and_a_disc_rattling_in_an_elliptical_hole_warm_equal_cold() {
+    // the support-point search (ellipse on its flat floor, rocking and turning) and a search for
+    // two points (a disc wandering in an elliptical hole, both walls near)
+    let e = Curve::ellipse(Vec2::zeros(), 0.3, 0.2, 0.0, "e").unwrap();
+    let line =
+        ContactPair::new("el", Contour::Curve(Box::new(e)), Contour::Line { point: Vec2::zeros(), normal: Vec2::y() })
+            .unwrap();
+    let mut rng = Rng::new(21);
+    let (spin, drift, lift) =
+        (Smooth::new(&mut rng, 1.0, 1.0), Smooth::new(&mut rng, 0.1, 2.0), Smooth::new(&mut rng, 1e-3, 6.0));
+    let n = 3000;
+    let warm = follow(&line, (TAU, TAU), n, 1e-9, |i| {
+        let t = i as f64 / n as f64;
+        let theta = spin.at(t) + PI * t;
+        // the lowest point's height over the floor: the support function along -y
+        let h = ((0.3 * theta.sin()).powi(2) + (0.2 * theta.cos()).powi(2)).sqrt();
+        (
+            moving(planar_pose(theta, drift.at(t), h + lift.at(t)), 2.0, (0.1, 0.0)),
+            moving(Pose::IDENTITY, 0.0, (0.0, 0.0)),
+        )
+    });
+    eprintln!("ellipse–line: warm starts in {warm} of {n} evaluations");
+    assert!(warm > n / 2, "ellipse–line: warm starts in {warm} of {n} evaluations");
+
+    let (a, b, r) = (0.5, 0.3, 0.28);
+    let hole = Contour::Curve(Box::new(Curve::ellipse(Vec2::zeros(), a, b, 0.0, "hole").unwrap().flipped()));
+    let pair = ContactPair::new("h", Contour::Circle { center: Vec2::zeros(), radius: r }, hole)
+        .unwrap()
+        .with_points(2)
+        .unwrap();
+    let (x, y) = (Smooth::new(&mut rng, 0.1, 2.0), Smooth::new(&mut rng, 0.015, 3.0));
+    let warm = follow(&pair, (TAU, TAU), n, 1e-9, |i| {
+        let t = i as f64 / n as f64;
+        (
+            moving(planar_pose(0.0, x.at(t), y.at(t)), 0.0, (0.3, 0.1)),
+            moving(planar_pose(0.0, 0.0, 0.0), 0.5, (0.0, 0.0)),
+        )
+    });
+    eprintln!("disc in a hole, 2 points: warm starts in {warm} of {n} evaluations");
+    assert!(warm > n / 2, "disc in a hole: warm starts in {warm} of {n} evaluations");
+}
