@@ -106,6 +106,7 @@ def simulate(
     max_steps: int | None = None,
     max_wall: float | None = None,
     sensors: Sequence[str] | None = None,
+    warm_search: bool = True,
 ) -> Results:
     """Simulates ``model`` from ``t0`` to ``t_end``.
 
@@ -132,6 +133,9 @@ def simulate(
     ``"marker/arm/tip/*"``, ``"energy/total"``); the engine then skips the bodies, accelerations,
     constraint and force values nothing asked for (default None: everything). A pattern that
     matches no signal of the model is a SettingsError naming it.
+    ``warm_search``: contact searches of planar curved contours start from the last evaluation's
+    contact points while the bodies have provably not moved far enough to change them (the same
+    points as a full search, see docs/contours.md); ``False`` searches from scratch every time.
     """
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
@@ -145,6 +149,7 @@ def simulate(
 
         q0, u0 = assemble(model, q0, u0, float(t0), keep=keep)
     settings = _settings(model, t_end, integrator, output_dt, q0, u0, t0, stabilization, on_singular, max_steps, max_wall)
+    settings["warm_search"] = bool(warm_search)
     chosen = None
     if sensors is not None:
         from .results import record_selection

@@ -24,11 +24,17 @@
 //!   gears in mesh (m = 2 mm, backlash 0.05 m each, standard centre distance; 2 points: the drive
 //!   and the coast side, 4: each tooth flank), gear 1 at random angles and gear 2 at the
 //!   conjugate angle with the drive flanks 10 µm apart, both turning;
+//! - `narrow_curve/<pair>_sequence_{cold,warm}/100`: [`contact_kinematics`] along 100
+//!   consecutive small relative motions (a cam turning by 2 mrad per evaluation, an ellipse
+//!   pair's bodies turning and orbiting near contact by 1-2 mrad, gears turning by 1 mrad), cold
+//!   (every evaluation searches) and warm ([`contact_kinematics_warm`] carrying the search state
+//!   through the sequence; the jump back to its start searches cold once per 100).
+//!
 //! - `narrow_surface/<pair>_evaluate/100`, `..._kinematics/100`: spatial parametric pairs
 //!   (ellipsoid–ellipsoid apart and overlapping, revolution–plane with an egg-shaped spline profile, sphere–revolution,
 //!   sphere–patch and ellipsoid–patch on a 33 × 33 terrain patch) at random placements near contact, both bodies
 //!   turning, beside the closed-form sphere–sphere and ellipsoid–plane pairs; every call searches
-//!   from scratch (there is no warm start);
+//!   from scratch (no warm start for the spatial pairs);
 //!
 //! - `mesh/<pair>_evaluate/100`, `mesh/<pair>_kinematics/100`: sphere–mesh and box–mesh (8
 //!   corner queries) on wavy terrains of 98, 10 082 and 100 352 triangles, beside sphere–plane
@@ -43,8 +49,8 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
 use mechsys_core::contact::{
-    contact_kinematics, evaluate, Aabb, BodyMotion, ContactKinematics, ContactPair, ContactPoint, Contour,
-    SweepAndPrune,
+    contact_kinematics, contact_kinematics_warm, evaluate, Aabb, BodyMotion, ContactKinematics, ContactPair,
+    ContactPoint, Contour, SweepAndPrune,
 };
 use mechsys_core::math::{Mat3, Vec3};
 use mechsys_core::spatial::{Motion, Pose};
@@ -127,6 +133,7 @@ fn bench_narrow(c: &mut Criterion) {
     g.finish();
     bench_box_box(c);
     bench_curves(c);
+    bench_sequences(c);
     bench_gears(c);
     bench_mesh(c);
     bench_surfaces(c);
@@ -349,6 +356,112 @@ fn bench_curves(c: &mut Criterion) {
                 black_box(&kin);
             })
         });
+    }
+    g.finish();
+}
+
+/// Curve pairs along sequences of small relative motions: every evaluation searching cold vs
+/// the search warm-started from the previous evaluation (see the module docs).
+fn bench_sequences(c: &mut Criterion) {
+    use mechsys_core::contact::SearchHint;
+    use mechsys_core::geometry::curve::{Curve, Follower, Vec2};
+    use mechsys_core::geometry::gear::GearSpec;
+    let n = 100;
+    let rz = |t: f64| nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), t).into_inner();
+    let at = |pose: Pose, w: f64| BodyMotion {
+        pose,
+        twist: Motion::new(Vec3::new(0.0, 0.0, w), Vec3::zeros()),
+        acc: Motion::ZERO,
+    };
+    let ellipse = |a, b| Contour::Curve(Box::new(Curve::ellipse(Vec2::zeros(), a, b, 0.0, "e").expect("valid")));
+    let ang: Vec<f64> = (0..=360).map(|i| std::f64::consts::TAU * i as f64 / 360.0).collect();
+    let lift: Vec<f64> = ang.iter().map(|t| 0.004 * (1.0 - t.cos())).collect();
+    let cam = Contour::Curve(Box::new(
+        Curve::cam(&ang, &lift, 0.03, Follower::Roller { radius: 0.01, eccentricity: 0.0 }, 1.0, "cam").expect("valid"),
+    ));
+    let roller = Contour::Circle { center: Vec2::zeros(), radius: 0.01 };
+    // body 1 near contact with body 2 along direction ψ (its centre distance put at a gap of
+    // 0.1 mm by a few cold evaluations), body 1 turned by θ1, body 2 by θ2
+    let near = |pair: &ContactPair, psi: f64, t1: f64, t2: f64| {
+        let x1 = |d: f64| Pose::new(rz(t1), Vec3::new(d * psi.cos(), d * psi.sin(), 0.0));
+        let mut d = 0.5;
+        let mut k = vec![ContactKinematics::default(); pair.candidates()];
+        for _ in 0..8 {
+            contact_kinematics(pair, &at(x1(d), 0.0), &at(Pose::new(rz(t2), Vec3::zeros()), 0.0), &mut k)
+                .expect("room");
+            d -= k[0].point.g_n - 1e-4;
+        }
+        (at(x1(d), 1.0), at(Pose::new(rz(t2), Vec3::zeros()), -2.0))
+    };
+    let mut cases: Vec<(String, ContactPair, Vec<(BodyMotion, BodyMotion)>)> = Vec::new();
+    for (name, c1, c2) in [
+        ("circle_ellipse", roller.clone(), ellipse(0.3, 0.2)),
+        ("roller_cam", roller, cam),
+        ("ellipse_ellipse", ellipse(0.3, 0.2), ellipse(0.25, 0.15)),
+    ] {
+        let pair = ContactPair::new(name, c1, c2).expect("valid pair");
+        let seq = (0..n)
+            .map(|i| {
+                let k = i as f64;
+                if name == "roller_cam" {
+                    // the follower on its axis, the cam turning by 2 mrad per evaluation
+                    near(&pair, std::f64::consts::FRAC_PI_2, 0.0, 0.3 + 2e-3 * k)
+                } else {
+                    near(&pair, 0.7 + 1e-3 * k, 0.2 + 2e-3 * k, -0.1 - 1e-3 * k)
+                }
+            })
+            .collect();
+        cases.push((name.to_string(), pair, seq));
+    }
+    for (z1, z2) in [(17usize, 31usize), (40, 97)] {
+        let m = 0.002;
+        let gear = |z| Curve::gear(&GearSpec { backlash: 0.05 * m, ..GearSpec::new(m, z) }, "gear").expect("valid");
+        let (g1, g2) = (gear(z1), gear(z2));
+        let (q1, q2) = (g1.as_gear().expect("gear").clone(), g2.as_gear().expect("gear").clone());
+        let alpha = 20f64.to_radians();
+        let a = 0.5 * m * (z1 + z2) as f64;
+        let phi1 = q1.base_half_angle() + alpha;
+        let phi2 = (a * alpha.sin() - 1e-5 - q1.base_radius() * phi1) / q2.base_radius();
+        let c0 = std::f64::consts::PI - alpha + phi2 - q2.base_half_angle();
+        let pair = ContactPair::new("mesh", Contour::Curve(Box::new(g1)), Contour::Curve(Box::new(g2)))
+            .expect("valid pair")
+            .with_points(2)
+            .expect("points");
+        let seq = (0..n)
+            .map(|i| {
+                let t1 = 0.1 + 1e-3 * i as f64;
+                let t2 = c0 - (z1 as f64 / z2 as f64) * t1;
+                (at(Pose::new(rz(t1), Vec3::zeros()), 10.0), at(Pose::new(rz(t2), Vec3::new(a, 0.0, 0.0)), -5.0))
+            })
+            .collect();
+        cases.push((format!("gears_{z1}_{z2}_2"), pair, seq));
+    }
+    let mut g = c.benchmark_group("narrow_curve");
+    g.throughput(Throughput::Elements(n as u64));
+    for (name, pair, seq) in &cases {
+        let m = pair.candidates();
+        let mut kin = vec![ContactKinematics::default(); m];
+        g.bench_with_input(BenchmarkId::new(format!("{name}_sequence_cold"), n), &n, |b, _| {
+            b.iter(|| {
+                for (b1, b2) in seq {
+                    contact_kinematics(pair, b1, b2, &mut kin).expect("room");
+                }
+                black_box(&kin);
+            })
+        });
+        let mut hints = vec![SearchHint::default(); m];
+        let mut warm = 0;
+        g.bench_with_input(BenchmarkId::new(format!("{name}_sequence_warm"), n), &n, |b, _| {
+            b.iter(|| {
+                warm = 0;
+                for (b1, b2) in seq {
+                    contact_kinematics_warm(pair, b1, b2, &mut kin, Some(&mut hints)).expect("room");
+                    warm += hints[0].was_warm() as usize;
+                }
+                black_box(&kin);
+            })
+        });
+        eprintln!("{name}: {warm} of {n} evaluations warm");
     }
     g.finish();
 }

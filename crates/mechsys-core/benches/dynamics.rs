@@ -160,6 +160,7 @@ fn bench_stepping(c: &mut Criterion) {
             max_steps: None,
             max_wall: None,
             record: Default::default(),
+            warm_search: true,
         };
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {

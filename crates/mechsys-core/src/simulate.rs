@@ -52,6 +52,14 @@ pub struct Settings {
     /// What is recorded beyond the state, energies and momenta (default: everything).
     #[serde(default)]
     pub record: RecordSelection,
+    /// Warm-start the contact searches of planar parametric contours (default; the same roots as
+    /// cold searches, see [`crate::contact::SearchHint`]); `false`: every evaluation searches cold.
+    #[serde(default = "warm_search_default")]
+    pub warm_search: bool,
+}
+
+fn warm_search_default() -> bool {
+    true
 }
 
 /// Which groups of signals a run records. The state (t, q, u), energies, momenta and contact
@@ -1282,6 +1290,7 @@ fn time_stepping(
     let every = (settings.output_dt / dt).round() as u64;
     let mut stepper = MoreauJean::new(model, dt, solver)?;
     stepper.project = project;
+    stepper.warm_search = settings.warm_search;
     let mut group_stats = vec![crate::integrator::moreau_jean::GroupStats::default(); model.contact_groups.len()];
     let (mut data, mut ws) = (Data::new(model), dynamics::Workspace::new(model));
     let mut y = y0;
@@ -1458,6 +1467,7 @@ fn event_driven(
     use crate::integrator::event_driven::{self, Phase};
     let (nq, nu, np) = (model.nq, model.nu, model.n_contact_points);
     let mut phase = Phase::new(model, cb, opts)?;
+    phase.warm_search = settings.warm_search;
     let mut y = vec![0.0; phase.state_len()];
     y[..nq + nu + 2].copy_from_slice(&y0);
     let e = nq + nu;

@@ -81,3 +81,42 @@ fn projected_steps_do_not_allocate() {
     assert!(st.projections() > 300, "only {} projected steps", st.projections());
     assert_eq!(n, 0, "{n} allocations in 350 projected steps");
 }
+
+/// A roller pressed by gravity on a spinning elliptical cam (a planar curve pair whose contact
+/// search warm-starts between steps): after a first run, the same run allocates nothing, warm
+/// starts and cold searches alike.
+#[test]
+fn curve_contact_steps_do_not_allocate_after_warm_up() {
+    let json = r#"{
+        "name": "ellipse-cam", "gravity": [0, -9.81, 0], "planar": true,
+        "bodies": [
+            {"name": "cam", "mass": 1.0, "inertia": [0.001, 0.001, 0.001]},
+            {"name": "roller", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]}
+        ],
+        "joints": [
+            {"name": "shaft", "type": "revolute", "parent": "ground", "child": "cam", "axis": [0, 0, 1], "u0": [20.0]},
+            {"name": "guide", "type": "prismatic", "parent": "ground", "child": "roller", "axis": [0, 1, 0], "q0": [0.061]}
+        ],
+        "contacts": [{"name": "cam", "body1": "roller", "contour1": {"type": "circle", "radius": 0.01},
+                      "body2": "cam", "contour2": {"type": "ellipse", "semi_axes": [0.05, 0.035]},
+                      "friction": {"type": "coulomb", "mu": 0.1}, "impact": {"type": "newton", "eps": 0.0}}]
+    }"#;
+    let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
+    let h = 1e-4;
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0 });
+    let mut st = MoreauJean::new(&model, h, method).unwrap();
+    assert!(st.warm_search);
+    let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
+    let run = |st: &mut MoreauJean, data: &mut Data, ws: &mut Workspace| -> (usize, f64) {
+        let (mut q, mut u) = (model.q0(), model.u0());
+        let before = allocations();
+        for k in 0..2000 {
+            st.step(&model, data, ws, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
+        }
+        (allocations() - before, q[1])
+    };
+    let (_, y1) = run(&mut st, &mut data, &mut ws);
+    let (second, y2) = run(&mut st, &mut data, &mut ws);
+    assert_eq!(second, 0, "{second} allocations in 2000 steps after warm-up");
+    assert!((y1 - y2).abs() < 1e-12, "the repeated run is the same run: {y1} vs {y2}");
+}

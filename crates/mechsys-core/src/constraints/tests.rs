@@ -238,6 +238,7 @@ fn drift_control_choices() {
             max_steps: None,
             max_wall: None,
             record: Default::default(),
+            warm_search: true,
         };
         let rec = simulate(&model, &settings, &NoCallbacks, None).unwrap();
         rec.constraint_violation.iter().fold(0.0f64, |m, v| m.max(v.abs()))

@@ -43,6 +43,7 @@ use crate::math::Vec3;
 use crate::model::contact::Contact;
 use crate::spatial::{Motion, Pose};
 
+use super::narrow::warm::SearchHint;
 use super::narrow::{ContactPair, ContactPoint};
 
 /// Placement, twist and spatial acceleration of a body, world convention (about the origin).
@@ -133,11 +134,30 @@ pub fn contact_kinematics(
     b2: &BodyMotion,
     out: &mut [ContactKinematics],
 ) -> Result<()> {
+    contact_kinematics_warm(pair, b1, b2, out, None)
+}
+
+/// [`contact_kinematics`] with the contact search warm-started from `search` (one
+/// [`SearchHint`] per candidate, kept by the caller from one evaluation of this pair to the next;
+/// the empty default searches cold): planar parametric contours refine the last roots while the
+/// relative motion since the last full search provably keeps them (see
+/// [`super::narrow::warm`]), the same roots as the cold search to Newton's tolerance. `None`:
+/// always cold. No allocation.
+pub fn contact_kinematics_warm(
+    pair: &ContactPair,
+    b1: &BodyMotion,
+    b2: &BodyMotion,
+    out: &mut [ContactKinematics],
+    search: Option<&mut [SearchHint]>,
+) -> Result<()> {
     pair.check_len(out.len())?;
+    if let Some(s) = &search {
+        pair.check_len(s.len())?;
+    }
     let (tw1, tw2) = (&b1.twist, &b2.twist);
     let surface = pair.surface_velocity();
     // one evaluation of the pair: shared work (a box–box manifold) is done once for all candidates
-    pair.each_candidate(&b1.pose, &b2.pose, Some((tw1, tw2)), |k, r| {
+    let each = |k: usize, r: &super::narrow::Raw| {
         let t = pair.tangents(&b2.pose, &r.n, Some((&tw2.w, &r.nd)));
         let (v1, v2) = (b1.point_velocity(&r.p1), b2.point_velocity(&r.p2));
         // a moving surface: its material slides over its contour at the body-fixed velocity u_i,
@@ -166,7 +186,11 @@ pub fn contact_kinematics(
             w_tilde: [0.0, surf[0], surf[1]],
             omega_rel: [r.n.dot(&dw), t.t1.dot(&dw), t.t2.dot(&dw)],
         };
-    });
+    };
+    match search {
+        Some(s) => pair.each_candidate_warm(&b1.pose, &b2.pose, Some((tw1, tw2)), s, each),
+        None => pair.each_candidate(&b1.pose, &b2.pose, Some((tw1, tw2)), each),
+    }
     Ok(())
 }
 
@@ -174,6 +198,8 @@ pub fn contact_kinematics(
 /// `data` (the tree's kinematics at (q, u) done, `data.a` as the caller set it) for a pair of
 /// contours; from the gap function at (t, q, u) for a gap contact, whose `w̄` is always the
 /// velocity-product part and whose rows land in `data.gap`. Errors name the contact.
+/// `search`: the contact's points' search state for a warm start (see
+/// [`contact_kinematics_warm`]), `None` for a cold search.
 #[allow(clippy::too_many_arguments)]
 pub fn contact_point_kinematics(
     con: &Contact,
@@ -183,11 +209,12 @@ pub fn contact_point_kinematics(
     u: &[f64],
     cb: &dyn Callbacks,
     out: &mut [ContactKinematics],
+    search: Option<&mut [SearchHint]>,
 ) -> Result<()> {
     match con.gap() {
         None => {
             let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
-            contact_kinematics(con.pair().expect("a contour contact"), &b1, &b2, out)
+            contact_kinematics_warm(con.pair().expect("a contour contact"), &b1, &b2, out, search)
         }
         Some((f, slot)) => f.evaluate(t, q, u, cb, &mut data.gap, slot, &mut out[0]).map_err(|e| match e {
             Error::Callback(m) => Error::Callback(format!("gap contact '{}': {m}", con.name)),

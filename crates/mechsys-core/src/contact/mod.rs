@@ -43,6 +43,8 @@ pub use broad::{Aabb, SweepAndPrune};
 pub use contour::{Contour, ContourKind, Vec2};
 pub use group::GroupPhase;
 pub use kinematics::{
-    at_contact, contact_kinematics, contact_point_kinematics, gap_with_accelerations, BodyMotion, ContactKinematics,
+    at_contact, contact_kinematics, contact_kinematics_warm, contact_point_kinematics, gap_with_accelerations,
+    BodyMotion, ContactKinematics,
 };
+pub use narrow::warm::SearchHint;
 pub use narrow::{candidates, evaluate, ContactPair, ContactPoint};

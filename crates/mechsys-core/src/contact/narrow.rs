@@ -58,12 +58,14 @@ use crate::geometry::revolution::Revolution;
 use crate::geometry::surface::Patch;
 use curve_pair::{CurveGeometry, First};
 use mesh_pair::MeshGeometry;
+use warm::SearchHint;
 
 pub mod box_box;
 pub mod convex_pair;
 pub mod curve_pair;
 pub mod mesh_pair;
 pub mod surface_pair;
+pub mod warm;
 
 /// One candidate contact: gap, frame and the two surface points, world components.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -467,18 +469,48 @@ impl ContactPair {
         if let Geometry::Curve(g) = &self.geometry {
             if g.shared() {
                 if self.swapped {
-                    g.all(x2, x1, twists.map(|(a, b)| (b, a)), out);
+                    g.all(x2, x1, twists.map(|(a, b)| (b, a)), out, None);
                     for o in out.iter_mut() {
                         *o = o.reversed();
                     }
                 } else {
-                    g.all(x1, x2, twists, out);
+                    g.all(x1, x2, twists, out, None);
                 }
                 return;
             }
         }
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.candidate(k, x1, x2, twists);
+        }
+    }
+
+    /// [`Self::each_candidate`] with the planar curve searches warm-started from `hints` (one per
+    /// candidate, kept by the caller between evaluations of this pair; see [`warm`]); the other
+    /// pairs have nothing to warm-start and ignore them.
+    pub(crate) fn each_candidate_warm(
+        &self,
+        x1: &Pose,
+        x2: &Pose,
+        twists: Option<(&Motion, &Motion)>,
+        hints: &mut [SearchHint],
+        mut f: impl FnMut(usize, &Raw),
+    ) {
+        let Geometry::Curve(g) = &self.geometry else {
+            return self.each_candidate(x1, x2, twists, f);
+        };
+        // the search and its hints are in canonical order
+        let (x1, x2, tw) = if self.swapped { (x2, x1, twists.map(|(a, b)| (b, a))) } else { (x1, x2, twists) };
+        let mut buf = [Raw::default(); curve_pair::MAX_POINTS];
+        let (out, hints) = (&mut buf[..self.count], &mut hints[..self.count]);
+        if g.shared() {
+            g.all(x1, x2, tw, out, Some(hints));
+        } else {
+            for (k, (o, h)) in out.iter_mut().zip(hints.iter_mut()).enumerate() {
+                *o = g.one(k, x1, x2, tw, Some(h));
+            }
+        }
+        for (k, r) in out.iter().enumerate() {
+            f(k, &if self.swapped { r.reversed() } else { *r });
         }
     }
 
@@ -594,7 +626,7 @@ impl ContactPair {
             }
             Geometry::CircleCircle { c1, r1, c2, r2 } => circle_circle(x1, x2, tw, c1, *r1, c2, *r2),
             Geometry::BoxBox { a, b, scale } => box_box::box_box(x1, x2, tw, a, b, *scale, k),
-            Geometry::Curve(g) => g.one(k, x1, x2, tw),
+            Geometry::Curve(g) => g.one(k, x1, x2, tw, None),
             Geometry::Cavity { c1, r1, c2, axis, r2, across } => cavity(x1, x2, tw, c1, *r1, c2, axis, *r2, across),
             Geometry::EllipsoidHalfSpace { center, shape, point, normal } => {
                 ellipsoid_half_space(x1, x2, tw, center, shape, point, normal)
@@ -1234,3 +1266,6 @@ mod mesh_tests;
 
 #[cfg(test)]
 mod surface_tests;
+
+#[cfg(test)]
+mod warm_tests;

@@ -36,7 +36,7 @@
 use nalgebra::DMatrix;
 
 use crate::contact::{
-    at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase,
+    at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase, SearchHint,
 };
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -156,6 +156,11 @@ pub struct MoreauJean {
     /// Contact dimension of the local problem (2 if every contact is planar, else 3).
     dim: usize,
     kin: Vec<ContactKinematics>,
+    /// Per candidate point: the contact search's state between evaluations (warm starts).
+    search: Vec<SearchHint>,
+    /// Warm-start the contact searches of planar parametric contours (the same roots as cold
+    /// searches; off: every evaluation searches cold).
+    pub warm_search: bool,
     /// Local rows of every candidate (dim × nu per point), world-Jacobian projections.
     w_rows: DMatrix<f64>,
     x_cols: Vec<f64>,
@@ -250,6 +255,8 @@ impl MoreauJean {
             method,
             dim,
             kin: vec![ContactKinematics::default(); np],
+            search: vec![SearchHint::default(); np],
+            warm_search: true,
             w_rows: DMatrix::zeros(if use_sparse { 0 } else { dim * np.max(1) }, nu),
             x_cols: if use_sparse { Vec::new() } else { vec![0.0; dim * np * nu] },
             problem,
@@ -403,8 +410,10 @@ impl MoreauJean {
         self.act.clear();
         for con in &model.contacts {
             let k = &mut self.kin[con.first..con.first + con.points()];
+            let s = self.warm_search.then(|| &mut self.search[con.first..con.first + con.points()]);
             // a gap function reads the step's start velocities (its w̃ does not depend on them)
-            contact_point_kinematics(con, data, tm, &self.q_mid, u, cb, k).map_err(|e| at_contact(e, &con.name, tm))?;
+            contact_point_kinematics(con, data, tm, &self.q_mid, u, cb, k, s)
+                .map_err(|e| at_contact(e, &con.name, tm))?;
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
                 if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
@@ -838,7 +847,9 @@ impl MoreauJean {
     /// (after a kinematics pass), for the records.
     pub fn measure(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
         for con in &model.contacts {
-            contact_point_kinematics(con, data, t, q, u, cb, &mut self.kin[con.first..con.first + con.points()])
+            let pts = con.first..con.first + con.points();
+            let s = self.warm_search.then(|| &mut self.search[pts.clone()]);
+            contact_point_kinematics(con, data, t, q, u, cb, &mut self.kin[pts], s)
                 .map_err(|e| at_contact(e, &con.name, t))?;
         }
         Ok(())

@@ -26,16 +26,24 @@
 //! it; roots that are not minima (the far side of a concave flank) are refused. When no seed
 //! converges, the best sample pair is used as it is (finite, approximate).
 //!
+//! **Warm start.** Given the state of the last evaluation ([`SearchHint`]), each search first
+//! tries Newton from the previous roots when the relative motion since the last full search is
+//! provably too small to change them (see [`super::warm`]); it records its basins and margin
+//! when it searches in full.
+//!
 //! **Several points.** With `count > 1` the `count` deepest roots are kept, ordered by their
 //! parameter on the curve (so a candidate keeps its index while its root persists); slots
 //! without a root are *unused* candidates whose gap exceeds any real one. Gear pairs, whose
 //! roots come and go with every tooth change, give each root the slot of its flank side and
 //! tooth colour instead (`GearSlots`).
 
-use crate::geometry::curve::{cross, Bracket, Chunk, Curve, Jet2, Vec2, CHUNK, CONVERGED, MAX_SAMPLES, NEWTON_ITERATIONS};
+use crate::geometry::curve::{
+    cross, Bracket, Chunk, Curve, Jet2, Vec2, CHUNK, CONVERGED, MAX_SAMPLES, NEWTON_ITERATIONS,
+};
 use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};
 
+use super::warm::{in_window, Basins, SearchHint};
 use super::{vel, Raw};
 
 /// Most candidates per curve pair (a stack buffer holds them).
@@ -69,6 +77,9 @@ struct Root {
     s2: f64,
     /// Ranking key: smaller is deeper.
     key: f64,
+    /// Warm starts: the window of the searched parameter and the key at the cold search.
+    window: [f64; 2],
+    cold_key: f64,
 }
 
 /// The best roots found so far (sorted by key), without allocation.
@@ -171,6 +182,11 @@ impl<'a> Relative<'a> {
     fn new(x1: &'a Pose, x2: &'a Pose) -> Self {
         let a2t = x2.a.transpose();
         Relative { x1, x2, b: a2t * x1.a, c: a2t * (x1.r - x2.r) }
+    }
+    /// The placement a warm start compares: `[A2ᵀ A1]_xy` (row-major), `[A2ᵀ (r1 - r2)]_xy`.
+    fn placement(&self) -> ([f64; 4], [f64; 2]) {
+        let b = &self.b;
+        ([b[(0, 0)], b[(0, 1)], b[(1, 0)], b[(1, 1)]], [self.c.x, self.c.y])
     }
     /// A point of body 1 (body frame) in body 2's plane.
     #[inline]
@@ -282,39 +298,56 @@ impl CurveGeometry {
         !matches!(self, CurveGeometry::OnCurve { first: First::Points { centers, .. }, .. } if centers.len() > 1)
     }
 
-    /// Candidate `k` alone (one search per candidate: a polygon's vertices).
-    pub(crate) fn one(&self, k: usize, x1: &Pose, x2: &Pose, tw: Option<(&Motion, &Motion)>) -> Raw {
+    /// Candidate `k` alone (one search per candidate: a polygon's vertices), warm-started from
+    /// `hint` (that candidate's) when given.
+    pub(crate) fn one(
+        &self,
+        k: usize,
+        x1: &Pose,
+        x2: &Pose,
+        tw: Option<(&Motion, &Motion)>,
+        hint: Option<&mut SearchHint>,
+    ) -> Raw {
         let mut out = [Raw::default(); 1];
         match self {
             CurveGeometry::OnCurve { first: First::Points { centers, radius }, second, .. } => {
-                point_curve(&centers[k], *radius, second, 1, 0.0, x1, x2, tw, &mut out);
+                let hint = hint.map(std::slice::from_mut);
+                point_curve(&centers[k], *radius, second, 1, 0.0, x1, x2, tw, &mut out, hint);
             }
             _ => {
                 let mut all = [Raw::default(); MAX_POINTS];
-                self.all(x1, x2, tw, &mut all);
+                self.all(x1, x2, tw, &mut all, None);
                 return all[k];
             }
         }
         out[0]
     }
 
-    /// All candidates into `out[..count]` (shared search).
-    pub(crate) fn all(&self, x1: &Pose, x2: &Pose, tw: Option<(&Motion, &Motion)>, out: &mut [Raw]) {
+    /// All candidates into `out[..count]` (shared search), warm-started from `hints` (one per
+    /// candidate, see [`super::warm`]) when given.
+    pub(crate) fn all(
+        &self,
+        x1: &Pose,
+        x2: &Pose,
+        tw: Option<(&Motion, &Motion)>,
+        out: &mut [Raw],
+        mut hints: Option<&mut [SearchHint]>,
+    ) {
         match self {
             CurveGeometry::OnCurve { first: First::Points { centers, radius }, second, count, reach } => {
                 if centers.len() == 1 {
-                    point_curve(&centers[0], *radius, second, *count, *reach, x1, x2, tw, out);
+                    point_curve(&centers[0], *radius, second, *count, *reach, x1, x2, tw, out, hints);
                 } else {
                     for (k, o) in out.iter_mut().enumerate().take(centers.len()) {
-                        *o = self.one(k, x1, x2, tw);
+                        *o = self.one(k, x1, x2, tw, hints.as_deref_mut().map(|h| &mut h[k]));
                     }
                 }
             }
             CurveGeometry::OnCurve { first: First::Curve(c1), second, count, reach } => {
-                curve_curve(c1, second, *count, *reach, x1, x2, tw, out)
+                curve_curve(c1, second, *count, *reach, x1, x2, tw, out, hints)
             }
             CurveGeometry::OnLine { curve, point, normal, count, reach } => {
-                curve_line(curve, point, normal, *count, *reach, x1, x2, tw, out)
+                curve_line(curve, point, normal, *count, *reach, x1, x2, tw, out, hints)
             }
         }
     }
@@ -350,6 +383,59 @@ fn fill(roots: &mut Roots, count: usize, param: impl Fn(&Root) -> f64, mut make:
     }
 }
 
+/// The period of a closed contour's parameter.
+fn period(curve: &Curve) -> Option<f64> {
+    curve.is_closed().then(|| curve.range().1 - curve.range().0)
+}
+
+/// The chunk holding parameter `s` (its sample and the piece of curve up to the next one).
+fn chunk_of(curve: &Curve, s: f64) -> &Chunk {
+    let s = curve.wrap(s);
+    let i = curve.samples().partition_point(|x| x.s <= s).saturating_sub(1);
+    let chunks = curve.chunks();
+    &chunks[chunks.partition_point(|c| c.first <= i).saturating_sub(1)]
+}
+
+/// Newton tolerance on a warm root's key against the bound `cold key + δ` (round-off).
+fn key_tolerance(curve: &Curve) -> f64 {
+    1e-12 * (1.0 + curve.bound().1)
+}
+
+/// Leaves the search's state in `hints` for the next evaluation (see [`super::warm`]): each
+/// candidate's root; after a cold search also the margin, the placement and the windows.
+/// `bound(g_best, g_worst)` is the lowest key the regions the search pruned (and, with several
+/// points, its reach) allow; `param` and `same` name the searched parameter.
+#[allow(clippy::too_many_arguments)]
+fn leave(
+    hints: &mut [SearchHint],
+    sel: &[Option<Root>],
+    warm: bool,
+    basins: Option<&Basins<Root>>,
+    searched: &Curve,
+    param: impl Fn(&Root) -> f64,
+    same: impl Fn(&Root, &Root) -> bool,
+    bound: impl Fn(f64, f64) -> f64,
+    placement: ([f64; 4], [f64; 2]),
+) {
+    let mut windows = [[0.0; 2]; MAX_POINTS];
+    if warm {
+        hints[0].set_warm();
+    } else {
+        let other = basins.and_then(|b| b.margin(sel, &param, |r| r.key, same, period(searched), &mut windows));
+        let keys = sel.iter().flatten().map(|r| r.key);
+        let (best, worst) = keys.fold((f64::INFINITY, f64::NEG_INFINITY), |(b, w), k| (b.min(k), w.max(k)));
+        let margin = other.map_or(-1.0, |o| o.min(bound(best, worst)) - worst);
+        hints[0].set_cold(margin, &placement.0, &placement.1);
+    }
+    for (k, (h, r)) in hints.iter_mut().zip(sel).enumerate() {
+        h.root = r.is_some();
+        if let Some(r) = r {
+            h.s = [r.s1, r.s2];
+            (h.window, h.key) = if warm { (r.window, r.cold_key) } else { (windows[k], r.key) };
+        }
+    }
+}
+
 /// A centre of body 1 (body frame, inflated by `radius`) against `curve` on body 2.
 #[allow(clippy::too_many_arguments)]
 fn point_curve(
@@ -362,39 +448,81 @@ fn point_curve(
     x2: &Pose,
     tw: Option<(&Motion, &Motion)>,
     out: &mut [Raw],
+    hints: Option<&mut [SearchHint]>,
 ) {
     let rel = Relative::new(x1, x2);
     let y = rel.point3(center);
+    let placement = ([0.0; 4], [y.x, y.y]);
     let mut roots = Roots::new(count.max(1));
-    foot_points(curve, &y, reach, &mut roots);
+    // warm: the point moved by δ = |y - y0|; Newton from each previous foot point
+    let warm = hints.as_deref().is_some_and(|h| {
+        let delta = h[0].moved(&placement.0, &placement.1, &Vec2::zeros(), 0.0);
+        h[0].allows(delta)
+            && h[..count].iter().all(|h| {
+                let Some((s, j)) = h.root.then(|| curve.foot(&y, h.s[1])).flatten() else { return false };
+                let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
+                let ok = in_window(s, &h.window, period(curve)) && key <= h.key + delta + key_tolerance(curve);
+                let r = Root { s1: 0.0, s2: curve.wrap(s), key, window: h.window, cold_key: h.key };
+                roots.push(r, |a, b| same_param(curve, a.s2, b.s2));
+                ok
+            })
+            && roots.len == count
+            // with several points the cold search would keep each root's chunk: within its reach
+            // of the closest point (the best root, every other region being farther)
+            && roots.list[..roots.len].iter().all(|r| {
+                let ch = chunk_of(curve, r.s2);
+                (y - ch.center).norm() - ch.radius <= roots.list[0].key + reach
+            })
+    });
+    // (recorded for a later warm start only: a few kB to clear)
+    let mut basins = (hints.is_some() && !warm).then(Basins::new);
+    let mut ub = 0.0;
+    if !warm {
+        roots = Roots::new(count.max(1));
+        // a band of a tenth of the curve's size beyond the pruning: the margin's reach
+        ub = foot_points(curve, &y, reach, &mut roots, basins.as_mut(), 0.1 * curve.bound().1);
+    }
     let o2 = curve.offset();
     let c2d = Vec2::new(center.x, center.y);
-    fill(&mut roots, count, |r| r.s2, |k, root| {
-        out[k] = match root {
-            None => unused(&rel, &c2d, radius, &curve.bound().0, curve.bound().1, tw),
-            Some(root) => {
-                let j = curve.eval(root.s2);
-                let d = y - j[0];
-                let nu = curve.outward(&j[1]);
-                let g = d.dot(&nu) - radius - o2;
-                let n = rel.world2(&nu);
-                let cw = x1.point_to_parent(center);
-                let p1 = cw - n * radius;
-                let mut r = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
-                if let Some(tw) = tw {
-                    let yd = rel.point_rate(tw, &cw);
-                    let fs = -j[1].norm_squared() + d.dot(&j[2]);
-                    let sd = if fs.abs() > 0.0 { -yd.dot(&j[1]) / fs } else { 0.0 };
-                    let nud = normal_rate(&nu, &j) * sd;
-                    let gd = (yd - j[1] * sd).dot(&nu) + d.dot(&nud);
-                    r.nd = tw.1.w.cross(&n) + rel.world2(&nud);
-                    r.p1d = vel(tw.0, &cw) - r.nd * radius;
-                    r.p2d = r.p1d - n * gd - r.nd * g;
+    let mut sel = [None; MAX_POINTS];
+    fill(
+        &mut roots,
+        count,
+        |r| r.s2,
+        |k, root| {
+            sel[k] = root.copied();
+            out[k] = match root {
+                None => unused(&rel, &c2d, radius, &curve.bound().0, curve.bound().1, tw),
+                Some(root) => {
+                    let j = curve.eval(root.s2);
+                    let d = y - j[0];
+                    let nu = curve.outward(&j[1]);
+                    let g = d.dot(&nu) - radius - o2;
+                    let n = rel.world2(&nu);
+                    let cw = x1.point_to_parent(center);
+                    let p1 = cw - n * radius;
+                    let mut r = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
+                    if let Some(tw) = tw {
+                        let yd = rel.point_rate(tw, &cw);
+                        let fs = -j[1].norm_squared() + d.dot(&j[2]);
+                        let sd = if fs.abs() > 0.0 { -yd.dot(&j[1]) / fs } else { 0.0 };
+                        let nud = normal_rate(&nu, &j) * sd;
+                        let gd = (yd - j[1] * sd).dot(&nu) + d.dot(&nud);
+                        r.nd = tw.1.w.cross(&n) + rel.world2(&nud);
+                        r.p1d = vel(tw.0, &cw) - r.nd * radius;
+                        r.p2d = r.p1d - n * gd - r.nd * g;
+                    }
+                    r
                 }
-                r
-            }
-        };
-    });
+            };
+        },
+    );
+    if let Some(h) = hints {
+        // the chunks not looked at are farther than that
+        let bound = |_, _| ub;
+        let same = |a: &Root, b: &Root| same_param(curve, a.s2, b.s2);
+        leave(h, &sel[..count], warm, basins.as_ref(), curve, |r| r.s2, same, bound, placement);
+    }
 }
 
 /// Calls `at_min(i)` for every local minimum of the sampled `value(i)` over the samples of the
@@ -415,8 +543,20 @@ fn sampled_minima(
             if vi < best.0 {
                 best = (vi, i);
             }
-            let prev = if i > 0 { value(i - 1) } else if closed { value(n - 1) } else { f64::INFINITY };
-            let next = if i + 1 < n { value(i + 1) } else if closed { value(0) } else { f64::INFINITY };
+            let prev = if i > 0 {
+                value(i - 1)
+            } else if closed {
+                value(n - 1)
+            } else {
+                f64::INFINITY
+            };
+            let next = if i + 1 < n {
+                value(i + 1)
+            } else if closed {
+                value(0)
+            } else {
+                f64::INFINITY
+            };
             if vi <= prev && vi <= next {
                 at_min(i);
             }
@@ -425,24 +565,45 @@ fn sampled_minima(
     best
 }
 
-/// Local minima of the distance from `y` to the curve's samples, refined to foot points.
-fn foot_points(curve: &Curve, y: &Vec2, reach: f64, roots: &mut Roots) {
-    let samples = curve.samples();
-    let ub = curve.chunks().iter().map(|c| (y - c.center).norm() + c.radius).fold(f64::INFINITY, f64::min);
+/// Local minima of the distance from `y` to the curve's samples, refined to foot points; returns
+/// the bound of the regions the search did not look at. Recording for a warm start (`basins`),
+/// it also looks `band` further, at competitors only (their minima go to `basins`, never to
+/// `roots`: the roots are those of the plain search), so that the margin is not limited by the
+/// pruning's upper bound.
+fn foot_points(
+    curve: &Curve,
+    y: &Vec2,
+    reach: f64,
+    roots: &mut Roots,
+    mut basins: Option<&mut Basins<Root>>,
+    band: f64,
+) -> f64 {
+    let (samples, chunks) = (curve.samples(), curve.chunks());
+    let ub = chunks.iter().map(|c| (y - c.center).norm() + c.radius).fold(f64::INFINITY, f64::min);
+    let band = if basins.is_some() { band } else { 0.0 };
+    let below = |ch: &Chunk| (y - ch.center).norm() - ch.radius;
     let best = sampled_minima(
         curve,
-        |ch| (y - ch.center).norm() - ch.radius <= ub + reach,
+        |ch| below(ch) <= ub + reach + band,
         |i| (y - samples[i].r).norm(),
         |i| {
-            if let Some((s, j)) = curve.foot(y, samples[i].s) {
+            let searched = chunks.get(i / CHUNK).is_some_and(|ch| below(ch) <= ub + reach);
+            let root = curve.foot(y, samples[i].s).map(|(s, j)| {
                 let key = (y - j[0]).dot(&curve.outward(&j[1])).abs();
-                roots.push(Root { s1: 0.0, s2: curve.wrap(s), key }, |a, b| same_param(curve, a.s2, b.s2));
+                Root { s2: curve.wrap(s), key, ..Default::default() }
+            });
+            if let (Some(r), true) = (root, searched) {
+                roots.push(r, |a, b| same_param(curve, a.s2, b.s2));
+            }
+            if let Some(b) = basins.as_deref_mut() {
+                b.push(samples[i].s, root);
             }
         },
     );
     if roots.len == 0 && best.0.is_finite() {
-        roots.push(Root { s1: 0.0, s2: samples[best.1].s, key: best.0 }, |_, _| false);
+        roots.push(Root { s2: samples[best.1].s, key: best.0, ..Default::default() }, |_, _| false);
     }
+    ub + reach + band
 }
 
 /// A curve on body 1 against the half-plane of body 2 (2-D `point`, unit `normal`).
@@ -457,69 +618,112 @@ fn curve_line(
     x2: &Pose,
     tw: Option<(&Motion, &Motion)>,
     out: &mut [Raw],
+    hints: Option<&mut [SearchHint]>,
 ) {
     let rel = Relative::new(x1, x2);
     let (samples, chunks) = (curve.samples(), curve.chunks());
     let height = |i: usize| m.dot(&rel.point(&samples[i].r));
-    let ub = chunks.iter().map(|c| m.dot(&rel.point(&c.center)) + c.radius).fold(f64::INFINITY, f64::min);
     let mut roots = Roots::new(count.max(1));
     let jet = |s: f64| {
         let j = curve.eval(s);
         (rel.point(&j[0]), rel.dir(&j[1]), rel.dir(&j[2]), j)
     };
-    let best = sampled_minima(
-        curve,
-        |ch| m.dot(&rel.point(&ch.center)) - ch.radius <= ub + reach,
-        height,
-        |i| {
-            // Newton on m·ρ1'(s) = 0 towards the minimum of the height
-            let cap = 2.0 * curve.step();
-            let mut s = samples[i].s;
-            let mut ok = false;
-            for _ in 0..NEWTON_ITERATIONS {
-                let (_, r1, r2, _) = jet(s);
-                let (f, fs) = (m.dot(&r1), m.dot(&r2));
-                let ds = if fs > 0.0 { (-f / fs).clamp(-cap, cap) } else { -f.signum() * cap };
-                s += ds;
-                if ds.abs() <= CONVERGED * curve.step() {
-                    ok = m.dot(&jet(s).2) > 0.0;
-                    break;
+    // Newton on m·ρ1'(s) = 0 towards the minimum of the height from `s`: the root (unwrapped)
+    // and its key, if it converges to a minimum
+    let newton = |mut s: f64| -> Option<(f64, f64)> {
+        let cap = 2.0 * curve.step();
+        for _ in 0..NEWTON_ITERATIONS {
+            let (_, r1, r2, _) = jet(s);
+            let (f, fs) = (m.dot(&r1), m.dot(&r2));
+            let ds = if fs > 0.0 { (-f / fs).clamp(-cap, cap) } else { -f.signum() * cap };
+            s += ds;
+            if ds.abs() <= CONVERGED * curve.step() {
+                let (rho, _, rho2, _) = jet(s);
+                return (m.dot(&rho2) > 0.0).then(|| (s, m.dot(&(rho - point))));
+            }
+        }
+        None
+    };
+    let same = |a: &Root, b: &Root| same_param(curve, a.s1, b.s1);
+    let placement = rel.placement();
+    // warm: every point of the curve moved by at most δ (its bounding circle)
+    let warm = hints.as_deref().is_some_and(|h| {
+        let (c, r) = curve.bound();
+        let delta = h[0].moved(&placement.0, &placement.1, &c, r);
+        h[0].allows(delta)
+            && h[..count].iter().all(|h| {
+                let Some((s, key)) = h.root.then(|| newton(h.s[0])).flatten() else { return false };
+                let ok = in_window(s, &h.window, period(curve)) && key <= h.key + delta + key_tolerance(curve);
+                roots.push(Root { s1: curve.wrap(s), key, window: h.window, cold_key: h.key, ..Default::default() }, same);
+                ok
+            })
+            && roots.len == count
+            // with several points: each root's chunk within the reach of the lowest point
+            && roots.list[..roots.len].iter().all(|r| {
+                let ch = chunk_of(curve, r.s1);
+                m.dot(&(rel.point(&ch.center) - point)) - ch.radius <= roots.list[0].key + reach
+            })
+    });
+    let mut basins = (hints.is_some() && !warm).then(Basins::new);
+    let mut ub = 0.0;
+    if !warm {
+        roots = Roots::new(count.max(1));
+        ub = chunks.iter().map(|c| m.dot(&rel.point(&c.center)) + c.radius).fold(f64::INFINITY, f64::min);
+        let best = sampled_minima(
+            curve,
+            |ch| m.dot(&rel.point(&ch.center)) - ch.radius <= ub + reach,
+            height,
+            |i| {
+                let root = newton(samples[i].s).map(|(s, key)| Root { s1: curve.wrap(s), key, ..Default::default() });
+                if let Some(r) = root {
+                    roots.push(r, same);
                 }
-            }
-            if ok {
-                let key = m.dot(&(jet(s).0 - point));
-                roots.push(Root { s1: curve.wrap(s), s2: 0.0, key }, |a, b| same_param(curve, a.s1, b.s1));
-            }
-        },
-    );
-    if roots.len == 0 && best.0.is_finite() {
-        roots.push(Root { s1: samples[best.1].s, s2: 0.0, key: best.0 }, |_, _| false);
+                if let Some(b) = basins.as_mut() {
+                    b.push(samples[i].s, root);
+                }
+            },
+        );
+        if roots.len == 0 && best.0.is_finite() {
+            roots.push(Root { s1: samples[best.1].s, key: best.0, ..Default::default() }, |_, _| false);
+        }
     }
     let o1 = curve.offset();
-    fill(&mut roots, count, |r| r.s1, |k, root| {
-        out[k] = match root {
-            None => unused(&rel, &curve.bound().0, curve.bound().1, point, 0.0, tw),
-            Some(root) => {
-                let (rho, rho1, rho2, j) = jet(root.s1);
-                let g = m.dot(&(rho - point)) - o1;
-                let n = rel.world2(m);
-                let pb = x1.point_to_parent(&lift(&j[0]));
-                let p1 = pb - n * o1;
-                let mut r = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
-                if let Some(tw) = tw {
-                    let rhod = rel.point_rate(tw, &pb);
-                    let rho1d = rel.dir_rate(tw, &j[1]);
-                    let fs = m.dot(&rho2);
-                    let sd = if fs.abs() > 0.0 { -m.dot(&rho1d) / fs } else { 0.0 };
-                    let gd = m.dot(&(rhod + rho1 * sd));
-                    r.nd = tw.1.w.cross(&n);
-                    r.p1d = vel(tw.0, &pb) + x1.a * lift(&j[1]) * sd - r.nd * o1;
-                    r.p2d = r.p1d - n * gd - r.nd * g;
+    let mut sel = [None; MAX_POINTS];
+    fill(
+        &mut roots,
+        count,
+        |r| r.s1,
+        |k, root| {
+            sel[k] = root.copied();
+            out[k] = match root {
+                None => unused(&rel, &curve.bound().0, curve.bound().1, point, 0.0, tw),
+                Some(root) => {
+                    let (rho, rho1, rho2, j) = jet(root.s1);
+                    let g = m.dot(&(rho - point)) - o1;
+                    let n = rel.world2(m);
+                    let pb = x1.point_to_parent(&lift(&j[0]));
+                    let p1 = pb - n * o1;
+                    let mut r = Raw { g, n, p1, p2: p1 - n * g, ..Default::default() };
+                    if let Some(tw) = tw {
+                        let rhod = rel.point_rate(tw, &pb);
+                        let rho1d = rel.dir_rate(tw, &j[1]);
+                        let fs = m.dot(&rho2);
+                        let sd = if fs.abs() > 0.0 { -m.dot(&rho1d) / fs } else { 0.0 };
+                        let gd = m.dot(&(rhod + rho1 * sd));
+                        r.nd = tw.1.w.cross(&n);
+                        r.p1d = vel(tw.0, &pb) + x1.a * lift(&j[1]) * sd - r.nd * o1;
+                        r.p2d = r.p1d - n * gd - r.nd * g;
+                    }
+                    r
                 }
-                r
-            }
-        };
-    });
+            };
+        },
+    );
+    if let Some(h) = hints {
+        // pruned chunks are higher than ub + reach (keys: heights over the line's point)
+        let bound = |_, _| ub + reach - m.dot(point);
+        leave(h, &sel[..count], warm, basins.as_ref(), curve, |r| r.s1, same, bound, placement);
+    }
 }
 
 /// Two curves: seeds from the sampled signed distance of curve 1's samples to curve 2.
@@ -533,135 +737,9 @@ fn curve_curve(
     x2: &Pose,
     tw: Option<(&Motion, &Motion)>,
     out: &mut [Raw],
+    hints: Option<&mut [SearchHint]>,
 ) {
     let rel = Relative::new(x1, x2);
-    let (s1, ch1) = (c1.samples(), c1.chunks());
-    let (s2, ch2) = (c2.samples(), c2.chunks());
-    let n1 = s1.len();
-    // chunk pruning: keep the chunks that may hold a point within the best upper bound (+ reach).
-    // Only chunks reaching into the other curve's bounding circle give the upper bound, and only
-    // chunks that may come that close to the other's bounding circle are paired (a gear pair
-    // meshes over a few of its hundreds of chunks).
-    const N: usize = MAX_SAMPLES / CHUNK + 1;
-    let mut keep1 = [false; N];
-    let mut keep2 = [false; N];
-    let mut centers1 = [Vec2::zeros(); N];
-    for (a, ca) in ch1.iter().enumerate() {
-        centers1[a] = rel.point(&ca.center);
-    }
-    let (b1c, b1r) = (rel.point(&c1.bound().0), c1.bound().1);
-    let (b2c, b2r) = c2.bound();
-    let mut list1 = [0u16; N];
-    let mut list2 = [0u16; N];
-    let near = |list: &mut [u16; N], centers: &dyn Fn(usize) -> (Vec2, f64), n: usize, c: &Vec2, r: f64, by: f64| {
-        let mut len = 0;
-        for a in 0..n {
-            let (ca, ra) = centers(a);
-            if (ca - c).norm_squared() <= (ra + r + by).powi(2) {
-                list[len] = a as u16;
-                len += 1;
-            }
-        }
-        len
-    };
-    let chunk1 = |a: usize| (centers1[a], ch1[a].radius);
-    let chunk2 = |b: usize| (ch2[b].center, ch2[b].radius);
-    let mut n1n = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, 0.0);
-    let mut n2n = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, 0.0);
-    if n1n == 0 || n2n == 0 {
-        // the bounding circles are apart: every chunk may give the bound
-        (n1n, n2n) = (ch1.len(), ch2.len());
-        for (a, l) in list1.iter_mut().enumerate().take(n1n) {
-            *l = a as u16;
-        }
-        for (b, l) in list2.iter_mut().enumerate().take(n2n) {
-            *l = b as u16;
-        }
-    }
-    // the chunk pair with the closest bounding circles, and the closest of its samples: every
-    // sample lies on its curve, so that distance bounds the curves' distance from above
-    let mut closest = (f64::INFINITY, 0usize, 0usize);
-    for &a in &list1[..n1n] {
-        let (ca, ra) = chunk1(a as usize);
-        for &b in &list2[..n2n] {
-            let (cb, rb) = chunk2(b as usize);
-            let d = (ca - cb).norm() - ra - rb;
-            if d < closest.0 {
-                closest = (d, a as usize, b as usize);
-            }
-        }
-    }
-    let mut ub = f64::INFINITY;
-    let (ka, kb) = (&ch1[closest.1], &ch2[closest.2]);
-    for i in ka.first..ka.first + ka.count {
-        let p = rel.point(&s1[i].r);
-        for jdx in kb.first..kb.first + kb.count {
-            ub = ub.min((p - s2[jdx].r).norm_squared());
-        }
-    }
-    let ub = ub.sqrt();
-    let n1k = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, ub + reach);
-    let n2k = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, ub + reach);
-    for &a in &list1[..n1k] {
-        let (ca, ra) = chunk1(a as usize);
-        for &b in &list2[..n2k] {
-            let (cb, rb) = chunk2(b as usize);
-            if (ca - cb).norm_squared() <= (ub + reach + ra + rb).powi(2) {
-                keep1[a as usize] = true;
-                keep2[b as usize] = true;
-            }
-        }
-    }
-    let mut kept2 = [0u16; N];
-    let mut n2kept = 0;
-    for (b, k) in keep2.iter().enumerate().take(ch2.len()) {
-        if *k {
-            kept2[n2kept] = b as u16;
-            n2kept += 1;
-        }
-    }
-    // signed distance of a kept sample of curve 1 to the kept samples of curve 2 (recomputed for
-    // the neighbours instead of stored: no buffers of sample length on the stack; a small cache
-    // serves a sample's value to its neighbours)
-    // (squared distances; the chunk that held the previous sample's partner is tried first)
-    let last = std::cell::Cell::new(0usize);
-    let phi_of = |i: usize| -> (f64, usize) {
-        if !keep1[i / CHUNK] {
-            return (f64::INFINITY, 0);
-        }
-        let p = rel.point(&s1[i].r);
-        let mut best = (f64::INFINITY, 0usize);
-        let first = last.get().min(n2kept.saturating_sub(1));
-        for k in std::iter::once(first).chain((0..n2kept).filter(|&k| k != first)) {
-            let cb = &ch2[kept2[k] as usize];
-            let reach = best.0.sqrt() + cb.radius;
-            if best.0.is_finite() && (p - cb.center).norm_squared() > reach * reach {
-                continue;
-            }
-            for jdx in cb.first..cb.first + cb.count {
-                let dd = (p - s2[jdx].r).norm_squared();
-                if dd < best.0 {
-                    best = (dd, jdx);
-                    last.set(k);
-                }
-            }
-        }
-        let sign = if (p - s2[best.1].r).dot(&s2[best.1].nu) < 0.0 { -1.0 } else { 1.0 };
-        (sign * best.0.sqrt(), best.1)
-    };
-    let cache = std::cell::RefCell::new(([usize::MAX; 4], [(0.0, 0usize); 4], 0usize));
-    let phi = |i: usize| -> (f64, usize) {
-        let mut c = cache.borrow_mut();
-        if let Some(k) = c.0.iter().position(|&j| j == i) {
-            return c.1[k];
-        }
-        let v = phi_of(i);
-        let slot = c.2;
-        c.0[slot] = i;
-        c.1[slot] = v;
-        c.2 = (slot + 1) % 4;
-        v
-    };
     let handed = rel.handed();
     let map1 = |j1: &Jet2| [rel.point(&j1[0]), rel.dir(&j1[1]), rel.dir(&j1[2]), rel.dir(&j1[3])];
     let jet1 = |a: f64| map1(&c1.eval(a));
@@ -672,27 +750,15 @@ fn curve_curve(
     // gear pairs: one candidate per flank side and tooth colour (see `gear_slots`)
     let slots = gear_slots(c1, c2, count).and_then(|r| r.ok());
     let mut roots = Roots::new(if slots.is_some() { MAX_ROOTS } else { count.max(1) });
-    let mut best = (f64::INFINITY, 0usize, 0usize);
     let cap1 = 2.0 * c1.step();
-    let samples1 = (0..ch1.len()).filter(|&a| keep1[a]).flat_map(|a| ch1[a].first..ch1[a].first + ch1[a].count);
-    for i in samples1 {
-        let (pi, partner) = phi(i);
-        if pi < best.0 {
-            best = (pi, i, partner);
-        }
-        let prev = if i > 0 { phi(i - 1).0 } else if c1.is_closed() { phi(n1 - 1).0 } else { f64::INFINITY };
-        let next = if i + 1 < n1 { phi(i + 1).0 } else if c1.is_closed() { phi(0).0 } else { f64::INFINITY };
-        if !(pi <= prev && pi <= next) {
-            continue;
-        }
-        // minimize the signed distance φ(s1) of curve 1's point to curve 2 (the foot point s2
-        // follows s1): φ' = ν2·ρ1' (envelope theorem), φ'' = ν2·ρ1'' + ν2'·ρ1' ds2/ds1
-        let (mut a, mut b) = (s1[i].s, s2[partner].s);
-        let mut ok = false;
+    // minimize the signed distance φ(s1) of curve 1's point to curve 2 from (a, b) (the foot
+    // point s2 follows s1): φ' = ν2·ρ1' (envelope theorem), φ'' = ν2·ρ1'' + ν2'·ρ1' ds2/ds1;
+    // the minimum (unwrapped parameters) if Newton converges to one
+    let newton = |mut a: f64, mut b: f64| -> Option<(f64, f64)> {
         let mut bracket = Bracket::new();
         for _ in 0..NEWTON_ITERATIONS {
             let r1 = jet1(a);
-            let Some((foot, j2)) = c2.foot(&r1[0], b) else { break };
+            let (foot, j2) = c2.foot(&r1[0], b)?;
             b = foot;
             let d = r1[0] - j2[0];
             let nu2 = c2.outward(&j2[1]);
@@ -706,31 +772,222 @@ fn curve_curve(
             a += da;
             b += db_da * da;
             if da.abs() <= CONVERGED * c1.step() {
-                ok = c2.foot(&jet1(a)[0], b).map(|f| b = f.0).is_some() && fpp > 0.0;
-                break;
+                let ok = c2.foot(&jet1(a)[0], b).map(|f| b = f.0).is_some() && fpp > 0.0;
+                return ok.then_some((a, b));
             }
         }
-        if !ok {
-            continue;
-        }
+        None
+    };
+    // the root at a minimum (a, b) and whether it is a contact: the mapped curve's outward normal
+    // and curvature (a projection when body 1 is tilted; turned over it runs the other way round)
+    let assess = |a: f64, b: f64| -> (Root, bool) {
         let (r1, _, j2) = jets(a, b);
-        // the mapped curve's outward normal and curvature (a projection when body 1 is tilted;
-        // turned over it runs the other way round)
         let nu1p = c1.outward(&r1[1]) * handed;
         let nu2 = c2.outward(&j2[1]);
         let g = (r1[0] - j2[0]).dot(&nu2);
         let k1 = c1.curvature_of(&[r1[0], r1[1], r1[2], r1[3]]) * handed;
         let k2 = c2.curvature_of(&j2);
-        if nu1p.dot(&nu2) < 0.0 && k1 + k2 + g * k1 * k2 > 0.0 {
-            roots.push(Root { s1: c1.wrap(a), s2: c2.wrap(b), key: g }, |p, q| {
-                same_param(c1, p.s1, q.s1) && same_param(c2, p.s2, q.s2)
-            });
+        let root = Root { s1: c1.wrap(a), s2: c2.wrap(b), key: g, ..Default::default() };
+        (root, nu1p.dot(&nu2) < 0.0 && k1 + k2 + g * k1 * k2 > 0.0)
+    };
+    let same = |p: &Root, q: &Root| same_param(c1, p.s1, q.s1) && same_param(c2, p.s2, q.s2);
+    let placement = rel.placement();
+    // warm: every point of curve 1 moved by at most δ (its bounding circle)
+    let warm = hints.as_deref().is_some_and(|h| {
+        let (c, r) = c1.bound();
+        let delta = h[0].moved(&placement.0, &placement.1, &c, r);
+        h[0].allows(delta)
+            && h[..count].iter().all(|h| {
+                let Some((a, b)) = h.root.then(|| newton(h.s[0], h.s[1])).flatten() else { return false };
+                let (root, valid) = assess(a, b);
+                let ok = valid && in_window(a, &h.window, period(c1)) && root.key <= h.key + delta + key_tolerance(c1);
+                roots.push(Root { window: h.window, cold_key: h.key, ..root }, same);
+                ok
+            })
+            && roots.len == h[..count].len()
+            // the cold search keeps every chunk pair within ub + reach, ub at least the closest
+            // distance (the best root's when it is positive, every other region being farther;
+            // else 0): a root whose chunks' bounding circles are that close is kept
+            && {
+                let best = roots.list[..roots.len].iter().map(|r| r.key).fold(f64::INFINITY, f64::min).max(0.0);
+                roots.list[..roots.len].iter().all(|r| {
+                    let (a, b) = (chunk_of(c1, r.s1), chunk_of(c2, r.s2));
+                    (rel.point(&a.center) - b.center).norm() - a.radius - b.radius <= best + reach
+                })
+            }
+    });
+    let mut basins = (hints.is_some() && !warm).then(Basins::new);
+    let mut ub_out = 0.0;
+    if !warm {
+        roots = Roots::new(if slots.is_some() { MAX_ROOTS } else { count.max(1) });
+        let (s1, ch1) = (c1.samples(), c1.chunks());
+        let (s2, ch2) = (c2.samples(), c2.chunks());
+        let n1 = s1.len();
+        // chunk pruning: keep the chunks that may hold a point within the best upper bound (+ reach).
+        // Only chunks reaching into the other curve's bounding circle give the upper bound, and only
+        // chunks that may come that close to the other's bounding circle are paired (a gear pair
+        // meshes over a few of its hundreds of chunks).
+        const N: usize = MAX_SAMPLES / CHUNK + 1;
+        let mut keep1 = [false; N];
+        let mut keep2 = [false; N];
+        let mut centers1 = [Vec2::zeros(); N];
+        for (a, ca) in ch1.iter().enumerate() {
+            centers1[a] = rel.point(&ca.center);
         }
-    }
-    if roots.len == 0 && best.0.is_finite() {
-        roots.push(Root { s1: s1[best.1].s, s2: s2[best.2].s, key: best.0 }, |_, _| false);
+        let (b1c, b1r) = (rel.point(&c1.bound().0), c1.bound().1);
+        let (b2c, b2r) = c2.bound();
+        let mut list1 = [0u16; N];
+        let mut list2 = [0u16; N];
+        let near =
+            |list: &mut [u16; N], centers: &dyn Fn(usize) -> (Vec2, f64), n: usize, c: &Vec2, r: f64, by: f64| {
+                let mut len = 0;
+                for a in 0..n {
+                    let (ca, ra) = centers(a);
+                    if (ca - c).norm_squared() <= (ra + r + by).powi(2) {
+                        list[len] = a as u16;
+                        len += 1;
+                    }
+                }
+                len
+            };
+        let chunk1 = |a: usize| (centers1[a], ch1[a].radius);
+        let chunk2 = |b: usize| (ch2[b].center, ch2[b].radius);
+        let mut n1n = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, 0.0);
+        let mut n2n = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, 0.0);
+        if n1n == 0 || n2n == 0 {
+            // the bounding circles are apart: every chunk may give the bound
+            (n1n, n2n) = (ch1.len(), ch2.len());
+            for (a, l) in list1.iter_mut().enumerate().take(n1n) {
+                *l = a as u16;
+            }
+            for (b, l) in list2.iter_mut().enumerate().take(n2n) {
+                *l = b as u16;
+            }
+        }
+        // the chunk pair with the closest bounding circles, and the closest of its samples: every
+        // sample lies on its curve, so that distance bounds the curves' distance from above
+        let mut closest = (f64::INFINITY, 0usize, 0usize);
+        for &a in &list1[..n1n] {
+            let (ca, ra) = chunk1(a as usize);
+            for &b in &list2[..n2n] {
+                let (cb, rb) = chunk2(b as usize);
+                let d = (ca - cb).norm() - ra - rb;
+                if d < closest.0 {
+                    closest = (d, a as usize, b as usize);
+                }
+            }
+        }
+        let mut ub = f64::INFINITY;
+        let (ka, kb) = (&ch1[closest.1], &ch2[closest.2]);
+        for i in ka.first..ka.first + ka.count {
+            let p = rel.point(&s1[i].r);
+            for jdx in kb.first..kb.first + kb.count {
+                ub = ub.min((p - s2[jdx].r).norm_squared());
+            }
+        }
+        let ub_cold = ub.sqrt();
+        let ub = ub_cold;
+        let n1k = near(&mut list1, &chunk1, ch1.len(), &b2c, b2r, ub + reach);
+        let n2k = near(&mut list2, &chunk2, ch2.len(), &b1c, b1r, ub + reach);
+        for &a in &list1[..n1k] {
+            let (ca, ra) = chunk1(a as usize);
+            for &b in &list2[..n2k] {
+                let (cb, rb) = chunk2(b as usize);
+                if (ca - cb).norm_squared() <= (ub + reach + ra + rb).powi(2) {
+                    keep1[a as usize] = true;
+                    keep2[b as usize] = true;
+                }
+            }
+        }
+        let mut kept2 = [0u16; N];
+        let mut n2kept = 0;
+        for (b, k) in keep2.iter().enumerate().take(ch2.len()) {
+            if *k {
+                kept2[n2kept] = b as u16;
+                n2kept += 1;
+            }
+        }
+        // signed distance of a kept sample of curve 1 to the kept samples of curve 2 (recomputed for
+        // the neighbours instead of stored: no buffers of sample length on the stack; a small cache
+        // serves a sample's value to its neighbours)
+        // (squared distances; the chunk that held the previous sample's partner is tried first)
+        let last = std::cell::Cell::new(0usize);
+        let phi_of = |i: usize| -> (f64, usize) {
+            if !keep1[i / CHUNK] {
+                return (f64::INFINITY, 0);
+            }
+            let p = rel.point(&s1[i].r);
+            let mut best = (f64::INFINITY, 0usize);
+            let first = last.get().min(n2kept.saturating_sub(1));
+            for k in std::iter::once(first).chain((0..n2kept).filter(|&k| k != first)) {
+                let cb = &ch2[kept2[k] as usize];
+                let reach = best.0.sqrt() + cb.radius;
+                if best.0.is_finite() && (p - cb.center).norm_squared() > reach * reach {
+                    continue;
+                }
+                for jdx in cb.first..cb.first + cb.count {
+                    let dd = (p - s2[jdx].r).norm_squared();
+                    if dd < best.0 {
+                        best = (dd, jdx);
+                        last.set(k);
+                    }
+                }
+            }
+            let sign = if (p - s2[best.1].r).dot(&s2[best.1].nu) < 0.0 { -1.0 } else { 1.0 };
+            (sign * best.0.sqrt(), best.1)
+        };
+        let cache = std::cell::RefCell::new(([usize::MAX; 4], [(0.0, 0usize); 4], 0usize));
+        let phi = |i: usize| -> (f64, usize) {
+            let mut c = cache.borrow_mut();
+            if let Some(k) = c.0.iter().position(|&j| j == i) {
+                return c.1[k];
+            }
+            let v = phi_of(i);
+            let slot = c.2;
+            c.0[slot] = i;
+            c.1[slot] = v;
+            c.2 = (slot + 1) % 4;
+            v
+        };
+        let mut best = (f64::INFINITY, 0usize, 0usize);
+        let samples1 = (0..ch1.len()).filter(|&a| keep1[a]).flat_map(|a| ch1[a].first..ch1[a].first + ch1[a].count);
+        for i in samples1 {
+            let (pi, partner) = phi(i);
+            if pi < best.0 {
+                best = (pi, i, partner);
+            }
+            let prev = if i > 0 {
+                phi(i - 1).0
+            } else if c1.is_closed() {
+                phi(n1 - 1).0
+            } else {
+                f64::INFINITY
+            };
+            let next = if i + 1 < n1 {
+                phi(i + 1).0
+            } else if c1.is_closed() {
+                phi(0).0
+            } else {
+                f64::INFINITY
+            };
+            if !(pi <= prev && pi <= next) {
+                continue;
+            }
+            let root = newton(s1[i].s, s2[partner].s).map(|(a, b)| assess(a, b));
+            if let Some((r, true)) = root {
+                roots.push(r, same);
+            }
+            if let Some(b) = basins.as_mut() {
+                b.push(s1[i].s, root.map(|r| r.0));
+            }
+        }
+        if roots.len == 0 && best.0.is_finite() {
+            roots.push(Root { s1: s1[best.1].s, s2: s2[best.2].s, key: best.0, ..Default::default() }, |_, _| false);
+        }
+        ub_out = ub_cold;
     }
     let (o1, o2) = (c1.offset(), c2.offset());
+    let mut sel = [None; MAX_POINTS];
     let make = |root: Option<&Root>| match root {
         None => unused(&rel, &c1.bound().0, c1.bound().1, &c2.bound().0, c2.bound().1, tw),
         Some(root) => {
@@ -778,8 +1035,28 @@ fn curve_curve(
             for (k, o) in out.iter_mut().enumerate().take(count) {
                 *o = make(best[k].as_ref());
             }
+            sel = best;
         }
-        None => fill(&mut roots, count, |r| r.s1, |k, root| out[k] = make(root)),
+        None => fill(
+            &mut roots,
+            count,
+            |r| r.s1,
+            |k, root| {
+                sel[k] = root.copied();
+                out[k] = make(root)
+            },
+        ),
+    }
+    if let Some(h) = hints {
+        // pruned chunk pairs are farther apart than ub + reach, and outside each other unless the
+        // curves overlap deeper than that (a chunk of curve 1 inside curve 2 is joined to the
+        // crossing by points at every smaller depth, kept and above the deepest root)
+        let prune = ub_out + reach;
+        // gear pairs: whether the cold search finds a root at a flank's end (the tip rounding)
+        // depends on its sampling, so its roots through a tooth handover are not a continuous
+        // family a warm start could follow; they always search cold
+        let gears = c1.as_gear().is_some() || c2.as_gear().is_some();
+        let bound = |best: f64, _| if -best < prune && !gears { prune } else { f64::NEG_INFINITY };
+        leave(h, &sel[..count], warm, basins.as_ref(), c1, |r| r.s1, same, bound, placement);
     }
 }
-

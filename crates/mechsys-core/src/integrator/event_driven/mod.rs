@@ -151,6 +151,13 @@ pub struct Phase<'a> {
     gap_offset: Vec<f64>,
     /// Contact kinematics of the last evaluation (`w̄` with the velocity-product accelerations).
     pub kin: Vec<ContactKinematics>,
+    /// Per candidate point: the contact search's state between evaluations. Trial states come
+    /// out of time order (rejected steps, root finding); a warm start compares the placement with
+    /// the one of the last cold search, whatever came between, so any order is safe.
+    search: Vec<crate::contact::SearchHint>,
+    /// Warm-start the contact searches of planar parametric contours (the same roots as cold
+    /// searches; off: every evaluation searches cold).
+    pub warm_search: bool,
     /// Normal forces of the last evaluation (N).
     pub lam_n: Vec<f64>,
     /// Tangential forces, t1 and t2 components (N).

@@ -4,7 +4,8 @@ use nalgebra::DMatrix;
 
 use super::{EventWork, Options, Phase, JAM, PYRAMID};
 use crate::contact::{
-    at_contact, contact_kinematics, contact_point_kinematics, gap_with_accelerations, BodyMotion, ContactKinematics,
+    at_contact, contact_kinematics_warm, contact_point_kinematics, gap_with_accelerations, BodyMotion,
+    ContactKinematics,
 };
 use crate::data::Data;
 use crate::dynamics::sparse::Saddle;
@@ -42,6 +43,8 @@ impl<'a> Phase<'a> {
             slip_margin: vec![1.0; np],
             slip_margin_start: vec![1.0; np],
             kin: vec![ContactKinematics::default(); np],
+            search: vec![crate::contact::SearchHint::default(); np],
+            warm_search: true,
             lam_n: vec![0.0; np],
             lam_t: vec![[0.0; 2]; np],
             friction_power: 0.0,
@@ -153,7 +156,9 @@ impl<'a> Phase<'a> {
         }
         self.a_free = c;
         for con in &model.contacts {
-            contact_point_kinematics(con, data, t, q, u, self.cb, &mut self.kin[con.first..con.first + con.points()])
+            let pts = con.first..con.first + con.points();
+            let s = self.warm_search.then(|| &mut self.search[pts.clone()]);
+            contact_point_kinematics(con, data, t, q, u, self.cb, &mut self.kin[pts], s)
                 .map_err(|e| at_contact(e, &con.name, t))?;
         }
         Ok(p)
@@ -526,8 +531,10 @@ impl<'a> Phase<'a> {
                 k[0] = self.kin[con.first];
                 gap_with_accelerations(con, &self.data, &self.data.udot, &mut k[0]);
             } else {
-                let (b1, b2) = (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
-                contact_kinematics(con.pair().expect("a contour contact"), &b1, &b2, &mut k[..n])?;
+                let (b1, b2) =
+                    (BodyMotion::from_data(&self.data, con.body1), BodyMotion::from_data(&self.data, con.body2));
+                let s = self.warm_search.then(|| &mut self.search[pts.clone()]);
+                contact_kinematics_warm(con.pair().expect("a contour contact"), &b1, &b2, &mut k[..n], s)?;
             }
             for (j, kk) in k[..n].iter().enumerate() {
                 let pt = con.first + j;

@@ -94,7 +94,7 @@ impl Projection {
                     continue;
                 }
                 // (the rates come from stale velocities and are not used: only g, n and points)
-                contact_point_kinematics(con, data, t, q, u, cb, &mut self.kin[range.clone()])
+                contact_point_kinematics(con, data, t, q, u, cb, &mut self.kin[range.clone()], None)
                     .map_err(|e| crate::contact::at_contact(e, &con.name, t))?;
                 for pt in range {
                     if closed(pt) && self.kin[pt].point.g_n < -TOLERANCE {

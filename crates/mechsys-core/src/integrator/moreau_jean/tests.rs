@@ -152,3 +152,46 @@ fn block_delassus_is_w_minv_wt() {
     }
     assert!(checked > 20, "only {checked} steps with three or more contacts");
 }
+
+/// A roller pressed by gravity on a spinning elliptical cam: the curve contact's search
+/// warm-starts between steps (most steps), and the trajectory is the one of cold searches.
+#[test]
+fn curve_contacts_warm_start_between_steps_and_match_cold_searches() {
+    let json = r#"{
+        "name": "ellipse-cam", "gravity": [0, -9.81, 0], "planar": true,
+        "bodies": [
+            {"name": "cam", "mass": 1.0, "inertia": [0.001, 0.001, 0.001]},
+            {"name": "roller", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]}
+        ],
+        "joints": [
+            {"name": "shaft", "type": "revolute", "parent": "ground", "child": "cam", "axis": [0, 0, 1], "u0": [5.0]},
+            {"name": "guide", "type": "prismatic", "parent": "ground", "child": "roller", "axis": [0, 1, 0], "q0": [0.0605]}
+        ],
+        "contacts": [{"name": "cam", "body1": "roller", "contour1": {"type": "circle", "radius": 0.01},
+                      "body2": "cam", "contour2": {"type": "ellipse", "semi_axes": [0.05, 0.035]},
+                      "friction": {"type": "coulomb", "mu": 0.1}, "impact": {"type": "newton", "eps": 0.0}}]
+    }"#;
+    let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
+    let h = 1e-4;
+    let run = |warm: bool| {
+        let mut st = MoreauJean::new(&model, h, nsgs_tight()).unwrap();
+        st.warm_search = warm;
+        let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
+        let (mut q, mut u) = (model.q0(), model.u0());
+        let (mut warm_steps, mut closed) = (0, 0);
+        for k in 0..3000 {
+            st.step(&model, &mut data, &mut ws, k as f64 * h, &mut q, &mut u, &NoCallbacks).unwrap();
+            warm_steps += st.search[0].was_warm() as usize;
+            closed += (st.results[0].impulse_n > 0.0) as usize;
+        }
+        (q, u, warm_steps, closed)
+    };
+    let (qw, uw, warm_steps, closed) = run(true);
+    let (qc, uc, cold_warm, _) = run(false);
+    assert_eq!(cold_warm, 0);
+    assert!(closed > 1000, "the roller rides on the cam: {closed} of 3000 steps closed");
+    assert!(warm_steps > 1500, "warm searches in {warm_steps} of 3000 steps");
+    for (a, b) in qw.iter().zip(&qc).chain(uw.iter().zip(&uc)) {
+        assert!((a - b).abs() < 1e-10, "warm {a} vs cold {b}");
+    }
+}
