@@ -291,6 +291,35 @@ fn bench_gears(c: &mut Criterion) {
     g.finish();
 }
 
+/// [`evaluate`] and [`contact_kinematics`] of a one-candidate `pair` at each of the placement
+/// pairs `bodies` (`<name>_evaluate/n`, `<name>_kinematics/n`).
+fn bench_single(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    pair: &ContactPair,
+    bodies: &[(BodyMotion, BodyMotion)],
+) {
+    let n = bodies.len();
+    let mut points = vec![ContactPoint::default(); n];
+    g.bench_with_input(BenchmarkId::new(format!("{name}_evaluate"), n), &n, |b, _| {
+        b.iter(|| {
+            for ((b1, b2), out) in bodies.iter().zip(points.iter_mut()) {
+                evaluate(pair, &b1.pose, &b2.pose, std::slice::from_mut(out)).expect("room for 1");
+            }
+            black_box(&points);
+        })
+    });
+    let mut kin = vec![ContactKinematics::default(); n];
+    g.bench_with_input(BenchmarkId::new(format!("{name}_kinematics"), n), &n, |b, _| {
+        b.iter(|| {
+            for ((b1, b2), out) in bodies.iter().zip(kin.iter_mut()) {
+                contact_kinematics(pair, b1, b2, std::slice::from_mut(out)).expect("room for 1");
+            }
+            black_box(&kin);
+        })
+    });
+}
+
 /// Planar parametric pairs near contact, in plane motion: [`evaluate`] and
 /// [`contact_kinematics`] per pair (the global start over the sampled chunks and Newton on the
 /// parameters each call; there is no warm start), next to the closed-form circle–circle pair.
@@ -338,24 +367,7 @@ fn bench_curves(c: &mut Criterion) {
                 (b1, b2)
             })
             .collect();
-        let mut points = vec![ContactPoint::default(); n];
-        g.bench_with_input(BenchmarkId::new(format!("{name}_evaluate"), n), &n, |b, _| {
-            b.iter(|| {
-                for ((b1, b2), out) in bodies.iter().zip(points.iter_mut()) {
-                    evaluate(&pair, &b1.pose, &b2.pose, std::slice::from_mut(out)).expect("room for 1");
-                }
-                black_box(&points);
-            })
-        });
-        let mut kin = vec![ContactKinematics::default(); n];
-        g.bench_with_input(BenchmarkId::new(format!("{name}_kinematics"), n), &n, |b, _| {
-            b.iter(|| {
-                for ((b1, b2), out) in bodies.iter().zip(kin.iter_mut()) {
-                    contact_kinematics(&pair, b1, b2, std::slice::from_mut(out)).expect("room for 1");
-                }
-                black_box(&kin);
-            })
-        });
+        bench_single(&mut g, name, &pair, &bodies);
     }
     g.finish();
 }
@@ -557,24 +569,7 @@ fn bench_surfaces(c: &mut Criterion) {
                 (b1, b2)
             })
             .collect();
-        let mut points = vec![ContactPoint::default(); n];
-        g.bench_with_input(BenchmarkId::new(format!("{name}_evaluate"), n), &n, |b, _| {
-            b.iter(|| {
-                for ((b1, b2), out) in bodies.iter().zip(points.iter_mut()) {
-                    evaluate(&pair, &b1.pose, &b2.pose, std::slice::from_mut(out)).expect("room for 1");
-                }
-                black_box(&points);
-            })
-        });
-        let mut kin = vec![ContactKinematics::default(); n];
-        g.bench_with_input(BenchmarkId::new(format!("{name}_kinematics"), n), &n, |b, _| {
-            b.iter(|| {
-                for ((b1, b2), out) in bodies.iter().zip(kin.iter_mut()) {
-                    contact_kinematics(&pair, b1, b2, std::slice::from_mut(out)).expect("room for 1");
-                }
-                black_box(&kin);
-            })
-        });
+        bench_single(&mut g, name, &pair, &bodies);
     }
     g.finish();
 }
