@@ -46,10 +46,7 @@ simulation = dict(t_end=6.0, integrator=ms.EventDriven(), output_dt=1e-3)
 
 
 def period(res) -> float:
-    x = res["joint/free/q"][:, 0]
-    k = np.where((x[:-1] > 0) & (x[1:] <= 0))[0]
-    tc = res.t[k] + (res.t[k + 1] - res.t[k]) * x[k] / (x[k] - x[k + 1])
-    return float(np.diff(tc).mean())
+    return ms.analysis.period(res.t, res["joint/free/q"][:, 0])
 
 
 if __name__ == "__main__":

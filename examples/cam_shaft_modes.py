@@ -58,10 +58,7 @@ simulation = dict(t_end=4 * 2 * np.pi / OMEGA, integrator=ms.EventDriven(), outp
 
 def period(res) -> float:
     """Mean period of the shaft's twist from its downward zero crossings."""
-    x = res["joint/shaft/q"]
-    k = np.where((x[:-1] > 0) & (x[1:] <= 0))[0]
-    tc = res.t[k] + (res.t[k + 1] - res.t[k]) * x[k] / (x[k] - x[k + 1])
-    return float(np.diff(tc).mean())
+    return ms.analysis.period(res.t, res["joint/shaft/q"])
 
 
 if __name__ == "__main__":

@@ -52,11 +52,8 @@ simulation = dict(t_end=3.0, integrator=ms.EventDriven(), output_dt=1e-3)
 
 
 def period(t, x) -> float:
-    """Mean period from the downward crossings of the mean."""
-    x = x - 0.5 * (x.max() + x.min())
-    k = np.where((x[:-1] > 0) & (x[1:] <= 0))[0]
-    tc = t[k] + (t[k + 1] - t[k]) * x[k] / (x[k] - x[k + 1])
-    return float(np.diff(tc).mean())
+    """Mean period from the downward crossings of the middle of the range."""
+    return ms.analysis.period(t, x, level=None)
 
 
 def expected_periods() -> tuple[float, float]:

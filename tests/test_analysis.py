@@ -127,3 +127,13 @@ def test_pseudo_inverse_relation_recovers_generalized_velocities():
     zdot = np.concatenate([np.concatenate([st["velocity"][k], st["angular_velocity"][k]]) for k in (1, 2, 3)])
     np.testing.assert_allclose(j @ u, zdot, atol=1e-12)
     np.testing.assert_allclose(ms.analysis.velocities_from_system(m, q, zdot), u, atol=1e-12)
+
+
+def test_period_of_a_sampled_sine_from_its_interpolated_crossings():
+    t = np.linspace(0.0, 10.0, 2001)
+    np.testing.assert_allclose(ms.analysis.period(t, np.sin(2 * np.pi * t / 1.3)), 1.3, rtol=1e-5)
+    # about the middle of its range (an offset sine), or about a given level
+    np.testing.assert_allclose(ms.analysis.period(t, 3.0 + np.cos(2 * np.pi * t / 0.7), level=None), 0.7, rtol=1e-5)
+    np.testing.assert_allclose(ms.analysis.period(t, 3.0 + np.cos(2 * np.pi * t / 0.7), level=3.0), 0.7, rtol=1e-5)
+    with pytest.raises(ms.errors.SettingsError, match="need at least 2"):
+        ms.analysis.period(t, np.exp(-t))

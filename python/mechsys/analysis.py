@@ -210,4 +210,20 @@ def coordinate_partitioning(model: Model, q=None, t: float = 0.0, tol: float = 1
     return {"independent": [names[i] for i in ind], "dependent": [names[i] for i in dep], "velocity_map": vmap}
 
 
-__all__ = ["assemble", "kinematic_analysis", "static_equilibrium", "system_jacobian", "velocities_from_system", "coordinate_partitioning"]
+def period(t, x, level: float | None = 0.0) -> float:
+    """The mean period of an oscillating signal ``x(t)`` from its downward crossings of ``level``
+    (0 by default; ``None``: the middle of its range), each located by linear interpolation
+    between samples. A SettingsError when there are fewer than two crossings."""
+    t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
+    if t.shape != x.shape or t.ndim != 1:
+        raise SettingsError(f"period: t and x must be 1-D arrays of one length, got shapes {t.shape} and {x.shape}")
+    y = x - (0.5 * (x.max() + x.min()) if level is None else float(level))
+    k = np.where((y[:-1] > 0) & (y[1:] <= 0))[0]
+    if k.size < 2:
+        raise SettingsError(f"period: {k.size} downward crossing(s) of the level in the signal; need at least 2")
+    tc = t[k] + (t[k + 1] - t[k]) * y[k] / (y[k] - y[k + 1])
+    return float(np.diff(tc).mean())
+
+
+__all__ = ["assemble", "kinematic_analysis", "static_equilibrium", "system_jacobian", "velocities_from_system",
+           "coordinate_partitioning", "period"]
