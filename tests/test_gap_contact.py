@@ -151,6 +151,8 @@ def test_bad_gap_functions_are_refused_naming_the_contact():
         pendulum("0.3 - ").build()
     with pytest.raises(ModelError, match="'wall'.friction: a friction law needs a tangential coordinate"):
         pendulum("0.3 - sin(swing)", friction=ms.laws.Coulomb(mu=0.3)).build()
+    with pytest.raises(ModelError, match=r"'wall'.gap: \"0.3 - 0.1 \* t\" reads no joint coordinate"):
+        pendulum("0.3 - 0.1 * t").build()
     with pytest.raises(ModelError, match="'wall'.tangents: at most 2 tangential coordinates"):
         pendulum("0.3 - sin(swing)", tangents=["swing"] * 3).build()
     m = ms.Model("free", gravity=(0, 0, -G))

@@ -593,6 +593,12 @@ pub(super) fn validate_gap(
                     }))
                 };
                 let e = Expr::parse(text, resolve).map_err(|m| Error::Model(format!("{what}.{key}: {m} in \"{text}\"")))?;
+                // a function of time alone has no row: nothing the contact force could act on
+                crate::ensure!(
+                    !e.slots().is_empty(),
+                    Model,
+                    "{what}.{key}: \"{text}\" reads no joint coordinate; a contact function must depend on the motion"
+                );
                 terms.push(GapTerm::Expr(e));
             }
             GapTermDescription::Callback { callback } => {
