@@ -1,0 +1,289 @@
+"""URDF import (mechsys.urdf) checked against Pinocchio's own URDF parser and dynamics.
+
+The arm below is written for this test: joint origins turned by rpy angles, inertial frames
+offset and turned in their links, a prismatic joint, a fixed link with mass, a massless tool frame
+and a mimic joint. Pinocchio reads the same text, so any mistake in our frames, in the rotation of
+the inertia tensors or in the joint axes shows up in M(q) and in the gravity torques.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mechsys as ms
+from mechsys.modelfile import load_model
+from mechsys.urdf import load_urdf
+
+pin = pytest.importorskip("pinocchio")
+
+
+def inertial(mass, xyz, rpy, ixx, iyy, izz, ixy=0.0, ixz=0.0, iyz=0.0):
+    return (f'<inertial><origin xyz="{xyz}" rpy="{rpy}"/><mass value="{mass}"/>'
+            f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="{ixy}" ixz="{ixz}" iyz="{iyz}"/></inertial>')
+
+
+ARM = f"""<?xml version="1.0"?>
+<robot name="test_arm">
+  <link name="base">{inertial(5.0, "0 0 0.05", "0 0 0", 0.02, 0.02, 0.03)}
+    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
+  </link>
+  <link name="shoulder">{inertial(2.0, "0.01 0.02 0.1", "0.3 -0.2 0.5", 0.011, 0.013, 0.007, 0.001, -0.0005, 0.0002)}
+    <collision><origin xyz="0 0 0.1" rpy="0.2 0 0"/><geometry><cylinder radius="0.04" length="0.2"/></geometry></collision>
+    <visual><geometry><sphere radius="0.05"/></geometry></visual>
+  </link>
+  <link name="upper_arm">{inertial(1.5, "0.15 0 0.01", "0 0.4 -0.3", 0.004, 0.021, 0.02, 0.0003, 0.0001, -0.0002)}
+    <collision><origin xyz="0.15 0 0" rpy="0 1.5707963 0"/><geometry><cylinder radius="0.03" length="0.3"/></geometry></collision>
+  </link>
+  <link name="slider">{inertial(0.8, "0.05 0.01 0", "-0.7 0.1 0.2", 0.002, 0.003, 0.0025)}</link>
+  <link name="camera">{inertial(0.3, "0.02 0 0.01", "0 0 0.9", 0.0004, 0.0005, 0.0003)}</link>
+  <link name="wrist">{inertial(0.5, "0 0.03 0.02", "0.5 0.5 0.5", 0.0011, 0.0009, 0.0008, 0.0001)}
+    <collision><geometry><sphere radius="0.03"/></geometry></collision>
+  </link>
+  <link name="finger">{inertial(0.1, "0.02 0 0", "0 0 0", 0.00005, 0.00006, 0.00004)}</link>
+  <link name="tool0"/>
+  <joint name="j_shoulder" type="revolute">
+    <parent link="base"/><child link="shoulder"/>
+    <origin xyz="0.01 -0.02 0.1" rpy="0.1 0.2 -0.3"/><axis xyz="0 0 1"/>
+    <limit lower="-2.5" upper="2.5" effort="80" velocity="3"/>
+  </joint>
+  <joint name="j_elbow" type="revolute">
+    <parent link="shoulder"/><child link="upper_arm"/>
+    <origin xyz="0.02 0.05 0.2" rpy="-1.2 0.3 0.7"/><axis xyz="0 0.6 0.8"/>
+    <limit lower="-1.8" upper="1.9" effort="40" velocity="3"/>
+  </joint>
+  <joint name="j_slide" type="prismatic">
+    <parent link="upper_arm"/><child link="slider"/>
+    <origin xyz="0.3 0.01 -0.02" rpy="0.4 -0.1 0.25"/><axis xyz="1 0 0"/>
+    <limit lower="-0.05" upper="0.12" effort="100" velocity="0.5"/>
+  </joint>
+  <joint name="j_camera" type="fixed">
+    <parent link="upper_arm"/><child link="camera"/>
+    <origin xyz="0.1 0.04 0.03" rpy="0 -0.6 1.1"/>
+  </joint>
+  <joint name="j_wrist" type="continuous">
+    <parent link="slider"/><child link="wrist"/>
+    <origin xyz="0.08 0 0.01" rpy="0.9 0.1 -0.4"/><axis xyz="1 1 0"/>
+  </joint>
+  <joint name="j_finger" type="revolute">
+    <parent link="wrist"/><child link="finger"/>
+    <origin xyz="0.03 0.01 0" rpy="0 0 0.2"/><axis xyz="0 0 1"/>
+    <limit lower="-0.5" upper="0.5" effort="5" velocity="2"/>
+    <mimic joint="j_wrist" multiplier="0.5" offset="0.1"/>
+  </joint>
+  <joint name="j_tool" type="fixed">
+    <parent link="wrist"/><child link="tool0"/>
+    <origin xyz="0 0 0.05" rpy="3.14159 0 0"/>
+  </joint>
+</robot>
+"""
+
+GRAVITY = np.array([0.0, 0.0, -9.81])
+
+
+def pin_model():
+    model = pin.buildModelFromXML(ARM)
+    model.gravity.linear = GRAVITY
+    return model
+
+
+def pin_configuration(pmodel, values: dict) -> np.ndarray:
+    """A pinocchio q from {joint name: value}: Pinocchio orders joints its own way, so map by name."""
+    q = pin.neutral(pmodel)
+    for name, v in values.items():
+        jid = pmodel.getJointId(name)
+        assert jid < pmodel.njoints, name
+        j = pmodel.joints[jid]
+        if j.nq == 2:  # a continuous joint: Pinocchio's coordinates are (cos q, sin q)
+            q[j.idx_q : j.idx_q + 2] = np.cos(v), np.sin(v)
+        else:
+            q[j.idx_q] = v
+    return q
+
+
+def pin_to_ours(pmodel, ours: ms.Model):
+    """Index map: our velocity index k has Pinocchio's index perm[k] (by joint name)."""
+    perm = []
+    for j in ours.joint_info():
+        if j["nu"] == 0:
+            continue
+        assert j["nu"] == 1
+        perm.append(pmodel.joints[pmodel.getJointId(j["name"])].idx_v)
+    return np.array(perm)
+
+
+def random_configurations(n, seed=3):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        yield {"j_shoulder": rng.uniform(-2.5, 2.5), "j_elbow": rng.uniform(-1.8, 1.9), "j_slide": rng.uniform(-0.05, 0.12),
+               "j_wrist": rng.uniform(-np.pi, np.pi), "j_finger": rng.uniform(-0.5, 0.5)}
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return load_urdf(ARM)
+
+
+def test_tree_is_as_written(arm):
+    m = arm.model
+    names = [b["name"] for b in m.body_info()]
+    assert set(names) == {"shoulder", "upper_arm", "slider", "camera", "wrist", "finger"}
+    assert arm.markers == {"tool0": "wrist"}
+    kinds = {j["name"]: j["type"] for j in m.joint_info()}
+    assert kinds == {"j_shoulder": "revolute", "j_elbow": "revolute", "j_slide": "prismatic", "j_camera": "fixed",
+                     "j_wrist": "revolute", "j_finger": "revolute"}
+    assert m.nu == 5
+    assert arm.limits["j_elbow"].lower == pytest.approx(-1.8) and arm.limits["j_elbow"].upper == pytest.approx(1.9)
+    assert arm.limits["j_slide"].effort == pytest.approx(100.0)
+    assert arm.mimics == {"j_finger": ("j_wrist", 0.5, 0.1)}
+    assert [c["type"] for c in m.build().constraints()] == ["coupler"]
+    assert set(arm.contours) == {"base", "shoulder", "upper_arm", "wrist"}
+    assert arm.contours["base"][0][0] == "ground"
+    assert arm.visuals["shoulder"][0].kind == "sphere"
+
+
+@pytest.mark.parametrize("values", list(random_configurations(6)))
+def test_mass_matrix_matches_pinocchio(arm, values):
+    pmodel = pin_model()
+    pdata = pmodel.createData()
+    qp = pin_configuration(pmodel, values)
+    Mp = pin.crba(pmodel, pdata, qp)
+    Mp = np.triu(Mp) + np.triu(Mp, 1).T
+    perm = pin_to_ours(pmodel, arm.model)
+    q = arm.model.state_vector(values, "q")
+    M = ms.dynamics.mass_matrix(arm.model, q)
+    np.testing.assert_allclose(M, Mp[np.ix_(perm, perm)], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("values", list(random_configurations(4, seed=11)))
+def test_gravity_torques_match_pinocchio(arm, values):
+    pmodel = pin_model()
+    pdata = pmodel.createData()
+    qp = pin_configuration(pmodel, values)
+    # Pinocchio's g(q) is the torque that holds the robot (M a + g = tau); our h = -g (M u' = h + tau)
+    g = pin.computeGeneralizedGravity(pmodel, pdata, qp)
+    perm = pin_to_ours(pmodel, arm.model)
+    q = arm.model.state_vector(values, "q")
+    h = ms.dynamics.nonlinear_effects(arm.model, q, np.zeros(arm.model.nu))
+    np.testing.assert_allclose(h, -g[perm], rtol=0, atol=1e-11)
+    assert np.max(np.abs(g)) > 1.0  # the comparison is not a trivial one of zeros
+
+
+def test_tool_marker_is_where_pinocchio_has_the_frame(arm):
+    pmodel = pin_model()
+    pdata = pmodel.createData()
+    values = {"j_shoulder": 0.4, "j_elbow": -0.7, "j_slide": 0.03, "j_wrist": 1.2, "j_finger": 0.0}
+    pin.framesForwardKinematics(pmodel, pdata, pin_configuration(pmodel, values))
+    ref = pdata.oMf[pmodel.getFrameId("tool0")]
+    pose = ms.kinematics.marker_pose(arm.model, arm.model.state_vector(values, "q"), "wrist", "tool0") \
+        if hasattr(ms.kinematics, "marker_pose") else None
+    if pose is None:
+        pytest.skip("no marker pose function in mechsys.kinematics")
+    np.testing.assert_allclose(pose["position"], ref.translation, atol=1e-12)
+
+
+def test_round_trip_through_toml(arm, tmp_path):
+    from mechsys.cli import cli
+    from click.testing import CliRunner
+
+    src = tmp_path / "arm.urdf"
+    src.write_text(ARM)
+    out = tmp_path / "arm.toml"
+    r = CliRunner().invoke(cli, ["import", str(src), "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    model, _ = load_model(out)
+    for values in random_configurations(3, seed=5):
+        q = arm.model.state_vector(values, "q")
+        np.testing.assert_allclose(ms.dynamics.mass_matrix(model, q), ms.dynamics.mass_matrix(arm.model, q), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(ms.dynamics.nonlinear_effects(model, q, np.zeros(5)),
+                                   ms.dynamics.nonlinear_effects(arm.model, q, np.zeros(5)), rtol=0, atol=1e-13)
+    r = CliRunner().invoke(cli, ["info", str(src)])
+    assert r.exit_code == 0, r.output
+    assert "j_elbow" in r.output and "coupler" in r.output
+
+
+def test_limit_stops_hold_the_joint(tmp_path):
+    text = f"""<robot name="one"><link name="base"/>
+      <link name="arm">{inertial(1.0, "0.5 0 0", "0 0 0", 0.001, 0.08, 0.08)}</link>
+      <joint name="swing" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+        <limit lower="-0.3" upper="0.3" effort="1" velocity="1"/></joint></robot>"""
+    imp = load_urdf(text, limits="stops")
+    assert [c["name"] for c in imp.model.build().contacts()] == ["swing_lower", "swing_upper"]
+    # released level, gravity -z pulls the arm down: about +y that is a positive angle
+    res = ms.simulate(imp.model, t_end=1.0, integrator=ms.MoreauJean(dt=1e-3))
+    q = res["q/swing"] if "q/swing" in res.signals else res.q[:, 0]
+    assert np.max(q) <= 0.3 + 1e-3 and np.max(q) > 0.29
+
+
+def test_free_base_root():
+    imp = load_urdf(ARM, root="free")
+    m = imp.model
+    assert m.nq == 7 + 5 and m.nu == 6 + 5
+    assert "base" in [b["name"] for b in m.body_info()]
+    # a free-floating robot at rest falls: its base accelerates with g whatever the arm does
+    q = m.q0()
+    a = ms.dynamics.forward_dynamics(m, q, np.zeros(m.nu))
+    assert np.all(np.isfinite(a))
+
+
+# ---- errors ------------------------------------------------------------------------------------
+
+def _one_joint(kind="revolute", child_inertial=None, extra="", child_geometry=""):
+    child_inertial = inertial(1.0, "0 0 0", "0 0 0", 0.01, 0.01, 0.01) if child_inertial is None else child_inertial
+    return f"""<robot name="bad"><link name="base"/>
+      <link name="arm">{child_inertial}{child_geometry}</link>
+      <joint name="j1" type="{kind}"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>{extra}</robot>"""
+
+
+def test_errors_name_the_item(tmp_path):
+    with pytest.raises(ms.ModelError, match="no such URDF file"):
+        load_urdf(str(tmp_path / "missing.urdf"))
+    with pytest.raises(ms.ModelError, match="joint 'j1': unknown joint type 'screw'"):
+        load_urdf(_one_joint("screw"))
+    with pytest.raises(ms.ModelError, match="link 'arm': a moving link needs a mass > 0, got mass 0"):
+        load_urdf(_one_joint(child_inertial=inertial(0.0, "0 0 0", "0 0 0", 0.01, 0.01, 0.01)))
+    with pytest.raises(ms.ModelError, match="link 'arm': a moving link needs a mass > 0, got mass -2"):
+        load_urdf(_one_joint(child_inertial=inertial(-2.0, "0 0 0", "0 0 0", 0.01, 0.01, 0.01)))
+    with pytest.raises(ms.ModelError, match="link 'arm': a moving link needs a mass > 0, got no <inertial>"):
+        load_urdf(_one_joint(child_inertial=""))
+    with pytest.raises(ms.ModelError, match="link 'arm': the inertia is not positive definite"):
+        load_urdf(_one_joint(child_inertial=inertial(1.0, "0 0 0", "0 0 0", 0.01, 0.01, -0.01)))
+    with pytest.raises(ms.ModelError, match=r"link 'arm'.collision\[0\]: mesh file 'meshes/arm.stl' not found"):
+        load_urdf(_one_joint(child_geometry='<collision><geometry><mesh filename="meshes/arm.stl"/></geometry></collision>'))
+    f = tmp_path / "bad.urdf"
+    f.write_text(_one_joint(child_geometry='<visual><geometry><mesh filename="package://arm_pkg/arm.stl"/></geometry></visual>'))
+    with pytest.raises(ms.ModelError, match=r"bad.urdf: link 'arm'.visual\[0\]: mesh file 'package://arm_pkg/arm.stl' not found"):
+        load_urdf(f, package_dirs=[tmp_path])
+    cyclic = _one_joint(extra='<link name="c"/><link name="d"/>'
+                              '<joint name="jc" type="fixed"><parent link="d"/><child link="c"/></joint>'
+                              '<joint name="jd" type="fixed"><parent link="c"/><child link="d"/></joint>')
+    with pytest.raises(ms.ModelError, match="link\\(s\\) 'c', 'd' are not reachable from the root 'base'"):
+        load_urdf(cyclic)
+    two_parents = _one_joint(extra='<joint name="j2" type="fixed"><parent link="base"/><child link="arm"/></joint>')
+    with pytest.raises(ms.ModelError, match="joint 'j2': link 'arm' already has the parent joint 'j1'"):
+        load_urdf(two_parents)
+    disconnected = _one_joint(extra='<link name="lonely"/>')
+    with pytest.raises(ms.ModelError, match="not one tree: 2 links have no parent joint \\('base', 'lonely'\\)"):
+        load_urdf(disconnected)
+    with pytest.raises(ms.ModelError, match="joint 'j1': child link 'nowhere' is not defined"):
+        load_urdf(_one_joint().replace('<child link="arm"/>', '<child link="nowhere"/>'))
+    with pytest.raises(ms.ModelError, match="cannot read the URDF"):
+        load_urdf("<robot name='x'><link name='a'>")
+    with pytest.raises(ms.ModelError, match="root must be 'ground' or 'free'"):
+        load_urdf(_one_joint(), root="wall")
+
+
+def test_mesh_collision_is_read_and_placed(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    trimesh.creation.box(extents=(0.1, 0.2, 0.3)).export(tmp_path / "block.stl")
+    (tmp_path / "robot.urdf").write_text(_one_joint(
+        child_geometry='<collision><origin xyz="0 0 1" rpy="0 0 1.5707963267948966"/>'
+                       '<geometry><mesh filename="block.stl" scale="2 2 2"/></geometry></collision>'))
+    imp = load_urdf(tmp_path / "robot.urdf")
+    body, mesh = imp.contours["arm"][0]
+    assert body == "arm" and isinstance(mesh, ms.contours.Mesh)
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    # scaled by 2 and turned a quarter about z: x and y extents swap
+    np.testing.assert_allclose(hi - lo, [0.4, 0.2, 0.6], atol=1e-12)
+    np.testing.assert_allclose(0.5 * (hi + lo), [0, 0, 1], atol=1e-12)
