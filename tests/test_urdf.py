@@ -169,17 +169,23 @@ def test_gravity_torques_match_pinocchio(arm, values):
     assert np.max(np.abs(g)) > 1.0  # the comparison is not a trivial one of zeros
 
 
-def test_tool_marker_is_where_pinocchio_has_the_frame(arm):
+def test_link_placements_match_pinocchio(arm):
+    """Every body frame and the tool marker where Pinocchio puts the same link frames."""
     pmodel = pin_model()
     pdata = pmodel.createData()
     values = {"j_shoulder": 0.4, "j_elbow": -0.7, "j_slide": 0.03, "j_wrist": 1.2, "j_finger": 0.0}
     pin.framesForwardKinematics(pmodel, pdata, pin_configuration(pmodel, values))
+    q = arm.model.state_vector(values, "q")
+    states = ms.kinematics.body_states(arm.model, q)
+    for k, name in enumerate(states["body_names"]):
+        if name == "ground":
+            continue
+        ref = pdata.oMf[pmodel.getFrameId(name)]
+        np.testing.assert_allclose(states["position"][k], ref.translation, atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(states["rotation"][k], ref.rotation, atol=1e-12, err_msg=name)
+    marker = next(m for b in arm.model.to_dict()["bodies"] if b["name"] == "wrist" for m in b["markers"])
     ref = pdata.oMf[pmodel.getFrameId("tool0")]
-    pose = ms.kinematics.marker_pose(arm.model, arm.model.state_vector(values, "q"), "wrist", "tool0") \
-        if hasattr(ms.kinematics, "marker_pose") else None
-    if pose is None:
-        pytest.skip("no marker pose function in mechsys.kinematics")
-    np.testing.assert_allclose(pose["position"], ref.translation, atol=1e-12)
+    np.testing.assert_allclose(ms.kinematics.point_position(arm.model, q, "wrist", marker["position"]), ref.translation, atol=1e-12)
 
 
 def test_round_trip_through_toml(arm, tmp_path):
@@ -211,7 +217,7 @@ def test_limit_stops_hold_the_joint(tmp_path):
     assert [c["name"] for c in imp.model.build().contacts()] == ["swing_lower", "swing_upper"]
     # released level, gravity -z pulls the arm down: about +y that is a positive angle
     res = ms.simulate(imp.model, t_end=1.0, integrator=ms.MoreauJean(dt=1e-3))
-    q = res["q/swing"] if "q/swing" in res.signals else res.q[:, 0]
+    q = res["joint/swing/q"]
     assert np.max(q) <= 0.3 + 1e-3 and np.max(q) > 0.29
 
 

@@ -99,6 +99,16 @@ def _yourdfpy():
 
 def _parse(source, label: str, yourdfpy) -> Any:
     """The yourdfpy robot description, parsed without loading meshes (we resolve and check them)."""
+    import xml.etree.ElementTree as ET
+
+    # yourdfpy quietly recovers from broken XML; a truncated file must be an error instead
+    try:
+        text = source.getvalue() if isinstance(source, io.BytesIO) else Path(source).read_bytes()
+        top = ET.fromstring(text)
+    except ET.ParseError as e:
+        raise ModelError(f"{label}: cannot read the URDF (not well-formed XML: {e})") from None
+    if top.tag != "robot":
+        raise ModelError(f"{label}: cannot read the URDF (the top element is <{top.tag}>, expected <robot>)")
     try:
         urdf = yourdfpy.URDF.load(source, build_scene_graph=False, load_meshes=False, load_collision_meshes=False)
     except Exception as e:  # noqa: BLE001 - a malformed file raises anything from lxml or yourdfpy
