@@ -221,7 +221,8 @@ class _Loader:
         if not np.all(np.isfinite(I_f)) or not np.isfinite(mass):
             raise ModelError(f"{w}: the mass and inertia must be finite numbers")
         # the tensor is given in the inertial frame's axes; the body wants link axes
-        return mass, R @ I_f @ R.T, p
+        I_b = R @ I_f @ R.T
+        return mass, 0.5 * (I_b + I_b.T), p  # symmetric to the last bit, as the engine checks it
 
     def check_inertia(self, name: str, data) -> None:
         w = f"{self.label}: link '{name}'"
