@@ -302,3 +302,39 @@ def test_mesh_collision_is_read_and_placed(tmp_path):
     # scaled by 2 and turned a quarter about z: x and y extents swap
     np.testing.assert_allclose(hi - lo, [0.4, 0.2, 0.6], atol=1e-12)
     np.testing.assert_allclose(0.5 * (hi + lo), [0, 0, 1], atol=1e-12)
+
+
+def test_planar_and_floating_joints():
+    """A planar joint moves its link in the plane normal to the URDF axis; a floating joint is a
+    Free joint whose mass matrix equals Pinocchio's free flyer at an unturned placement."""
+    text = f"""<robot name="pf"><link name="base"/>
+      <link name="puck">{inertial(2.0, "0.1 0 0", "0.3 0.2 0.1", 0.01, 0.02, 0.015)}</link>
+      <link name="drone">{inertial(1.5, "0 0.05 0", "0 0.4 0", 0.03, 0.02, 0.04, 0.001)}</link>
+      <joint name="slide_plane" type="planar"><parent link="base"/><child link="puck"/>
+        <origin xyz="0 0 0.2" rpy="0.3 0 0"/><axis xyz="0 1 1"/></joint>
+      <joint name="fly" type="floating"><parent link="base"/><child link="drone"/>
+        <origin xyz="1 0 0" rpy="0 0 0"/></joint></robot>"""
+    imp = load_urdf(text)
+    m = imp.model
+    q = m.state_vector({"slide_plane": [0.3, -0.2, 0.7]}, "q")
+    # every motion of the puck's centre of mass is across the plane normal (the axis in the world)
+    normal = ms.kinematics.rot_x(0.3) @ (np.array([0.0, 1.0, 1.0]) / np.sqrt(2.0))
+    jv, _ = ms.kinematics.point_jacobian(m, q, "puck", (0.1, 0.0, 0.0))
+    np.testing.assert_allclose(normal @ jv[:, :3], 0.0, atol=1e-14)
+    assert np.linalg.matrix_rank(jv[:, :3]) == 2
+    # and the link keeps its orientation in the plane: the origin sits where the joint put it
+    p0 = ms.kinematics.point_position(m, m.q0(), "puck")
+    np.testing.assert_allclose(p0, [0.0, 0.0, 0.2], atol=1e-15)
+
+    pmodel = pin.buildModelFromXML(text.replace("""<joint name="slide_plane" type="planar"><parent link="base"/><child link="puck"/>
+        <origin xyz="0 0 0.2" rpy="0.3 0 0"/><axis xyz="0 1 1"/></joint>""", "").replace(
+        f"""<link name="puck">{inertial(2.0, "0.1 0 0", "0.3 0.2 0.1", 0.01, 0.02, 0.015)}</link>""", ""))
+    pdata = pmodel.createData()
+    fly = next(j for j in m.joint_info() if j["name"] == "fly")
+    qp = pin.neutral(pmodel)
+    qp[:3] = (0.2, 0.1, -0.3)
+    q = m.state_vector({"fly": [0.2, 0.1, -0.3, 1.0, 0.0, 0.0, 0.0]}, "q")
+    Mp = pin.crba(pmodel, pdata, qp)
+    Mp = np.triu(Mp) + np.triu(Mp, 1).T
+    sl = slice(fly["iu"], fly["iu"] + 6)
+    np.testing.assert_allclose(ms.dynamics.mass_matrix(m, q)[sl, sl], Mp, rtol=0, atol=1e-12)
