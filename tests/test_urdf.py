@@ -338,3 +338,32 @@ def test_planar_and_floating_joints():
     Mp = np.triu(Mp) + np.triu(Mp, 1).T
     sl = slice(fly["iu"], fly["iu"] + 6)
     np.testing.assert_allclose(ms.dynamics.mass_matrix(m, q)[sl, sl], Mp, rtol=0, atol=1e-12)
+
+
+def test_more_errors(monkeypatch):
+    bad_mimic = _one_joint().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="ghost"/>')
+    with pytest.raises(ms.ModelError, match="joint 'j1'.mimic: mimicked joint 'ghost' is not defined"):
+        load_urdf(bad_mimic)
+    with pytest.raises(ms.ModelError, match="limits must be 'data' or 'stops'"):
+        load_urdf(_one_joint(), limits="soft")
+    with pytest.raises(ms.ModelError, match="joint 'j-1': a limit stop's gap expression needs a joint name"):
+        load_urdf(_one_joint().replace('name="j1"', 'name="j-1"'), limits="stops")
+    with pytest.raises(ms.ModelError, match="joint 'j1': the axis must be a non-zero vector"):
+        load_urdf(_one_joint().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'))
+    with pytest.raises(ms.ModelError, match="the top element is <model>, expected <robot>"):
+        load_urdf("<model name='x'/>")
+    monkeypatch.setitem(__import__("sys").modules, "yourdfpy", None)
+    with pytest.raises(ms.ModelError, match="needs the 'yourdfpy' package"):
+        load_urdf(_one_joint())
+
+
+def test_toml_writer_round_trips_awkward_values():
+    import tomllib
+
+    from mechsys.tomlwrite import dumps
+
+    desc = {"name": 'arm "7" — ünïcode\\path', "gravity": [0.0, -9.81, 1e-300], "flag": True,
+            "bodies": [{"name": "a b", "inertia": [[1.0, 0.1], [0.1, 2.0]], "frame": {"position": [0.1, 0.2, 0.3]},
+                        "limit": float("inf")}]}
+    back = tomllib.loads(dumps(desc, "a header\nover two lines"))
+    assert back == desc
