@@ -367,3 +367,21 @@ def test_toml_writer_round_trips_awkward_values():
                         "limit": float("inf")}]}
     back = tomllib.loads(dumps(desc, "a header\nover two lines"))
     assert back == desc
+
+
+def test_primitive_contours_are_placed_in_the_body():
+    text = _one_joint(child_geometry='<collision><origin xyz="0.1 0.2 0.3" rpy="0.3 -0.4 1.1"/>'
+                                     '<geometry><box size="0.2 0.4 0.6"/></geometry></collision>'
+                                     '<collision><origin xyz="0 0 0.5" rpy="1.5707963267948966 0 0"/>'
+                                     '<geometry><cylinder radius="0.05" length="0.3"/></geometry></collision>')
+    (_, box), (_, cyl) = load_urdf(text).contours["arm"]
+    d = box.describe("box")
+    # URDF rpy: R = Rz(yaw) Ry(pitch) Rx(roll), fixed axes
+    k = ms.kinematics
+    R = k.rot_z(1.1) @ k.rot_y(-0.4) @ k.rot_x(0.3)
+    np.testing.assert_allclose(k.cardan_xyz_to_matrix(d["rotation"]["cardan"]), R, atol=1e-14)
+    np.testing.assert_allclose(d["half_extents"], [0.1, 0.2, 0.3])
+    np.testing.assert_allclose(d["center"], [0.1, 0.2, 0.3])
+    # a cylinder along the link's z turned a quarter about x lies along -y
+    np.testing.assert_allclose(cyl.axis, [0.0, -1.0, 0.0], atol=1e-15)
+    assert cyl.length == pytest.approx(0.3) and cyl.center == pytest.approx((0.0, 0.0, 0.5))

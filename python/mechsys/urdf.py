@@ -34,6 +34,7 @@ from . import contours as _contours
 from . import joints as _joints
 from .contacts import GapContact
 from .errors import ModelError
+from .kinematics import matrix_to_cardan_xyz
 from .model import Model
 
 _KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -134,18 +135,6 @@ def _planar_alignment(axis: np.ndarray) -> np.ndarray:
     x = np.cross(helper, z)
     x /= np.linalg.norm(x)
     return np.column_stack([x, np.cross(z, x), z])
-
-
-def _cardan(R: np.ndarray) -> list[float]:
-    """x-y-z Cardan angles of R = Rx(a) Ry(b) Rz(c), the convention of the contours' ``cardan``."""
-    b = float(np.arcsin(np.clip(R[0, 2], -1.0, 1.0)))
-    if abs(R[0, 2]) < 1.0 - 1e-12:
-        a = float(np.arctan2(-R[1, 2], R[2, 2]))
-        c = float(np.arctan2(-R[0, 1], R[0, 0]))
-    else:  # gimbal lock: put all of the turn about x into a
-        a = float(np.arctan2(R[2, 1], R[1, 1]))
-        c = 0.0
-    return [a, b, c]
 
 
 class _Loader:
@@ -266,7 +255,7 @@ class _Loader:
             raise ModelError(f"{what}: no <geometry>")
         if g.box is not None:
             half = 0.5 * np.asarray(g.box.size, dtype=float)
-            c = _contours.Box(half_extents=tuple(half), center=tuple(p), cardan=_cardan(R)) if as_contour else None
+            c = _contours.Box(half_extents=tuple(half), center=tuple(p), cardan=tuple(matrix_to_cardan_xyz(R))) if as_contour else None
             return "box", half, None, c, (R, p)
         if g.sphere is not None:
             r = float(g.sphere.radius)
