@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms
+from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, urdf
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -23,6 +23,7 @@ from .joints import Frame
 from .model import Body, Model
 from .results import Results, load
 from .simulate import simulate
+from .urdf import load_urdf
 
 
 def plot(results, signals, out=None, **kwargs):
@@ -38,6 +39,7 @@ __all__ = [
     "Body",
     "Frame",
     "simulate",
+    "load_urdf",
     "Results",
     "load",
     "plot",
@@ -57,6 +59,7 @@ __all__ = [
     "contours",
     "laws",
     "mechanisms",
+    "urdf",
     "analysis",
     "bearings",
     "forces",

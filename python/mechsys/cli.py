@@ -5,6 +5,7 @@ linear vibrations.
 
     mechsys run model.toml --t-end 2 --out results.h5 --plot q.png
     mechsys info model.toml
+    mechsys import robot.urdf -o robot.toml
     mechsys signals results.h5
     mechsys plot results.h5 joint/hinge/q energy/total --out q.svg
     mechsys linear model.toml --at equilibrium --frf 0:1 --campbell spin:0:500:51 --whirl x,y
@@ -323,7 +324,13 @@ def info(model_file: Path) -> None:
     A .py model file is executed as Python code: run only files you trust."""
     from .modelfile import load_model
 
-    model, sim = load_model(model_file)
+    if model_file.suffix.lower() == ".urdf":
+        # a robot description is read as it would be imported (fixed base, limits as data)
+        from .urdf import load_urdf
+
+        model, sim = load_urdf(model_file).model, {}
+    else:
+        model, sim = load_model(model_file)
     core = model.build()
     bodies = model.body_info()
     joints = model.joint_info()
@@ -390,6 +397,33 @@ def info(model_file: Path) -> None:
             if isinstance(v, dict) and "type" in v:
                 v = _describe_integrator({"integrator": v})
             click.echo(f"  {k} = {v}")
+
+
+@cli.command("import")
+@click.argument("urdf_file", metavar="ROBOT.urdf", type=click.Path(path_type=Path, dir_okay=False))
+@click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False), help="TOML model file [default: ROBOT.toml].")
+@click.option("--root", type=click.Choice(["ground", "free"]), default="ground", show_default=True,
+              help="Fixed base (the root link is the ground) or a free-floating base.")
+@click.option("--limits", type=click.Choice(["data", "stops"]), default="data", show_default=True,
+              help="Joint limits as data only, or also as gap-contact stops.")
+@click.option("--package-dir", "package_dirs", multiple=True, type=click.Path(path_type=Path, file_okay=False),
+              help="Folder searched for package:// meshes (repeatable).")
+def import_cmd(urdf_file: Path, out: Path | None, root: str, limits: str, package_dirs: tuple[Path, ...]) -> None:
+    """Import a URDF robot description as a TOML model file that run and info accept.
+
+    Links become bodies, joints joints, mimic joints couplers. Collision geometry is not written
+    (attach it from Python with mechsys.load_urdf(...).contours)."""
+    from .tomlwrite import dumps
+    from .urdf import load_urdf
+
+    imp = load_urdf(urdf_file, root=root, limits=limits, package_dirs=list(package_dirs), contours=None)
+    out = out if out is not None else urdf_file.with_suffix(".toml")
+    header = f"Imported from {urdf_file.name} by mechsys import (root = {root}, limits = {limits})."
+    if imp.limits:
+        header += "\nJoint limits [lower, upper]: " + ", ".join(
+            f"{n} [{lim.lower}, {lim.upper}]" for n, lim in imp.limits.items())
+    out.write_text(dumps(imp.model.to_dict(), header), encoding="utf-8")
+    click.echo(f"wrote {out} ({len(imp.model.body_info())} bodies, {len(imp.model.joint_info())} joints, nu = {imp.model.nu})")
 
 
 @cli.command()
