@@ -1,4 +1,5 @@
-//! Model fixtures shared by tests and benchmarks: spatial chains of uniform rods.
+//! Model fixtures shared by tests and benchmarks: spatial chains of uniform rods, and a roller
+//! on a spinning elliptical cam.
 
 use crate::model::description::*;
 use crate::model::Model;
@@ -60,4 +61,27 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
 /// The validated chain model.
 pub fn chain(n: usize, joint_type: &str) -> Model {
     Model::from_description(chain_description(n, joint_type)).expect("fixture chain is valid")
+}
+
+/// A roller (radius 0.01 m, 0.1 kg) on a prismatic guide pressed by gravity on an elliptical cam
+/// (semi-axes 0.05, 0.035 m) spinning freely at `speed` rad/s, the roller's centre at `y0`: a
+/// planar curve contact whose search warm-starts between steps.
+pub fn ellipse_cam(speed: f64, y0: f64) -> Model {
+    let json = format!(
+        r#"{{
+        "name": "ellipse-cam", "gravity": [0, -9.81, 0], "planar": true,
+        "bodies": [
+            {{"name": "cam", "mass": 1.0, "inertia": [0.001, 0.001, 0.001]}},
+            {{"name": "roller", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]}}
+        ],
+        "joints": [
+            {{"name": "shaft", "type": "revolute", "parent": "ground", "child": "cam", "axis": [0, 0, 1], "u0": [{speed}]}},
+            {{"name": "guide", "type": "prismatic", "parent": "ground", "child": "roller", "axis": [0, 1, 0], "q0": [{y0}]}}
+        ],
+        "contacts": [{{"name": "cam", "body1": "roller", "contour1": {{"type": "circle", "radius": 0.01}},
+                      "body2": "cam", "contour2": {{"type": "ellipse", "semi_axes": [0.05, 0.035]}},
+                      "friction": {{"type": "coulomb", "mu": 0.1}}, "impact": {{"type": "newton", "eps": 0.0}}}}]
+    }}"#
+    );
+    Model::from_description(ModelDescription::from_json(&json).expect("valid JSON")).expect("valid model")
 }

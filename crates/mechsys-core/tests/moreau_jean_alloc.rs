@@ -87,21 +87,7 @@ fn projected_steps_do_not_allocate() {
 /// starts and cold searches alike.
 #[test]
 fn curve_contact_steps_do_not_allocate_after_warm_up() {
-    let json = r#"{
-        "name": "ellipse-cam", "gravity": [0, -9.81, 0], "planar": true,
-        "bodies": [
-            {"name": "cam", "mass": 1.0, "inertia": [0.001, 0.001, 0.001]},
-            {"name": "roller", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]}
-        ],
-        "joints": [
-            {"name": "shaft", "type": "revolute", "parent": "ground", "child": "cam", "axis": [0, 0, 1], "u0": [20.0]},
-            {"name": "guide", "type": "prismatic", "parent": "ground", "child": "roller", "axis": [0, 1, 0], "q0": [0.061]}
-        ],
-        "contacts": [{"name": "cam", "body1": "roller", "contour1": {"type": "circle", "radius": 0.01},
-                      "body2": "cam", "contour2": {"type": "ellipse", "semi_axes": [0.05, 0.035]},
-                      "friction": {"type": "coulomb", "mu": 0.1}, "impact": {"type": "newton", "eps": 0.0}}]
-    }"#;
-    let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
+    let model = mechsys_core::fixtures::ellipse_cam(20.0, 0.061);
     let h = 1e-4;
     let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();

@@ -722,7 +722,7 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 let nu = model.nu;
                 let mut k = crate::contact::ContactKinematics::default();
                 let zero = std::mem::take(&mut data.zero_u);
-                let res = function.evaluate(t, q, &zero, cb, &mut data.gap, *slot, &mut k);
+                let res = function.evaluate(t, q, &zero, cb, &mut data.gap, *slot, true, &mut k);
                 data.zero_u = zero;
                 res.map_err(in_constraint(c, ""))?;
                 for j in 0..c.kind.rows() {
@@ -839,7 +839,7 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64
             }
             ConstraintKind::Gap { function, slot, .. } => {
                 let mut k = crate::contact::ContactKinematics::default();
-                function.evaluate(t, q, u, cb, &mut data.gap, *slot, &mut k).map_err(in_constraint(c, ""))?;
+                function.evaluate(t, q, u, cb, &mut data.gap, *slot, false, &mut k).map_err(in_constraint(c, ""))?;
                 data.gamma[r] = -k.wbar_n;
                 for j in 1..c.kind.rows() {
                     data.gamma[r + j] = -k.wbar_t[j - 1];

@@ -94,8 +94,10 @@ impl GapFunction {
         self.terms.iter().any(|t| matches!(t, GapTerm::Callback(_)))
     }
 
-    /// The contact's kinematics at (q, u, t) into `out`, its rows into `rows` (3 × nu, zero
-    /// rows for missing tangents). No allocation once `work` has its capacity.
+    /// The contact's kinematics at (q, u, t) into `out`, and with `with_rows` its rows into
+    /// `work.rows` (3 × nu, zero rows for missing tangents) and `w̃`; without, only `g`, `ġ`
+    /// and `w̄` (the acceleration stage of a held gap, whose rows the position stage left at the
+    /// same q). No allocation once `work` has its capacity.
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
@@ -105,12 +107,15 @@ impl GapFunction {
         cb: &dyn Callbacks,
         work: &mut GapWork,
         slot: usize,
+        with_rows: bool,
         out: &mut ContactKinematics,
     ) -> Result<()> {
         let nu = u.len();
         let GapWork { rows, vars2, vars1, stack2, stack1, grad } = work;
         let rows = &mut rows[3 * slot * nu..3 * (slot + 1) * nu];
-        rows.fill(0.0);
+        if with_rows {
+            rows.fill(0.0);
+        }
         let mut value = [[0.0; 3]; 3]; // per term: g, ġ, w̄
         let mut w_tilde = [0.0; 3];
         for (k, term) in self.terms.iter().enumerate() {
@@ -122,6 +127,9 @@ impl GapFunction {
                     vars2.extend(self.coordinates.iter().map(|&(iq, iu)| Dual2_64::new(q[iq], u[iu], 0.0)));
                     let r = e.eval(vars2, Dual2_64::new(t, 1.0, 0.0), stack2);
                     value[k] = [r.re, r.v1, r.v2];
+                    if !with_rows {
+                        continue;
+                    }
                     // the rows, one coordinate at a time
                     vars1.clear();
                     vars1.extend(self.coordinates.iter().map(|&(iq, _)| Dual64::from(q[iq])));
@@ -138,6 +146,9 @@ impl GapFunction {
                 GapTerm::Callback(id) => {
                     // q̇ = u everywhere in a model whose gap callbacks validated: rows are ∂g/∂q
                     value[k] = cb.gap_function(*id, t, q, u, grad)?;
+                    if !with_rows {
+                        continue;
+                    }
                     let mut wu = 0.0;
                     for (i, r) in row.iter_mut().enumerate() {
                         *r = grad[i];

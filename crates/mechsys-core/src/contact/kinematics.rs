@@ -216,7 +216,7 @@ pub fn contact_point_kinematics(
             let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
             contact_kinematics_warm(con.pair().expect("a contour contact"), &b1, &b2, out, search)
         }
-        Some((f, slot)) => f.evaluate(t, q, u, cb, &mut data.gap, slot, &mut out[0]).map_err(|e| match e {
+        Some((f, slot)) => f.evaluate(t, q, u, cb, &mut data.gap, slot, true, &mut out[0]).map_err(|e| match e {
             Error::Callback(m) => Error::Callback(format!("gap contact '{}': {m}", con.name)),
             other => other,
         }),

@@ -83,7 +83,9 @@ impl Phase<'_> {
             let acc: f64 = (0..nu).map(|i| self.rows[(a * d, i)] * self.a_free[i]).sum::<f64>() + self.kin[pt].wbar_n;
             let con = model.contact_of_point(pt);
             let kp = &self.kin[pt].point;
-            // (a gap function's gap is a function of the coordinates: its round-off is about ε)
+            // (the contact points' coordinates set the round-off of a contour pair's gap; a gap
+            // function's points are its fixed frame's origin, its gap a function of the
+            // coordinates: a round-off of about ε)
             let scale = if con.gap().is_some() {
                 1.0
             } else {

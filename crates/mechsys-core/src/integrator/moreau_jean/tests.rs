@@ -157,21 +157,7 @@ fn block_delassus_is_w_minv_wt() {
 /// warm-starts between steps (most steps), and the trajectory is the one of cold searches.
 #[test]
 fn curve_contacts_warm_start_between_steps_and_match_cold_searches() {
-    let json = r#"{
-        "name": "ellipse-cam", "gravity": [0, -9.81, 0], "planar": true,
-        "bodies": [
-            {"name": "cam", "mass": 1.0, "inertia": [0.001, 0.001, 0.001]},
-            {"name": "roller", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]}
-        ],
-        "joints": [
-            {"name": "shaft", "type": "revolute", "parent": "ground", "child": "cam", "axis": [0, 0, 1], "u0": [5.0]},
-            {"name": "guide", "type": "prismatic", "parent": "ground", "child": "roller", "axis": [0, 1, 0], "q0": [0.0605]}
-        ],
-        "contacts": [{"name": "cam", "body1": "roller", "contour1": {"type": "circle", "radius": 0.01},
-                      "body2": "cam", "contour2": {"type": "ellipse", "semi_axes": [0.05, 0.035]},
-                      "friction": {"type": "coulomb", "mu": 0.1}, "impact": {"type": "newton", "eps": 0.0}}]
-    }"#;
-    let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
+    let model = crate::fixtures::ellipse_cam(5.0, 0.0605);
     let h = 1e-4;
     let run = |warm: bool| {
         let mut st = MoreauJean::new(&model, h, nsgs_tight()).unwrap();
