@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.deps-stamp
 BUILD  := $(VENV)/.build-stamp
 CORE_SOURCES := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml Cargo.lock pyproject.toml
 
-.PHONY: all demo test test-rust test-python bench bench-rust build clean
+.PHONY: all demo test test-rust test-python bench bench-rust build clean viewer
 
 all: build
 
@@ -21,7 +21,18 @@ $(BUILD): $(STAMP) $(CORE_SOURCES)
 	VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH $(VENV)/bin/maturin develop --release --quiet
 	touch $(BUILD)
 
-build: $(BUILD)
+# The browser viewer's JavaScript (three.js, uPlot and viewer/src), bundled from the pinned npm
+# packages into the Python package's data; skipped with a note where npm is missing.
+VIEWER_JS := python/mechsys/viewer/_bundle/viewer.js
+$(VIEWER_JS): viewer/package.json viewer/package-lock.json $(wildcard viewer/src/*.js)
+	@if command -v npm >/dev/null 2>&1; then \
+		cd viewer && npm ci --no-audit --no-fund --loglevel=error && npm run --silent build && \
+		cp node_modules/uplot/dist/uPlot.min.css ../python/mechsys/viewer/_bundle/; \
+	else echo "note: npm not found, the browser viewer (mechsys view) is not built"; fi
+
+viewer: $(VIEWER_JS)
+
+build: $(BUILD) viewer
 
 demo: $(BUILD)
 	$(PY) examples/woodpecker.py

@@ -68,6 +68,7 @@ class Model:
         self._constraints: list[Any] = []
         self._contacts: list[Any] = []
         self._contact_groups: list[Any] = []
+        self._visuals: list[dict] = []
         self._ground_markers: list[dict] = []
         self._built: tuple[str, Any, list] | None = None
         self._engine: tuple | None = None
@@ -208,6 +209,54 @@ class Model:
         self._invalidate()
         return group
 
+    def add_visual(self, body: "str | Body", shape, *, name: str = "", color: Sequence[float] | None = None,
+                   opacity: float | None = None, scale: float = 1.0, position: Sequence[float] = (0.0, 0.0, 0.0),
+                   cardan: Sequence[float] | None = None) -> dict:
+        """Adds a shape the viewer draws on ``body`` (no contact): a contour of
+        :mod:`mechsys.contours` (placed by its own centre and angles), or a mesh — a file (STL,
+        OBJ, PLY, glTF, ... read through trimesh), a ``trimesh.Trimesh`` or ``(vertices,
+        triangles)`` — scaled by ``scale`` and placed at ``position`` turned by ``cardan``
+        angles (x-y-z) in the body frame. ``color`` is RGB in [0, 1], ``opacity`` in (0, 1]."""
+        from pathlib import Path
+
+        from .contours import Contour, Mesh, _mesh_arrays, _read_mesh_file
+
+        body_name = body.name if isinstance(body, Body) else body
+        what = f"visual '{name}'" if name else f"visual on body '{body_name}'"
+        if not isinstance(body_name, str):
+            raise ModelError(f"{what}.body: expected a body or its name, got {type(body).__name__}")
+        if isinstance(shape, Contour) and not isinstance(shape, Mesh):
+            desc = shape.describe(f"{what}.shape")
+        else:
+            if isinstance(shape, Mesh):
+                v, t = shape.vertices, shape.triangles
+            elif isinstance(shape, (str, Path)):
+                v, t = _read_mesh_file(shape, f"{what}.shape")
+            elif hasattr(shape, "vertices") and hasattr(shape, "faces"):
+                v, t = np.asarray(shape.vertices, dtype=float), np.asarray(shape.faces)
+            elif isinstance(shape, (tuple, list)) and len(shape) == 2:
+                v, t = shape
+            else:
+                raise ModelError(f"{what}.shape: expected a mechsys.contours contour, a mesh file, a trimesh mesh "
+                                 f"or (vertices, triangles), got {type(shape).__name__}")
+            v, t = _mesh_arrays(v, t, scale, False, f"{what}.shape")
+            from .kinematics import cardan_xyz_to_matrix
+
+            rot = np.eye(3) if cardan is None else np.asarray(cardan_xyz_to_matrix(_vec3(cardan, f"{what}.cardan")))
+            v = v @ rot.T + np.asarray(_vec3(position, f"{what}.position"))
+            desc = {"type": "mesh", "vertices": v.tolist(), "triangles": t.tolist()}
+        visual: dict[str, Any] = {"name": str(name), "body": body_name, "shape": desc}
+        if color is not None:
+            visual["color"] = _vec3(color, f"{what}.color")
+        if opacity is not None:
+            try:
+                visual["opacity"] = float(opacity)
+            except (TypeError, ValueError):
+                raise ModelError(f"{what}.opacity: expected a number in (0, 1], got {opacity!r}") from None
+        self._visuals.append(visual)
+        self._invalidate()
+        return visual
+
     # ---- description and engine model -----------------------------------------------------------
     def describe(self) -> tuple[dict, list]:
         """The plain-data description (as in a model file) and the Python callbacks it refers to."""
@@ -249,6 +298,8 @@ class Model:
         groups = [g if isinstance(g, dict) else g.describe(callbacks) for g in self._contact_groups]
         if groups:
             desc["contact_groups"] = groups
+        if self._visuals:
+            desc["visuals"] = copy.deepcopy(self._visuals)
         return desc, callbacks
 
     def to_dict(self) -> dict:
@@ -308,7 +359,9 @@ class Model:
         elif gaps:
             raise ModelError(f"model.gap_contacts: expected a list of tables, got {type(gaps).__name__}")
         m._contact_groups = seq("contact_groups")
-        known = {"name", "gravity", "planar", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts", "contact_groups"}
+        m._visuals = seq("visuals")
+        known = {"name", "gravity", "planar", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts",
+                 "contact_groups", "visuals"}
         extra = set(desc) - known
         if extra:
             # let the engine produce the canonical message for a misspelt top-level key

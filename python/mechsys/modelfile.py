@@ -249,6 +249,10 @@ def _resolve_meshes(data: dict, folder: Path) -> None:
         if isinstance(c, dict):
             for k in ("contour1", "contour2"):
                 fix(c.get(k), f"{label(c, 'contacts', i)}.{k}")
+    visuals = data.get("visuals", [])
+    for i, v in enumerate(visuals if isinstance(visuals, list) else []):
+        if isinstance(v, dict):
+            fix(v.get("shape"), f"{label(v, 'visuals', i)}.shape")
     groups = data.get("contact_groups", [])
     for i, g in enumerate(groups if isinstance(groups, list) else []):
         if isinstance(g, dict):

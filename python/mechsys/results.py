@@ -264,6 +264,9 @@ class Results:
                     # second contour towards the first), inertial components
                     put(f"{pre}/point", raw["contact_point"][:, sl, :], "m", xyz if n == 1 else None)
                     put(f"{pre}/normal", raw["contact_normal"][:, sl, :], "1", xyz if n == 1 else None)
+                if "contact_friction" in raw:
+                    # the friction force on the first contour's body, inertial components
+                    put(f"{pre}/friction_force", raw["contact_friction"][:, sl, :], "N", xyz if n == 1 else None)
                 put(f"{pre}/gd_n", raw["contact_gd_n"][:, sl], "m/s")
                 put(f"{pre}/gd_t", raw["contact_gd_t"][:, sl, :nt] if nt > 1 else raw["contact_gd_t"][:, sl, 0], "m/s")
                 if "contact_omega" in raw:
@@ -725,7 +728,7 @@ def _per_second(unit: str) -> str:
 # ---- selective recording (simulate(sensors=...)) ---------------------------------------------------
 _ACCELERATION_SUFFIXES = ("udot", "/acceleration", "/angular_acceleration", "/com_acceleration", "/reaction_force",
                           "/reaction_torque", "/tangential_acceleration", "/normal_acceleration")
-_CONTACT_SUFFIXES = ("g_n", "point", "normal", "gd_n", "gd_t", "spin", "rolling", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
+_CONTACT_SUFFIXES = ("g_n", "point", "normal", "friction_force", "gd_n", "gd_t", "spin", "rolling", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
                      "friction_reserve")
 _GROUP_SUFFIXES = ("closed", "max_penetration", "impulse_n", "lambda_n", "pairs", "impulse_against", "force_against")
 

@@ -53,6 +53,7 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
         contacts: vec![],
         contact_groups: vec![],
         gap_contacts: vec![],
+        visuals: vec![],
         planar: false,
         constraints: vec![],
     }

@@ -238,6 +238,8 @@ pub struct Recording {
     pub contact_point: Vec<f64>,
     /// Contact normals from contour 2 towards contour 1, I components (n_out × points × 3).
     pub contact_normal: Vec<f64>,
+    /// Friction forces on contour 1's body, λ_T1 t1 + λ_T2 t2, I components (n_out × points × 3), N.
+    pub contact_friction: Vec<f64>,
     /// Relative normal velocities ġ_N (n_out × n_points), m/s.
     pub contact_gd_n: Vec<f64>,
     /// Relative tangential velocities ġ_T (n_out × n_points × 2), m/s.
@@ -969,7 +971,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         + 23.0 * bodies
         + 3.0 * model.nc as f64
         + 2.0 * model.n_force_outputs as f64
-        + 14.0 * model.n_contact_points as f64
+        + 17.0 * model.n_contact_points as f64
         + 10.0;
     let bytes = samples * width * 8.0;
     let budget = crate::resources::memory_budget();
@@ -1402,6 +1404,8 @@ fn time_stepping(
             rec.contact_impulse_t.extend_from_slice(&it);
             rec.contact_lambda_n.push(in_ / span);
             rec.contact_lambda_t.extend_from_slice(&[it[0] / span, it[1] / span]);
+            let f_t = (kk.point.t1 * it[0] + kk.point.t2 * it[1]) / span;
+            rec.contact_friction.extend_from_slice(f_t.as_slice());
             rec.contact_state.push(r.state);
             let con = model.contact_of_point(pt);
             // the reserve of the last step (forces of that step)
@@ -1503,6 +1507,8 @@ fn event_driven(
             rec.contact_impulse_t.extend_from_slice(&i_t);
             rec.contact_lambda_n.push(ph.lam_n[pt]);
             rec.contact_lambda_t.extend_from_slice(&ph.lam_t[pt]);
+            let f_t = kk.point.t1 * ph.lam_t[pt][0] + kk.point.t2 * ph.lam_t[pt][1];
+            rec.contact_friction.extend_from_slice(f_t.as_slice());
             rec.contact_state.push(ph.state_code(pt));
             let con = model.contact_of_point(pt);
             let lt = (ph.lam_t[pt][0].powi(2) + ph.lam_t[pt][1].powi(2)).sqrt();

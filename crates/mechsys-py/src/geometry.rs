@@ -2,8 +2,8 @@
 //! geometry of an involute gear contour as the engine builds it.
 
 use mechsys_core::geometry::curve::Curve;
-use mechsys_core::model::contact::gear_spec;
-use mechsys_core::model::contact_description::GearDescription;
+use mechsys_core::model::contact::{gear_spec, planar_curve};
+use mechsys_core::model::contact_description::{ContourDescription, GearDescription};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -55,6 +55,36 @@ fn gear_geometry<'py>(py: Python<'py>, description: &str, what: &str, samples: u
     Ok(out)
 }
 
+/// `samples` points (body frame, `samples × 2`) of the planar curve contour `description` (the
+/// JSON of a contour table: ellipse, spline, cam or gear) at equal parameter steps, with the
+/// roller offset of a cam included; an open spline is sampled between its first and last points.
+/// For drawing (the viewer).
+#[pyfunction]
+#[pyo3(signature = (description, what, samples = 400))]
+fn curve_outline<'py>(py: Python<'py>, description: &str, what: &str, samples: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let de = &mut serde_json::Deserializer::from_str(description);
+    let d: ContourDescription = serde_path_to_error::deserialize(de).map_err(|e| {
+        let m = e.inner().to_string();
+        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
+        PyMechsysError(mechsys_core::Error::Model(format!("{what}.{}: {m}", e.path())))
+    })?;
+    if samples < 2 {
+        return Err(PyMechsysError(mechsys_core::Error::Model(format!("{what}: samples must be ≥ 2, got {samples}"))).into());
+    }
+    let curve = planar_curve(&d, what).map_err(PyMechsysError::from)?;
+    let (lo, hi) = curve.range();
+    // a closed curve's end is its start: not repeated
+    let n = if curve.is_closed() { samples } else { samples - 1 };
+    let pts: Vec<Vec<f64>> = (0..samples)
+        .map(|i| {
+            let p = curve.frame(lo + (hi - lo) * i as f64 / n as f64).point;
+            vec![p.x, p.y]
+        })
+        .collect();
+    Ok(PyArray2::from_vec2(py, &pts)?)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(gear_geometry, m)?)
+    m.add_function(wrap_pyfunction!(gear_geometry, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_outline, m)?)
 }

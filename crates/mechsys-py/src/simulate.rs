@@ -306,6 +306,7 @@ fn simulate<'py>(
         put("contact_gap", rec.contact_gap, &[n, np])?;
         put("contact_point", rec.contact_point, &[n, np, 3])?;
         put("contact_normal", rec.contact_normal, &[n, np, 3])?;
+        put("contact_friction", rec.contact_friction, &[n, np, 3])?;
         put("contact_gd_n", rec.contact_gd_n, &[n, np])?;
         put("contact_gd_t", rec.contact_gd_t, &[n, np, 2])?;
         put("contact_omega", rec.contact_omega, &[n, np, 3])?;

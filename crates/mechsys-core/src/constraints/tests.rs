@@ -61,6 +61,7 @@ pub(super) fn model_with_all_kinds() -> Model {
         contacts: vec![],
         contact_groups: vec![],
         gap_contacts: vec![],
+        visuals: vec![],
         planar: false,
         constraints: vec![
             ConstraintDescription::Point {
@@ -214,6 +215,7 @@ fn drift_control_choices() {
         contacts: vec![],
         contact_groups: vec![],
         gap_contacts: vec![],
+        visuals: vec![],
         planar: false,
         constraints: vec![ConstraintDescription::Distance {
             name: "rod".into(),

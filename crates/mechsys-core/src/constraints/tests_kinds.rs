@@ -60,6 +60,7 @@ fn model_with_new_kinds() -> Model {
         contacts: vec![],
         contact_groups: vec![],
         gap_contacts: vec![],
+        visuals: vec![],
         planar: false,
         constraints: vec![
             ConstraintDescription::PointOnLine {
@@ -627,6 +628,7 @@ fn model_with_user_rows(rate: bool, offset: bool) -> Model {
         contacts: vec![],
         contact_groups: vec![],
         gap_contacts: vec![],
+        visuals: vec![],
         planar: false,
         constraints: vec![
             ConstraintDescription::Velocity {

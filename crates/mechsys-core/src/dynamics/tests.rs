@@ -74,6 +74,7 @@ fn mixed_tree() -> Model {
         contacts: vec![],
         contact_groups: vec![],
         gap_contacts: vec![],
+        visuals: vec![],
         planar: false,
         constraints: vec![],
     })

@@ -623,6 +623,57 @@ pub(super) fn validate_gap(
 
 /// Validates one contact group (body indices resolved by `body`): names, contours, that every
 /// kind of pair the group can form has a contact geometry, and the laws.
+/// The planar curve (ellipse, spline, cam, gear) of a contour description, as the engine builds
+/// it, for drawing its outline; other contours are refused by name.
+pub fn planar_curve(c: &ContourDescription, what: &str) -> Result<Curve> {
+    match contour(c, true, what, no_rotation)? {
+        Contour::Curve(curve) => Ok(*curve),
+        other => Err(Error::Model(format!("{what}: expected a curve (ellipse, spline, cam or gear), got {}", other.kind()))),
+    }
+}
+
+/// Checks a visual: its body exists, its shape is a valid contour, its colour and opacity in range.
+pub(super) fn validate_visual(
+    d: &super::description::VisualDescription,
+    i: usize,
+    body: impl Fn(&str, &str) -> Result<usize>,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3>,
+) -> Result<()> {
+    let what = if d.name.is_empty() { format!("visuals[{i}]") } else { format!("visuals[{i}] '{}'", d.name) };
+    body(&d.body, &format!("{what}.body"))?;
+    if let ContourDescription::Mesh { vertices, triangles, .. } = &d.shape {
+        // a drawn mesh need not be closed or consistently wound (CAD exports often are not):
+        // only finite vertices and indices in range
+        for (k, v) in vertices.iter().enumerate() {
+            crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}.shape.vertices[{k}]: must be finite, got {v:?}");
+        }
+        for (t, tri) in triangles.iter().enumerate() {
+            for (j, &i) in tri.iter().enumerate() {
+                crate::ensure!(
+                    i >= 0 && (i as usize) < vertices.len(),
+                    Model,
+                    "{what}.shape.triangles[{t}][{j}]: vertex index {i} out of range (the mesh has {} vertices)",
+                    vertices.len()
+                );
+            }
+        }
+    } else {
+        let c = contour(&d.shape, planar(&d.shape), &format!("{what}.shape"), rotation)?;
+        c.validate(&format!("{what}.shape ({})", c.kind()))?;
+    }
+    if let Some(rgb) = d.color {
+        crate::ensure!(
+            rgb.iter().all(|v| (0.0..=1.0).contains(v)),
+            Model,
+            "{what}.color: expected three numbers in [0, 1], got {rgb:?}"
+        );
+    }
+    if let Some(a) = d.opacity {
+        crate::ensure!(a > 0.0 && a <= 1.0, Model, "{what}.opacity: expected a number in (0, 1], got {a}");
+    }
+    Ok(())
+}
+
 pub(super) fn validate_group(
     d: &ContactGroupDescription,
     index: usize,

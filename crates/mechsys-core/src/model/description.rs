@@ -49,6 +49,29 @@ pub struct ModelDescription {
     /// prismatic and planar joints in the plane), loop closures keep only their in-plane rows.
     #[serde(default)]
     pub planar: bool,
+    /// Shapes drawn by the viewer only (no contact): a contour's geometry or a triangle mesh on a
+    /// body, with an optional colour.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub visuals: Vec<VisualDescription>,
+}
+
+/// A shape drawn on a body by the viewer; the engine only checks it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VisualDescription {
+    /// Visual name (optional; for the viewer's legend).
+    #[serde(default)]
+    pub name: String,
+    /// The body carrying it (`ground` allowed).
+    pub body: String,
+    /// Its geometry, written as a contact contour (body frame).
+    pub shape: super::contact_description::ContourDescription,
+    /// RGB colour, each in [0, 1].
+    #[serde(default)]
+    pub color: Option<[f64; 3]>,
+    /// Opacity in (0, 1].
+    #[serde(default)]
+    pub opacity: Option<f64>,
 }
 
 /// A bilateral constraint. Read through a JSON value so that a malformed entry's error names the

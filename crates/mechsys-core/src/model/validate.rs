@@ -1245,6 +1245,10 @@ impl Model {
             contact_groups.push(super::contact::validate_group(d, i, body, rotation)?);
         }
 
+        for (i, d) in desc.visuals.iter().enumerate() {
+            super::contact::validate_visual(d, i, body, rotation)?;
+        }
+
         let qdot_is_u = !joints.iter().any(|j| j.kind.has_quaternion());
         let body_index = bodies.iter().enumerate().map(|(i, b)| (b.name.clone(), i)).collect();
         let n_force_outputs = forces.iter().map(|f| f.outputs(iu)).sum();
