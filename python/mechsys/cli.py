@@ -8,6 +8,7 @@ linear vibrations.
     mechsys import robot.urdf -o robot.toml
     mechsys signals results.h5
     mechsys plot results.h5 joint/hinge/q energy/total --out q.svg
+    mechsys view results.h5 --trail bird --out page.html
     mechsys linear model.toml --at equilibrium --frf 0:1 --campbell spin:0:500:51 --whirl x,y
 
 Errors in the input (model files, settings, results files) are printed as one line
@@ -314,6 +315,58 @@ def plot_cmd(results_file: Path, signals: tuple[str, ...], out: Path | None, tit
     out_path = check_outputs({"results file": results_file}, {"--out": out_path}, follow_symlinks)["--out"]
     plot(res, _split_signals(signals), out=out_path, title=title)
     click.echo(f"plot  {out_path}")
+
+
+@cli.command()
+@click.argument("source", metavar="RESULTS.h5|MODEL", type=click.Path(path_type=Path, dir_okay=False))
+@click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False),
+              help="Page to write (.html) [default: RESULTS.html, or MODEL-mode-K.html].")
+@click.option("--signals", "signals", multiple=True, metavar="NAME[,NAME...]", help="Signals to plot beside the scene.")
+@click.option("--trail", "trails", multiple=True, metavar="BODY[:x,y,z]",
+              help="Draw the path of a body point (body frame; default its origin). Repeatable.")
+@click.option("--follow", metavar="BODY", help="The body the camera follows at start.")
+@click.option("--max-frames", "max_frames", type=int, default=1500, show_default=True,
+              help="Frames kept in the page (uniform in time, plus every event).")
+@click.option("--mode", "mode", type=int, metavar="K",
+              help="MODEL only: animate mode K (from 1) of the linearization (see --at).")
+@click.option("--at", "at", type=click.Choice(["q0", "equilibrium"]), default="q0", show_default=True,
+              help="With --mode: linearize at the model's q0/u0 or at the static equilibrium found from q0.")
+@click.option("--open", "open_browser", is_flag=True, help="Open the page in the web browser.")
+@click.option("--follow-symlinks", "follow_symlinks", is_flag=True,
+              help="Write through an output path that is a symbolic link (refused by default).")
+def view(source: Path, out: Path | None, signals: tuple[str, ...], trails: tuple[str, ...], follow: str | None,
+         max_frames: int, mode: int | None, at: str, open_browser: bool, follow_symlinks: bool) -> None:
+    """Write a self-contained 3D viewer page (scene, timeline, contact forces, plots) of a results
+    file, or of a mode shape of a model file (--mode); it works offline from a file: URL."""
+    from . import viewer
+    from .files import check_outputs
+
+    if mode is None:
+        from .results import load
+
+        if source.suffix.lower() in (".toml", ".py"):
+            raise click.UsageError(f"{source} is a model file: run it first (mechsys run), or give --mode K to see a mode shape")
+        target = load(source)
+        default = source.with_suffix(".html")
+    else:
+        from . import linear as lin_mod
+        from .modelfile import load_model
+
+        model, _ = load_model(source)
+        lin = lin_mod.linearize(model, at=at)
+        count = len(lin.modes().eigenvalues)
+        if not 1 <= mode <= count:
+            raise click.BadParameter(f"mode {mode}: the model has modes 1 to {count}", param_hint="--mode")
+        target = viewer.mode_results(lin, mode - 1)
+        default = source.with_name(f"{source.stem}-mode-{mode}.html")
+    out_path = check_outputs({"input file": source}, {"--out": out or default}, follow_symlinks)["--out"]
+    page = viewer.to_html(target, out_path, signals=_split_signals(signals) if signals else None, trails=trails,
+                          follow=follow, max_frames=max_frames)
+    click.echo(f"page  {page}")
+    if open_browser:
+        import webbrowser
+
+        webbrowser.open(Path(page).resolve().as_uri())
 
 
 @cli.command()

@@ -572,6 +572,13 @@ class Results:
         out._columns = columns
         return out
 
+    def to_html(self, path: str | Path, **options) -> Path:
+        """Writes the browser viewer page of this run (see :mod:`mechsys.viewer`; options as
+        :func:`mechsys.viewer.page_data`: ``signals``, ``trails``, ``follow``, ``max_frames``)."""
+        from .viewer import to_html
+
+        return to_html(self, path, **options)
+
     def to_csv(self, path: str | Path, signals: Iterable[str] | None = None) -> Path:
         """Writes chosen signals (all scalar and vector ones if None) as CSV with a header row
         ``t [s], name[i] [unit], ...``."""

@@ -68,6 +68,7 @@ function main() {
     bodies[b].group.quaternion.set(pose[o + 4], pose[o + 5], pose[o + 6], pose[o + 3]);
     box.expandByObject(bodies[b].group);
   }
+  trails.forEach((line) => { line.geometry.computeBoundingBox(); box.union(line.geometry.boundingBox); });
   if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(L, L, L));
   const center = box.getCenter(new THREE.Vector3());
   const radius = Math.max(box.getSize(new THREE.Vector3()).length() * 0.6, L * 0.3);
@@ -93,7 +94,9 @@ function main() {
   const timeLabel = document.getElementById('time');
   document.getElementById('info').textContent =
     `${nb} bodies · ${data.contacts.length} contact points · ${nf} of ${data.recorded} frames · ${fmt(duration)} s`;
-  document.getElementById('legend').innerHTML = data.contacts.length
+  const legend = document.getElementById('legend');
+  legend.style.display = data.contacts.length ? '' : 'none';
+  legend.innerHTML = data.contacts.length
     ? '<i style="background:#2f6fd6"></i>stick<i style="background:#e8871e"></i>slip<i style="background:#9aa0a6"></i>open' : '';
 
   const plots = buildPlots(document.getElementById('plots'), data.plots, (time) => setTime(time, true));

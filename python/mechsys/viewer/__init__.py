@@ -223,12 +223,12 @@ def _default_signals(res) -> list[str]:
             names.append(f"contact/{c}/lambda_n")
     if "energy/total" in res and not names:
         names.append("energy/total")
-    if "q" in res:
+    if "q" in res and np.asarray(res["q"]).reshape(len(res.t), -1).shape[1] <= 6:
         names.insert(0, "q")
     return names[:3]
 
 
-def _body_shapes(model: dict, extent: float, marker: float) -> dict[str, list[dict]]:
+def _body_shapes(model: dict, extent: float, marker: float, bounds=None, up=None) -> dict[str, list[dict]]:
     """Drawable parts per body ("ground" included) from contacts, groups and visuals, each contour
     once even when several contacts use it."""
     seen: dict[str, set] = {}
@@ -239,7 +239,10 @@ def _body_shapes(model: dict, extent: float, marker: float) -> dict[str, list[di
         if key in seen.setdefault(body, set()):
             return
         seen[body].add(key)
-        for part in contour_parts(contour, extent, marker, what):
+        for part in contour_parts(contour, extent, marker, what, bounds if body == "ground" else None):
+            if part.get("ground") and up is not None and abs(float(np.dot(part["normal"], up))) < 0.7:
+                # a wall: seen through, so it hides nothing
+                part["opacity"] = 0.25
             if color is not None:
                 part["color"] = list(color)
             if opacity is not None:
@@ -278,6 +281,10 @@ def _rods(model: dict, body: str, com, rod: float) -> list[dict]:
             if f.get(f"body{k}") == body and f"point{k}" in f:
                 pts.append(f[f"point{k}"])
     com = np.asarray(com, dtype=float)
+    if len(pts) == 1:
+        # one attachment (a pendulum's rod): drawn through the centre of mass to its mirror point,
+        # the length of a uniform rod
+        pts.append((2.0 * com - np.asarray(pts[0], dtype=float)).tolist())
     parts = []
     for p in pts:
         p = np.asarray(p, dtype=float)
@@ -375,7 +382,11 @@ def page_data(source, *, signals: Sequence[str] | None = None, max_frames: int =
     travel = float(np.ptp(pos.reshape(-1, 3), axis=0).max()) if pos.size else 0.0
     scene = max([travel, *sizes, 1e-3])
     marker = 0.015 * scene
-    shapes = _body_shapes(model, 3.0 * scene, marker)
+    lo = pos.reshape(-1, 3).min(axis=0) if pos.size else np.zeros(3)
+    hi = pos.reshape(-1, 3).max(axis=0) if pos.size else np.zeros(3)
+    g = np.asarray(model.get("gravity", [0, 0, 0]), dtype=float)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else None
+    shapes = _body_shapes(model, 3.0 * scene, marker, (lo, hi), up)
     triads = _triads(model)
 
     body_entries = []
@@ -393,8 +404,6 @@ def page_data(source, *, signals: Sequence[str] | None = None, max_frames: int =
                              "stick": not drawn_by_contours})
     ground = {"name": "ground", "parts": [_encode_part(p) for p in shapes.get("ground", [])], "triads": triads.get("ground", [])}
 
-    lo = pos.reshape(-1, 3).min(axis=0) if pos.size else np.zeros(3)
-    hi = pos.reshape(-1, 3).max(axis=0) if pos.size else np.zeros(3)
     out: dict[str, Any] = {
         "title": title or m.title or "mechsys",
         "bounds": [lo.tolist(), hi.tolist()],

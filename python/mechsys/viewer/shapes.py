@@ -108,8 +108,9 @@ def _planar_band(p0, p1, normal2, width: float, z: float = 0.0) -> list[Part]:
     return [_mesh(v, [[0, 1, 2], [0, 2, 3]]), _line(v[:2], False)]
 
 
-def contour_parts(d: dict, extent: float, marker: float, what: str = "contour") -> list[Part]:
-    """Drawable parts of a contour description ``d`` (a contour table, body frame)."""
+def contour_parts(d: dict, extent: float, marker: float, what: str = "contour", bounds=None) -> list[Part]:
+    """Drawable parts of a contour description ``d`` (a contour table, body frame); ``bounds``
+    (low and high corners, body frame) limits a plane to the part under the motion."""
     kind = d.get("type")
     center = np.asarray(d.get("center", (0.0, 0.0, 0.0)), dtype=float)
     if kind == "point":
@@ -154,11 +155,22 @@ def contour_parts(d: dict, extent: float, marker: float, what: str = "contour") 
         return [_lathe(prof, _basis(d["axis"]), center, closed_profile=False)]
     if kind == "plane":
         n = np.asarray(d["normal"], dtype=float)
+        n = n / np.linalg.norm(n)
         frame = _basis(n)
         p = np.asarray(d["point"], dtype=float)
-        e1, e2 = frame[:, 0] * extent / 2, frame[:, 1] * extent / 2
-        v = np.array([p - e1 - e2, p + e1 - e2, p + e1 + e2, p - e1 + e2])
-        return [dict(_mesh(v, [[0, 1, 2], [0, 2, 3]]), side="double", ground=True)]
+        if bounds is not None:
+            # the part of the plane under the motion: the bounds' corners projected on it, with a margin
+            lo, hi = np.asarray(bounds[0], dtype=float), np.asarray(bounds[1], dtype=float)
+            corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+            c1, c2 = (corners - p) @ frame[:, 0], (corners - p) @ frame[:, 1]
+            pad = 0.25 * extent / 3
+            a1, b1, a2, b2 = c1.min() - pad, c1.max() + pad, c2.min() - pad, c2.max() + pad
+        else:
+            a1 = a2 = -extent / 2
+            b1 = b2 = extent / 2
+        e1, e2 = frame[:, 0], frame[:, 1]
+        v = np.array([p + a1 * e1 + a2 * e2, p + b1 * e1 + a2 * e2, p + b1 * e1 + b2 * e2, p + a1 * e1 + b2 * e2])
+        return [dict(_mesh(v, [[0, 1, 2], [0, 2, 3]]), side="double", ground=True, normal=n.tolist())]
     if kind == "line":
         n = np.asarray(d["normal"][:2], dtype=float)
         n /= np.linalg.norm(n)
