@@ -137,3 +137,18 @@ def test_period_of_a_sampled_sine_from_its_interpolated_crossings():
     np.testing.assert_allclose(ms.analysis.period(t, 3.0 + np.cos(2 * np.pi * t / 0.7), level=3.0), 0.7, rtol=1e-5)
     with pytest.raises(ms.errors.SettingsError, match="need at least 2"):
         ms.analysis.period(t, np.exp(-t))
+
+
+def test_static_equilibrium_leaves_a_level_pendulum_downhill_to_the_hanging_one():
+    # held level the pendulum's stiffness vanishes: Newton alone has no step there
+    from mechsys.modelfile import load_model
+
+    root = Path(__file__).resolve().parents[1]
+    for name in ("pendulum.toml", "double_pendulum.toml"):
+        model, _ = load_model(root / "examples" / name)
+        eq = ms.analysis.static_equilibrium(model)
+        # hanging: every rod along -y, the first at -pi/2 (mod 2 pi), the second straight on
+        np.testing.assert_allclose(np.mod(eq["q"][0] + np.pi / 2, 2 * np.pi), 0.0, atol=1e-9)
+        np.testing.assert_allclose(eq["q"][1:], 0.0, atol=1e-9)
+        lin = ms.linear.linearize(model, q=eq["q"])
+        assert lin.modes().stable and np.all(lin.modes().natural_frequency > 0)

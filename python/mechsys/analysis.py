@@ -144,8 +144,26 @@ def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10,
             kmat[:, i] = ((h_of(qp) + gp.T @ lam) - (h_of(qm) + gm.T @ lam)) / (2 * eps)
         jac = np.block([[kmat, g.T], [g, np.zeros((nc, nc))]])
         step = np.linalg.lstsq(jac, -f, rcond=1e-12)[0]
-        qk = core.integrate(qk, step[:nu], 1.0)
-        lam = lam + step[nu:]
+        norm_f = np.linalg.norm(f)
+        q_new, lam_new = qk, lam
+        # Newton with halving while the residual does not fall
+        for _half in range(6):
+            q_try, lam_try = core.integrate(qk, step[:nu], 1.0), lam + step[nu:]
+            phi_t, g_t, _ = _core.constraint_jacobian(core, q_try, t, callbacks)
+            if np.linalg.norm(np.concatenate([h_of(q_try) + g_t.T @ lam_try, phi_t])) < norm_f:
+                q_new, lam_new = q_try, lam_try
+                break
+            step = step / 2
+        else:
+            # no descent: a stationary point of the residual that is no equilibrium (a pendulum
+            # held level: its stiffness vanishes there). Step downhill along the applied forces
+            # -h, within the constraints' tangent space, by at most 0.2 (rad or m).
+            down = -(h + g.T @ lam)
+            if nc:
+                basis = np.linalg.svd(g)[2][np.linalg.matrix_rank(g):].T if g.size else np.eye(nu)
+                down = basis @ (basis.T @ down)
+            q_new = core.integrate(qk, down * (0.2 / max(np.abs(down).max(), 1e-300)), 1.0)
+        qk, lam = q_new, lam_new
     else:
         raise SolverError(f"static equilibrium: Newton did not converge (residual {np.abs(f).max():.3e})")
     names = {c["name"]: lam[c["row"] : c["row"] + c["rows"]].copy() for c in core.constraints()}
