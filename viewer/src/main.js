@@ -227,7 +227,15 @@ function main() {
     bodyPosition: (name) => bodies[data.bodies.findIndex((b) => b.name === name)].group.position.toArray(),
     bodyQuaternion: (name) => { const q = bodies[data.bodies.findIndex((b) => b.name === name)].group.quaternion; return [q.w, q.x, q.y, q.z]; },
     contactVisible: (k) => contacts[k].dot.visible,
+    contactColor: (k) => contacts[k].dot.material.color.getHex(),
     plotCount: plots.length,
+    // the body groups actually in the scene (not the data's list)
+    sceneBodyCount: () => scene.children.filter((o) => o.isGroup && o.name !== 'ground' && bodies.some((b) => b.group === o)).length,
+    triadsVisible: () => triads.length > 0 && triads.every((x) => x.visible),
+    cameraTarget: () => controls.target.toArray(),
+    // as playback does, from the current time: impacts passed on the way flash
+    advanceTo: (time) => setTime(time, false),
+    flashCount: () => flashes.length,
   };
 }
 
