@@ -19,6 +19,7 @@ Runs on its own (prints the operating points, the threshold both ways and the ru
 writes results/rotor_bearing.h5 and results/rotor_bearing.png) and as a model file:
 
     mechsys run examples/rotor_bearing.py     # the run-up, into oil whip
+    mechsys view results/rotor_bearing.h5     # the rotor in the browser (a page beside the file)
 """
 
 from __future__ import annotations
@@ -48,6 +49,12 @@ def build(speed: float | None = None) -> ms.Model:
     m.add_joint(ms.joints.Planar("float", m.ground, rotor, q0=[op.offset[0], op.offset[1], 0.0], u0=[0.0, 0.0, w]))
     m.add_force(ms.forces.HydrodynamicBearing("brg", rotor, m.ground, radius=R, length=L, clearance=C,
                                               viscosity=ETA, theory="short"))
+    # for the viewer (mechsys view): the journal, a disc with a stripe that shows the spin, and
+    # the bearing's housing on the ground
+    m.add_visual(rotor, ms.contours.Cylinder(radius=R, length=0.3, axis=(0, 0, 1)), name="journal", color=(0.55, 0.57, 0.6))
+    m.add_visual(rotor, ms.contours.Cylinder(radius=0.16, length=0.04, axis=(0, 0, 1), center=(0, 0, 0.1)), name="disc")
+    m.add_visual(rotor, ms.contours.Box(half_extents=(0.07, 0.01, 0.022), center=(0.09, 0, 0.1)), name="stripe", color=(0.9, 0.3, 0.1))
+    m.add_visual(m.ground, ms.contours.Torus(radius=R + 0.012, tube=0.012, axis=(0, 0, 1)), name="housing", opacity=0.6)
     if speed is None:
         m.add_force(ms.forces.Servo("motor", "float", index=2, mode="velocity", kd=200.0,
                                     reference=ms.functions.Table([0.0, T_RUN], [W0, W1])))

@@ -340,3 +340,18 @@ def test_mechsys_view_mode_of_a_model_file(tmp_path):
     assert (tmp_path / "m.html").stat().st_size > 100_000
     r = mechsys("view", str(ROOT / "examples" / "pendulum.toml"), "--mode", "9", "-o", str(tmp_path / "m.html"))
     assert r.returncode == 2 and "modes 1 to" in r.stderr
+
+
+def test_solids_are_wound_outward():
+    """Front faces outward (three.js culls back faces): each triangle's normal points away from
+    the solid's centre."""
+    for d in (ms.contours.Sphere(radius=0.5).describe("s"), ms.contours.Cylinder(radius=0.2, length=1.0).describe("c"),
+              ms.contours.Box(half_extents=(1, 2, 3)).describe("b"), ms.contours.Ellipsoid(semi_axes=(1, 2, 3)).describe("e"),
+              ms.contours.Capsule(a=(0, 0, -1), b=(0, 0, 1), radius=0.3).describe("k")):
+        (part,) = shapes.contour_parts(d, 10.0, 0.01)
+        v, f = part["v"].astype(float), part["f"]
+        n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+        centroid = v[f].mean(axis=1)
+        area = np.linalg.norm(n, axis=1)
+        keep = area > 1e-12 * area.max()
+        assert np.all(np.einsum("ij,ij->i", n[keep], centroid[keep]) > 0), d["type"]

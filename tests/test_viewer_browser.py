@@ -202,3 +202,24 @@ def test_a_mode_shape_page(browser, tmp_path):
     p.js("(k) => window.mechsys.setFrame(k)", k)
     np.testing.assert_allclose(p.js("window.mechsys.bodyPosition('lower')"), anim.position[k, 1], atol=1e-6)
     assert "mode 2" in p.page.locator("#title").inner_text()
+
+
+@pytest.mark.parametrize("example, t_end", [("woodpecker", 0.05), ("sphere_pile", 0.05), ("four_bar", 0.2), ("rotor_bearing", 0.02)])
+def test_each_showcase_example_gives_a_page_from_mechsys_view(browser, tmp_path, example, t_end):
+    """The acceptance examples, each run briefly from its own model and settings, saved, turned
+    into a page by the command line, and loaded."""
+    import subprocess
+    import sys
+
+    ns = runpy.run_path(str(ROOT / "examples" / f"{example}.py"), run_name="not_main")
+    res = ms.simulate(ns["model"], **dict(ns["simulation"], t_end=t_end))
+    src = res.save(tmp_path / f"{example}.h5")
+    r = subprocess.run([sys.executable, "-m", "mechsys", "view", str(src)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    p = Page(browser, tmp_path / f"{example}.html")
+    assert p.errors == []
+    assert p.js("window.mechsys.sceneBodyCount()") == len(res.model["bodies"])
+    last = p.js("window.mechsys.frames - 1")
+    p.js("(k) => window.mechsys.setFrame(k)", last)
+    name = res.model["bodies"][-1]["name"]
+    np.testing.assert_allclose(p.js(f"window.mechsys.bodyPosition('{name}')"), res[f"body/{name}/position"][-1], atol=1e-6)

@@ -71,7 +71,8 @@ def _grid(points: np.ndarray, wrap_u: bool, wrap_v: bool) -> Part:
     b = idx[(iu[:, None] + 1) % nu, iv[None, :]]
     c = idx[(iu[:, None] + 1) % nu, (iv[None, :] + 1) % nv]
     d = idx[iu[:, None], (iv[None, :] + 1) % nv]
-    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    # wound so that (profile direction) x (around direction) points out: a lathe's outside
+    faces = np.concatenate([np.stack([a, c, b], -1).reshape(-1, 3), np.stack([a, d, c], -1).reshape(-1, 3)])
     return _mesh(points.reshape(-1, 3), faces)
 
 
