@@ -57,6 +57,7 @@ bench: $(BUILD)
 	$(PY) benches/stiff.py --out docs/benchmarks.md
 	$(PY) benches/bearing.py --out docs/benchmarks.md
 	$(PY) benches/planar.py --out docs/benchmarks.md
+	$(PY) benches/viewer.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results
