@@ -127,3 +127,10 @@ if __name__ == "__main__":
     fig.savefig("results/woodpecker_schemes.png", dpi=120)
     print("wrote results/woodpecker.h5, results/woodpecker_event_driven.h5, results/woodpecker.png, "
           "results/woodpecker_schemes.png")
+    # the 3D page: open results/woodpecker.html in a browser (also: mechsys view results/woodpecker.h5)
+    try:
+        page = ed.to_html("results/woodpecker.html", trails=["bird"],
+                          signals=["joint/pin/q", "contact/beak/lambda_n", "contact/lower_right/state"])
+        print(f"wrote {page} (the run in the browser: scene, timeline, contact forces, plots)")
+    except ms.ResultsError as e:  # the viewer's JavaScript is built by `make build` where npm is found
+        print(f"no viewer page: {e}")
