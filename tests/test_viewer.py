@@ -355,3 +355,12 @@ def test_solids_are_wound_outward():
         area = np.linalg.norm(n, axis=1)
         keep = area > 1e-12 * area.max()
         assert np.all(np.einsum("ij,ij->i", n[keep], centroid[keep]) > 0), d["type"]
+
+
+def test_view_writes_a_page_and_in_a_notebook_returns_an_inline_frame(bouncing, monkeypatch, tmp_path):
+    page = ms.view(bouncing, tmp_path / "v.html", open_browser=False)
+    assert Path(page).read_text().count('id="mechsys-data"') == 1
+    monkeypatch.setattr(viewer, "_in_notebook", lambda: True)
+    shown = ms.view(bouncing)
+    html_text = shown._repr_html_()
+    assert html_text.startswith("<iframe srcdoc=") and "mechsys-data" in html_text

@@ -544,6 +544,16 @@ def to_html(source, path: str | Path | None = None, **options) -> Path | str:
     return target
 
 
+class Inline:
+    """A page shown inline by Jupyter (its ``_repr_html_``): the page in an iframe."""
+
+    def __init__(self, html_text: str):
+        self.data = html_text
+
+    def _repr_html_(self) -> str:
+        return self.data
+
+
 def _in_notebook() -> bool:
     try:
         from IPython import get_ipython  # type: ignore[import-not-found]
@@ -558,11 +568,9 @@ def view(source, path: str | Path | None = None, *, open_browser: bool = True, h
     to ``path`` (default: a temporary file) and opened in the web browser. Returns the notebook
     display object or the page's path."""
     if _in_notebook() and path is None:
-        from IPython.display import HTML  # type: ignore[import-not-found]
-
         page = to_html(source, None, **options)
-        return HTML(f'<iframe srcdoc="{html.escape(str(page), quote=True)}" style="width:100%;height:{int(height)}px;'
-                    'border:0"></iframe>')
+        return Inline(f'<iframe srcdoc="{html.escape(str(page), quote=True)}" style="width:100%;height:{int(height)}px;'
+                      'border:0"></iframe>')
     if path is None:
         fd, name = tempfile.mkstemp(prefix="mechsys-view-", suffix=".html")
         os.close(fd)
