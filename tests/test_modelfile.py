@@ -417,3 +417,24 @@ def test_a_callback_in_a_toml_file_is_refused_at_load_naming_the_element(tmp_pat
     text = PENDULUM_TOML.replace("[simulation]", extra + "\n[simulation]")
     with pytest.raises(ModelError, match=re.escape(f"{where}: a callback needs a Python callable")):
         load_model(write(tmp_path, text))
+
+
+def test_the_description_an_engine_writes_reads_back_for_every_example():
+    """A results file stores the engine's description (absent values written as null): it must
+    build the same model again (the viewer and parameter studies rebuild models from it)."""
+    import glob
+    import json
+    import warnings
+
+    from mechsys.modelfile import load_model
+
+    root = Path(__file__).resolve().parents[1]
+    files = sorted(glob.glob(str(root / "examples" / "*.py"))) + sorted(glob.glob(str(root / "examples" / "*.toml")))
+    assert len(files) > 20
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for f in files:
+            m, _ = load_model(f)
+            d = json.loads(m.build().description_json())
+            again = ms.Model.from_dict(d, m.callbacks)
+            assert json.loads(again.build().description_json()) == d, f

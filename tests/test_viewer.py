@@ -364,3 +364,12 @@ def test_view_writes_a_page_and_in_a_notebook_returns_an_inline_frame(bouncing, 
     shown = ms.view(bouncing)
     html_text = shown._repr_html_()
     assert html_text.startswith("<iframe srcdoc=") and "mechsys-data" in html_text
+
+
+def test_a_run_recorded_without_body_poses_is_drawn_from_its_coordinates():
+    m = two_rods()
+    full = ms.simulate(m, t_end=0.5, integrator=ms.RK4(dt=1e-3), output_dt=0.01)
+    sparse = ms.simulate(m, t_end=0.5, integrator=ms.RK4(dt=1e-3), output_dt=0.01, sensors=["joint/*/q"])
+    assert "body/lower/position" not in sparse
+    a, b = viewer.page_data(full), viewer.page_data(sparse)
+    np.testing.assert_allclose(arr(b["pose"]), arr(a["pose"]), atol=1e-6)

@@ -361,7 +361,7 @@ class Model:
         m._contact_groups = seq("contact_groups")
         m._visuals = seq("visuals")
         known = {"name", "gravity", "planar", "bodies", "joints", "forces", "ground_markers", "constraints", "contacts",
-                 "contact_groups", "visuals"}
+                 "gap_contacts", "contact_groups", "visuals"}
         extra = set(desc) - known
         if extra:
             # let the engine produce the canonical message for a misspelt top-level key

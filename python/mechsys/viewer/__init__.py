@@ -88,12 +88,31 @@ def _motion(res) -> _Motion:
     if have:
         pos = np.stack([np.asarray(res[f"body/{b}/position"]) for b in bodies], 1) if bodies else np.zeros((len(t), 0, 3))
         rot = np.stack([np.asarray(res[f"body/{b}/orientation"]) for b in bodies], 1) if bodies else np.zeros((len(t), 0, 4))
-    elif "q" in res:
-        pos, rot = _poses_from_q(model, np.asarray(res["q"]))
+    elif (q := _coordinates(res, model)) is not None:
+        pos, rot = _poses_from_q(model, q)
     else:
         raise ResultsError("the results hold neither the bodies' poses (body/*/position, body/*/orientation) nor the "
-                           "coordinates q; record them (sensors='body/*') to view this run")
+                           "coordinates (q or every joint/*/q); record them (sensors='body/*') to view this run")
     return _Motion(t, model, bodies, pos, rot, results=res, title=model.get("name", ""), events=list(res.events))
+
+
+def _coordinates(res, model_dict: dict):
+    """q of every sample: the recorded ``q``, or assembled from each joint's ``joint/<j>/q``."""
+    if "q" in res:
+        return np.asarray(res["q"])
+    from ..model import Model
+
+    joints = Model.from_dict(model_dict).build().joints()
+    n = len(res.t)
+    q = np.zeros((n, sum(j["nq"] for j in joints)))
+    for j in joints:
+        if j["nq"] == 0:
+            continue
+        name = f"joint/{j['name']}/q"
+        if name not in res:
+            return None
+        q[:, j["iq"]: j["iq"] + j["nq"]] = np.asarray(res[name]).reshape(n, j["nq"])
+    return q
 
 
 def _poses_from_q(model_dict: dict, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

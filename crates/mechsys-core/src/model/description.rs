@@ -853,7 +853,14 @@ fn one_or_many_value<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Res
 }
 
 fn one_or_many_opt<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<f64>>, D::Error> {
-    one_or_many(d).map(Some)
+    // null (how an absent value is written back out) reads as absent, so a written
+    // description reads back
+    let v = Option::<OneOrMany>::deserialize(d)
+        .map_err(|_| serde::de::Error::custom("expected a finite number or a list of finite numbers"))?;
+    Ok(v.map(|v| match v {
+        OneOrMany::One(x) => vec![x],
+        OneOrMany::Many(v) => v,
+    }))
 }
 
 fn default_bearing_theory() -> String {
