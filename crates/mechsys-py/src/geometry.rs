@@ -10,18 +10,23 @@ use pyo3::types::PyDict;
 
 use crate::errors::PyMechsysError;
 
+/// A contour table from its JSON; errors name `what` and the key path.
+fn parse<T: serde::de::DeserializeOwned>(description: &str, what: &str) -> PyResult<T> {
+    let de = &mut serde_json::Deserializer::from_str(description);
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let m = e.inner().to_string();
+        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
+        PyMechsysError(mechsys_core::Error::Model(format!("{what}.{}: {m}", e.path()))).into()
+    })
+}
+
 /// Radii, roll angles, roundings and parameter lengths of the gear described by `description`
 /// (the JSON of a `type = "gear"` contour table without its `type`), and `samples` points of its
 /// outline (body frame, `samples × 2`, at equal steps of the arc-length parameter from 0).
 #[pyfunction]
 #[pyo3(signature = (description, what, samples = 0))]
 fn gear_geometry<'py>(py: Python<'py>, description: &str, what: &str, samples: usize) -> PyResult<Bound<'py, PyDict>> {
-    let de = &mut serde_json::Deserializer::from_str(description);
-    let d: GearDescription = serde_path_to_error::deserialize(de).map_err(|e| {
-        let m = e.inner().to_string();
-        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
-        PyMechsysError(mechsys_core::Error::Model(format!("{what}.{}: {m}", e.path())))
-    })?;
+    let d: GearDescription = parse(description, what)?;
     let spec = gear_spec(&d, what).map_err(PyMechsysError::from)?;
     let curve = Curve::gear(&spec, what).map_err(PyMechsysError::from)?;
     let g = curve.as_gear().expect("a gear contour");
@@ -62,12 +67,7 @@ fn gear_geometry<'py>(py: Python<'py>, description: &str, what: &str, samples: u
 #[pyfunction]
 #[pyo3(signature = (description, what, samples = 400))]
 fn curve_outline<'py>(py: Python<'py>, description: &str, what: &str, samples: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let de = &mut serde_json::Deserializer::from_str(description);
-    let d: ContourDescription = serde_path_to_error::deserialize(de).map_err(|e| {
-        let m = e.inner().to_string();
-        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
-        PyMechsysError(mechsys_core::Error::Model(format!("{what}.{}: {m}", e.path())))
-    })?;
+    let d: ContourDescription = parse(description, what)?;
     if samples < 2 {
         return Err(PyMechsysError(mechsys_core::Error::Model(format!("{what}: samples must be ≥ 2, got {samples}"))).into());
     }
