@@ -277,3 +277,41 @@ def test_group_with_a_bilateral_constraint_takes_the_dense_path():
     for k in ("energy/dissipated_impact", "energy/dissipated_friction"):
         np.testing.assert_allclose(rg[k], rc[k], rtol=1e-10, atol=1e-14)
     assert rg["energy/dissipated_impact"][-1] > 1e-3
+
+
+def test_group_points_are_the_closed_explicit_contacts():
+    """The group's recorded points (contact/<g>/points, point_forces, point_states) are those of
+    the equivalent explicit contacts closed in the same step: the same places, the same forces
+    (normal and friction together), the same states."""
+    kw = dict(n=12, half=0.12, mu=0.3, eps=0.3, seed=4)
+    # a sample every step: the explicit contacts' forces (impulses since the last sample over the
+    # interval) are then the last step's, as the group records them
+    rg = ms.simulate(pile(**kw), 0.4, tight(), output_dt=1e-3)
+    rc = ms.simulate(pile(group=False, **kw), 0.4, tight(), output_dt=1e-3)
+    assert rg.unit("contact/pile/points") == "m" and rg.unit("contact/pile/point_forces") == "N"
+    contacts = sorted({n.split("/")[1] for n in rc.names() if n.startswith("contact/c")})
+    checked = 0
+    for i in range(50, len(rg.t), 25):
+        want = []
+        for c in contacts:
+            ln = rc[f"contact/{c}/lambda_n"][i]
+            if ln > 0:
+                f = rc[f"contact/{c}/normal"][i] * ln + rc[f"contact/{c}/friction_force"][i]
+                want.append([*rc[f"contact/{c}/point"][i], *f, rc[f"contact/{c}/state"][i]])
+        pts, frc = rg["contact/pile/points"][i], rg["contact/pile/point_forces"][i]
+        keep = ~np.isnan(pts[:, 0])
+        got = np.column_stack([pts[keep], frc[keep], rg["contact/pile/point_states"][i][keep]])
+        assert len(got) == len(want) == rg["contact/pile/closed"][i]
+        if not want:
+            continue
+        order = lambda a: a[np.lexsort(np.round(a[:, 2::-1].T, 3))]  # noqa: E731
+        got, want = order(got), order(np.array(want))
+        # the group's geometry is that of the step's midpoint, the explicit contacts' that of the
+        # sample: points apart by at most half a step's travel, the same impulses (so the same
+        # force magnitudes) along tangents turned as little
+        np.testing.assert_allclose(got[:, :3], want[:, :3], atol=1e-4)
+        np.testing.assert_allclose(np.linalg.norm(got[:, 3:6], axis=1), np.linalg.norm(want[:, 3:6], axis=1), rtol=1e-8)
+        np.testing.assert_allclose(got[:, 3:6], want[:, 3:6], atol=2e-3 * np.abs(want[:, 3:6]).max())
+        np.testing.assert_array_equal(got[:, 6], want[:, 6])
+        checked += len(got)
+    assert checked > 50

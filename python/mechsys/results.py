@@ -294,6 +294,24 @@ class Results:
                 put(f"{pre}/pairs", raw["group_pairs"][:, k], "1")
                 put(f"{pre}/impulse_against", raw["group_impulse_against"][:, k, :], "N s")
                 put(f"{pre}/force_against", raw["group_impulse_against"][:, k, :] / span[:, None], "N")
+            if "group_points" in raw:
+                # the points closed in the last step before each sample, padded to the most any
+                # sample has (NaN, state open)
+                counts = np.asarray(raw["group_point_count"], dtype=np.int64)
+                flat = np.asarray(raw["group_points"])
+                starts = np.concatenate([[0], np.cumsum(counts.reshape(-1))])[:-1].reshape(counts.shape)
+                for k, g in enumerate(engine.contact_groups()):
+                    pre = f"contact/{g['name']}"
+                    width = int(counts[:, k].max(initial=0))
+                    pts = np.full((len(counts), width, 3), np.nan)
+                    frc = np.full((len(counts), width, 3), np.nan)
+                    st = np.zeros((len(counts), width), dtype=np.int8)
+                    for i in range(len(counts)):
+                        c, a = counts[i, k], starts[i, k]
+                        pts[i, :c], frc[i, :c], st[i, :c] = flat[a:a + c, :3], flat[a:a + c, 3:6], flat[a:a + c, 6]
+                    put(f"{pre}/points", pts, "m")
+                    put(f"{pre}/point_forces", frc, "N")
+                    put(f"{pre}/point_states", st, "1")
         for a in s.values():
             a.setflags(write=False)
         lazy = {}
@@ -737,7 +755,8 @@ _ACCELERATION_SUFFIXES = ("udot", "/acceleration", "/angular_acceleration", "/co
                           "/reaction_torque", "/tangential_acceleration", "/normal_acceleration")
 _CONTACT_SUFFIXES = ("g_n", "point", "normal", "friction_force", "gd_n", "gd_t", "spin", "rolling", "lambda_n", "lambda_t", "impulse_n", "impulse_t", "state",
                      "friction_reserve")
-_GROUP_SUFFIXES = ("closed", "max_penetration", "impulse_n", "lambda_n", "pairs", "impulse_against", "force_against")
+_GROUP_SUFFIXES = ("closed", "max_penetration", "impulse_n", "lambda_n", "pairs", "impulse_against", "force_against",
+                   "points", "point_forces", "point_states")
 
 
 def signal_universe(engine) -> list[str]:

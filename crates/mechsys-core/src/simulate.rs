@@ -278,6 +278,12 @@ pub struct Recording {
     /// Contact groups: impulse of the `against` contours on the members summed since the
     /// previous sample, world components (n_out × n_groups × 3), N s.
     pub group_impulse_against: Vec<f64>,
+    /// Contact groups: the number of points closed in the last step before each sample
+    /// (n_out × n_groups) and those points, in sample then group order, `[x, y, z, fx, fy, fz,
+    /// state]` each (point on the first contour, force on its body in N, world components).
+    pub group_point_count: Vec<usize>,
+    /// See [`Recording::group_point_count`].
+    pub group_points: Vec<[f64; 7]>,
     /// Contact events of either contact scheme, in time order.
     pub events: Vec<EventRecord>,
     /// Integrator counters.
@@ -1428,6 +1434,11 @@ fn time_stepping(
             rec.group_impulse_n.push(g.impulse_n);
             rec.group_pairs.push(g.pairs as f64);
             rec.group_impulse_against.extend_from_slice(&g.impulse_against);
+        }
+        for g in 0..group_stats.len() {
+            let pts = stepper.group_points(g);
+            rec.group_point_count.push(pts.len());
+            rec.group_points.extend_from_slice(pts);
         }
         budget.wall(t_rec)?;
         match report_progress(progress, rec.t.len(), t_rec) {

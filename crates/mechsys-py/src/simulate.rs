@@ -326,6 +326,9 @@ fn simulate<'py>(
         put("group_impulse_n", rec.group_impulse_n, &[n, ng])?;
         put("group_pairs", rec.group_pairs, &[n, ng])?;
         put("group_impulse_against", rec.group_impulse_against, &[n, ng, 3])?;
+        let total = rec.group_points.len();
+        put("group_point_count", rec.group_point_count.iter().map(|&c| c as f64).collect(), &[n, ng])?;
+        put("group_points", rec.group_points.iter().flatten().copied().collect(), &[total, 7])?;
     }
     let st = PyDict::new(py);
     st.set_item("steps", rec.stats.steps)?;

@@ -12,9 +12,9 @@ What the page shows:
   body with neither is drawn as rods from its centre of mass to its joints and attachment points;
 * joint frames and markers as axis triads (toggle "frames"), the path of chosen points as
   trails, a camera that orbits, pans, zooms and follows a body;
-* contacts (explicit ones; groups record no points): a dot at the contact point, the normal
-  force and the friction force as arrows scaled by magnitude, coloured by state (open grey, stick
-  blue, slip orange), impacts flashed at their events;
+* contacts: a dot at the contact point, the normal force and the friction force as arrows scaled
+  by magnitude, coloured by state (open grey, stick blue, slip orange), impacts flashed at their
+  events; a contact group's closed points with their whole contact force as one arrow;
 * plots of signals with a cursor following the timeline; a click on a plot moves the timeline.
 
 Frames are decimated to at most ``max_frames`` (uniform in time, plus every event's sample), so
@@ -41,6 +41,7 @@ __all__ = ["page_data", "to_html", "view", "mode_results", "bundle_path"]
 
 _BUNDLE = Path(__file__).parent / "_bundle"
 _STATE_NAMES = ["open", "stick", "slip"]
+_MAX_GROUP_SLOTS = 400  # contact points drawn per group and frame
 
 
 def bundle_path() -> Path:
@@ -521,6 +522,22 @@ def _contacts(res, model: dict, idx: np.ndarray, scene: float) -> list[dict]:
             raw.append((label, name, p[:, k], n[:, k], ln[:, k], ft[:, k], st[:, k]))
             fmax = max(fmax, float(np.nanmax(np.abs(_finite(ln[:, k])), initial=0.0)),
                        float(np.nanmax(np.linalg.norm(_finite(ft[:, k]), axis=-1), initial=0.0)))
+    # contact groups: the points closed in the last step before each sample (padded slots)
+    for g in model.get("contact_groups", []):
+        name = g["name"]
+        if f"contact/{name}/points" not in res:
+            continue
+        p = np.asarray(res[f"contact/{name}/points"])[idx][:, :_MAX_GROUP_SLOTS]
+        f = np.asarray(res[f"contact/{name}/point_forces"])[idx][:, :_MAX_GROUP_SLOTS]
+        st = np.asarray(res[f"contact/{name}/point_states"])[idx][:, :_MAX_GROUP_SLOTS]
+        for k in range(p.shape[1]):
+            fk = _finite(f[:, k])
+            # the force split along and across the normal is not recorded: the whole force is
+            # drawn as the "normal" arrow, no friction arrow
+            ln = np.linalg.norm(fk, axis=1)
+            unit = np.divide(fk, ln[:, None], out=np.zeros_like(fk), where=ln[:, None] > 0)
+            raw.append((f"{name}[{k}]", name, p[:, k], unit, ln, np.zeros_like(fk), st[:, k]))
+            fmax = max(fmax, float(ln.max(initial=0.0)))
     scale = 0.2 * scene / fmax if fmax > 0 else 0.0
     for label, name, p, n, ln, ft, st in raw:
         out.append({"name": label, "contact": name, "point": _b64(_finite(p), "float32"),

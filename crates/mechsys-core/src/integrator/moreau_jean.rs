@@ -130,6 +130,10 @@ struct Active {
     source: Source,
 }
 
+/// Closed points a contact group keeps for the record, per contour of the group (members and
+/// `against`): a sphere in a pile touches its neighbours and the floor at a few points.
+pub const GROUP_POINTS_PER_CONTOUR: usize = 8;
+
 /// What a contact group did since the last [`MoreauJean::take_group_stats`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct GroupStats {
@@ -199,6 +203,9 @@ pub struct MoreauJean {
     /// Broad and narrow phase of each contact group.
     pub groups: Vec<GroupPhase>,
     group_stats: Vec<GroupStats>,
+    /// Per group: the points closed in the last step, `[p (3), force on the first contour's body
+    /// (3), state]`, at most the capacity reserved up front (no allocation while stepping).
+    group_points: Vec<Vec<[f64; 7]>>,
     act: Vec<Active>,
     sparse: Option<SparseRows>,
     /// Steps taken (for the validity of the groups' warm starts).
@@ -287,6 +294,11 @@ impl MoreauJean {
             unconverged: (0, 0.0),
             groups: model.contact_groups.iter().map(GroupPhase::new).collect(),
             group_stats: vec![GroupStats::default(); model.contact_groups.len()],
+            group_points: model
+                .contact_groups
+                .iter()
+                .map(|g| Vec::with_capacity(GROUP_POINTS_PER_CONTOUR * (g.members.len() + g.against.len()).max(8)))
+                .collect(),
             act: Vec::with_capacity(np),
             sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
             steps: 0,
@@ -300,6 +312,13 @@ impl MoreauJean {
     /// Whether the contact problem is assembled sparsely.
     pub fn is_sparse(&self) -> bool {
         self.sparse.is_some()
+    }
+
+    /// Each group's points closed in the last step: `[x, y, z, fx, fy, fz, state]`, the contact
+    /// point on the first contour and the contact force on its body (impulse over the step, world
+    /// components). At most [`GROUP_POINTS_PER_CONTOUR`] per contour of the group are kept.
+    pub fn group_points(&self, group: usize) -> &[[f64; 7]] {
+        &self.group_points[group]
     }
 
     /// The statistics of each contact group since the last call, then reset (the count of closed
@@ -654,6 +673,7 @@ impl MoreauJean {
             for s in self.group_stats.iter_mut() {
                 s.closed = 0;
             }
+            self.group_points.iter_mut().for_each(Vec::clear);
             let mut after = [0.0; 3];
             let r_scale = 1.0 + self.r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let q_scale = 1.0 + self.problem.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -693,6 +713,12 @@ impl MoreauJean {
                         }
                         if imp[0] > 0.0 {
                             st.closed += 1;
+                            let pts = &mut self.group_points[group];
+                            if pts.len() < pts.capacity() {
+                                let p = &self.act[ai].point;
+                                let f = (p.n * imp[0] + p.t1 * imp[1] + p.t2 * imp[2]) / h;
+                                pts.push([p.p1.x, p.p1.y, p.p1.z, f.x, f.y, f.z, code as f64]);
+                            }
                         }
                     }
                 }
@@ -734,6 +760,7 @@ impl MoreauJean {
             for s in self.group_stats.iter_mut() {
                 s.closed = 0;
             }
+            self.group_points.iter_mut().for_each(Vec::clear);
         }
         // explicit points that are not active carry no impulse and are open
         let mut next = 0;
