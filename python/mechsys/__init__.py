@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, urdf
+from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, mjcf, urdf
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -24,6 +24,7 @@ from .model import Body, Model
 from .results import Results, load
 from .simulate import simulate
 from .urdf import load_urdf
+from .mjcf import load_mjcf
 
 
 def plot(results, signals, out=None, **kwargs):
@@ -40,6 +41,7 @@ __all__ = [
     "Frame",
     "simulate",
     "load_urdf",
+    "load_mjcf",
     "Results",
     "load",
     "plot",
@@ -60,6 +62,7 @@ __all__ = [
     "laws",
     "mechanisms",
     "urdf",
+    "mjcf",
     "analysis",
     "bearings",
     "forces",
