@@ -6,14 +6,14 @@ STAMP  := $(VENV)/.deps-stamp
 BUILD  := $(VENV)/.build-stamp
 CORE_SOURCES := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml Cargo.lock pyproject.toml
 
-.PHONY: all demo test test-rust test-python bench bench-rust build clean
+.PHONY: all demo test test-rust test-python bench bench-rust build clean docs
 
 all: build
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin
+	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin mujoco mkdocs "mkdocstrings[python]"
 	touch $(STAMP)
 
 # The core in release mode, installed into the venv as an editable package.
@@ -22,6 +22,10 @@ $(BUILD): $(STAMP) $(CORE_SOURCES)
 	touch $(BUILD)
 
 build: $(BUILD)
+
+# The guides and the API reference from the docstrings into site/; --strict fails on a broken link or reference.
+docs: $(STAMP)
+	$(VENV)/bin/mkdocs build --strict
 
 demo: $(BUILD)
 	$(PY) examples/woodpecker.py
@@ -48,4 +52,4 @@ bench: $(BUILD)
 	$(PY) benches/planar.py --out docs/benchmarks.md
 
 clean:
-	rm -rf $(VENV) target results
+	rm -rf $(VENV) target results site

@@ -55,12 +55,19 @@ class ModelImport:
     turned into markers."""
 
     model: Model
+    """The imported model."""
     root: str
+    """The root link (URDF) or ``"world"`` (MJCF)."""
     limits: dict[str, JointLimit] = field(default_factory=dict)
+    """{joint: :class:`JointLimit`}."""
     contours: dict[str, list] = field(default_factory=dict)
+    """{link or body: [(mechsys body, contour)]}."""
     visuals: dict[str, list[Visual]] = field(default_factory=dict)
+    """{link or body: [:class:`Visual`]}."""
     mimics: dict[str, tuple[str, float, float]] = field(default_factory=dict)
+    """{joint: (mimicked joint, multiplier, offset)} (URDF ``<mimic>``)."""
     markers: dict[str, str] = field(default_factory=dict)
+    """{massless fixed link or body: the mechsys body that carries it as a marker}."""
 
     def contour_list(self) -> list:
         """Every contour as ``OnBody`` (the body and its contour), for a contact group's members."""

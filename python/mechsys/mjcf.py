@@ -55,6 +55,7 @@ class MJCFImport(ModelImport):
     the model holds that the import leaves out."""
 
     ignored: list[str] = field(default_factory=list)
+    """What the model holds that the import leaves out, each item named."""
 
 
 def _mujoco():

@@ -6,7 +6,8 @@ frames, the inertias, the contours) is ours, so every error can name the link, j
 Frames. A URDF link frame is the mechsys body frame. A joint's ``<origin>`` places the joint frame
 in the parent link, which is exactly a mechsys ``parent_frame`` (rotation ``A`` with
 ``v_parent = A v_joint``); the child link frame is the joint frame at q = 0, so ``child_frame``
-is the identity (except for a planar joint, see :func:`_planar_alignment`). The ``<inertial>``
+is the identity (except for a planar joint, whose plane normal to the axis becomes the
+mechsys joint frame's x-y plane). The ``<inertial>``
 frame may be offset and turned in the link: its origin is the body's centre of mass and its
 tensor, given in the inertial frame's axes, is turned into link axes as ``R I R^T``.
 
