@@ -35,6 +35,7 @@ def test_strict_build_of_the_docs(tmp_path):
 @pytest.mark.parametrize("broken, message", [
     ("role", "pkg.mod.f: :func:`nowhere` names nothing in the package"),
     ("hidden", "Could not find cross-reference target 'pkg.mod._private'"),
+    ("unreadable", "cannot read the role ':func:`more <g>`'"),
     ("link", "contains a link 'missing.md', but the target is not found"),
     ("anchor", "no such anchor"),
 ])
@@ -44,7 +45,7 @@ def test_strict_build_fails_on_a_broken_reference(tmp_path, broken, message):
     (tmp_path / "pkg").mkdir(parents=True)
     (tmp_path / "pkg" / "pkg").mkdir()
     (tmp_path / "pkg" / "pkg" / "__init__.py").write_text('"""A package."""\n')
-    role = {"role": ":func:`nowhere`", "hidden": ":func:`_private`"}.get(broken, ":func:`g`")
+    role = {"role": ":func:`nowhere`", "hidden": ":func:`_private`", "unreadable": ":func:`more <g>`"}.get(broken, ":func:`g`")
     (tmp_path / "pkg" / "pkg" / "mod.py").write_text(
         f'"""A module."""\n\n\ndef f():\n    """Calls {role}."""\n\n\ndef g():\n    """Is called."""\n\n\n'
         'def _private():\n    """Hidden."""\n')

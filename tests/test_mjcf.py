@@ -141,6 +141,36 @@ def test_free_joint_matches_mujoco_with_its_velocity_convention():
         assert np.abs(d.qacc).max() > 1.0
 
 
+TWO_JOINTS = """<mujoco model="two"><compiler angle="radian"/><option gravity="0.5 0 -9.81"/>
+  <worldbody><body name="hip" pos="0 0 1" euler="0.2 -0.1 0.3">
+    <joint name="hx" axis="1 0.2 0" pos="0.02 0 0.01" ref="0.3"/><joint name="hy" axis="0 1 0.3" pos="0.02 0 0.01" ref="-0.2"
+      damping="0.3" stiffness="1.5" springref="0.1"/>
+    <inertial pos="0.1 0.02 -0.2" quat="0.9 0.1 0.3 0" mass="2" diaginertia="0.04 0.03 0.02"/>
+    <body name="piston" pos="0.1 0 -0.4" euler="0.4 0 0">
+      <joint name="turn" axis="0 0.6 0.8" pos="0 0.01 0" ref="0.5"/><joint name="push" type="slide" axis="0 0.6 0.8" ref="0.05"/>
+      <inertial pos="0.03 0 -0.05" quat="0.7 0 0.7 0.1" mass="0.7" diaginertia="0.002 0.003 0.004"/>
+    </body></body></worldbody></mujoco>"""
+
+
+def test_two_joints_on_a_body_as_universal_and_cylindrical():
+    imp = load_mjcf(TWO_JOINTS)
+    kinds = {j["name"]: j["type"] for j in imp.model.joint_info()}
+    assert kinds == {"hx_hy": "universal", "turn_push": "cylindrical"}
+    assert imp.compound == {"hx_hy": ["hx", "hy"], "turn_push": ["turn", "push"]}
+    m = mj_model(TWO_JOINTS)
+    np.testing.assert_allclose(imp.model.q0(), m.qpos0, atol=0)
+    for q, v in configurations(m, 4, seed=8):
+        d, M_ref = mj_state(m, q, v)
+        np.testing.assert_allclose(ms.dynamics.mass_matrix(imp.model, q), M_ref, rtol=0, atol=1e-12 * np.abs(M_ref).max())
+        a = ms.dynamics.forward_dynamics(imp.model, q, v)
+        np.testing.assert_allclose(a, d.qacc, rtol=0, atol=1e-11 * np.abs(d.qacc).max())
+    with pytest.raises(ms.ModelError, match="joint 'hx' is a coordinate of the mechsys joint 'hx_hy'"):
+        load_mjcf(TWO_JOINTS.replace('ref="0.3"', 'ref="0.3" range="-1 1"'), limits="stops")
+    apart = TWO_JOINTS.replace('pos="0.02 0 0.01" ref="-0.2"', 'pos="0.03 0 0.01" ref="-0.2"')
+    with pytest.raises(ms.ModelError, match=r"body 'hip': 2 joints \('hx' \(hinge\), 'hy' \(hinge\)\).*two hinges through one point"):
+        load_mjcf(apart)
+
+
 def test_limit_stops_and_cli_round_trip(tmp_path):
     from click.testing import CliRunner
 

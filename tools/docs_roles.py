@@ -14,6 +14,7 @@ import re
 import griffe
 
 log = logging.getLogger("mkdocs.plugins.mechsys_roles")
+ANY_ROLE = re.compile(r":(?:py:)?(?:class|func|meth|attr|mod|data|exc|obj):`[^`]*`?")
 ROLE = re.compile(r":(?:py:)?(class|func|meth|attr|mod|data|exc|obj):`([~!.]?)([A-Za-z_][\w.]*)`")
 EXTERNAL = ("numpy", "scipy", "matplotlib", "pandas", "xarray", "h5py", "mujoco", "trimesh", "yourdfpy", "click")
 
@@ -28,6 +29,8 @@ class SphinxRoles(griffe.Extension):
             return
         if obj.docstring is not None:
             obj.docstring.value = ROLE.sub(lambda m: self.replace(obj, m), obj.docstring.value)
+            for left in ANY_ROLE.findall(obj.docstring.value):
+                log.warning("%s: cannot read the role %r (write :role:`name` or :role:`~dotted.name`)", obj.path, left)
         for member in list(obj.members.values()):
             if not member.is_alias:
                 self.visit(member)

@@ -14,11 +14,14 @@ the parent frame). A ball joint's quaternion and a free joint's position and qua
 MuJoCo's ``qpos`` too. Velocities: hinge, slide and ball are MuJoCo's ``qvel``; a free joint's
 linear velocity is in the body frame here and in the world frame in MuJoCo (``v_B = R^T v_W``).
 
-Bodies without a joint are welded to their parent: with mass, a body on a :class:`Fixed
-<mechsys.joints.Fixed>` joint; without mass, or welded to the world, a marker on the body they
-hang from (their geometry goes there too). A body with more than one joint has no mechsys
-counterpart (mechsys bodies need a mass, so there is no chain of massless bodies) and is an
-error naming the body and its joints.
+Bodies without a joint are welded to their parent: with mass, a body on a
+:class:`~mechsys.joints.Fixed` joint; without mass, or welded to the world, a marker on the body they
+hang from (their geometry goes there too). Two joints on one body become one mechsys joint when
+one reproduces them with MuJoCo's coordinates: two hinges through one point a
+:class:`~mechsys.joints.Universal` joint, a hinge and then a slide along its axis a
+:class:`~mechsys.joints.Cylindrical` joint, named ``<joint1>_<joint2>``. Other
+combinations have no mechsys counterpart (mechsys bodies need a mass, so there is no chain of
+massless bodies) and are an error naming the body and its joints.
 
 Geoms become contours (sphere, capsule, box, cylinder, ellipsoid, plane and mesh, with their
 vertices from the compiled model) and visual records; height fields and SDFs are visual records
@@ -56,6 +59,8 @@ class MJCFImport(ModelImport):
 
     ignored: list[str] = field(default_factory=list)
     """What the model holds that the import leaves out, each item named."""
+    compound: dict[str, list[str]] = field(default_factory=dict)
+    """{mechsys joint: [MuJoCo joints]} for the bodies with two joints (see :func:`load_mjcf`)."""
 
 
 def _mujoco():
@@ -127,10 +132,14 @@ def load_mjcf(source, *, contours: str | None = "collision", limits: str = "data
     m, label = _compile(source, mujoco)
     out = _Walker(m, mujoco, label).build(name, contours)
     if limits == "stops":
+        in_compound = {j: c for c, js in out.compound.items() for j in js}
         for j, lim in out.limits.items():
             if lim.lower is None:
                 raise ModelError(f"{label}: joint '{j}': a ball joint's cone limit cannot be a gap stop "
                                  "(load with limits='data')")
+            if j in in_compound:
+                raise ModelError(f"{label}: joint '{j}' is a coordinate of the mechsys joint '{in_compound[j]}': its "
+                                 "limit cannot be a gap stop (load with limits='data')")
         add_limit_stops(out.model, out.limits, label)
     if out.ignored and unsupported != "ignore":
         text = f"{label}: not imported: " + "; ".join(out.ignored)
@@ -198,25 +207,36 @@ class _Walker:
                                           parent_frame=_joints.Frame(position=tuple(pb), rotation=Rb.tolist())))
             place[b] = (bname, np.eye(3), np.zeros(3))
             return
-        if count > 1:
-            names = ", ".join(f"'{self.joints[j]}' ({_JOINTS[int(m.jnt_type[j])]})" for j in range(first, first + count))
-            raise ModelError(f"{w}: {count} joints ({names}): mechsys has one joint per body, and no massless bodies "
-                             "to chain them (split the body into bodies with mass, one joint each)")
-        j = first
-        jname, kind = self.joints[j], _JOINTS[int(m.jnt_type[j])]
-        wj = f"{self.label}: joint '{jname}'"
         check_inertia(w, mass, inertia)
         model.add_body(bname, mass, inertia, com=tuple(com))
         place[b] = (bname, np.eye(3), np.zeros(3))
+        if count > 1:
+            self.compound(b, parent, Rb, pb, out)
+        else:
+            self.joint(first, bname, parent, Rb, pb, out)
+        for j in range(first, first + count):
+            self.limit(j, out)
+
+    def spring_damper(self, js: list[int]) -> dict:
+        """Joint damping and stiffness (about ``springref``) of hinge and slide joints."""
+        m, extra = self.m, {}
+        d = [float(m.dof_damping[m.jnt_dofadr[j]]) for j in js]
+        k = [float(m.jnt_stiffness[j]) for j in js]
+        if any(d):
+            extra["damper"] = _joints.JointDamper(d if len(d) > 1 else d[0])
+        if any(k):
+            q_free = [float(m.qpos_spring[m.jnt_qposadr[j]]) for j in js]
+            extra["spring"] = _joints.JointSpring(k if len(k) > 1 else k[0], q_free if len(k) > 1 else q_free[0])
+        return extra
+
+    def joint(self, j: int, bname: str, parent: str, Rb: np.ndarray, pb: np.ndarray, out: MJCFImport) -> None:
+        m, model = self.m, out.model
+        jname, kind = self.joints[j], _JOINTS[int(m.jnt_type[j])]
+        wj = f"{self.label}: joint '{jname}'"
         p = np.array(m.jnt_pos[j], dtype=float)
         axis = np.array(m.jnt_axis[j], dtype=float)
-        qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
-        extra = {}
-        if kind in ("hinge", "slide"):
-            if m.dof_damping[da] != 0.0:
-                extra["damper"] = _joints.JointDamper(float(m.dof_damping[da]))
-            if m.jnt_stiffness[j] != 0.0:
-                extra["spring"] = _joints.JointSpring(float(m.jnt_stiffness[j]), float(m.qpos_spring[qa]))
+        qa = int(m.jnt_qposadr[j])
+        extra = self.spring_damper([j]) if kind in ("hinge", "slide") else {}
         if kind == "hinge":
             ref = float(m.qpos0[qa])
             frame = _joints.Frame(position=tuple(Rb @ p + pb), rotation=(Rb @ rot_axis(axis, -ref)).tolist())
@@ -232,18 +252,55 @@ class _Walker:
             model.add_joint(_joints.Spherical(jname, parent, bname, parent_frame=frame,
                                               child_frame=_joints.Frame(position=tuple(p))))
         else:  # free: MuJoCo's qpos is the body frame in the world, whatever the parent
-            if parent != "ground" or int(m.body_parentid[b]) != 0:
+            if parent != "ground":
                 raise ModelError(f"{wj}: a free joint is placed in the world; mechsys's Free joint is relative to "
                                  f"its parent, so body '{bname}' must be a child of the world body")
             model.add_joint(_joints.Free(jname, "ground", bname, q0=[float(x) for x in m.qpos0[qa:qa + 7]]))
-        if m.jnt_limited[j]:
-            lo, hi = (float(x) for x in m.jnt_range[j])
-            if kind in ("hinge", "slide"):
-                if lo > hi:
-                    raise ModelError(f"{wj}: the lower limit {lo:g} is above the upper limit {hi:g}")
-                out.limits[jname] = JointLimit(lo, hi)
-            elif kind == "ball":
-                out.limits[jname] = JointLimit(None, hi)  # a cone: the largest angle from the reference
+
+    def compound(self, b: int, parent: str, Rb: np.ndarray, pb: np.ndarray, out: MJCFImport) -> None:
+        """Two joints on one body that one mechsys joint reproduces with MuJoCo's coordinates: two
+        hinges through one point (Universal) or a hinge and then a slide along its axis
+        (Cylindrical). Anything else is an error naming the body and its joints."""
+        m, bname = self.m, self.bodies[b]
+        first, count = int(m.body_jntadr[b]), int(m.body_jntnum[b])
+        js = list(range(first, first + count))
+        kinds = [_JOINTS[int(m.jnt_type[j])] for j in js]
+        p = [np.array(m.jnt_pos[j], dtype=float) for j in js]
+        a = [np.array(m.jnt_axis[j], dtype=float) for j in js]
+        ref = [float(m.qpos0[m.jnt_qposadr[j]]) for j in js]
+        name = "_".join(self.joints[j] for j in js)
+        tol = 1e-12
+        if kinds == ["hinge", "hinge"] and np.allclose(p[0], p[1], rtol=0, atol=tol) and np.linalg.norm(np.cross(a[0], a[1])) > 1e-9:
+            # R(a1, q1 - r1) R(a2, q2 - r2) = R(a1, -r1) [R(a1, q1) R(a2, q2)] R(a2, -r2)
+            frame = _joints.Frame(position=tuple(Rb @ p[0] + pb), rotation=(Rb @ rot_axis(a[0], -ref[0])).tolist())
+            child = _joints.Frame(position=tuple(p[0]), rotation=rot_axis(a[1], ref[1]).tolist())
+            joint = _joints.Universal(name, parent, bname, axis=tuple(a[0]), axis2=tuple(a[1]), parent_frame=frame,
+                                      child_frame=child, q0=ref, **self.spring_damper(js))
+        elif kinds == ["hinge", "slide"] and np.allclose(a[0], a[1], rtol=0, atol=tol):
+            # rotation about and translation along one axis commute: both references go to the parent frame
+            frame = _joints.Frame(position=tuple(Rb @ (p[0] - ref[1] * a[0]) + pb), rotation=(Rb @ rot_axis(a[0], -ref[0])).tolist())
+            joint = _joints.Cylindrical(name, parent, bname, axis=tuple(a[0]), parent_frame=frame,
+                                        child_frame=_joints.Frame(position=tuple(p[0])), q0=ref, **self.spring_damper(js))
+        else:
+            names = ", ".join(f"'{self.joints[j]}' ({k})" for j, k in zip(js, kinds))
+            raise ModelError(f"{self.label}: body '{bname}': {count} joints ({names}): mechsys has one joint per body and no "
+                             "massless bodies to chain them; two hinges through one point (universal) and a hinge then a "
+                             "slide along its axis (cylindrical) are imported, other combinations are not")
+        out.model.add_joint(joint)
+        out.compound[name] = [self.joints[j] for j in js]
+
+    def limit(self, j: int, out: MJCFImport) -> None:
+        m = self.m
+        if not m.jnt_limited[j]:
+            return
+        jname, kind = self.joints[j], _JOINTS[int(m.jnt_type[j])]
+        lo, hi = (float(x) for x in m.jnt_range[j])
+        if kind in ("hinge", "slide"):
+            if lo > hi:
+                raise ModelError(f"{self.label}: joint '{jname}': the lower limit {lo:g} is above the upper limit {hi:g}")
+            out.limits[jname] = JointLimit(lo, hi)
+        elif kind == "ball":
+            out.limits[jname] = JointLimit(None, hi)  # a cone: the largest angle from the reference
 
     def unsupported(self, out: MJCFImport) -> None:
         m, notes = self.m, out.ignored
