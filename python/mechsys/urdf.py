@@ -306,6 +306,14 @@ class _Loader:
             other = j.mimic.joint
             if other not in kinds:
                 raise ModelError(f"{w}: mimicked joint '{other}' is not defined")
+            chain, follow = [j.name], other
+            while follow is not None and follow not in chain:
+                chain.append(follow)
+                nxt = next((k for k in order if k.name == follow), None)
+                follow = nxt.mimic.joint if nxt is not None and nxt.mimic is not None else None
+            if follow is not None:
+                raise ModelError(f"{w}: the mimic joints form a cycle ({' -> '.join(chain + [follow])}): "
+                                 "no joint in it moves on its own")
             single = ("revolute", "continuous", "prismatic")
             if kinds[other] not in single or j.type not in single:
                 raise ModelError(f"{w}: only revolute, continuous and prismatic joints can mimic each other "
