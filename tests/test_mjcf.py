@@ -65,6 +65,7 @@ def arm():
 
 def test_tree_is_as_written(arm):
     m = arm.model
+    assert m.name == "test_arm" and load_mjcf("<mujoco><worldbody/></mujoco>").model.name == "MuJoCo Model"
     assert [b["name"] for b in m.body_info()] == ["base", "upper", "camera", "slider", "wrist", "finger"]
     kinds = {j["name"]: j["type"] for j in m.joint_info()}
     assert kinds == {"j_base": "revolute", "j_shoulder": "revolute", "camera_weld": "fixed", "j_slide": "prismatic",

@@ -172,7 +172,7 @@ class _Walker:
         gravity = np.array(m.opt.gravity, dtype=float)
         if m.opt.disableflags & int(self.mj.mjtDisableBit.mjDSBL_GRAVITY):
             gravity = np.zeros(3)
-        model_name = name or (self.mj.mj_id2name(m, self.mj.mjtObj.mjOBJ_MODEL, 0) if hasattr(self.mj.mjtObj, "mjOBJ_MODEL") else None)
+        model_name = name or bytes(m.names[:200]).split(b"\0", 1)[0].decode(errors="replace")  # <mujoco model=...> comes first
         model = Model(model_name or "mjcf", gravity=tuple(gravity))
         out = MJCFImport(model=model, root="world")
         if "ground" in self.bodies:
