@@ -263,9 +263,10 @@ def test_dropped_sphere_rests_on_the_imported_floor():
     """The plane and sphere geoms as contours: a free ball falls onto the floor and rests one
     radius above it."""
     text = """<mujoco><worldbody><geom name="floor" type="plane" size="1 1 0.1"/>
-      <body name="ball" pos="0 0 0.3"><freejoint name="ball_free"/><geom name="skin" type="sphere" size="0.05" mass="0.5"/></body>
+      <body name="ball" pos="0 0 0.3"><freejoint/><geom name="skin" type="sphere" size="0.05" mass="0.5"/></body>
       </worldbody></mujoco>"""
     imp = load_mjcf(text)
+    assert [j["name"] for j in imp.model.joint_info()] == ["ball_free"]  # an unnamed joint: after its body
     (floor,), (skin,) = imp.contours["world"], imp.contours["ball"]
     m = imp.model
     m.add_contact(ms.Contact("floor", ms.contours.OnBody(*skin), ms.contours.OnBody(*floor)))

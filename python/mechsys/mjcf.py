@@ -71,13 +71,14 @@ def _mujoco():
     return mujoco
 
 
-def _names(m, mujoco, kind, count: int, prefix: str) -> list[str]:
-    """Every object's name; unnamed ones get ``<prefix><id>`` (made unique against the named)."""
+def _names(m, mujoco, kind, count: int, prefix) -> list[str]:
+    """Every object's name; unnamed ones get ``prefix(id)`` or ``<prefix><id>`` (made unique
+    against the named ones)."""
     names = [mujoco.mj_id2name(m, kind, i) or "" for i in range(count)]
     taken = set(names)
     for i, n in enumerate(names):
         if not n:
-            cand = f"{prefix}{i}"
+            cand = prefix(i) if callable(prefix) else f"{prefix}{i}"
             while cand in taken:
                 cand += "_"
             names[i] = cand
@@ -155,7 +156,9 @@ class _Walker:
         obj = mujoco.mjtObj
         self.bodies = _names(m, mujoco, obj.mjOBJ_BODY, m.nbody, "body")
         self.bodies[0] = "world"
-        self.joints = _names(m, mujoco, obj.mjOBJ_JOINT, m.njnt, "joint")
+        # an unnamed joint is called after its body and kind: <body>_free, <body>_hinge, ...
+        self.joints = _names(m, mujoco, obj.mjOBJ_JOINT, m.njnt,
+                             lambda j: f"{self.bodies[m.jnt_bodyid[j]]}_{_JOINTS[int(m.jnt_type[j])]}")
         self.geoms = _names(m, mujoco, obj.mjOBJ_GEOM, m.ngeom, "geom")
 
     def body_pose(self, b: int) -> tuple[np.ndarray, np.ndarray]:
@@ -321,6 +324,8 @@ class _Walker:
                                    (m.neq, obj.mjOBJ_EQUALITY, "equality constraint"), (m.nsensor, obj.mjOBJ_SENSOR, "sensor")):
             for i in range(count):
                 notes.append(f"{label} '{self.mj.mj_id2name(m, kind, i) or i}'")
+        if m.npair or m.nexclude:
+            notes.append(f"{m.npair} contact pair(s) and {m.nexclude} exclude(s) (pair contours with ms.Contact instead)")
         if getattr(m, "nflex", 0):
             notes.append(f"{m.nflex} flex object(s)")
         if m.opt.density != 0.0 or m.opt.viscosity != 0.0 or np.any(np.asarray(m.opt.wind) != 0.0):
