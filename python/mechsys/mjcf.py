@@ -38,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
+from . import contours as _contours
 from . import joints as _joints
 from ._import import JointLimit, ModelImport, Visual, add_limit_stops, check_inertia, check_limit_mode, primitive_contour
-from . import contours as _contours
 from .errors import ModelError
 from .kinematics import quat_to_matrix, rot_axis
 from .model import Model
