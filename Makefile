@@ -6,14 +6,14 @@ STAMP  := $(VENV)/.deps-stamp
 BUILD  := $(VENV)/.build-stamp
 CORE_SOURCES := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml Cargo.lock pyproject.toml
 
-.PHONY: all demo test test-rust test-python bench bench-rust build clean viewer
+.PHONY: all demo test test-rust test-python bench bench-rust build clean viewer docs
 
 all: build
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin playwright
+	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin playwright mujoco mkdocs "mkdocstrings[python]"
 	touch $(STAMP)
 
 # The core in release mode, installed into the venv as an editable package.
@@ -33,6 +33,10 @@ $(VIEWER_JS): viewer/package.json viewer/package-lock.json $(wildcard viewer/src
 viewer: $(VIEWER_JS)
 
 build: $(BUILD) viewer
+
+# The guides and the API reference from the docstrings into site/; --strict fails on a broken link or reference.
+docs: $(STAMP)
+	$(VENV)/bin/mkdocs build --strict
 
 demo: $(BUILD)
 	$(PY) examples/woodpecker.py
@@ -60,4 +64,4 @@ bench: $(BUILD)
 	$(PY) benches/viewer.py --out docs/benchmarks.md
 
 clean:
-	rm -rf $(VENV) target results
+	rm -rf $(VENV) target results site

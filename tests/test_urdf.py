@@ -357,6 +357,37 @@ def test_more_errors(monkeypatch):
         load_urdf(_one_joint())
 
 
+def test_bad_files_are_errors_naming_the_item(tmp_path):
+    """The bad-input catalogue of URDF files: every case a ModelError naming the file, link or
+    joint, and none of them slow (a cycle must not send the tree walk round and round)."""
+    import time
+
+    arm_inertial = inertial(1.0, "0 0 0", "0 0 0", 0.01, 0.01, 0.01)
+    two = f"""<robot name="loop"><link name="a">{arm_inertial}</link><link name="b">{arm_inertial}</link>
+      <joint name="ab" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>
+      <joint name="ba" type="revolute"><parent link="b"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>"""
+    mimic_loop = _one_joint(extra=f'<link name="tip">{arm_inertial}</link><joint name="j2" type="revolute"><parent link="arm"/>'
+                                  '<child link="tip"/><axis xyz="0 0 1"/><mimic joint="j1"/></joint>') \
+        .replace('<axis xyz="0 0 1"/>\n', '<axis xyz="0 0 1"/><mimic joint="j2"/>\n', 1)
+    (tmp_path / "junk.stl").write_bytes(b"\x00\x01 not a mesh" * 8)
+    (tmp_path / "junk.urdf").write_text(_one_joint(child_geometry='<collision><geometry><mesh filename="junk.stl"/></geometry></collision>'))
+    (tmp_path / "empty.urdf").write_text("")
+    cases = [
+        (two, "no root link: the joints form a cycle through every link"),
+        (_one_joint(extra='<joint name="self" type="fixed"><parent link="arm"/><child link="arm"/></joint>'),
+         "joint 'self': link 'arm' already has the parent joint 'j1'"),
+        (mimic_loop, r"joint 'j1'.mimic: the mimic joints form a cycle \(j1 -> j2 -> j1\)"),
+        (_one_joint().replace('<axis xyz="0 0 1"/>', '<origin xyz="nan 0 0"/><axis xyz="0 0 1"/>'), "joint 'j1': the origin is not a finite transform"),
+        (tmp_path / "junk.urdf", r"junk.urdf: link 'arm'.collision\[0\]: mesh file 'junk.stl'"),
+        (tmp_path / "empty.urdf", "empty.urdf: cannot read the URDF"),
+    ]
+    for source, message in cases:
+        start = time.perf_counter()
+        with pytest.raises(ms.ModelError, match=message):
+            load_urdf(source)
+        assert time.perf_counter() - start < 5.0, message
+
+
 def test_toml_writer_round_trips_awkward_values():
     import tomllib
 

@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, urdf, viewer
+from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, mjcf, urdf, viewer
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -25,6 +25,7 @@ from .results import Results, load
 from .simulate import simulate
 from .urdf import load_urdf
 from .viewer import view
+from .mjcf import load_mjcf
 
 
 def plot(results, signals, out=None, **kwargs):
@@ -43,6 +44,7 @@ __all__ = [
     "load_urdf",
     "view",
     "viewer",
+    "load_mjcf",
     "Results",
     "load",
     "plot",
@@ -63,6 +65,7 @@ __all__ = [
     "laws",
     "mechanisms",
     "urdf",
+    "mjcf",
     "analysis",
     "bearings",
     "forces",

@@ -5,7 +5,7 @@ linear vibrations.
 
     mechsys run model.toml --t-end 2 --out results.h5 --plot q.png
     mechsys info model.toml
-    mechsys import robot.urdf -o robot.toml
+    mechsys import robot.urdf -o robot.toml     (or a MuJoCo model.xml)
     mechsys signals results.h5
     mechsys plot results.h5 joint/hinge/q energy/total --out q.svg
     mechsys view results.h5 --trail bird --out page.html
@@ -382,6 +382,10 @@ def info(model_file: Path) -> None:
         from .urdf import load_urdf
 
         model, sim = load_urdf(model_file).model, {}
+    elif model_file.suffix.lower() in _MJCF_SUFFIXES:
+        from .mjcf import load_mjcf
+
+        model, sim = load_mjcf(model_file, unsupported="ignore").model, {}
     else:
         model, sim = load_model(model_file)
     core = model.build()
@@ -452,30 +456,43 @@ def info(model_file: Path) -> None:
             click.echo(f"  {k} = {v}")
 
 
+_MJCF_SUFFIXES = (".xml", ".mjcf")
+
+
 @cli.command("import")
-@click.argument("urdf_file", metavar="ROBOT.urdf", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("urdf_file", metavar="ROBOT.urdf|MODEL.xml", type=click.Path(path_type=Path, dir_okay=False))
 @click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False), help="TOML model file [default: ROBOT.toml].")
 @click.option("--root", type=click.Choice(["ground", "free"]), default="ground", show_default=True,
-              help="Fixed base (the root link is the ground) or a free-floating base.")
+              help="URDF: fixed base (the root link is the ground) or a free-floating base.")
 @click.option("--limits", type=click.Choice(["data", "stops"]), default="data", show_default=True,
               help="Joint limits as data only, or also as gap-contact stops.")
 @click.option("--package-dir", "package_dirs", multiple=True, type=click.Path(path_type=Path, file_okay=False),
-              help="Folder searched for package:// meshes (repeatable).")
+              help="URDF: folder searched for package:// meshes (repeatable).")
 def import_cmd(urdf_file: Path, out: Path | None, root: str, limits: str, package_dirs: tuple[Path, ...]) -> None:
-    """Import a URDF robot description as a TOML model file that run and info accept.
+    """Import a URDF robot description or a MuJoCo MJCF model (.xml, .mjcf; compiled by the
+    mujoco package) as a TOML model file that run and info accept.
 
-    Links become bodies, joints joints, mimic joints couplers. Collision geometry is not written
-    (attach it from Python with mechsys.load_urdf(...).contours)."""
+    Links (bodies) become bodies, joints joints, URDF mimic joints couplers. Collision geometry is
+    not written (attach it from Python with mechsys.load_urdf(...).contours or load_mjcf)."""
+    from ._import import limits_header
     from .tomlwrite import dumps
-    from .urdf import load_urdf
 
-    imp = load_urdf(urdf_file, root=root, limits=limits, package_dirs=list(package_dirs), contours=None)
+    if urdf_file.suffix.lower() in _MJCF_SUFFIXES:
+        from .mjcf import load_mjcf
+
+        if root != "ground" or package_dirs:
+            raise click.UsageError("--root and --package-dir apply to URDF files (an MJCF file places its own free joints)")
+        imp = load_mjcf(urdf_file, limits=limits, contours=None)
+        header = f"Imported from {urdf_file.name} by mechsys import (MJCF, limits = {limits})."
+        if imp.ignored:
+            header += "\nNot imported: " + "; ".join(imp.ignored)
+    else:
+        from .urdf import load_urdf
+
+        imp = load_urdf(urdf_file, root=root, limits=limits, package_dirs=list(package_dirs), contours=None)
+        header = f"Imported from {urdf_file.name} by mechsys import (root = {root}, limits = {limits})."
     out = out if out is not None else urdf_file.with_suffix(".toml")
-    header = f"Imported from {urdf_file.name} by mechsys import (root = {root}, limits = {limits})."
-    if imp.limits:
-        header += "\nJoint limits [lower, upper]: " + ", ".join(
-            f"{n} [{lim.lower}, {lim.upper}]" for n, lim in imp.limits.items())
-    out.write_text(dumps(imp.model.to_dict(), header), encoding="utf-8")
+    out.write_text(dumps(imp.model.to_dict(), header + limits_header(imp)), encoding="utf-8")
     click.echo(f"wrote {out} ({len(imp.model.body_info())} bodies, {len(imp.model.joint_info())} joints, nu = {imp.model.nu})")
 
 

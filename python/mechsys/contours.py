@@ -515,7 +515,7 @@ class Spline(Contour):
         """Samples a curve ``f(s) -> (x, y)`` at ``samples`` parameters over ``s_range`` (for a
         closed curve the end of the range is the start again and is not repeated). The spline's
         error against ``f`` falls with the fourth power of the spacing (about ``h⁴ κ³`` for
-        spacing ``h`` and curvature ``κ``); check it with :func:`mechsys.contours.spline_error`."""
+        spacing ``h`` and curvature ``κ``); check it by evaluating ``f`` between the samples."""
         what = "Spline.from_function"
         try:
             lo, hi = (float(v) for v in s_range)

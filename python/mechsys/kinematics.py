@@ -35,12 +35,12 @@ import numpy as np
 from . import _core
 from .errors import SettingsError
 
-#: Threshold on |sin theta| (Euler) or |cos beta| (Cardan) below which ``H*`` is singular.
 SINGULAR_TOL: float = _core.SINGULAR_TOL
-#: Largest entry of |A^T A - E| accepted for an argument that must be a rotation matrix.
+"""Threshold on |sin theta| (Euler) or |cos beta| (Cardan) below which ``H*`` is singular."""
 ROTATION_MATRIX_TOL: float = _core.ROTATION_MATRIX_TOL
-#: Largest | |q| - 1 | accepted for arguments that must be unit quaternions or unit axes.
+"""Largest entry of |A^T A - E| accepted for an argument that must be a rotation matrix."""
 UNIT_TOL: float = _core.UNIT_TOL
+"""Largest | |q| - 1 | accepted for arguments that must be unit quaternions or unit axes."""
 
 # ---------------------------------------------------------------------------------------------
 # Elementary rotations, tilde

@@ -6,7 +6,8 @@ frames, the inertias, the contours) is ours, so every error can name the link, j
 Frames. A URDF link frame is the mechsys body frame. A joint's ``<origin>`` places the joint frame
 in the parent link, which is exactly a mechsys ``parent_frame`` (rotation ``A`` with
 ``v_parent = A v_joint``); the child link frame is the joint frame at q = 0, so ``child_frame``
-is the identity (except for a planar joint, see :func:`_planar_alignment`). The ``<inertial>``
+is the identity (except for a planar joint, whose plane normal to the axis becomes the
+mechsys joint frame's x-y plane). The ``<inertial>``
 frame may be offset and turned in the link: its origin is the body's centre of mass and its
 tensor, given in the inertial frame's axes, is turned into link axes as ``R I R^T``.
 
@@ -22,8 +23,6 @@ fixed to instead, and its contours move to that body too.
 from __future__ import annotations
 
 import io
-import re
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -32,62 +31,17 @@ import numpy as np
 from . import constraints as _constraints
 from . import contours as _contours
 from . import joints as _joints
-from .contacts import GapContact
+from ._import import JointLimit, ModelImport, Visual, add_limit_stops, check_inertia, check_limit_mode, primitive_contour
 from .errors import ModelError
-from .kinematics import matrix_to_cardan_xyz
 from .model import Model
 
 _KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-_IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
-@dataclass
-class JointLimit:
-    """A URDF ``<limit>``: position bounds (rad or m; None where the file gives none, as for a
-    continuous joint), the effort (N m or N) and the velocity (rad/s or m/s) limits."""
-
-    lower: float | None
-    upper: float | None
-    effort: float | None = None
-    velocity: float | None = None
-
-
-@dataclass
-class Visual:
-    """A visual element of a link, kept for a viewer: the geometry ``kind`` (box, sphere,
-    cylinder, mesh), its ``size`` data (half extents, radius, radius and length, or the mesh
-    scale), the resolved mesh ``file`` and the placement ``origin`` (4x4, in the body frame the
-    link ended up on)."""
-
-    kind: str
-    origin: np.ndarray
-    size: Any = None
-    file: str | None = None
-
-
-@dataclass
-class URDFImport:
-    """The result of :func:`load_urdf`.
-
-    ``model``: the :class:`mechsys.Model`; ``limits``: {joint: :class:`JointLimit`} for every
-    joint with a ``<limit>``; ``contours``: {link: [(body, contour)]} from the collision (or
-    visual) geometry, placed in the frame of the body that carries it, ready for
-    ``model.add_contact(ms.Contact(..., body.contour(c)))`` or a contact group; ``visuals``:
-    {link: [:class:`Visual`]}; ``mimics``: {joint: (mimicked joint, multiplier, offset)};
-    ``markers``: {link: body} for the massless fixed links turned into markers; ``root``: the
-    root link's name."""
-
-    model: Model
-    root: str
-    limits: dict[str, JointLimit] = field(default_factory=dict)
-    contours: dict[str, list] = field(default_factory=dict)
-    visuals: dict[str, list[Visual]] = field(default_factory=dict)
-    mimics: dict[str, tuple[str, float, float]] = field(default_factory=dict)
-    markers: dict[str, str] = field(default_factory=dict)
-
-    def contour_list(self) -> list:
-        """Every contour as ``OnBody`` (the body and its contour), for a contact group's members."""
-        return [_contours.OnBody(body, c) for items in self.contours.values() for body, c in items]
+class URDFImport(ModelImport):
+    """The result of :func:`load_urdf` (see :class:`mechsys._import.ModelImport`): ``contours``
+    come from the collision (or visual) geometry of each link, ``mimics`` from ``<mimic>``,
+    ``markers`` are the massless fixed links, ``root`` is the root link's name."""
 
 
 def _yourdfpy():
@@ -214,14 +168,8 @@ class _Loader:
         return mass, 0.5 * (I_b + I_b.T), p  # symmetric to the last bit, as the engine checks it
 
     def check_inertia(self, name: str, data) -> None:
-        w = f"{self.label}: link '{name}'"
-        if data is None or data[0] <= 0.0:
-            got = "no <inertial>" if data is None else f"mass {data[0]:g}"
-            raise ModelError(f"{w}: a moving link needs a mass > 0, got {got}")
-        eig = np.linalg.eigvalsh(0.5 * (data[1] + data[1].T))
-        if eig[0] <= 0.0:
-            raise ModelError(f"{w}: the inertia is not positive definite (principal moments "
-                             f"{', '.join(f'{e:.6g}' for e in eig)} kg m^2)")
+        check_inertia(f"{self.label}: link '{name}'", None if data is None else data[0], None if data is None else data[1],
+                      noun="link", missing="no <inertial>")
 
     # ---- geometry --------------------------------------------------------------------------------
     def mesh_path(self, filename: str, what: str) -> Path:
@@ -253,17 +201,11 @@ class _Loader:
         g = element.geometry
         if g is None:
             raise ModelError(f"{what}: no <geometry>")
-        if g.box is not None:
-            half = 0.5 * np.asarray(g.box.size, dtype=float)
-            c = _contours.Box(half_extents=tuple(half), center=tuple(p), cardan=tuple(matrix_to_cardan_xyz(R))) if as_contour else None
-            return "box", half, None, c, (R, p)
-        if g.sphere is not None:
-            r = float(g.sphere.radius)
-            return "sphere", r, None, (_contours.Sphere(radius=r, center=tuple(p)) if as_contour else None), (R, p)
-        if g.cylinder is not None:
-            r, length = float(g.cylinder.radius), float(g.cylinder.length)
-            c = _contours.Cylinder(radius=r, length=length, axis=tuple(R[:, 2]), center=tuple(p)) if as_contour else None
-            return "cylinder", (r, length), None, c, (R, p)
+        for kind, size in (("box", None if g.box is None else 0.5 * np.asarray(g.box.size, dtype=float)),
+                           ("sphere", None if g.sphere is None else float(g.sphere.radius)),
+                           ("cylinder", None if g.cylinder is None else (float(g.cylinder.radius), float(g.cylinder.length)))):
+            if size is not None:
+                return kind, size, None, (primitive_contour(kind, size, R, p) if as_contour else None), (R, p)
         if g.mesh is not None:
             path = self.mesh_path(g.mesh.filename, what)
             scale = np.ones(3) if g.mesh.scale is None else np.broadcast_to(np.asarray(g.mesh.scale, dtype=float), (3,))
@@ -364,6 +306,14 @@ class _Loader:
             other = j.mimic.joint
             if other not in kinds:
                 raise ModelError(f"{w}: mimicked joint '{other}' is not defined")
+            chain, follow = [j.name], other
+            while follow is not None and follow not in chain:
+                chain.append(follow)
+                nxt = next((k for k in order if k.name == follow), None)
+                follow = nxt.mimic.joint if nxt is not None and nxt.mimic is not None else None
+            if follow is not None:
+                raise ModelError(f"{w}: the mimic joints form a cycle ({' -> '.join(chain + [follow])}): "
+                                 "no joint in it moves on its own")
             single = ("revolute", "continuous", "prismatic")
             if kinds[other] not in single or j.type not in single:
                 raise ModelError(f"{w}: only revolute, continuous and prismatic joints can mimic each other "
@@ -375,19 +325,9 @@ class _Loader:
             out.model.add_constraint(_constraints.Coupler(f"{j.name}_mimic", j.name, other, mult, off))
 
     def _stops(self, out: URDFImport) -> None:
-        if self.limit_mode == "data":
-            return
-        if self.limit_mode != "stops":
-            raise ModelError(f"load_urdf: limits must be 'data' or 'stops', got {self.limit_mode!r}")
-        for name, lim in out.limits.items():
-            if lim.lower is None or lim.upper is None:
-                continue
-            if not _IDENTIFIER.match(name):
-                raise ModelError(f"{self.label}: joint '{name}': a limit stop's gap expression needs a joint name made of "
-                                 "letters, digits and '_' (rename the joint, or load with limits='data')")
-            # open while positive: above the lower bound and below the upper one
-            out.model.add_contact(GapContact(f"{name}_lower", gap=f"{name} - ({lim.lower!r})"))
-            out.model.add_contact(GapContact(f"{name}_upper", gap=f"({lim.upper!r}) - {name}"))
+        check_limit_mode(self.limit_mode, "load_urdf")
+        if self.limit_mode == "stops":
+            add_limit_stops(out.model, out.limits, self.label)
 
     def _geometry(self, out: URDFImport, place) -> None:
         if self.contour_source not in ("collision", "visual", None):
