@@ -274,3 +274,25 @@ def test_dropped_sphere_rests_on_the_imported_floor():
     z = res["body/ball/position"][-1, 2]
     v_impact, dt = np.sqrt(2 * 9.81 * 0.25), 1e-3
     assert abs(z - 0.05) <= v_impact * dt
+
+
+def test_geoms_are_drawn_as_visuals_at_mujocos_places():
+    """Every drawable geom becomes a visual on its body (the floor plane is left out): the
+    centre of each in the world at q0 is MuJoCo's geom position."""
+    import mujoco
+
+    imp = ms.load_mjcf(str(ARM))
+    m = mujoco.MjModel.from_xml_path(str(ARM))
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    vis = imp.model.to_dict()["visuals"]
+    assert len(vis) == sum(1 for g in range(m.ngeom) if m.geom_type[g] != mujoco.mjtGeom.mjGEOM_PLANE)
+    states = ms.kinematics.body_states(imp.model, np.asarray(d.qpos))
+    names = ["ground"] + [b["name"] for b in imp.model.build().bodies()]
+    for v in vis:
+        g = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, v["name"])
+        shape = v["shape"]
+        local = np.asarray(shape["center"]) if "center" in shape else 0.5 * (np.asarray(shape["a"]) + np.asarray(shape["b"]))
+        k = names.index(v["body"])
+        world = np.asarray(states["rotation"][k]) @ local + np.asarray(states["position"][k])
+        np.testing.assert_allclose(world, d.geom_xpos[g], atol=1e-12)

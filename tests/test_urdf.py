@@ -434,3 +434,33 @@ def test_collision_contours_attach_to_contacts():
     v_impact, dt = np.sqrt(2 * 9.81 * 0.25), 1e-3
     assert abs(z - (0.05 - 0.1)) <= v_impact * dt
     assert np.abs(res["body/ball/velocity"][-1]).max() < 1e-9
+
+
+def test_visual_elements_become_model_visuals_the_viewer_draws(tmp_path):
+    """Each <visual> is drawn on the body its link ended up on: primitives as their contours
+    placed by the origin, meshes read from their file with the scale, the material's colour kept."""
+    import trimesh
+
+    trimesh.creation.box(extents=(1.0, 1.0, 1.0)).export(tmp_path / "cube.stl")
+    urdf = _one_joint(child_geometry=(
+        '<visual><origin xyz="0.1 0 0" rpy="0 0 0"/><geometry><box size="0.2 0.4 0.6"/></geometry>'
+        '<material name="red"><color rgba="0.9 0.1 0.1 1"/></material></visual>'
+        '<visual><origin xyz="0 0 0.5" rpy="0 0 0"/><geometry><mesh filename="cube.stl" scale="0.1 0.2 0.3"/></geometry></visual>'))
+    f = tmp_path / "arm.urdf"
+    f.write_text(urdf)
+    imp = load_urdf(f)
+    vis = [v for v in imp.model.to_dict()["visuals"] if v["body"] == "arm"]
+    assert len(vis) == 2
+    box, mesh = vis
+    assert box["shape"]["type"] == "box" and box["color"] == pytest.approx([0.9, 0.1, 0.1])
+    np.testing.assert_allclose(box["shape"]["half_extents"], [0.1, 0.2, 0.3])
+    np.testing.assert_allclose(box["shape"]["center"], [0.1, 0.0, 0.0], atol=1e-15)
+    v = np.asarray(mesh["shape"]["vertices"])
+    np.testing.assert_allclose(v.min(axis=0), [-0.05, -0.1, 0.35], atol=1e-12)
+    np.testing.assert_allclose(v.max(axis=0), [0.05, 0.1, 0.65], atol=1e-12)
+    # the engine accepts them and the viewer draws them on the body
+    from mechsys import viewer
+
+    res = ms.simulate(imp.model, t_end=0.01)
+    names = [p["name"] for b in viewer.page_data(res)["bodies"] for p in b["parts"]]
+    assert "arm.visual[0]" in names and "arm.visual[1]" in names

@@ -8,6 +8,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from pathlib import Path
+
 import numpy as np
 
 from . import contours as _contours
@@ -105,6 +107,29 @@ def primitive_contour(kind: str, size, R: np.ndarray, p: np.ndarray):
     if kind == "plane":
         return _contours.Plane(normal=tuple(R[:, 2]), point=p)
     return None
+
+
+def add_visual(model: Model, body: str, vis: Visual, name: str, color=None) -> None:
+    """Draws an imported geometry element on ``body`` (``Model.add_visual``): primitives as their
+    contours, mesh files read through trimesh with their scale and placement; planes and kinds
+    without a drawable form are left out."""
+    R, p = vis.origin[:3, :3], vis.origin[:3, 3]
+    rgb = None
+    if color is not None:
+        rgb = tuple(float(min(max(c, 0.0), 1.0)) for c in list(color)[:3])
+    opacity = float(color[3]) if color is not None and len(color) > 3 and 0.0 < float(color[3]) < 1.0 else None
+    if vis.kind == "mesh":
+        if vis.file is None or not Path(vis.file).is_file():
+            return
+        v, t = _contours._read_mesh_file(vis.file, f"{name}: mesh file '{vis.file}'")
+        scale = np.broadcast_to(np.asarray(1.0 if vis.size is None else vis.size, dtype=float), (3,))
+        model.add_visual(body, ((np.asarray(v, dtype=float) * scale) @ R.T + p, t), name=name, color=rgb, opacity=opacity)
+        return
+    if vis.kind == "plane":
+        return
+    c = primitive_contour(vis.kind, vis.size, R, p)
+    if c is not None:
+        model.add_visual(body, c, name=name, color=rgb, opacity=opacity)
 
 
 def check_limit_mode(mode: str, caller: str) -> None:

@@ -40,7 +40,8 @@ import numpy as np
 
 from . import contours as _contours
 from . import joints as _joints
-from ._import import JointLimit, ModelImport, Visual, add_limit_stops, check_inertia, check_limit_mode, primitive_contour
+from ._import import (JointLimit, ModelImport, Visual, add_limit_stops, add_visual, check_inertia, check_limit_mode,
+                      primitive_contour)
 from .errors import ModelError
 from .kinematics import quat_to_matrix, rot_axis
 from .model import Model
@@ -349,7 +350,16 @@ class _Walker:
                 file = self.mj.mj_id2name(m, self.mj.mjtObj.mjOBJ_MESH, int(m.geom_dataid[g]))
             T = np.eye(4)
             T[:3, :3], T[:3, 3] = R, p
-            out.visuals.setdefault(self.bodies[b], []).append(Visual(kind, T, size, file))
+            vis = Visual(kind, T, size, file)
+            out.visuals.setdefault(self.bodies[b], []).append(vis)
+            # drawn by the viewer: primitives as their contours, meshes from MuJoCo's compiled vertices
+            rgba = np.asarray(m.geom_rgba[g], dtype=float)
+            if kind == "mesh":
+                mesh = self.mesh(int(m.geom_dataid[g]), R, p, f"{self.label}: geom '{gname}'")
+                out.model.add_visual(body, (mesh.vertices, mesh.triangles), name=gname, color=tuple(rgba[:3]),
+                                     opacity=float(rgba[3]) if 0.0 < rgba[3] < 1.0 else None)
+            elif rgba[3] > 0.0:
+                add_visual(out.model, body, vis, gname, rgba)
             collides = m.geom_contype[g] != 0 or m.geom_conaffinity[g] != 0
             if mode is None or (mode == "collision" and not collides):
                 continue

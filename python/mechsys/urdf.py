@@ -31,7 +31,8 @@ import numpy as np
 from . import constraints as _constraints
 from . import contours as _contours
 from . import joints as _joints
-from ._import import JointLimit, ModelImport, Visual, add_limit_stops, check_inertia, check_limit_mode, primitive_contour
+from ._import import (JointLimit, ModelImport, Visual, add_limit_stops, add_visual, check_inertia, check_limit_mode,
+                      primitive_contour)
 from .errors import ModelError
 from .model import Model
 
@@ -339,7 +340,10 @@ class _Loader:
                 kind, size, file, c, (R, p) = self.geometry(v, what, A, b, self.contour_source == "visual")
                 T = np.eye(4)
                 T[:3, :3], T[:3, 3] = R, p
-                out.visuals.setdefault(name, []).append(Visual(kind, T, size, file))
+                vis = Visual(kind, T, size, file)
+                out.visuals.setdefault(name, []).append(vis)
+                rgba = getattr(getattr(getattr(v, "material", None), "color", None), "rgba", None)
+                add_visual(out.model, body, vis, f"{name}.visual[{k}]", rgba)
                 if c is not None:
                     out.contours.setdefault(name, []).append((body, c))
             for k, col in enumerate(link.collisions or []):
