@@ -11,7 +11,7 @@ import pytest
 from scipy import linalg
 
 from mechsys import elastic as el
-from mechsys.continuum import gauss_legendre
+from mechsys.continuum import gauss_legendre, skew
 from mechsys.errors import ModelError
 
 E, NU, RHO, L = 210e9, 0.3, 7850.0, 1.0
@@ -326,3 +326,55 @@ def test_unit_confusion_warning_and_bad_model_input(tmp_path):
         el.fe_model(np.zeros((3, 3)), np.eye(12), np.eye(18))
     with pytest.raises(ModelError, match="BeamSection: Iy must be > 0"):
         el.BeamSection(E=1.0, G=1.0, rho=1.0, A=1.0, Iy=0.0, Iz=1.0, J=1.0)
+
+
+def _direct_kinetic_energy(pos, masses, disp, vel, v, w):
+    """½ Σ m_p |v + ω × (r_p + u_p) + u̇_p|² over mass points (eq. 2.192 with eq. 2.191)."""
+    vp = v + np.cross(w, pos + disp) + vel
+    return 0.5 * np.sum(masses * np.sum(vp * vp, axis=1))
+
+
+def test_floating_frame_mass_matrix_reproduces_the_kinetic_energy():
+    rng = np.random.default_rng(7)
+    fe = el.beam_model(SEC, L, 12, planar=True)
+    body = el.modal_reduction(fe, 4, fixed={0: "clamped"}, name="blade")
+    pos, mp, interp = fe.mass_points
+    T = body.modes.reshape(-1, body.n_coordinates)
+    # the inertia of the mass points equals the one from the FE mass matrix (Gauss is exact),
+    # except about the beam axis, where the FE model also has the section's polar inertia
+    I_pts = -np.einsum("p,pij,pjk->ik", mp, np.array([skew(r) for r in pos]), np.array([skew(r) for r in pos]))
+    assert I_pts[1:, 1:] == pytest.approx(body.inertia[1:, 1:], rel=1e-12, abs=1e-12)
+    assert body.inertia[0, 0] - I_pts[0, 0] == pytest.approx(RHO * SEC.Ip * L, rel=1e-12)
+    for _ in range(3):
+        q = rng.normal(size=4) * 0.05
+        qd = rng.normal(size=4)
+        v = rng.normal(size=3)
+        w = np.array([0.0, *rng.normal(size=2)])  # no spin about the beam axis (its polar inertia is not in the mass points)
+        disp = np.einsum("pad,d->pa", interp, T @ q)
+        vel = np.einsum("pad,d->pa", interp, T @ qd)
+        t_direct = _direct_kinetic_energy(pos, mp, disp, vel, v, w)
+        assert body.kinetic_energy(v, w, q, qd) == pytest.approx(t_direct, rel=1e-11)
+    Mq = body.mass_matrix(q)
+    assert np.allclose(Mq, Mq.T) and np.linalg.eigvalsh(Mq)[0] > 0
+    with pytest.raises(ModelError, match="'blade': q must be 4 finite values"):
+        body.mass_matrix([0.0, 1.0])
+
+
+def test_lumped_invariants_from_a_file_give_the_exact_point_mass_energy(tmp_path):
+    rng = np.random.default_rng(11)
+    nodes = rng.normal(size=(5, 3))
+    masses = rng.uniform(0.5, 2.0, size=5)
+    q = 3
+    modes = rng.normal(size=(5, 6, q))
+    Mq = np.einsum("i,iak,ial->kl", masses, modes[:, :3], modes[:, :3])  # ∫ΦᵀΦ dm of the point masses
+    path = tmp_path / "points.npz"
+    np.savez(path, nodes=nodes, M=Mq, K=np.diag([1.0, 4.0, 9.0]) * 1e4, modes=modes, node_masses=masses)
+    body = el.load_reduced(path)
+    assert body.mass == pytest.approx(masses.sum(), rel=1e-14)
+    assert body.first_moment == pytest.approx(masses @ nodes, rel=1e-13)
+    assert body.M == pytest.approx(Mq, rel=1e-14)
+    for _ in range(3):
+        qq, qd, v, w = rng.normal(size=q), rng.normal(size=q), rng.normal(size=3), rng.normal(size=3)
+        disp = np.einsum("iak,k->ia", modes[:, :3], qq)
+        vel = np.einsum("iak,k->ia", modes[:, :3], qd)
+        assert body.kinetic_energy(v, w, qq, qd) == pytest.approx(_direct_kinetic_energy(nodes, masses, disp, vel, v, w), rel=1e-12)

@@ -131,7 +131,11 @@ def euler_bernoulli_mode(bc: str, k: int, x, L: float, derivative: int = 0) -> n
     """
     if derivative not in (0, 1, 2, 3):
         raise ModelError(f"euler_bernoulli_mode: derivative must be 0..3, got {derivative}")
+    if not (np.isfinite(L) and L > 0):
+        raise ModelError(f"euler_bernoulli_mode: L must be > 0, got {L}")
     x = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(x)):
+        raise ModelError("euler_bernoulli_mode: x has non-finite entries")
     beta = euler_bernoulli_roots(bc, k)[-1] / L
     bx, bL = beta * x, beta * L
     d = derivative
@@ -173,6 +177,11 @@ def timoshenko_pinned_pinned(k: int, E: float, G: float, kappa: float, rho: floa
     With w = W sin(k π x / L), ψ = Ψ cos(k π x / L) the two equations give
     (ρAω² − κGA a²)(ρIω² − EI a² − κGA) − (κGA a)² = 0, a = kπ/L; the lower root in ω².
     """
+    for name, v in (("E", E), ("G", G), ("kappa", kappa), ("rho", rho), ("A", A), ("I", I), ("L", L)):
+        if not (np.isfinite(v) and v > 0):
+            raise ModelError(f"timoshenko_pinned_pinned: {name} must be > 0, got {v}")
+    if int(k) != k or k < 1:
+        raise ModelError(f"timoshenko_pinned_pinned: k must be a positive integer, got {k}")
     a = k * np.pi / L
     s = kappa * G * A
     c2 = rho * A * rho * I
@@ -703,6 +712,54 @@ class ReducedBody:
         """Write the body in the layout of :func:`save_reduced`."""
         return save_reduced(self, path)
 
+    def _q(self, q, what):
+        q = np.zeros(self.n_coordinates) if q is None else np.asarray(q, dtype=float)
+        if q.shape != (self.n_coordinates,) or not np.all(np.isfinite(q)):
+            raise ModelError(f"elastic body {self.name!r}: {what} must be {self.n_coordinates} finite values, got {q!r}")
+        return q
+
+    def mass_matrix(self, q=None) -> np.ndarray:
+        """Floating-frame mass matrix M(q), (6 + n) x (6 + n), for the velocities (v, ω, q̇) in the
+        body frame, such that T = ½ xᵀ M(q) x is the kinetic energy of the class docstring:
+
+            [[ m I,         −(c + C_t q)~,     C_t              ],
+             [ (c + C_t q)~, I(q),             C_r + Σ q_k G_k  ],
+             [ C_tᵀ,         (C_r + Σ q_k G_k)ᵀ, M              ]]
+
+        Needs the second-order invariants (I2, Gk; I1) when q ≠ 0.
+        """
+        q = self._q(q, "q")
+        n = self.n_coordinates
+        cq = self.first_moment + self.Ct @ q
+        Iq = self.inertia.copy()
+        Crq = self.Cr.copy()
+        if np.any(q != 0):
+            if self.I1 is None or self.I2 is None or self.Gk is None:
+                raise ModelError(f"elastic body {self.name!r}: mass_matrix(q != 0) needs the second-order invariants I1, I2, Gk")
+            Iq += np.einsum("k,kij->ij", q, self.I1) + np.einsum("k,l,klij->ij", q, q, self.I2)
+            Crq += np.einsum("k,kij->ij", q, self.Gk)
+        out = np.zeros((6 + n, 6 + n))
+        out[:3, :3] = self.mass * np.eye(3)
+        out[:3, 3:6] = -skew(cq)
+        out[3:6, :3] = skew(cq)
+        out[:3, 6:] = self.Ct
+        out[6:, :3] = self.Ct.T
+        out[3:6, 3:6] = 0.5 * (Iq + Iq.T)
+        out[3:6, 6:] = Crq
+        out[6:, 3:6] = Crq.T
+        out[6:, 6:] = self.M
+        return out
+
+    def kinetic_energy(self, v, omega, q=None, qdot=None) -> float:
+        """T = ½ xᵀ M(q) x with x = (v, ω, q̇) (eq. 2.192 with the Ritz separation); v, ω of the
+        body frame in body coordinates."""
+        v = np.asarray(v, dtype=float)
+        omega = np.asarray(omega, dtype=float)
+        if v.shape != (3,) or omega.shape != (3,) or not (np.all(np.isfinite(v)) and np.all(np.isfinite(omega))):
+            raise ModelError(f"elastic body {self.name!r}: v and omega must be finite 3-vectors, got {v!r}, {omega!r}")
+        x = np.concatenate([v, omega, self._q(qdot, "qdot")])
+        return float(0.5 * x @ self.mass_matrix(q) @ x)
+
 
 def _validate(b: ReducedBody) -> None:
     if not isinstance(b.name, str) or not b.name:
@@ -748,7 +805,10 @@ def _validate(b: ReducedBody) -> None:
             "fix the body frame's reference conditions or drop the mode"
         )
     b.omega = np.sqrt(w2)
-    m = float(b.mass)
+    try:
+        m = float(np.asarray(b.mass, dtype=float).reshape(()))
+    except (TypeError, ValueError):
+        raise ModelError(f"{w}: mass must be a number, got {b.mass!r}") from None
     if not (np.isfinite(m) and m > 0):
         raise ModelError(f"{w}: mass must be > 0, got {b.mass}")
     b.mass = m
@@ -810,7 +870,9 @@ def geometric_stiffness(model: FEModel, axial_force) -> np.ndarray:
     return KG
 
 
-def _rotating_setup(section, length, n_elements, hub_radius, plane):
+def _rotating_setup(section, length, n_elements, hub_radius, plane, n_modes):
+    if int(n_modes) != n_modes or not 1 <= n_modes <= 2 * n_elements:
+        raise ModelError(f"rotating cantilever: n_modes must be 1..{2 * n_elements} (2 per element), got {n_modes}")
     if plane not in ("flap", "lag"):
         raise ModelError(f"rotating cantilever: plane must be 'flap' or 'lag', got {plane!r}")
     if not (np.isfinite(hub_radius) and hub_radius >= 0):
@@ -846,7 +908,7 @@ def rotating_cantilever_frequencies(section: BeamSection, length: float, Omega: 
     """
     if not np.isfinite(Omega):
         raise ModelError(f"rotating_cantilever_frequencies: Omega must be finite, got {Omega}")
-    M, K, G1 = _rotating_setup(section, length, n_elements, hub_radius, plane)
+    M, K, G1 = _rotating_setup(section, length, n_elements, hub_radius, plane, n_modes)
     w2 = linalg.eigh(K + Omega**2 * G1, M, eigvals_only=True, subset_by_index=[0, n_modes - 1])
     if w2[0] <= 0:
         raise ModelError(f"rotating_cantilever_frequencies: Omega = {Omega} rad/s makes the {plane} mode unstable (omega^2 = {w2[0]:.4g})")
@@ -857,7 +919,7 @@ def southwell_coefficients(section: BeamSection, length: float, *, n_elements: i
     """κ_k = dω_k²/dΩ² at Ω = 0 (Southwell: ω² ≈ ω₀² + κ Ω²), from first-order perturbation of
     the FE eigenproblem: κ_k = φ_kᵀ K_G1 φ_k / φ_kᵀ M φ_k with K_G1 the stress stiffening per
     unit Ω² (minus the spin softening for "lag")."""
-    M, K, G1 = _rotating_setup(section, length, n_elements, hub_radius, plane)
+    M, K, G1 = _rotating_setup(section, length, n_elements, hub_radius, plane, n_modes)
     _, V = linalg.eigh(K, M, subset_by_index=[0, n_modes - 1])
     return np.array([V[:, k] @ G1 @ V[:, k] / (V[:, k] @ M @ V[:, k]) for k in range(n_modes)])
 
@@ -955,6 +1017,8 @@ def load_reduced(path, name: str | None = None) -> ReducedBody:
     if nodes.ndim != 2 or nodes.shape[1] != 3:
         raise ModelError(f"{w}: nodes must be an (n, 3) array, got shape {nodes.shape}")
     M = np.asarray(data["M"], float)
+    if M.ndim != 2:
+        raise ModelError(f"{w}: M must be a square matrix, got shape {M.shape}")
     if modes.ndim != 3 or modes.shape[0] != len(nodes) or modes.shape[1] != 6 or modes.shape[2] != M.shape[0]:
         raise ModelError(f"{w}: modes must have shape (n_nodes, 6, n_coordinates) = ({len(nodes)}, 6, {M.shape[0]}), got {modes.shape}")
     interface = tuple(int(i) for i in np.asarray(data.get("interface", np.zeros(0, int))).ravel())
