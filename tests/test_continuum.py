@@ -141,6 +141,8 @@ def test_material_constants_conversions_and_validation():
         ({"G": 1e9, "mu": 2e9}, "G = 1000000000.0 and mu"),
         ({"E": E}, "got only \\['E'\\]"),
         ({"E": float("nan"), "nu": 0.3}, "E must be finite"),
+        ({"E": "210e9", "nu": 0.3}, "E must be a number, got .210e9."),
+        ({"E": E, "G": "x"}, "G must be a number"),
     ):
         with pytest.raises(ModelError, match=msg):
             cm.isotropic(**kw)

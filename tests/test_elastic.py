@@ -378,3 +378,22 @@ def test_lumped_invariants_from_a_file_give_the_exact_point_mass_energy(tmp_path
         disp = np.einsum("iak,k->ia", modes[:, :3], qq)
         vel = np.einsum("iak,k->ia", modes[:, :3], qd)
         assert body.kinetic_energy(v, w, qq, qd) == pytest.approx(_direct_kinetic_energy(nodes, masses, disp, vel, v, w), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "call, msg",
+    [
+        (lambda: el.beam_model(SEC, "1", 4), "beam_model: length must be a number, got '1'"),
+        (lambda: el.beam_model(SEC, 1.0, 2.5), "n_elements must be a positive integer, got 2.5"),
+        (lambda: el.BeamSection(E="a", G=1, rho=1, A=1, Iy=1, Iz=1, J=1), "BeamSection: E must be a number"),
+        (lambda: el.modal_reduction(el.beam_model(SEC, L, 4), 3, fixed={"a": "clamped"}, name="b"), "'b': node 'a' is not an integer index"),
+        (lambda: el.modal_reduction(el.beam_model(SEC, L, 4), 3, fixed={0: 5}, name="b"), "'b': node 0: give 'clamped', 'pinned' or a list"),
+        (lambda: el.craig_bampton(el.beam_model(SEC, L, 4), 3, interface=None, fixed={0: "clamped"}, name="b"), "'b': interface must be a list"),
+        (lambda: el.euler_bernoulli_mode("clamped-free", 1, [np.nan], L), "x has non-finite entries"),
+        (lambda: el.rotating_cantilever_frequencies(SEC, L, 10.0, n_modes=0), "n_modes must be 1..40"),
+        (lambda: el.timoshenko_pinned_pinned(1, E, SEC.G, SEC.kappa, RHO, SEC.A, SEC.Iy, -1.0), "timoshenko_pinned_pinned: L must be > 0"),
+    ],
+)
+def test_bad_arguments_are_named_errors(call, msg):
+    with pytest.raises(ModelError, match=msg):
+        call()

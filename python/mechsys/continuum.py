@@ -271,12 +271,21 @@ def isotropic(*, E=None, nu=None, G=None, lam=None, mu=None, density: float = 0.
     values; when more than two are given the others must agree to ``rtol``.
     Relations: G = E / (2 (1 + ν)) (reference after eq. 2.197), λ = E ν / ((1 + ν)(1 − 2ν)).
     """
+    for k, v in (("G", G), ("mu", mu)):
+        if v is not None and not isinstance(v, (int, float, np.integer, np.floating)):
+            raise ModelError(f"isotropic: {k} must be a number, got {v!r}")
     if G is not None and mu is not None and not np.isclose(G, mu, rtol=rtol, atol=0):
         raise ModelError(f"isotropic: G = {G} and mu = {mu} are the same constant and differ")
     if G is None:
         G = mu
     given = {k: v for k, v in (("E", E), ("nu", nu), ("G", G), ("lam", lam)) if v is not None}
     for k, v in given.items():
+        try:
+            if isinstance(v, (str, bytes)):
+                raise TypeError
+            v = given[k] = float(v)
+        except (TypeError, ValueError):
+            raise ModelError(f"isotropic: {k} must be a number, got {v!r}") from None
         if not np.isfinite(v):
             raise ModelError(f"isotropic: {k} must be finite, got {v}")
     if not np.isfinite(density) or density < 0:

@@ -75,6 +75,16 @@ _BC = ("clamped-free", "pinned-pinned", "free-free", "clamped-clamped", "clamped
 # ============================================================================================
 
 
+def _num(v, what: str) -> float:
+    """float(v), or a ModelError naming the item."""
+    try:
+        if isinstance(v, (str, bytes)):
+            raise TypeError
+        return float(v)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} must be a number, got {v!r}") from None
+
+
 def _char(bc: str, x: float) -> float:
     """Characteristic equation of bc, scaled by 1/cosh x so that it stays O(1)."""
     if bc == "clamped-free":  # cos x cosh x + 1 = 0
@@ -114,6 +124,7 @@ def euler_bernoulli_roots(bc: str, n: int) -> np.ndarray:
 def euler_bernoulli_frequencies(bc: str, n: int, E: float, I: float, rho: float, A: float, L: float) -> np.ndarray:
     """ω_k = (β_k L)² √(E I / (ρ A L⁴)) in rad/s for the first n elastic modes."""
     for k, v in (("E", E), ("I", I), ("rho", rho), ("A", A), ("L", L)):
+        v = _num(v, f"euler_bernoulli_frequencies: {k}")
         if not (np.isfinite(v) and v > 0):
             raise ModelError(f"euler_bernoulli_frequencies: {k} must be > 0, got {v}")
     return euler_bernoulli_roots(bc, n) ** 2 * np.sqrt(E * I / (rho * A * L**4))
@@ -178,6 +189,7 @@ def timoshenko_pinned_pinned(k: int, E: float, G: float, kappa: float, rho: floa
     (ρAω² − κGA a²)(ρIω² − EI a² − κGA) − (κGA a)² = 0, a = kπ/L; the lower root in ω².
     """
     for name, v in (("E", E), ("G", G), ("kappa", kappa), ("rho", rho), ("A", A), ("I", I), ("L", L)):
+        v = _num(v, f"timoshenko_pinned_pinned: {name}")
         if not (np.isfinite(v) and v > 0):
             raise ModelError(f"timoshenko_pinned_pinned: {name} must be > 0, got {v}")
     if int(k) != k or k < 1:
@@ -222,6 +234,7 @@ def timoshenko_frequencies(bc: str, n: int, E: float, G: float, kappa: float, rh
     Euler–Bernoulli frequencies (which bound them from above), are found by Brent's method.
     """
     for k, v in (("E", E), ("G", G), ("kappa", kappa), ("rho", rho), ("A", A), ("I", I), ("L", L)):
+        v = _num(v, f"timoshenko_frequencies: {k}")
         if not (np.isfinite(v) and v > 0):
             raise ModelError(f"timoshenko_frequencies: {k} must be > 0, got {v}")
     if bc not in _BC:
@@ -270,12 +283,13 @@ class BeamSection:
 
     def __post_init__(self):
         for k in ("E", "G", "rho", "A", "Iy", "Iz", "J", "kappa"):
-            v = getattr(self, k)
+            v = _num(getattr(self, k), f"BeamSection: {k}")
+            object.__setattr__(self, k, v)
             if not (np.isfinite(v) and v > 0):
                 raise ModelError(f"BeamSection: {k} must be > 0, got {v}")
         if self.Ip is None:
             object.__setattr__(self, "Ip", self.Iy + self.Iz)
-        elif not (np.isfinite(self.Ip) and self.Ip > 0):
+        elif not (np.isfinite(_num(self.Ip, "BeamSection: Ip")) and self.Ip > 0):
             raise ModelError(f"BeamSection: Ip must be > 0, got {self.Ip}")
 
     @classmethod
@@ -390,9 +404,10 @@ def beam_model(section: BeamSection, length: float, n_elements: int, *, start=(0
     ``planar`` keeps the motion in the local x–y plane (uz, rx, ry fixed at every node).
     Second-order invariants use ``gauss`` points per element as mass points (ρA w L each).
     """
+    length = _num(length, "beam_model: length")
     if not (np.isfinite(length) and length > 0):
         raise ModelError(f"beam_model: length must be > 0, got {length}")
-    if int(n_elements) != n_elements or n_elements < 1:
+    if not isinstance(n_elements, (int, np.integer)) or n_elements < 1:
         raise ModelError(f"beam_model: n_elements must be a positive integer, got {n_elements}")
     n_el = int(n_elements)
     Lam = _frame(direction, up)
@@ -479,7 +494,7 @@ def _check_symmetric(A, what, rtol=1e-9):
 
 
 def _node_index(node, n, what):
-    if isinstance(node, (bool, np.bool_)) or int(node) != node:
+    if isinstance(node, (bool, np.bool_)) or not isinstance(node, (int, np.integer)):
         raise ModelError(f"{what}: node {node!r} is not an integer index")
     i = int(node)
     if not -n <= i < n:
@@ -497,8 +512,10 @@ def _fixed_dofs(model: FEModel, fixed, what: str) -> list[int]:
             names = DOF_NAMES[:3]
         elif isinstance(spec, str):
             names = [spec]
-        else:
+        elif isinstance(spec, (list, tuple, set)):
             names = list(spec)
+        else:
+            raise ModelError(f"{what}: node {node}: give 'clamped', 'pinned' or a list of DOF names from {DOF_NAMES}, got {spec!r}")
         for nm in names:
             if nm not in DOF_NAMES:
                 raise ModelError(f"{what}: unknown DOF {nm!r} at node {node} (use 'clamped', 'pinned' or names from {DOF_NAMES})")
@@ -574,6 +591,8 @@ def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, name: 
     """
     what = f"elastic body {name!r}"
     dofs = _fixed_dofs(model, fixed, what)
+    if isinstance(interface, (str, bytes)) or not hasattr(interface, "__iter__"):
+        raise ModelError(f"{what}: interface must be a list of node indices, got {interface!r}")
     inodes = sorted({_node_index(i, model.n_nodes, what + " interface") for i in interface})
     if not inodes:
         raise ModelError(f"{what}: craig_bampton needs at least one interface node")
