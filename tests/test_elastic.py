@@ -397,3 +397,45 @@ def test_lumped_invariants_from_a_file_give_the_exact_point_mass_energy(tmp_path
 def test_bad_arguments_are_named_errors(call, msg):
     with pytest.raises(ModelError, match=msg):
         call()
+
+
+def test_analytic_beam_body_against_closed_forms_and_the_fe_beam():
+    m = RHO * SEC.A * L
+    body = el.analytic_beam_body(SEC, L, "clamped-free", 4, plane="xz", name="analytic")
+    w_cf = el.euler_bernoulli_roots("clamped-free", 4) ** 2 * omega_scale(SEC.Iy)
+    assert body.omega == pytest.approx(w_cf, rel=1e-9)  # eigenvalues of the integrated K, M
+    assert np.abs(body.M - np.eye(4)).max() < 1e-12
+    assert body.mass == pytest.approx(m, rel=1e-13)
+    assert np.diag(body.inertia) == pytest.approx([RHO * SEC.Ip * L, m * L**2 / 3, m * L**2 / 3], rel=1e-12)
+    frac = body.Ct[2] ** 2 / body.mass
+    assert frac == pytest.approx([0.6131, 0.1883, 0.0647, 0.0331], abs=6e-5)
+    # the same invariants from 40 Hermite elements (x-z modes are FE modes 1, 3, 5, 7 here)
+    fe = el.modal_reduction(el.beam_model(SEC, L, 40), 7, fixed={0: "clamped"}, name="fe")
+    for ka, kf in ((0, 0), (1, 2)):
+        s = np.sign(body.modes[-1, 2, ka] * fe.modes[-1, 2, kf])  # align the signs of the shapes
+        assert s * fe.Ct[:, kf] == pytest.approx(body.Ct[:, ka], rel=1e-6, abs=1e-9)
+        assert s * fe.Cr[:, kf] == pytest.approx(body.Cr[:, ka], rel=1e-6, abs=1e-9)
+        assert s * fe.modes[-1, :, kf] == pytest.approx(body.modes[-1, :, ka], rel=1e-6, abs=1e-8)
+        assert fe.I2[kf, kf] == pytest.approx(body.I2[ka, ka], rel=1e-6, abs=1e-9)
+    # free-free elastic modes carry no momentum (mean-axis conditions), first root 4.7300
+    ff = el.analytic_beam_body(SEC, L, "free-free", 2, name="ff")
+    assert ff.omega[0] == pytest.approx(4.73004074486270**2 * omega_scale(SEC.Iz), rel=1e-9)
+    assert np.abs(ff.Ct).max() < 1e-12 and np.abs(ff.Cr).max() < 1e-12
+    with pytest.raises(ModelError, match="plane must be 'xy' or 'xz'"):
+        el.analytic_beam_body(SEC, L, "clamped-free", 2, plane="yz")
+
+
+def test_craig_bampton_constraint_modes_are_the_static_shapes():
+    # a tip-only interface: unit tip deflection with the tip rotation held is 3 xi^2 - 2 xi^3,
+    # unit tip rotation ry = -w' (tip deflection held) is L (xi^2 - xi^3): cubic, so Hermite
+    # elements are exact and C_t = m/2 and m L/12
+    m = RHO * SEC.A * L
+    cb = el.craig_bampton(el.beam_model(SEC, L, 6), 3, interface=[-1], fixed={0: "clamped"}, name="cb")
+    iw, ir = cb.labels.index("n6.uz"), cb.labels.index("n6.ry")
+    assert cb.Ct[2, iw] == pytest.approx(m / 2, rel=1e-12)
+    assert cb.Ct[2, ir] == pytest.approx(m * L / 12, rel=1e-12)
+    xi = cb.nodes[:, 0] / L
+    assert cb.modes[:, 2, iw] == pytest.approx(3 * xi**2 - 2 * xi**3, abs=1e-12)
+    # the stiffness of the tip DOFs is the clamped-guided beam's: 12 EI/L^3 and 4 EI/L
+    assert cb.K[iw, iw] == pytest.approx(12 * E * SEC.Iy / L**3, rel=1e-10)
+    assert cb.K[ir, ir] == pytest.approx(4 * E * SEC.Iy / L, rel=1e-10)

@@ -15,8 +15,8 @@ space-dependent shapes Φ, evaluated once here, and time-dependent elastic coord
 
 Sources:
 
-* analytic Euler–Bernoulli modes (:func:`euler_bernoulli_roots`, :func:`euler_bernoulli_mode`)
-  and Timoshenko frequencies (:func:`timoshenko_frequencies`),
+* analytic Euler–Bernoulli modes (:func:`euler_bernoulli_roots`, :func:`euler_bernoulli_mode`,
+  as a body: :func:`analytic_beam_body`) and Timoshenko frequencies (:func:`timoshenko_frequencies`),
 * a built-in Euler–Bernoulli (Hermite) finite-element beam, planar or spatial
   (:func:`beam_model`), reduced by modal truncation (:func:`modal_reduction`) or Craig–Bampton
   (:func:`craig_bampton`),
@@ -51,6 +51,7 @@ __all__ = [
     "euler_bernoulli_mode",
     "timoshenko_frequencies",
     "timoshenko_pinned_pinned",
+    "analytic_beam_body",
     "beam_model",
     "fe_model",
     "modal_reduction",
@@ -637,18 +638,75 @@ def _skews(V):
     return np.stack([np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2)
 
 
+def _second_order(pos, mp, Phi) -> dict:
+    """I1, I2, G_k of mass points at pos (p, 3) with masses mp (p,) and translations Phi (p, 3, q)."""
+    rt = np.array([skew(r) for r in pos])  # (p, 3, 3)
+    Pt = _skews(Phi)  # (p, q, 3, 3)
+    I1 = -(np.einsum("p,pij,pkjl->kil", mp, rt, Pt) + np.einsum("p,pkij,pjl->kil", mp, Pt, rt))
+    I2 = -np.einsum("p,pkij,pljm->klim", mp, Pt, Pt)
+    Gk = np.einsum("p,pkij,pjl->kil", mp, Pt, Phi)
+    return dict(I1=I1, I2=0.5 * (I2 + I2.transpose(1, 0, 2, 3)), Gk=Gk)
+
+
 def _invariants(nodes, M_full, mass_points, T) -> dict:
     G = _rigid_modes(nodes)
     rig = G.T @ M_full @ G
     C = G.T @ M_full @ T
     pos, mp, interp = mass_points
     Phi = np.einsum("pad,dk->pak", interp, T)  # (p, 3, q) translation of each mass point
-    rt = np.array([skew(r) for r in pos])  # (p, 3, 3)
-    Pt = _skews(Phi)  # (p, q, 3, 3)
-    I1 = -(np.einsum("p,pij,pkjl->kil", mp, rt, Pt) + np.einsum("p,pkij,pjl->kil", mp, Pt, rt))
-    I2 = -np.einsum("p,pkij,pljm->klim", mp, Pt, Pt)
-    Gk = np.einsum("p,pkij,pjl->kil", mp, Pt, Phi)
-    return dict(mass=float(rig[0, 0]), first_moment=_vee(rig[3:, :3]), inertia=0.5 * (rig[3:, 3:] + rig[3:, 3:].T), Ct=C[:3], Cr=C[3:], I1=I1, I2=0.5 * (I2 + I2.transpose(1, 0, 2, 3)), Gk=Gk)
+    return dict(mass=float(rig[0, 0]), first_moment=_vee(rig[3:, :3]), inertia=0.5 * (rig[3:, 3:] + rig[3:, 3:].T), Ct=C[:3], Cr=C[3:], **_second_order(pos, mp, Phi))
+
+
+def analytic_beam_body(section: BeamSection, length: float, bc: str, n_modes: int, *, n_nodes: int = 11, plane: str = "xy", name: str = "elastic_body", cells: int = 40, order: int = 10) -> "ReducedBody":
+    """A reduced body from analytic Euler–Bernoulli modes of a uniform beam along body x from the
+    origin (bc as in :func:`euler_bernoulli_roots`; free–free: the elastic modes only).
+
+    ``plane`` "xy": deflection along y (bending stiffness E Iz, rotation rz = φ'); "xz": along z
+    (E Iy, ry = −φ'). Each shape is scaled to unit modal mass ∫ ρA φ² dx = 1. M = ∫ ρA φ_k φ_l dx
+    and K = ∫ E I φ_k'' φ_l'' dx, and every invariant, are integrated with ``cells`` x ``order``
+    Gauss–Legendre points; ``modes`` samples φ and φ' at ``n_nodes`` equidistant nodes.
+    The inertia about the beam axis includes the section's polar inertia ρ Ip L.
+    """
+    if plane not in ("xy", "xz"):
+        raise ModelError(f"analytic_beam_body: plane must be 'xy' or 'xz', got {plane!r}")
+    length = _num(length, "analytic_beam_body: length")
+    if not (np.isfinite(length) and length > 0):
+        raise ModelError(f"analytic_beam_body: length must be > 0, got {length}")
+    if not isinstance(n_nodes, (int, np.integer)) or n_nodes < 2:
+        raise ModelError(f"analytic_beam_body: n_nodes must be an integer >= 2, got {n_nodes!r}")
+    if not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
+        raise ModelError(f"analytic_beam_body: n_modes must be a positive integer, got {n_modes!r}")
+    I = section.Iz if plane == "xy" else section.Iy
+    d, rot, sgn = (1, 5, 1.0) if plane == "xy" else (2, 4, -1.0)
+    rA = section.rho * section.A
+    edges = np.linspace(0.0, length, cells + 1)
+    xg, wg = np.polynomial.legendre.leggauss(order)
+    x = np.concatenate([0.5 * (b - a) * xg + 0.5 * (a + b) for a, b in zip(edges[:-1], edges[1:])])
+    w = np.concatenate([0.5 * (b - a) * wg for a, b in zip(edges[:-1], edges[1:])])
+    phi = np.array([euler_bernoulli_mode(bc, k, x, length) for k in range(1, n_modes + 1)])  # (q, p)
+    scale = 1.0 / np.sqrt(rA * (phi**2) @ w)
+    phi *= scale[:, None]
+    ddphi = np.array([euler_bernoulli_mode(bc, k, x, length, 2) for k in range(1, n_modes + 1)]) * scale[:, None]
+    M = rA * (phi * w) @ phi.T
+    K = section.E * I * (ddphi * w) @ ddphi.T
+    pos = np.zeros((len(x), 3))
+    pos[:, 0] = x
+    mp = rA * w
+    Phi = np.zeros((len(x), 3, n_modes))
+    Phi[:, d, :] = phi.T
+    nodes = np.zeros((n_nodes, 3))
+    nodes[:, 0] = np.linspace(0.0, length, n_nodes)
+    modes = np.zeros((n_nodes, 6, n_modes))
+    for k in range(n_modes):
+        modes[:, d, k] = scale[k] * euler_bernoulli_mode(bc, k + 1, nodes[:, 0], length)
+        modes[:, rot, k] = sgn * scale[k] * euler_bernoulli_mode(bc, k + 1, nodes[:, 0], length, 1)
+    rt = np.array([skew(r) for r in pos])
+    inertia = -np.einsum("p,pij,pjk->ik", mp, rt, rt)
+    inertia[0, 0] += section.rho * section.Ip * length
+    return ReducedBody(
+        name=name, nodes=nodes, M=0.5 * (M + M.T), K=0.5 * (K + K.T), modes=modes, mass=float(mp.sum()), first_moment=mp @ pos, inertia=inertia,
+        Ct=np.einsum("p,pak->ak", mp, Phi), Cr=np.einsum("p,pab,pbk->ak", mp, rt, Phi), labels=tuple(f"mode{k + 1}" for k in range(n_modes)), **_second_order(pos, mp, Phi),
+    )
 
 
 # ============================================================================================
