@@ -738,6 +738,9 @@ class ReducedBody:
       I(q) = I₀ + Σ_k q_k I1_k + Σ_kl q_k q_l I2_kl = −∫ (r̃ + ũ)(r̃ + ũ) dm
     * ``Gk``  (q, 3, q) G_k = ∫ Φ̃_k Φ dm, so that ∫ ũ Φ dm = Σ_k q_k G_k.
 
+    The rotation of the mass elements themselves (the ω̃_BiBei u term of eq. 2.191, second order
+    in the elastic quantities) and, in I1/I2/G_k, the section's rotary inertia are left out.
+
     The zeroth- and first-order invariants (m, c, I₀, C_t, C_r, M) are taken with the full FE
     mass matrix M_FE and the nodal rigid-body motions Γ (node i: translation v − r̃_i ω,
     rotation ω): Γᵀ M_FE Γ = [[m I, −c̃], [c̃, I₀]], Γᵀ M_FE T = [C_t; C_r], so section rotary
