@@ -439,3 +439,16 @@ def test_craig_bampton_constraint_modes_are_the_static_shapes():
     # the stiffness of the tip DOFs is the clamped-guided beam's: 12 EI/L^3 and 4 EI/L
     assert cb.K[iw, iw] == pytest.approx(12 * E * SEC.Iy / L**3, rel=1e-10)
     assert cb.K[ir, ir] == pytest.approx(4 * E * SEC.Iy / L, rel=1e-10)
+
+
+@pytest.mark.parametrize("bc", ["clamped-free", "pinned-pinned", "free-free", "clamped-clamped", "clamped-pinned"])
+def test_timoshenko_transfer_matrix_reduces_to_euler_bernoulli_roots(bc):
+    # without shear flexibility (kappa G A -> infinity) and rotary inertia the boundary
+    # determinant vanishes at the Euler-Bernoulli frequencies of every support case
+    from scipy import optimize
+
+    EI, rhoA = E * SEC.Iy, RHO * SEC.A
+    for w_eb in el.euler_bernoulli_frequencies(bc, 3, E, SEC.Iy, RHO, SEC.A, L):
+        f = lambda w: el._timoshenko_det(w, bc, EI, np.inf, rhoA, 0.0, L)  # noqa: E731
+        root = optimize.brentq(f, 0.99 * w_eb, 1.01 * w_eb, xtol=1e-13 * w_eb)
+        assert root == pytest.approx(w_eb, rel=1e-10)

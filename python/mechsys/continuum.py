@@ -172,11 +172,7 @@ def polar_decomposition(F):
     """
     F = _checked_F(F, "polar_decomposition")
     W, s, Zt = np.linalg.svd(F)
-    R = W @ Zt
-    if np.linalg.det(R) < 0:  # cannot happen for det F > 0 up to round-off; fix the sign pair
-        W[:, -1] *= -1.0
-        s[-1] *= -1.0
-        R = W @ Zt
+    R = W @ Zt  # det R = sign(det F) = +1, the singular values being >= 0
     U = Zt.T @ np.diag(s) @ Zt
     V = W @ np.diag(s) @ W.T
     return R, 0.5 * (U + U.T), 0.5 * (V + V.T)
