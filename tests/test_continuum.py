@@ -193,3 +193,21 @@ def test_energy_of_stretched_and_bent_bar():
         cm.strain_energy_beam(lambda X: uniax, m, L, ("rect", b, -h))
     with pytest.raises(ModelError, match="bounds must be"):
         cm.strain_energy_box(lambda X: uniax, m, ((0, L), (1, 0), (0, h)))
+
+
+def test_finite_differences_then_polar_decomposition_of_a_general_field():
+    R0 = rot([0.3, -1.0, 0.4], 1.1)
+    Q = rot([1.0, 1.0, 0.0], 0.4)
+    U0 = Q @ np.diag([1.2, 0.9, 1.05]) @ Q.T  # stretch with principal axes off the coordinates
+    F0 = R0 @ U0
+    F = cm.deformation_gradient(lambda X: (F0 - np.eye(3)) @ X + np.array([1.0, 2.0, 3.0]), [0.5, -0.2, 0.1])
+    assert np.allclose(F, F0, atol=1e-12)
+    R, U, V = cm.polar_decomposition(F)
+    assert np.allclose(R, R0, atol=1e-11) and np.allclose(U, U0, atol=1e-11)
+    assert np.allclose(V, R0 @ U0 @ R0.T, atol=1e-11)
+    # U and V share the principal stretches; e = F^-T G F^-1 (push-forward of the Green strain)
+    assert np.allclose(np.linalg.eigvalsh(U), [0.9, 1.05, 1.2], atol=1e-11)
+    assert np.allclose(np.linalg.eigvalsh(V), [0.9, 1.05, 1.2], atol=1e-11)
+    Fi = np.linalg.inv(F)
+    assert np.allclose(cm.euler_almansi(F), Fi.T @ cm.green_lagrange(F) @ Fi, atol=1e-14)
+    assert np.allclose(cm.green_lagrange(F), 0.5 * (U0 @ U0 - np.eye(3)), atol=1e-11)
