@@ -5,7 +5,7 @@ Rust engine (:func:`simulate`), read named signals with units (:class:`Results`)
 (:func:`plot`) and save them to HDF5.
 """
 
-from . import analysis, bearings, constraints, contours, dynamics, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, mjcf, urdf, viewer
+from . import analysis, bearings, constraints, continuum, contours, dynamics, elastic, forces, functions, inertia, joints, kinematics, laws, linear, mechanisms, mjcf, urdf, viewer
 from ._core import __version__
 from .errors import (
     CallbackError,
@@ -71,6 +71,8 @@ __all__ = [
     "forces",
     "functions",
     "inertia",
+    "continuum",
+    "elastic",
     "dynamics",
     "kinematics",
     "MechsysError",
