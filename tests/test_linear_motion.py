@@ -229,7 +229,7 @@ def test_exact_derivatives_refused_for_callbacks():
     b = m.add_body("b", 1.0, [1, 1, 1])
     m.add_joint(ms.joints.Prismatic("x", m.ground, b, axis=(1, 0, 0), u0=1.0))
     m.add_force(ms.forces.PythonForce("push", lambda t, q, u: np.array([-q[0]])))
-    with pytest.raises(ms.SettingsError, match="exact derivatives do not cover force element 'push'"):
+    with pytest.raises(ms.SettingsError, match="exact derivatives do not cover 'push'"):
         ms.linear.linearize(m, method="exact", operating_point=True)
 
 

@@ -99,6 +99,7 @@ class Model:
         ejection_velocity: Sequence[float] = (0.0, 0.0, 0.0),
         ejection_point: Sequence[float] | None = None,
         mass_final: float | None = None,
+        elastic: dict | None = None,
     ) -> Body:
         """Adds a rigid body. ``inertia`` about the centre of mass in body components: a 3x3
         matrix, its diagonal, or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. A variable-mass body (section
@@ -126,6 +127,15 @@ class Model:
                 body["ejection_point"] = _vec3(ejection_point, f"body '{name}'.ejection_point")
             if mass_final is not None:
                 body["mass_final"] = float(mass_final)
+        if elastic is not None:
+            # the Ritz invariants of an elastic body (mechsys.elastic builds them); the engine checks them
+            if not isinstance(elastic, dict):
+                to_engine = getattr(elastic, "to_engine", None)
+                if to_engine is None:
+                    raise ModelError(f"body '{name}'.elastic: expected the invariants of an elastic body (a dict or "
+                                     f"an object with to_engine()), got {type(elastic).__name__}")
+                elastic = to_engine()
+            body["elastic"] = copy.deepcopy(elastic)
         self._bodies.append(body)
         self._invalidate()
         return Body(name, self)

@@ -140,6 +140,12 @@ class Results:
             qu += b
             uc += [f"{j['name']}.{x}" for x in c]
             uu_ += d
+        elastic = engine.elastic() if engine is not None and hasattr(engine, "elastic") else []
+        for e in elastic:
+            qc += [f"{e['body']}.e{k}" for k in range(e["ne"])]
+            qu += ["1"] * e["ne"]
+            uc += [f"{e['body']}.e{k}" for k in range(e["ne"])]
+            uu_ += ["1/s"] * e["ne"]
         # a selective recording (simulate(sensors=...)) holds some bodies only, maybe no
         # accelerations, constraint or force values
         if "body_index" in raw:
@@ -154,6 +160,16 @@ class Results:
         put("u", raw["u"], "mixed", uc, uu_)
         if acc:
             put("udot", raw["udot"], "mixed", uc, [_rate_unit(x) for x in uu_])
+        for e in elastic:
+            # elastic coordinates (their unit is that of the shape functions' normalization)
+            sl, ecols = slice(e["iq"], e["iq"] + e["ne"]), [f"e{k}" for k in range(e["ne"])]
+            put(f"body/{e['body']}/elastic_q", raw["q"][:, sl], "1", ecols)
+            su = slice(e["iu"], e["iu"] + e["ne"])
+            put(f"body/{e['body']}/elastic_u", raw["u"][:, su], "1/s", ecols)
+            if acc:
+                put(f"body/{e['body']}/elastic_udot", raw["udot"][:, su], "1/s^2", ecols)
+            qe = np.asarray(raw["q"][:, sl])
+            put(f"body/{e['body']}/strain_energy", 0.5 * np.einsum("ti,ij,tj->t", qe, np.asarray(e["stiffness"]), qe), "J")
         for j in joints:
             uq, uu, ua = _JOINT_UNITS.get(j["type"], ("", "", ""))
             if j["nq"] == 0:
@@ -763,6 +779,7 @@ def signal_universe(engine) -> list[str]:
     """Every signal name a run of the engine model can give (some only with contacts or the
     matching scheme): what ``sensors=`` patterns are checked against."""
     names = ["t", "q", "u", "udot"]
+    elastic_bodies = {e["body"] for e in engine.elastic()} if hasattr(engine, "elastic") else set()
     for j in engine.joints():
         if j["nq"]:
             names += [f"joint/{j['name']}/{x}" for x in ("q", "u", "udot")]
@@ -771,6 +788,8 @@ def signal_universe(engine) -> list[str]:
             names += [f"joint/{j['name']}/tangential_acceleration", f"joint/{j['name']}/normal_acceleration"]
     for b in engine.bodies():
         n = b["name"]
+        if n in elastic_bodies:
+            names += [f"body/{n}/{x}" for x in ("elastic_q", "elastic_u", "elastic_udot", "strain_energy")]
         names += [f"body/{n}/{x}" for x in ("position", "orientation", "velocity", "angular_velocity", "acceleration",
                                              "angular_acceleration", "mass", "kinetic_energy", "com_position",
                                              "com_velocity", "com_acceleration")]

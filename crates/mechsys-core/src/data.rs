@@ -129,6 +129,8 @@ pub struct Data {
     pub element_deflection: Vec<f64>,
     /// contacts: the user gap functions' scratch and their rows at the last evaluation.
     pub gap: crate::contact::gap::GapWork,
+    /// kinematics: each elastic body's coordinates, deformed invariants and couplings.
+    pub elastic: Vec<crate::elastic::ElasticWork>,
 }
 
 impl Data {
@@ -187,6 +189,7 @@ impl Data {
             slider_force: vec![0.0; model.n_sliders],
             element_force: vec![0.0; model.n_force_outputs],
             element_deflection: vec![0.0; model.n_force_outputs],
+            elastic: model.elastic.iter().map(crate::elastic::ElasticWork::new).collect(),
             gap: {
                 // the gap functions of contacts and of contacts held closed, by slot
                 let mut f: Vec<(usize, &crate::contact::gap::GapFunction)> =

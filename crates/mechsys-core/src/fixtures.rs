@@ -24,6 +24,7 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
             ejection_velocity: [0.0; 3],
             ejection_point: None,
             mass_final: None,
+            elastic: None,
         });
         let nq = match joint_type {
             "spherical" => 4,

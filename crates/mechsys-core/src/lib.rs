@@ -17,6 +17,7 @@ pub mod constraints;
 pub mod contact;
 pub mod data;
 pub mod dynamics;
+pub mod elastic;
 pub mod error;
 pub mod fixtures;
 pub mod forces;

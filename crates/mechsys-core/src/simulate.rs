@@ -1717,8 +1717,7 @@ fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &
     let all = nb_rec == model.nbodies() - 1;
     let mut next = 0;
     for i in 1..model.nbodies() {
-        let h = data.inertia[i].mul_motion(&data.v[i]);
-        let e = 0.5 * data.v[i].dot(&h);
+        let (h, e) = energy::body_momentum(model, data, i);
         if all || (next < nb_rec && rec.body_index[next] == i) {
             rec.body_kinetic.push(e);
             next += 1;

@@ -241,7 +241,7 @@ fn energies<'py>(
     let d = PyDict::new(py);
     d.set_item("kinetic", energy::kinetic_energy(m, &data))?;
     d.set_item("potential", energy::potential_energy(m, &data, q))?;
-    let per_body: Vec<f64> = (1..m.nbodies()).map(|i| energy::body_kinetic_energy(&data, i)).collect();
+    let per_body: Vec<f64> = (1..m.nbodies()).map(|i| energy::body_kinetic_energy(m, &data, i)).collect();
     d.set_item("kinetic_per_body", PyArray1::from_vec(py, per_body))?;
     let gravity: Vec<f64> = (1..m.nbodies()).map(|i| energy::body_gravity_energy(m, &data, i)).collect();
     d.set_item("gravity_per_body", PyArray1::from_vec(py, gravity))?;

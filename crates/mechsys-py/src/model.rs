@@ -85,6 +85,24 @@ impl PyModel {
         Ok(out)
     }
     /// One dict per joint in the engine's (topological) order: name, type, parent, child, iq, nq, iu, nu.
+    /// The elastic bodies: body name, coordinate and velocity offsets, number of elastic
+    /// coordinates, node names.
+    fn elastic<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut out = vec![];
+        for e in &self.model.elastic {
+            let d = PyDict::new(py);
+            d.set_item("body", &self.model.bodies[e.body].name)?;
+            d.set_item("iq", e.iq)?;
+            d.set_item("iu", e.iu)?;
+            d.set_item("ne", e.ne)?;
+            d.set_item("nodes", e.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>())?;
+            let k: Vec<Vec<f64>> = (0..e.ne).map(|r| (0..e.ne).map(|c| e.k[(r, c)]).collect()).collect();
+            d.set_item("stiffness", k)?;
+            out.push(d);
+        }
+        Ok(out)
+    }
+
     fn joints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mut out = vec![];
         for j in &self.model.joints {

@@ -18,6 +18,7 @@ pub(super) fn body(name: &str, m: f64, com: [f64; 3]) -> BodyDescription {
         ejection_velocity: [0.0; 3],
         ejection_point: None,
         mass_final: None,
+        elastic: None,
     }
 }
 

@@ -84,8 +84,8 @@ fn baumgarte(data: &mut Data, gu: &[f64]) {
 fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f64]) -> Result<bool> {
     let nc = model.nc;
     {
-        let Data { inertia, s, ic, .. } = &mut *data;
-        super::crba::composite_inertias(model, inertia, s, ic, |r, c, v| sp.put_mass(r, c, v));
+        let Data { inertia, s, ic, elastic, .. } = &mut *data;
+        super::crba::composite_inertias(model, inertia, s, ic, elastic, |r, c, v| sp.put_mass(r, c, v));
     }
     if !sp.factor_mass() {
         return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));

@@ -11,8 +11,8 @@ use crate::model::Model;
 /// [`crate::kinematics::positions`] and [`crate::kinematics::inertias`] calls.
 pub fn crba(model: &Model, data: &mut Data) {
     data.mass_matrix.as_mut_slice().fill(0.0);
-    let Data { ic, inertia, s, mass_matrix, .. } = data;
-    composite_inertias(model, inertia, s, ic, |r, c, v| {
+    let Data { ic, inertia, s, mass_matrix, elastic, .. } = data;
+    composite_inertias(model, inertia, s, ic, elastic, |r, c, v| {
         mass_matrix[(r, c)] = v;
         mass_matrix[(c, r)] = v;
     });
@@ -26,6 +26,7 @@ pub(crate) fn composite_inertias(
     inertia: &[crate::spatial::RigidInertia],
     s: &[[crate::spatial::Motion; 6]],
     ic: &mut [crate::spatial::RigidInertia],
+    elastic: &[crate::elastic::ElasticWork],
     mut put: impl FnMut(usize, usize, f64),
 ) {
     let nb = model.nbodies();
@@ -51,6 +52,24 @@ pub(crate) fn composite_inertias(
                 let jb = &model.joints[b - 1];
                 for kk in 0..jb.nu() {
                     put(jb.iu + kk, col, s[b][kk].dot(&f));
+                }
+                b = jb.parent;
+            }
+        }
+    }
+    // elastic coordinates: M_ee among themselves, S_jᵀ C_k with the joints carrying the body
+    for (e, w) in model.elastic.iter().zip(elastic) {
+        for k in 0..e.ne {
+            let col = e.iu + k;
+            for kk in 0..=k {
+                put(e.iu + kk, col, e.m_ee[(kk, k)]);
+            }
+            let f = &w.c[k];
+            let mut b = e.body;
+            while b != 0 {
+                let jb = &model.joints[b - 1];
+                for kk in 0..jb.nu() {
+                    put(jb.iu + kk, col, s[b][kk].dot(f));
                 }
                 b = jb.parent;
             }

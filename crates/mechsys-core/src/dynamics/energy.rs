@@ -10,15 +10,33 @@ use crate::kinematics::point_position;
 use crate::math::Vec3;
 use crate::model::{ForceElement, Model};
 
+/// Spatial momentum (world, about the origin) and kinetic energy of body i (requires kinematics
+/// and inertias); an elastic body adds its elastic velocities' share, `C q̇_e` and
+/// `Vᵀ C q̇_e + ½ q̇_eᵀ M_ee q̇_e` (eq. 2.192 after the Ritz separation).
+#[inline]
+pub fn body_momentum(model: &Model, data: &Data, i: usize) -> (crate::spatial::Force, f64) {
+    let v = &data.v[i];
+    let mut h = data.inertia[i].mul_motion(v);
+    let mut t = 0.5 * v.dot(&h);
+    if let Some(k) = model.bodies[i].elastic {
+        let (e, w) = (&model.elastic[k], &data.elastic[k]);
+        for j in 0..e.ne {
+            h += w.c[j] * w.qd[j];
+        }
+        t += crate::elastic::kinetic_energy_extra(e, w, v);
+    }
+    (h, t)
+}
+
 /// Kinetic energy of body i (requires kinematics and inertias).
 #[inline]
-pub fn body_kinetic_energy(data: &Data, i: usize) -> f64 {
-    data.inertia[i].kinetic_energy(&data.v[i])
+pub fn body_kinetic_energy(model: &Model, data: &Data, i: usize) -> f64 {
+    body_momentum(model, data, i).1
 }
 
 /// Total kinetic energy.
 pub fn kinetic_energy(model: &Model, data: &Data) -> f64 {
-    (1..model.nbodies()).map(|i| body_kinetic_energy(data, i)).sum()
+    (1..model.nbodies()).map(|i| body_kinetic_energy(model, data, i)).sum()
 }
 
 /// Gravitational potential energy of body i, zero at the inertial origin: `-m g · r_c`.
@@ -58,6 +76,9 @@ pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
             _ => {}
         }
     }
+    for e in &model.elastic {
+        v += crate::elastic::strain_energy(e, &q[e.iq..e.iq + e.ne]);
+    }
     for j in &model.joints {
         if let Some(s) = &j.spring {
             for k in 0..j.nu() {
@@ -75,7 +96,7 @@ pub fn momentum(model: &Model, data: &Data) -> (Vec3, Vec3) {
     let mut l = Vec3::zeros();
     for i in 1..model.nbodies() {
         // world convention: I v is (moment of momentum about the origin, momentum) directly
-        let h = data.inertia[i].mul_motion(&data.v[i]);
+        let h = body_momentum(model, data, i).0;
         p += h.f;
         l += h.n;
     }

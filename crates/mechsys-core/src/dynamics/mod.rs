@@ -75,7 +75,17 @@ pub fn prepare(
     cb: &dyn Callbacks,
 ) -> Result<Powers> {
     kinematics::forward_pass(model, data, t, q, u);
-    forces::evaluate(model, data, &mut ws.forces, t, q, u, cb)
+    let mut p = forces::evaluate(model, data, &mut ws.forces, t, q, u, cb)?;
+    for e in &model.elastic {
+        // the elastic bodies' material damping q̇ᵀ D q̇
+        let qd = &u[e.iu..e.iu + e.ne];
+        for k in 0..e.ne {
+            for l in 0..e.ne {
+                p.dissipated += qd[k] * e.d[(k, l)] * qd[l];
+            }
+        }
+    }
+    Ok(p)
 }
 
 /// One full forward evaluation: kinematics → forces → ABA; leaves `data.udot` and returns the power balance of the force elements.
@@ -90,7 +100,9 @@ pub fn forward_dynamics(
     tau: Option<&[f64]>,
     cb: &dyn Callbacks,
 ) -> Result<Powers> {
-    if model.nc > 0 {
+    if model.nc > 0 || !model.elastic.is_empty() {
+        // elastic coordinates couple with their body's reference motion through C: the
+        // tree-sparse factorization of M takes them (the articulated-body recursion does not)
         return constrained::forward_dynamics(model, data, ws, t, q, u, tau, cb);
     }
     let p = prepare(model, data, ws, t, q, u, cb)?;

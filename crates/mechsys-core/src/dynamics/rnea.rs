@@ -27,6 +27,9 @@ pub fn rnea_inward(model: &Model, data: &mut Data, out: &mut [f64]) {
         let iv = data.inertia[i].mul_motion(&data.v[i]);
         data.f[i] = data.inertia[i].mul_motion(&(data.a[i] - g)) + data.v[i].cross_force(&iv) - data.f_ext[i];
     }
+    if !model.elastic.is_empty() {
+        crate::elastic::rnea_terms(model, data, out);
+    }
     for (ji, j) in model.joints.iter().enumerate().rev() {
         let i = ji + 1;
         for k in 0..j.nu() {

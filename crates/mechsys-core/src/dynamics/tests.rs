@@ -20,6 +20,7 @@ fn mixed_tree() -> Model {
         ejection_velocity: [0.0; 3],
         ejection_point: None,
         mass_final: None,
+        elastic: None,
     };
     let joint =
         |name: &str, kind: &str, parent: &str, child: &str, pos: [f64; 3], axis: Option<[f64; 3]>| JointDescription {

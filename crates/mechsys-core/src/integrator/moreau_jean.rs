@@ -373,10 +373,10 @@ impl MoreauJean {
             let mut c = std::mem::take(&mut self.tmp_u);
             crate::dynamics::rnea::rnea_inward(model, data, &mut c);
             if pass == 0 {
-                let Data { inertia, s, ic, .. } = &mut *data;
+                let Data { inertia, s, ic, elastic, .. } = &mut *data;
                 let saddle = &mut ws.saddle;
                 let mut tree = self.sparse.as_mut().map(|sp| &mut sp.factor);
-                crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| {
+                crate::dynamics::crba::composite_inertias(model, inertia, s, ic, elastic, |r, col, v| {
                     saddle.put_mass(r, col, v);
                     if let Some(f) = tree.as_mut() {
                         f.put(r, col, v);

@@ -107,6 +107,24 @@ fn inertia_step(b: &crate::model::Body, data: &mut Data, i: usize, t: f64) {
     data.inertia[i] = crate::spatial::RigidInertia::from_com(m, &c, &i_c_w);
 }
 
+/// The stored elastic coordinates (and, with `u`, their rates) of every elastic body.
+fn store_elastic(model: &Model, data: &mut Data, q: &[f64], u: Option<&[f64]>) {
+    for (e, w) in model.elastic.iter().zip(data.elastic.iter_mut()) {
+        w.q.copy_from_slice(&q[e.iq..e.iq + e.ne]);
+        if let Some(u) = u {
+            w.qd.copy_from_slice(&u[e.iu..e.iu + e.ne]);
+        }
+    }
+}
+
+/// The elastic bodies' deformed inertias and couplings, after their rigid inertias.
+fn deform_elastic(model: &Model, data: &mut Data) {
+    for (k, e) in model.elastic.iter().enumerate() {
+        let b = &model.bodies[e.body];
+        crate::elastic::deform(e, data, k, b.mass, &b.com);
+    }
+}
+
 /// Position stage: placements `x_abs`, `x_joint` and motion subspaces `s` (world) of all bodies.
 ///
 /// eq. 2.46: A_IBi = A_IBi-1 · A_Bi-1Bi; eq. 2.51: r_IBi = r_IBi-1 + A_IBi-1 r_Bi-1Bi.
@@ -114,6 +132,7 @@ pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
         position_step(j, data, ji + 1, q);
     }
+    store_elastic(model, data, q, None);
 }
 
 /// Velocity stage: body twists `v` (eqs. 2.49, 2.52, 2.54, 2.55) and velocity-product terms `c`
@@ -122,6 +141,7 @@ pub fn velocities(model: &Model, data: &mut Data, q: &[f64], u: &[f64]) {
     for (ji, j) in model.joints.iter().enumerate() {
         velocity_step(j, data, ji + 1, q, u);
     }
+    store_elastic(model, data, q, Some(u));
 }
 
 /// Body inertias at time t in world components about the origin (variable masses scaled).
@@ -130,6 +150,7 @@ pub fn inertias(model: &Model, data: &mut Data, t: f64) {
     for (i, b) in model.bodies.iter().enumerate().skip(1) {
         inertia_step(b, data, i, t);
     }
+    deform_elastic(model, data);
 }
 
 /// Positions, velocities and inertias in one sweep over the tree (the stages of one evaluation
@@ -140,6 +161,10 @@ pub fn forward_pass(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64]
         position_step(j, data, i, q);
         velocity_step(j, data, i, q, u);
         inertia_step(&model.bodies[i], data, i, t);
+    }
+    if !model.elastic.is_empty() {
+        store_elastic(model, data, q, Some(u));
+        deform_elastic(model, data);
     }
 }
 
@@ -159,6 +184,9 @@ pub fn accelerations(model: &Model, data: &mut Data, udot: &[f64]) {
             a += data.s[i][k] * udot[j.iu + k];
         }
         data.a[i] = a;
+    }
+    for (e, w) in model.elastic.iter().zip(data.elastic.iter_mut()) {
+        w.qdd.copy_from_slice(&udot[e.iu..e.iu + e.ne]);
     }
 }
 

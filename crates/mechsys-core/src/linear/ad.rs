@@ -327,6 +327,10 @@ fn spring_force<T: Real>(k: f64, k3: f64, table: &(Vec<f64>, Vec<f64>), delta: T
 
 /// The name of the first force element the exact derivatives do not cover, if any.
 pub(super) fn unsupported(model: &Model) -> Option<&str> {
+    // elastic bodies are not in the generic tree: differences
+    if let Some(e) = model.elastic.first() {
+        return Some(&model.bodies[e.body].name);
+    }
     model.forces.iter().find(|fe| !covered(fe)).map(|fe| fe.name())
 }
 

@@ -218,7 +218,7 @@ fn check_point(model: &Model, q: &[f64], u: &[f64], how: Derivatives, what: &str
         Derivatives::Exact => {
             if let Some(name) = ad::unsupported(model) {
                 return Err(Error::Settings(format!(
-                    "{what}: exact derivatives do not cover force element '{name}' (a callback force); \
+                    "{what}: exact derivatives do not cover '{name}' (a callback force or an elastic body); \
                      use method \"auto\" or \"fd\" (central differences)"
                 )));
             }

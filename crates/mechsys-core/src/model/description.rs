@@ -409,6 +409,57 @@ pub struct BodyDescription {
     /// Mass at which the mass flow stops (burn-out), > 0; required when `mass_rate < 0`.
     #[serde(default)]
     pub mass_final: Option<f64>,
+    /// Makes the body elastic (floating frame of reference, [`crate::elastic`]); its mass, centre
+    /// of mass and inertia are then those of the undeformed body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic: Option<ElasticDescription>,
+}
+
+/// The elastic part of a body: Ritz invariants (body frame, SI), stiffness, damping, nodes.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElasticDescription {
+    /// Number of elastic coordinates n_e.
+    pub modes: usize,
+    /// `∫ Φ_k dm` per mode (n_e vectors).
+    pub s_t: Vec<[f64; 3]>,
+    /// `∫ r0 Φ_kᵀ dm` per mode, 3 × 3 row-major (n_e).
+    pub p1: Vec<[f64; 9]>,
+    /// `∫ Φ_k Φ_lᵀ dm` per pair, 3 × 3 row-major, at `k n_e + l` (n_e²).
+    pub p2: Vec<[f64; 9]>,
+    /// Stiffness matrix (n_e × n_e).
+    pub stiffness: Vec<Vec<f64>>,
+    /// Damping matrix (n_e × n_e); none by default.
+    #[serde(default)]
+    pub damping: Option<Vec<Vec<f64>>>,
+    /// Geometric stiffness of 12 unit body-force fields per unit mass: `e_x, e_y, e_z`, then
+    /// `e_a s_b` for a, b in x, y, z (a-major); none by default.
+    #[serde(default)]
+    pub geometric: Option<Vec<Vec<Vec<f64>>>>,
+    /// Nodes where markers attach.
+    #[serde(default)]
+    pub nodes: Vec<ElasticNodeDescription>,
+    /// Initial elastic coordinates (default zero).
+    #[serde(default)]
+    pub q0: Option<Vec<f64>>,
+    /// Initial elastic velocities (default zero).
+    #[serde(default)]
+    pub u0: Option<Vec<f64>>,
+}
+
+/// A node of an elastic body.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElasticNodeDescription {
+    /// Node name.
+    pub name: String,
+    /// Undeformed position, body frame (m).
+    pub position: [f64; 3],
+    /// Translation per unit elastic coordinate (n_e vectors).
+    pub translation: Vec<[f64; 3]>,
+    /// Small rotation per unit elastic coordinate (n_e vectors, or none).
+    #[serde(default)]
+    pub rotation: Vec<[f64; 3]>,
 }
 
 /// A linear spring on a joint coordinate: τ = -k (q - q_free).

@@ -63,6 +63,8 @@ pub struct Body {
     pub mass_final: f64,
     /// Whether the inertia tensor is diagonal in the body frame (fast path in the kinematics).
     pub principal_axes: bool,
+    /// Index into [`Model::elastic`] for an elastic body.
+    pub elastic: Option<usize>,
 }
 
 impl Body {
@@ -392,6 +394,8 @@ pub struct Model {
     pub contacts: Vec<contact::Contact>,
     /// Contact groups (pairs found by a broad phase at every step).
     pub contact_groups: Vec<contact::ContactGroup>,
+    /// Elastic bodies (floating frame of reference); their coordinates follow every joint's.
+    pub elastic: Vec<crate::elastic::ElasticBody>,
     /// Number of candidate contact points over all contacts.
     pub n_contact_points: usize,
     /// Total number of constraint equations.
@@ -443,6 +447,9 @@ impl Model {
         for j in &self.joints {
             q[j.iq..j.iq + j.nq()].copy_from_slice(&j.q0);
         }
+        for e in &self.elastic {
+            q[e.iq..e.iq + e.ne].copy_from_slice(&e.q0);
+        }
         q
     }
     /// The initial velocities given in the model (zero where none were given).
@@ -450,6 +457,9 @@ impl Model {
         let mut u = vec![0.0; self.nu];
         for j in &self.joints {
             u[j.iu..j.iu + j.nu()].copy_from_slice(&j.u0);
+        }
+        for e in &self.elastic {
+            u[e.iu..e.iu + e.ne].copy_from_slice(&e.u0);
         }
         u
     }
@@ -495,6 +505,9 @@ impl Model {
         for j in &self.joints {
             j.kind.qdot(&q[j.iq..j.iq + j.nq()], &u[j.iu..j.iu + j.nu()], &mut qd[j.iq..j.iq + j.nq()]);
         }
+        for e in &self.elastic {
+            qd[e.iq..e.iq + e.ne].copy_from_slice(&u[e.iu..e.iu + e.ne]);
+        }
     }
     /// The velocity tree: within a joint each velocity hangs on the previous one, a joint's first
     /// velocity on the last velocity of the nearest ancestor joint that has any. Returns the parent
@@ -510,6 +523,15 @@ impl Model {
             }
             last[ji + 1] = p;
         }
+        // elastic coordinates hang on their body's last velocity, one after another (they couple
+        // with the reference motion and each other)
+        for e in &self.elastic {
+            let mut p = last[e.body];
+            for k in 0..e.ne {
+                parent[e.iu + k] = p;
+                p = e.iu + k;
+            }
+        }
         parent
     }
     /// q ⊕ u·dt on the configuration manifold.
@@ -517,6 +539,11 @@ impl Model {
         for j in &self.joints {
             let (rq, ru) = (j.iq..j.iq + j.nq(), j.iu..j.iu + j.nu());
             j.kind.integrate(&q[rq.clone()], &u[ru], dt, &mut out[rq]);
+        }
+        for e in &self.elastic {
+            for k in 0..e.ne {
+                out[e.iq + k] = q[e.iq + k] + u[e.iu + k] * dt;
+            }
         }
     }
 }

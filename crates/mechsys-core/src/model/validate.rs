@@ -442,6 +442,7 @@ impl Model {
             ejection_point: Vec3::zeros(),
             mass_final: 0.0,
             principal_axes: true,
+            elastic: None,
         }];
         let mut variable_mass = false;
         for &ji in &order {
@@ -483,6 +484,7 @@ impl Model {
                 },
                 mass_final,
                 principal_axes: i_c.iter().enumerate().all(|(k, v)| k % 4 == 0 || *v == 0.0),
+                elastic: None,
             });
         }
 
@@ -622,6 +624,37 @@ impl Model {
             });
             iq += nq;
             iu += nu;
+        }
+
+        // ---- elastic bodies: their coordinates after every joint's ---------------------------------
+        let mut elastic = Vec::new();
+        for &ji in &order {
+            let bi = names[&desc.joints[ji].child] - 1;
+            let b = &desc.bodies[bi];
+            if let Some(ed) = &b.elastic {
+                let k = new_index[bi + 1];
+                crate::ensure!(
+                    b.mass_rate == 0.0,
+                    Model,
+                    "bodies[{bi}] '{}': an elastic body of variable mass is not supported",
+                    b.name
+                );
+                let body = &bodies[k];
+                let e = crate::elastic::validate(
+                    ed,
+                    k,
+                    body.mass,
+                    &body.com,
+                    &body.inertia,
+                    iq,
+                    iu,
+                    &format!("bodies[{bi}] '{}'", b.name),
+                )?;
+                iq += e.ne;
+                iu += e.ne;
+                bodies[k].elastic = Some(elastic.len());
+                elastic.push(e);
+            }
         }
 
         // ---- force elements ------------------------------------------------------------------------
@@ -1262,6 +1295,7 @@ impl Model {
             constraints,
             contacts,
             contact_groups,
+            elastic,
             n_contact_points,
             nc: row,
             planar,

@@ -127,8 +127,8 @@ impl<'a> Phase<'a> {
             *v = -*v;
         }
         {
-            let Data { inertia, s, ic, .. } = &mut *data;
-            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, |r, col, v| sp.put_mass(r, col, v));
+            let Data { inertia, s, ic, elastic, .. } = &mut *data;
+            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, elastic, |r, col, v| sp.put_mass(r, col, v));
         }
         if !sp.factor_mass() {
             self.a_free = c;
