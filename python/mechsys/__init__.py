@@ -23,6 +23,7 @@ from .joints import Frame
 from .model import Body, Model
 from .results import Results, load
 from .simulate import simulate
+from .study import Study, StudyError, study
 from .urdf import load_urdf
 
 
@@ -39,6 +40,9 @@ __all__ = [
     "Body",
     "Frame",
     "simulate",
+    "study",
+    "Study",
+    "StudyError",
     "load_urdf",
     "Results",
     "load",

@@ -473,8 +473,8 @@ def set_path(desc: dict, path: str, value: Any) -> bool:
         rest, where = parts[2:], f"{head}.{parts[1]}"
     else:
         node, rest, where = desc, parts, ""
-        if head not in desc and len(parts) == 1:
-            kinds = ", ".join(list(desc) + [k + ".NAME" for k in PATH_KINDS])
+        if head not in desc:
+            kinds = ", ".join([k for k in desc if k not in PATH_KINDS.values()] + [k + ".NAME" for k in PATH_KINDS])
             raise ModelError(f"parameter '{path}': unknown top-level key '{head}'; expected one of {kinds}")
     for k, key in enumerate(rest):
         last = k == len(rest) - 1
