@@ -395,6 +395,7 @@ class Model:
         if not isinstance(values, dict):
             raise ModelError(f"with_values: expected a dict of dotted path -> value, got {type(values).__name__}")
         desc, callbacks = self.describe()
+        desc = copy.deepcopy(desc)  # element dicts of the description are this model's own
         added = []
         for path, value in values.items():
             if set_path(desc, path, value):

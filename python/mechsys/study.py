@@ -33,7 +33,7 @@ class StudyError(MechsysError, ValueError):
 
 
 #: Seconds to wait for a Dask scheduler given by its address (and for its first worker).
-CONNECT_TIMEOUT = 10.0
+CONNECT_TIMEOUT = 5.0
 #: Study file format version.
 FORMAT_VERSION = 1
 
@@ -355,6 +355,7 @@ def study(
     pool: str = "processes",
     progress: bool = True,
     store: str | Path | None = None,
+    connect_timeout: float = CONNECT_TIMEOUT,
 ) -> "Study":
     """Runs one model over a sample of parameter values and collects metrics per case.
 
@@ -372,7 +373,8 @@ def study(
     threads with the GIL released instead, for models without Python callbacks); ``workers=1`` runs
     in this process. The functions must pickle (module-level functions) for processes.
     ``progress``: one progress bar over the cases. ``store``: a path to save the study to
-    (``.h5``, or ``.zarr`` with zarr installed). A case that raises is recorded (``status``
+    (``.h5``, or ``.zarr`` with zarr installed). ``connect_timeout``: seconds to reach a scheduler
+    given by address and to see its first worker. A case that raises is recorded (``status``
     ``failed``, its ``error``) and the study goes on."""
     model = None
     simulation: dict = {}
@@ -409,7 +411,7 @@ def study(
     bar = _bar(len(cases), progress)
     try:
         if client is not None:
-            outcomes = _run_dask(spec, cases, client, bar)
+            outcomes = _run_dask(spec, cases, client, bar, float(connect_timeout))
             where = "dask"
         else:
             count = int(workers) if workers is not None else (os.cpu_count() or 1)
@@ -526,28 +528,72 @@ def connect(client: Any, timeout: float = CONNECT_TIMEOUT):
         raise StudyError(f"client: expected a distributed.Client or a scheduler address such as 'tcp://host:8786', "
                          f"got {type(client).__name__}")
     addr = client if "://" in client else f"tcp://{client}"
+    _probe(client, addr, timeout)
     try:
         c = distributed.Client(addr, timeout=f"{timeout}s", set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as e:
+    except (OSError, TimeoutError) as e:
         raise StudyError(f"client: cannot reach the Dask scheduler at '{client}' within {timeout:g} s "
                          f"({type(e).__name__}: {' '.join(str(e).split())})") from None
+    except Exception as e:  # noqa: BLE001 - something answered there, but not a Dask scheduler
+        raise StudyError(f"client: cannot reach the Dask scheduler at '{client}': what answers there is not a "
+                         f"Dask scheduler ({type(e).__name__}: {' '.join(str(e).split())[:200]})") from None
     return c, True
 
 
-def _run_dask(spec: _Spec, cases: list[dict], client: Any, bar) -> list:
+def _probe(client: str, addr: str, timeout: float) -> None:
+    """A refused or unroutable TCP address fails at once here (the Dask client would retry it
+    until its timeout); other schemes are left to the client."""
+    import socket
+    from urllib.parse import urlsplit
+
+    try:
+        parts = urlsplit(addr)
+        host, port = parts.hostname, parts.port
+    except ValueError as e:
+        raise StudyError(f"client: '{client}' is not a scheduler address ({e}); expected tcp://host:port") from None
+    if parts.scheme != "tcp":
+        return
+    if not host or port is None:
+        raise StudyError(f"client: '{client}' is not a scheduler address; expected tcp://host:port")
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            # a Dask scheduler greets first (the 8-byte length of its handshake message); the Dask
+            # client would wait for that greeting without end
+            sock.settimeout(timeout)
+            head = b""
+            deadline = time.monotonic() + timeout
+            while len(head) < 8 and time.monotonic() < deadline:
+                chunk = sock.recv(8 - len(head))
+                if not chunk:
+                    break
+                head += chunk
+    except socket.timeout:
+        head = None
+    except OSError as e:
+        raise StudyError(f"client: cannot reach the Dask scheduler at '{client}' ({type(e).__name__}: "
+                         f"{e.strerror or e})") from None
+    if not head or len(head) < 8:
+        raise StudyError(f"client: cannot reach the Dask scheduler at '{client}': something accepts connections "
+                         f"there but sends no Dask greeting within {timeout:g} s")
+    if int.from_bytes(head, "little") > 1 << 24:
+        raise StudyError(f"client: cannot reach the Dask scheduler at '{client}': what answers there is not a "
+                         "Dask scheduler")
+
+
+def _run_dask(spec: _Spec, cases: list[dict], client: Any, bar, timeout: float = CONNECT_TIMEOUT) -> list:
     from distributed import as_completed
 
-    c, owned = connect(client)
+    c, owned = connect(client, timeout)
     try:
         try:
-            c.wait_for_workers(1, timeout=CONNECT_TIMEOUT)
+            c.wait_for_workers(1, timeout=timeout)
         except (TimeoutError, OSError) as e:
             raise StudyError(f"client: the Dask scheduler at '{c.scheduler.address}' has no worker "
-                             f"after {CONNECT_TIMEOUT:g} s ({type(e).__name__})") from None
+                             f"after {timeout:g} s ({type(e).__name__})") from None
         import uuid
 
         run_id = uuid.uuid4().hex
-        [shared] = c.scatter([spec], broadcast=True)
+        [shared] = c.scatter([spec], broadcast=True, hash=False)
         futures = [c.submit(_run_case, shared, i, case, pure=False, key=f"mechsys-case-{i}-{run_id}")
                    for i, case in enumerate(cases)]
         index = {f.key: i for i, f in enumerate(futures)}
