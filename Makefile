@@ -46,6 +46,7 @@ bench: $(BUILD)
 	$(PY) benches/stiff.py --out docs/benchmarks.md
 	$(PY) benches/bearing.py --out docs/benchmarks.md
 	$(PY) benches/planar.py --out docs/benchmarks.md
+	$(PY) benches/study.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results

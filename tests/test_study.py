@@ -338,6 +338,25 @@ def test_unreachable_scheduler_is_a_clear_error_quickly(tmp_path, kind, silent_s
     assert r.returncode == 2 and f"error: client: cannot reach the Dask scheduler at '{address}'" in r.stderr
 
 
+def test_ctrl_c_stops_a_process_study_without_waiting_for_its_cases(tmp_path):
+    import signal
+
+    cmd = [sys.executable, "-m", "mechsys", "study", QC, "--param", "force.suspension.d=500:3000:64", "--metric",
+           "max:t", "--set", "simulation.integrator={type = 'rk4', dt = 1e-5}", "--set", "simulation.t_end=2",
+           "--workers", "2", "--out", str(tmp_path / "s.h5")]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(4.0)  # the workers started and busy (64 cases of about 0.25 s each)
+        start = time.perf_counter()
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=60)
+    finally:
+        p.kill()
+    assert p.returncode == 130 and "interrupted" in err
+    assert time.perf_counter() - start < 10  # not the remaining cases
+    assert not (tmp_path / "s.h5").exists()
+
+
 # ---- the study file, plots and the command -------------------------------------------------------
 def test_save_load_round_trip_and_checksum(tmp_path):
     st = ms.study(QC, {"force.suspension.d": (500.0, 3000.0), "body.body.mass": (250.0, 350.0)},

@@ -492,15 +492,22 @@ def _run_processes(spec: _Spec, cases: list[dict], count: int, bar) -> list:
     blob = _pickled_spec(spec)
     ctx = multiprocessing.get_context("spawn")  # no fork of a process with engine threads
     outcomes: list = []
-    with ProcessPoolExecutor(max_workers=count, mp_context=ctx, initializer=_init_worker, initargs=(blob,)) as ex:
+    ex = ProcessPoolExecutor(max_workers=count, mp_context=ctx, initializer=_init_worker, initargs=(blob,))
+    try:
         futures = {ex.submit(_run_in_worker, i, c): i for i, c in enumerate(cases)}
         for fut in as_completed(futures):
             try:
                 outcomes.append(fut.result())
             except BrokenProcessPool as e:
-                outcomes.append((futures[fut], "failed", {}, (f"BrokenProcessPool: a worker process died ({e}); a script that starts a study "
-                                 "on processes must do so under if __name__ == '__main__':"), math.nan))
+                outcomes.append((futures[fut], "failed", {}, (f"BrokenProcessPool: a worker process died ({e}); a "
+                                 "script that starts a study on processes must do so under if __name__ == '__main__':"),
+                                 math.nan))
             bar.update(1)
+    except BaseException:
+        # Ctrl-C (or any error here): the cases not started are dropped, not waited for
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
+    ex.shutdown(wait=True)
     return outcomes
 
 
@@ -508,10 +515,15 @@ def _run_threads(spec: _Spec, cases: list[dict], count: int, bar) -> list:
     from concurrent.futures import ThreadPoolExecutor, as_completed
 
     outcomes: list = []
-    with ThreadPoolExecutor(max_workers=count) as ex:
+    ex = ThreadPoolExecutor(max_workers=count)
+    try:
         for fut in as_completed([ex.submit(_run_case, spec, i, c) for i, c in enumerate(cases)]):
             outcomes.append(fut.result())
             bar.update(1)
+    except BaseException:
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
+    ex.shutdown(wait=True)
     return outcomes
 
 
@@ -598,12 +610,17 @@ def _run_dask(spec: _Spec, cases: list[dict], client: Any, bar, timeout: float =
                    for i, case in enumerate(cases)]
         index = {f.key: i for i, f in enumerate(futures)}
         outcomes = []
-        for fut in as_completed(futures):
-            try:
-                outcomes.append(fut.result())
-            except Exception as e:  # noqa: BLE001 - a lost worker: the case is recorded as failed
-                outcomes.append((index[fut.key], "failed", {}, f"{type(e).__name__}: {' '.join(str(e).split())}", math.nan))
-            bar.update(1)
+        try:
+            for fut in as_completed(futures):
+                try:
+                    outcomes.append(fut.result())
+                except Exception as e:  # noqa: BLE001 - a lost worker: the case is recorded as failed
+                    outcomes.append((index[fut.key], "failed", {}, f"{type(e).__name__}: {' '.join(str(e).split())}",
+                                     math.nan))
+                bar.update(1)
+        except BaseException:
+            c.cancel(futures)  # Ctrl-C: the cluster stops working for this study
+            raise
         return outcomes
     finally:
         if owned:
