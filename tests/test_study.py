@@ -75,8 +75,14 @@ def test_model_with_module_function_pickles_lambda_named():
     res = ms.simulate(pickle.loads(pickle.dumps(model)), t_end=1.0, integrator=ms.RK4(dt=1e-3))
     # a constant 1 N on 2 kg from rest: x = t^2 / 4
     assert res["joint/slide/q"][-1] == pytest.approx(0.25, rel=1e-12)
+    lam = make(lambda t, q, u: np.ones(len(u)))
     with pytest.raises(ms.ModelError, match=r"force 'push'\.func: the Python function '.*<lambda>'"):
-        pickle.dumps(make(lambda t, q, u: np.ones(len(u))))
+        pickle.dumps(lam)
+    # a copy within the process keeps the lambda (copying does not go through pickle)
+    twin = copy.deepcopy(lam)
+    assert twin.ground.model is twin and twin._forces[0].func is lam._forces[0].func
+    again = ms.simulate(twin, t_end=1.0, integrator=ms.RK4(dt=1e-3))
+    assert again["joint/slide/q"].tobytes() == res["joint/slide/q"].tobytes()
 
 
 def test_results_pickle_with_derived_signals():

@@ -387,6 +387,22 @@ class Model:
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
 
+    def __copy__(self) -> "Model":
+        new = Model.__new__(type(self))
+        new.__dict__.update({k: v for k, v in self.__dict__.items() if k != "_warned"})
+        new._built = new._engine = None
+        return new
+
+    def __deepcopy__(self, memo: dict) -> "Model":
+        # (not through pickling: a copy in this process may keep a lambda)
+        new = Model.__new__(type(self))
+        memo[id(self)] = new
+        for k, v in self.__dict__.items():
+            if k not in ("_built", "_engine", "_warned"):
+                setattr(new, k, copy.deepcopy(v, memo))
+        new._built = new._engine = None
+        return new
+
     def with_values(self, values: dict) -> "Model":
         """A new model with values changed by dotted paths into the description, e.g.
         ``{"body.arm.mass": 2.0, "force.damper.d": 1500, "joint.pin.q0": [0.1],
