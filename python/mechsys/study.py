@@ -541,8 +541,26 @@ def connect(client: Any, timeout: float = CONNECT_TIMEOUT):
                          f"got {type(client).__name__}")
     addr = client if "://" in client else f"tcp://{client}"
     _probe(client, addr, timeout)
+    import threading
+
+    made: list = []
+
+    def make():
+        try:
+            made.append(distributed.Client(addr, timeout=f"{timeout}s", set_as_default=False))
+        except BaseException as e:  # noqa: BLE001 - handed to the waiting thread
+            made.append(e)
+
+    # the client's own timeout does not cover every stage of its handshake: a hard limit here
+    maker = threading.Thread(target=make, name="mechsys-dask-connect", daemon=True)
+    maker.start()
+    maker.join(timeout + 5.0)
+    if not made:
+        raise StudyError(f"client: cannot reach the Dask scheduler at '{client}': no answer within {timeout + 5.0:g} s")
     try:
-        c = distributed.Client(addr, timeout=f"{timeout}s", set_as_default=False)
+        if isinstance(made[0], BaseException):
+            raise made[0]
+        c = made[0]
     except (OSError, TimeoutError) as e:
         raise StudyError(f"client: cannot reach the Dask scheduler at '{client}' within {timeout:g} s "
                          f"({type(e).__name__}: {' '.join(str(e).split())})") from None
