@@ -145,11 +145,26 @@ def test_run_set_matches_python(tmp_path):
     ("body.car.mass=2", "no body named 'car'; the model's are: wheel, body"),
     ("simulation.tend=2", "unknown simulation key 'tend'"),
     ("force.suspension.d", "expected PATH=VALUE"),
+    ("simulation.t_end.x=1", "simulation.t_end is a value (3.0), not a table"),
+    ("simulation.integrator.dtt=1e-3", "simulation.integrator.dtt: unknown key for dopri5"),
 ])
 def test_run_set_errors_name_the_path(tmp_path, setting, message):
     r = CliRunner().invoke(cli, ["run", QC, "--set", setting, "--out", str(tmp_path / "r.h5")])
     assert r.exit_code == 2 and message in r.output
     assert not (tmp_path / "r.h5").exists()
+
+
+def test_simulation_paths_reach_integrator_and_solver_objects():
+    """A .py model file's integrator object: its parameters and its contact solver's by path."""
+    from mechsys.study import apply_values
+
+    model, sim = load_model(Path(QC).parent / "striking_pendulum.py")
+    _, changed = apply_values(model, sim, {"simulation.integrator.dt": 2e-4, "simulation.integrator.solver": "lemke"})
+    integ = simulation_kwargs(changed)["integrator"]
+    assert isinstance(integ, ms.MoreauJean) and integ.dt == 2e-4 and isinstance(integ.solver, ms.Lemke)
+    _, changed = apply_values(model, sim, {"simulation.integrator.solver.max_iter": 7})
+    assert simulation_kwargs(changed)["integrator"].solver.max_iter == 7
+    assert simulation_kwargs(sim)["integrator"].solver.max_iter != 7  # the original is untouched
 
 
 # ---- samples -------------------------------------------------------------------------------------

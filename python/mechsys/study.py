@@ -63,7 +63,7 @@ def apply_values(model: Model, simulation: dict | None, values: Mapping[str, Any
     """``model`` and its simulation table with dotted-path values applied: ``simulation.KEY...``
     paths go to the table (``simulation.t_end``, ``simulation.integrator.rtol``), all others to a
     new model (:meth:`Model.with_values`). Unknown paths are errors naming them."""
-    from .modelfile import SIMULATION_KEYS, _check_simulation, _integrator_dict
+    from .modelfile import SIMULATION_KEYS, _check_simulation
 
     sim = dict(simulation or {})
     model_values = {}
@@ -82,24 +82,31 @@ def apply_values(model: Model, simulation: dict | None, values: Mapping[str, Any
         if len(parts) == 1:
             sim[key] = value
             continue
-        node = _integrator_dict(sim.get(key)) if key == "integrator" else dict(sim.get(key) or {})
-        if node is None:
-            node = {}
-        sim[key] = node
+        sim[key] = node = _as_table(sim.get(key), f"simulation.{key}", path)
         for k, part in enumerate(parts[1:-1], start=1):
-            child = node.get(part)
-            child = dict(_integrator_dict(child) if key == "integrator" and part == "solver" and child is not None
-                         and not isinstance(child, dict) else (child or {}))
-            if not isinstance(child, dict):
-                raise SettingsError(f"parameter '{path}': simulation.{'.'.join(parts[:k + 1])} is not a table")
-            node[part] = child
-            node = child
+            node[part] = node = _as_table(node.get(part), f"simulation.{'.'.join(parts[:k + 1])}", path)
         node[parts[-1]] = value
     if model_values:
         model = model.with_values(model_values)
     if any(p.startswith("simulation.") for p in values):
         sim = _check_simulation(sim, model, allow_objects=True)
     return model, sim
+
+
+def _as_table(value: Any, where: str, path: str) -> dict:
+    """A copy of a simulation table, an integrator or solver object as its table, {} for none."""
+    from .modelfile import _INTEGRATOR_CLASSES, _SOLVER_CLASSES, _fields
+
+    if value is None:
+        return {}
+    if isinstance(value, Mapping):
+        return dict(value)
+    if isinstance(value, str):
+        return {"type": value.lower()}
+    table = _fields(value, {**_INTEGRATOR_CLASSES, **_SOLVER_CLASSES})
+    if table is None:
+        raise SettingsError(f"parameter '{path}': {where} is a value ({value!r}), not a table")
+    return table
 
 
 # ---- samples -------------------------------------------------------------------------------------
