@@ -547,8 +547,8 @@ def _check_picklable_callables(model: "Model") -> None:
             items = obj.items()
         elif isinstance(obj, (list, tuple)):
             items = enumerate(obj)
-        elif hasattr(obj, "__dict__"):
-            items = vars(obj).items()
+        elif hasattr(obj, "__dict__") and type(obj).__module__.startswith("mechsys"):
+            items = vars(obj).items()  # (other libraries' objects pickle as they define)
         else:
             return
         for key, v in items:

@@ -415,14 +415,16 @@ def study(
         raise StudyError(f"workers: expected a whole number >= 1, got {workers!r}")
 
     start = time.perf_counter()
+    count = min(int(workers) if workers is not None else (os.cpu_count() or 1), len(cases))
+    blob = _pickled_spec(spec) if client is None and pool == "processes" and count > 1 else b""
+    if client is not None:
+        client = connect(client, float(connect_timeout))
     bar = _bar(len(cases), progress)
     try:
         if client is not None:
             outcomes = _run_dask(spec, cases, client, bar, float(connect_timeout))
             where = "dask"
         else:
-            count = int(workers) if workers is not None else (os.cpu_count() or 1)
-            count = min(count, len(cases))
             if count <= 1:
                 outcomes = []
                 for i, c in enumerate(cases):
@@ -433,7 +435,7 @@ def study(
                 outcomes = _run_threads(spec, cases, count, bar)
                 where = f"{count} threads"
             else:
-                outcomes = _run_processes(spec, cases, count, bar)
+                outcomes = _run_processes(blob, cases, count, bar)
                 where = f"{count} processes"
     finally:
         bar.close()
@@ -472,8 +474,9 @@ def _pickled_spec(spec: _Spec) -> bytes:
     for what, obj in (("build", spec.build), ("run", spec.run), ("model", spec.model)):
         try:
             pickle.dumps(obj)
-        except MechsysError:
-            raise
+        except MechsysError as e:
+            raise type(e)(f"{e}; or run the study with pool='threads' or workers=1 (a Dask cluster takes such "
+                          "functions by value)") from None
         except Exception as e:  # noqa: BLE001
             name = getattr(obj, "__qualname__", type(obj).__name__)
             raise StudyError(f"{what}: '{name}' cannot be sent to worker processes ({type(e).__name__}: {e}); define "
@@ -491,15 +494,15 @@ def _pickled_spec(spec: _Spec) -> bytes:
     return pickle.dumps(spec)
 
 
-def _run_processes(spec: _Spec, cases: list[dict], count: int, bar) -> list:
+def _run_processes(blob: bytes, cases: list[dict], count: int, bar) -> list:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
-    blob = _pickled_spec(spec)
     ctx = multiprocessing.get_context("spawn")  # no fork of a process with engine threads
     outcomes: list = []
     ex = ProcessPoolExecutor(max_workers=count, mp_context=ctx, initializer=_init_worker, initargs=(blob,))
+    futures: dict = {}
     try:
         futures = {ex.submit(_run_in_worker, i, c): i for i, c in enumerate(cases)}
         for fut in as_completed(futures):
@@ -511,7 +514,10 @@ def _run_processes(spec: _Spec, cases: list[dict], count: int, bar) -> list:
                                  math.nan))
             bar.update(1)
     except BaseException:
-        # Ctrl-C (or any error here): the cases not started are dropped, not waited for
+        # Ctrl-C (or any error here): the cases not started are dropped, not waited for (each
+        # future cancelled here: the executor's own cancelling is skipped once it is collected)
+        for fut in futures:
+            fut.cancel()
         ex.shutdown(wait=False, cancel_futures=True)
         raise
     ex.shutdown(wait=True)
@@ -523,11 +529,15 @@ def _run_threads(spec: _Spec, cases: list[dict], count: int, bar) -> list:
 
     outcomes: list = []
     ex = ThreadPoolExecutor(max_workers=count)
+    futures: list = []
     try:
-        for fut in as_completed([ex.submit(_run_case, spec, i, c) for i, c in enumerate(cases)]):
+        futures = [ex.submit(_run_case, spec, i, c) for i, c in enumerate(cases)]
+        for fut in as_completed(futures):
             outcomes.append(fut.result())
             bar.update(1)
     except BaseException:
+        for fut in futures:
+            fut.cancel()
         ex.shutdown(wait=False, cancel_futures=True)
         raise
     ex.shutdown(wait=True)
@@ -617,10 +627,10 @@ def _probe(client: str, addr: str, timeout: float) -> None:
                          "Dask scheduler")
 
 
-def _run_dask(spec: _Spec, cases: list[dict], client: Any, bar, timeout: float = CONNECT_TIMEOUT) -> list:
+def _run_dask(spec: _Spec, cases: list[dict], connected: tuple, bar, timeout: float = CONNECT_TIMEOUT) -> list:
     from distributed import as_completed
 
-    c, owned = connect(client, timeout)
+    c, owned = connected
     try:
         try:
             c.wait_for_workers(1, timeout=timeout)
