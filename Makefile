@@ -13,7 +13,8 @@ all: build
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin "dask[distributed]"
+	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin
+	$(PY) -m pip install --quiet "dask[distributed]"  # parameter studies on a Dask cluster (tests/test_study.py)
 	touch $(STAMP)
 
 # The core in release mode, installed into the venv as an editable package.
