@@ -303,6 +303,13 @@ def test_failed_case_on_the_cluster(cluster_client):
     assert st.error[1].startswith("ModelError:") and "mass" in st.error[1]
 
 
+def test_a_bad_first_value_fails_its_case_only():
+    st = ms.study(QC, {"body.body.mass": [-1.0, 300.0]}, metrics={"final": "final:joint/body_y/q"},
+                  settings={"t_end": 0.2}, workers=1, progress=False)
+    assert list(st.status) == ["failed", "ok"]
+    assert st.error[0] == "ModelError: bodies[1] 'body'.mass: must be > 0, got -1"
+
+
 def test_non_finite_metric_fails_the_case():
     st = ms.study(QC, {"force.suspension.d": [1500.0]}, metrics={"bad": _nan_metric}, settings={"t_end": 0.1},
                   workers=1, progress=False)

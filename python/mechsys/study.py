@@ -449,7 +449,14 @@ def study(
 def _check_parameters(spec: _Spec, names: list[str], first: dict) -> None:
     """Errors naming a parameter the model (or build function) does not have, before any case runs."""
     if spec.model is not None:
-        apply_values(spec.model, spec.simulation, first)  # ModelError / SettingsError naming the path
+        try:
+            apply_values(spec.model, spec.simulation, first)
+        except MechsysError as e:
+            msg = str(e)
+            # a path the model does not have stops the study; a value the engine refuses fails
+            # only its case (the first case's value is no better than the others')
+            if msg.startswith("parameter '") or "not a key of the model description" in msg or "unknown key" in msg:
+                raise
         return
     try:
         sig = inspect.signature(spec.build)
