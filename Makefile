@@ -14,6 +14,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin playwright mujoco mkdocs "mkdocstrings[python]"
+	$(PY) -m pip install --quiet "dask[distributed]"  # parameter studies on a Dask cluster (tests/test_study.py)
 	touch $(STAMP)
 
 # The core in release mode, installed into the venv as an editable package.
@@ -62,6 +63,7 @@ bench: $(BUILD)
 	$(PY) benches/bearing.py --out docs/benchmarks.md
 	$(PY) benches/planar.py --out docs/benchmarks.md
 	$(PY) benches/viewer.py --out docs/benchmarks.md
+	$(PY) benches/study.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results site

@@ -23,6 +23,7 @@ from .joints import Frame
 from .model import Body, Model
 from .results import Results, load
 from .simulate import simulate
+from .study import Study, StudyError, study
 from .urdf import load_urdf
 from .viewer import view
 from .mjcf import load_mjcf
@@ -41,6 +42,9 @@ __all__ = [
     "Body",
     "Frame",
     "simulate",
+    "study",
+    "Study",
+    "StudyError",
     "load_urdf",
     "view",
     "viewer",

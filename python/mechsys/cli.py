@@ -169,6 +169,9 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.option("--max-wall", "max_wall", type=float, help="Stop after this many seconds of wall-clock time.")
 @click.option("--sensors", "sensors", multiple=True, metavar="PATTERN[,PATTERN...]",
               help="Record only these signals (names or patterns such as 'joint/*/q', 'marker/arm/tip/*'); repeat or separate by commas [default: everything].")
+@click.option("--set", "set_values", multiple=True, metavar="PATH=VALUE",
+              help="Change a model or simulation value by its dotted path (body.arm.mass=2, force.damper.d=1500, "
+                   "gravity=[0,0,-9.81], simulation.t_end=2); the value is a TOML literal; repeatable.")
 @click.option("--out", "out", type=click.Path(path_type=Path, dir_okay=False), help="HDF5 results file [default: results/<model name>.h5].")
 @click.option("--plot", "plot_out", type=click.Path(path_type=Path, dir_okay=False), help="Write a plot (.png, .svg or .pdf).")
 @click.option(
@@ -196,6 +199,7 @@ def run(
     max_steps: int | None,
     max_wall: float | None,
     sensors: tuple[str, ...],
+    set_values: tuple[str, ...],
     out: Path | None,
     plot_out: Path | None,
     signals: tuple[str, ...],
@@ -211,6 +215,10 @@ def run(
     from .modelfile import load_model, simulation_kwargs
 
     model, defaults = load_model(model_file)
+    if set_values:
+        from .study import apply_values, parse_assignment
+
+        model, defaults = apply_values(model, defaults, dict(parse_assignment(v) for v in set_values))
     kwargs = simulation_kwargs(
         defaults,
         t_end=t_end,
@@ -704,6 +712,11 @@ def _sweep_option(text: str):
     if n < 2 or not (np.isfinite(lo) and np.isfinite(hi)) or lo == hi:
         raise CliError(f"--sweep: need N >= 2 and finite START != STOP, got {text!r}")
     return parts[0], np.linspace(lo, hi, n)
+
+
+from .cli_study import study_cmd  # noqa: E402  (parameter studies, mechsys study)
+
+cli.add_command(study_cmd)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -434,11 +434,65 @@ class Model:
             raise ModelError(f"{which}0: the model has {n} {'coordinates' if which == 'q' else 'velocities'}, got {arr.size}")
         return arr
 
+    # ---- pickling and changed copies -----------------------------------------------------------
+    def __getstate__(self) -> dict:
+        """The plain description and element objects without the engine caches (rebuilt on first
+        use), so a model goes to a process pool or a Dask worker. A Python function in the model
+        must pickle itself (a module-level function); a lambda or a nested function is a
+        ModelError naming the element that holds it."""
+        _check_picklable_callables(self)
+        state = dict(self.__dict__)
+        state["_built"] = None
+        state["_engine"] = None
+        state.pop("_warned", None)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+    def __copy__(self) -> "Model":
+        new = Model.__new__(type(self))
+        new.__dict__.update({k: v for k, v in self.__dict__.items() if k != "_warned"})
+        new._built = new._engine = None
+        return new
+
+    def __deepcopy__(self, memo: dict) -> "Model":
+        # (not through pickling: a copy in this process may keep a lambda)
+        new = Model.__new__(type(self))
+        memo[id(self)] = new
+        for k, v in self.__dict__.items():
+            if k not in ("_built", "_engine", "_warned"):
+                setattr(new, k, copy.deepcopy(v, memo))
+        new._built = new._engine = None
+        return new
+
+    def with_values(self, values: dict) -> "Model":
+        """A new model with values changed by dotted paths into the description, e.g.
+        ``{"body.arm.mass": 2.0, "force.damper.d": 1500, "joint.pin.q0": [0.1],
+        "contact.beak.friction.mu": 0.2, "gravity": [0, 0, -9.81]}`` (see :func:`set_path`). This
+        model is left as it is; the new one is validated by the engine."""
+        if not isinstance(values, dict):
+            raise ModelError(f"with_values: expected a dict of dotted path -> value, got {type(values).__name__}")
+        desc, callbacks = self.describe()
+        desc = copy.deepcopy(desc)  # element dicts of the description are this model's own
+        added = []
+        for path, value in values.items():
+            if set_path(desc, path, value):
+                added.append(path)
+        try:
+            m = Model.from_dict(desc, callbacks)
+            m.build()
+        except ModelError as e:
+            if added and "unknown field" in str(e):
+                raise ModelError(f"{', '.join(added)}: not a key of the model description ({e})") from None
+            raise
+        return m
+
     def __repr__(self) -> str:
         return f"Model('{self.name}', bodies={len(self._bodies)}, joints={len(self._joints)}, forces={len(self._forces)})"
 
 
-__all__ = ["Model", "Body"]
+__all__ = ["Model", "Body", "set_path"]
 
 
 def _warn_static_below_sliding(desc: dict) -> None:
@@ -454,3 +508,120 @@ def _warn_static_below_sliding(desc: dict) -> None:
                 what = "contact" if kind == "contacts" else "contact group"
                 warnings.warn(f"{what} '{c.get('name')}': the static coefficient mu0 = {mu0} is below the sliding "
                               f"one mu = {mu}; it sticks up to mu", UserWarning, stacklevel=3)
+
+
+#: Dotted-path prefixes and the description lists they name (``body.arm`` is bodies[name=arm]).
+PATH_KINDS = {
+    "body": "bodies", "joint": "joints", "force": "forces", "constraint": "constraints", "contact": "contacts",
+    "gap_contact": "gap_contacts", "contact_group": "contact_groups", "ground_marker": "ground_markers",
+}
+
+
+def _names_at(node) -> list[str]:
+    if isinstance(node, dict):
+        return [str(k) for k in node]
+    if isinstance(node, list):
+        named = [x.get("name") for x in node if isinstance(x, dict) and isinstance(x.get("name"), str)]
+        return named if len(named) == len(node) else [str(i) for i in range(len(node))]
+    return []
+
+
+def set_path(desc: dict, path: str, value: Any) -> bool:
+    """Sets ``value`` at a dotted ``path`` in a model description dict (in place): the first part is
+    a top-level key (``gravity``, ``name``) or an element kind (``body``, ``joint``, ``force``,
+    ``constraint``, ``contact``, ``contact_group``, ``ground_marker``) followed by the element's
+    name; then keys of nested tables, names of named list entries (``markers``) or list indices.
+    An unknown part is a ModelError naming the path and listing what exists at that level. The
+    last key may be new to the element (a joint's ``q0`` not given before; the engine then checks
+    it): returns whether it was."""
+    if not isinstance(path, str) or not path or any(not p for p in path.split(".")):
+        raise ModelError(f"parameter {path!r}: expected a dotted path such as 'body.arm.mass'")
+    parts = path.split(".")
+    head = parts[0]
+    if head in PATH_KINDS or head in PATH_KINDS.values():
+        kind = PATH_KINDS.get(head, head)
+        if len(parts) < 3:
+            raise ModelError(f"parameter '{path}': give the element's name and a key, e.g. '{head}.NAME.KEY'")
+        if kind == "contacts":
+            pool = list(desc.get("contacts", [])) + list(desc.get("gap_contacts", []))
+        else:
+            pool = list(desc.get(kind, []))
+        node = next((e for e in pool if isinstance(e, dict) and e.get("name") == parts[1]), None)
+        if node is None:
+            names = ", ".join(str(e.get("name")) for e in pool if isinstance(e, dict)) or "(none)"
+            raise ModelError(f"parameter '{path}': no {head} named '{parts[1]}'; the model's are: {names}")
+        rest, where = parts[2:], f"{head}.{parts[1]}"
+    else:
+        node, rest, where = desc, parts, ""
+        if head not in desc:
+            kinds = ", ".join([k for k in desc if k not in PATH_KINDS.values()] + [k + ".NAME" for k in PATH_KINDS])
+            raise ModelError(f"parameter '{path}': unknown top-level key '{head}'; expected one of {kinds}")
+    for k, key in enumerate(rest):
+        last = k == len(rest) - 1
+        if isinstance(node, list):
+            idx = None
+            if key.isdigit():
+                idx = int(key)
+            else:
+                idx = next((i for i, x in enumerate(node) if isinstance(x, dict) and x.get("name") == key), None)
+            if idx is None or idx >= len(node):
+                raise ModelError(f"parameter '{path}': '{key}' is not an entry of {where or 'the model'}; "
+                                 f"entries: {', '.join(_names_at(node)) or '(none)'}")
+            if last:
+                node[idx] = value
+                return False
+            node, where = node[idx], f"{where}.{key}" if where else key
+            continue
+        if not isinstance(node, dict):
+            raise ModelError(f"parameter '{path}': {where} is a value ({node!r}), it has no '{key}'")
+        if key not in node:
+            if last and where:
+                node[key] = value
+                return True
+            raise ModelError(f"parameter '{path}': unknown key '{key}' at {where or 'the top level'}; "
+                             f"keys there: {', '.join(_names_at(node)) or '(none)'}")
+        if last:
+            node[key] = value
+            return False
+        node, where = node[key], f"{where}.{key}" if where else key
+    return False
+
+
+def _check_picklable_callables(model: "Model") -> None:
+    """ModelError naming the element (and attribute) whose Python function cannot be pickled."""
+    import pickle
+    import types
+
+    def walk(obj, where: str, depth: int):
+        if depth > 6 or isinstance(obj, (str, bytes, int, float, bool, type(None), np.ndarray, Body, Model)):
+            return
+        if isinstance(obj, (types.FunctionType, types.MethodType, types.BuiltinFunctionType)) or (
+                callable(obj) and not isinstance(obj, type) and not hasattr(obj, "__dataclass_fields__")
+                and not hasattr(obj, "__dict__")):
+            try:
+                pickle.dumps(obj)
+            except Exception as e:  # noqa: BLE001 - any failure to pickle is reported the same way
+                name = getattr(obj, "__qualname__", type(obj).__name__)
+                raise ModelError(f"{where}: the Python function '{name}' cannot be pickled ({type(e).__name__}: {e}); "
+                                 "define it at module level (not a lambda or a nested function) to send the model "
+                                 "to another process") from None
+            return
+        if isinstance(obj, dict):
+            items = obj.items()
+        elif isinstance(obj, (list, tuple)):
+            items = enumerate(obj)
+        elif hasattr(obj, "__dict__") and type(obj).__module__.startswith("mechsys"):
+            items = vars(obj).items()  # (other libraries' objects pickle as they define)
+        else:
+            return
+        for key, v in items:
+            walk(v, f"{where}.{key}" if not isinstance(key, int) else f"{where}[{key}]", depth + 1)
+
+    groups = (("joint", model._joints), ("force", model._forces), ("constraint", model._constraints),
+              ("contact", model._contacts), ("contact group", model._contact_groups))
+    for what, elements in groups:
+        for k, e in enumerate(elements if isinstance(elements, list) else []):
+            name = e.get("name") if isinstance(e, dict) else getattr(e, "name", None)
+            walk(e, f"{what} '{name}'" if name is not None else f"{what}[{k}]", 0)
+    for k, f in enumerate(model._extra_callbacks):
+        walk(f, f"model '{model.name}' callback {k}", 0)

@@ -353,6 +353,24 @@ class Results:
         self._lazy = {n: v for n, v in self._lazy.items() if n in keep}
         self._columns = {n: c for n, c in self._columns.items() if n in keep}
 
+    # ---- pickling ------------------------------------------------------------------------------
+    def __getstate__(self) -> dict:
+        """Signals, units and attributes; the derived signal groups still waiting to be computed
+        (they close over the engine model, which does not pickle) are computed first, as for
+        :meth:`save`, so the copy answers the same without an engine."""
+        for name in list(self._lazy):
+            if name in self._lazy:
+                self._materialize(name)
+        state = dict(self.__dict__)
+        state["_lazy"] = {}
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        for arr in self._signals.values():
+            if isinstance(arr, np.ndarray) and arr.flags.owndata:
+                arr.setflags(write=False)
+
     # ---- access --------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> np.ndarray:
         try:
