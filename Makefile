@@ -39,10 +39,10 @@ build: $(BUILD) viewer
 docs: $(STAMP)
 	$(VENV)/bin/mkdocs build --strict
 
-demo: $(BUILD)
+demo: build
 	$(PY) examples/woodpecker.py
 
-test: $(BUILD)
+test: build
 	cargo test -p mechsys-core
 	$(PY) -m pytest -q tests
 

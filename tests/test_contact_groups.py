@@ -299,7 +299,8 @@ def test_group_points_are_the_closed_explicit_contacts():
                 f = rc[f"contact/{c}/normal"][i] * ln + rc[f"contact/{c}/friction_force"][i]
                 want.append([*rc[f"contact/{c}/point"][i], *f, rc[f"contact/{c}/state"][i]])
         pts, frc = rg["contact/pile/points"][i], rg["contact/pile/point_forces"][i]
-        keep = ~np.isnan(pts[:, 0])
+        keep = rg["contact/pile/point_states"][i] != 0
+        assert np.all(pts[~keep] == 0.0) and keep.sum() == rg["contact/pile/closed"][i]
         got = np.column_stack([pts[keep], frc[keep], rg["contact/pile/point_states"][i][keep]])
         assert len(got) == len(want) == rg["contact/pile/closed"][i]
         if not want:

@@ -645,7 +645,10 @@ def _second_order(pos, mp, Phi) -> dict:
     I1 = -(np.einsum("p,pij,pkjl->kil", mp, rt, Pt) + np.einsum("p,pkij,pjl->kil", mp, Pt, rt))
     I2 = -np.einsum("p,pkij,pljm->klim", mp, Pt, Pt)
     Gk = np.einsum("p,pkij,pjl->kil", mp, Pt, Phi)
-    return dict(I1=I1, I2=0.5 * (I2 + I2.transpose(1, 0, 2, 3)), Gk=Gk)
+    # the engine's form of the same integrals: P1_k = ∫ r Φ_kᵀ dm, P2_kl = ∫ Φ_k Φ_lᵀ dm
+    P1 = np.einsum("p,pa,pbk->kab", mp, pos, Phi)
+    P2 = np.einsum("p,pak,pbl->klab", mp, Phi, Phi)
+    return dict(I1=I1, I2=0.5 * (I2 + I2.transpose(1, 0, 2, 3)), Gk=Gk, P1=P1, P2=P2)
 
 
 def _invariants(nodes, M_full, mass_points, T) -> dict:
@@ -703,9 +706,20 @@ def analytic_beam_body(section: BeamSection, length: float, bc: str, n_modes: in
     rt = np.array([skew(r) for r in pos])
     inertia = -np.einsum("p,pij,pjk->ik", mp, rt, rt)
     inertia[0, 0] += section.rho * section.Ip * length
+    geometric = None
+    if bc in ("clamped-free", "cantilever"):
+        # stress stiffening of the 12 unit body-force fields (per unit mass) the engine combines:
+        # along the beam only the axial field components load it, N(x) = ρA ∫_x^L b_x dξ (the
+        # tip is free); uniform e_x gives ρA (L - x), the linear field e_x s_x gives ρA (L² - x²)/2
+        dphi = np.array([euler_bernoulli_mode(bc, k, x, length, 1) for k in range(1, n_modes + 1)]) * scale[:, None]
+        kg = lambda n: (dphi * (n * w)) @ dphi.T  # noqa: E731
+        geometric = np.zeros((12, n_modes, n_modes))
+        geometric[0] = kg(rA * (length - x))
+        geometric[3] = kg(rA * 0.5 * (length**2 - x**2))
     return ReducedBody(
         name=name, nodes=nodes, M=0.5 * (M + M.T), K=0.5 * (K + K.T), modes=modes, mass=float(mp.sum()), first_moment=mp @ pos, inertia=inertia,
-        Ct=np.einsum("p,pak->ak", mp, Phi), Cr=np.einsum("p,pab,pbk->ak", mp, rt, Phi), labels=tuple(f"mode{k + 1}" for k in range(n_modes)), **_second_order(pos, mp, Phi),
+        Ct=np.einsum("p,pak->ak", mp, Phi), Cr=np.einsum("p,pab,pbk->ak", mp, rt, Phi), labels=tuple(f"mode{k + 1}" for k in range(n_modes)),
+        geometric=geometric, **_second_order(pos, mp, Phi),
     )
 
 
@@ -769,6 +783,9 @@ class ReducedBody:
     I1: np.ndarray | None = None
     I2: np.ndarray | None = None
     Gk: np.ndarray | None = None
+    P1: np.ndarray | None = None
+    P2: np.ndarray | None = None
+    geometric: np.ndarray | None = None
     interface_nodes: tuple = ()
     labels: tuple = ()
     omega: np.ndarray = field(init=False, repr=False)
@@ -829,6 +846,50 @@ class ReducedBody:
         out[6:, 3:6] = Crq.T
         out[6:, 6:] = self.M
         return out
+
+    def to_engine(self) -> dict:
+        """The engine's table of this body (``Model.add_body(..., elastic=...)``, ``[bodies.elastic]``
+        in a model file): the invariants S_t, P1, P2, the stiffness, the geometric stiffness
+        when known, and the nodes with their translations and small rotations per coordinate."""
+        if self.P1 is None or self.P2 is None:
+            raise ModelError(f"elastic body {self.name!r}: the engine needs the mass-point invariants P1 and P2 "
+                             "(bodies from analytic modes, the beam model and files that carry them have them)")
+        q = self.n_coordinates
+        out = {
+            "modes": q,
+            "s_t": np.asarray(self.Ct).T.tolist(),
+            "p1": [np.asarray(self.P1[k]).reshape(-1).tolist() for k in range(q)],
+            "p2": [np.asarray(self.P2[k, l]).reshape(-1).tolist() for k in range(q) for l in range(q)],
+            "stiffness": np.asarray(self.K).tolist(),
+            "nodes": [{"name": f"n{i}", "position": np.asarray(self.nodes[i]).tolist(),
+                       "translation": np.asarray(self.modes[i, :3, :]).T.tolist(),
+                       "rotation": np.asarray(self.modes[i, 3:, :]).T.tolist()} for i in range(len(self.nodes))],
+        }
+        if self.geometric is not None:
+            out["geometric"] = np.asarray(self.geometric).tolist()
+        return out
+
+    def inertia_about_center(self) -> np.ndarray:
+        """The undeformed inertia tensor about the centre of mass (body axes)."""
+        c = self.center_of_mass
+        return np.asarray(self.inertia) - self.mass * (c @ c * np.eye(3) - np.outer(c, c))
+
+    def damping(self, *, rayleigh=None, modal=None) -> np.ndarray:
+        """A damping matrix: ``rayleigh=(alpha, beta)`` gives αM + βK (eq. 2.207); ``modal=zeta``
+        (a number or one per mode) gives each undamped mode the damping ratio ζ."""
+        if (rayleigh is None) == (modal is None):
+            raise ModelError(f"elastic body {self.name!r}: damping needs rayleigh=(alpha, beta) or modal=zeta")
+        if rayleigh is not None:
+            a, b = (float(x) for x in rayleigh)
+            if not (np.isfinite(a) and np.isfinite(b) and a >= 0 and b >= 0):
+                raise ModelError(f"elastic body {self.name!r}: Rayleigh coefficients must be >= 0, got {rayleigh!r}")
+            return a * self.M + b * self.K
+        w2, V = linalg.eigh(self.K, self.M)
+        z = np.broadcast_to(np.asarray(modal, dtype=float), w2.shape)
+        if not np.all(np.isfinite(z)) or np.any(z < 0):
+            raise ModelError(f"elastic body {self.name!r}: modal damping ratios must be >= 0, got {modal!r}")
+        mv = self.M @ V
+        return mv @ np.diag(2.0 * z * np.sqrt(np.maximum(w2, 0.0))) @ mv.T
 
     def kinetic_energy(self, v, omega, q=None, qdot=None) -> float:
         """T = ½ xᵀ M(q) x with x = (v, ω, q̇) (eq. 2.192 with the Ritz separation); v, ω of the
@@ -899,7 +960,8 @@ def _validate(b: ReducedBody) -> None:
         raise ModelError(f"{w}: inertia is not positive semi-definite: {I0.tolist()}")
     arr("Ct", shape=(3, q))
     arr("Cr", shape=(3, q))
-    for key, shape in (("I1", (q, 3, 3)), ("I2", (q, q, 3, 3)), ("Gk", (q, 3, q))):
+    for key, shape in (("I1", (q, 3, 3)), ("I2", (q, q, 3, 3)), ("Gk", (q, 3, q)), ("P1", (q, 3, 3)), ("P2", (q, q, 3, 3)),
+                       ("geometric", (12, q, q))):
         if getattr(b, key) is not None:
             arr(key, shape=shape)
     b.interface_nodes = tuple(_node_index(i, n, f"{w}: interface") for i in b.interface_nodes)
@@ -1009,6 +1071,7 @@ def southwell_coefficients(section: BeamSection, length: float, *, n_elements: i
 # ============================================================================================
 
 _INVARIANT_KEYS = ("mass", "first_moment", "inertia", "Ct", "Cr")
+_SECOND_ORDER_KEYS = ("I1", "I2", "Gk", "P1", "P2", "geometric")
 _FORMAT = "mechsys-reduced-1"
 
 
@@ -1038,7 +1101,7 @@ def save_reduced(body: ReducedBody, path) -> Path:
     path = Path(path)
     data = {"format": np.array(_FORMAT), "units": np.array("SI"), "name": np.array(body.name), "nodes": body.nodes, "M": body.M, "K": body.K, "modes": body.modes,
             "interface": np.array(body.interface_nodes, dtype=np.int64), "labels": np.array(body.labels, dtype=str)}
-    for k in _INVARIANT_KEYS + ("I1", "I2", "Gk"):
+    for k in _INVARIANT_KEYS + _SECOND_ORDER_KEYS:
         v = getattr(body, k)
         if v is not None:
             data[k] = np.asarray(v)
@@ -1109,7 +1172,7 @@ def load_reduced(path, name: str | None = None) -> ReducedBody:
     if all(k in data for k in _INVARIANT_KEYS):
         inv = {k: np.asarray(data[k], float) for k in _INVARIANT_KEYS}
         inv["mass"] = float(inv["mass"])
-        for k in ("I1", "I2", "Gk"):
+        for k in _SECOND_ORDER_KEYS:
             inv[k] = np.asarray(data[k], float) if k in data else None
     elif "node_masses" in data:
         nm = np.asarray(data["node_masses"], float)

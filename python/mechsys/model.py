@@ -219,6 +219,35 @@ class Model:
         self._invalidate()
         return group
 
+    def add_elastic_body(self, name: str, reduced, *, damping=None, rayleigh=None, modal=None, stiffening: bool = True,
+                         q0=None, u0=None) -> Body:
+        """Adds an elastic body (floating frame of reference) from a :class:`mechsys.elastic.ReducedBody`
+        (analytic beam modes, the beam FE model reduced, or a file of an external FE code): its
+        mass properties are the undeformed body's, its elastic coordinates follow every joint's.
+        Damping: a matrix, ``rayleigh=(alpha, beta)`` or ``modal=zeta``. ``stiffening=False``
+        leaves out the geometric stiffness (a spinning beam's model then misses its centrifugal
+        stiffening). Joints attach to the body frame; the nodes are in ``reduced.nodes``."""
+        from .elastic import ReducedBody
+
+        if not isinstance(reduced, ReducedBody):
+            raise ModelError(f"body '{name}': expected a mechsys.elastic.ReducedBody, got {type(reduced).__name__}")
+        table = reduced.to_engine()
+        if not stiffening:
+            table.pop("geometric", None)
+        given = [x is not None for x in (damping, rayleigh, modal)]
+        if sum(given) > 1:
+            raise ModelError(f"body '{name}': give one of damping, rayleigh and modal")
+        if damping is not None:
+            table["damping"] = np.asarray(damping, dtype=float).tolist()
+        elif rayleigh is not None or modal is not None:
+            table["damping"] = reduced.damping(rayleigh=rayleigh, modal=modal).tolist()
+        if q0 is not None:
+            table["q0"] = np.asarray(q0, dtype=float).reshape(-1).tolist()
+        if u0 is not None:
+            table["u0"] = np.asarray(u0, dtype=float).reshape(-1).tolist()
+        return self.add_body(name, reduced.mass, reduced.inertia_about_center(), com=tuple(reduced.center_of_mass),
+                             elastic=table)
+
     def add_visual(self, body: "str | Body", shape, *, name: str = "", color: Sequence[float] | None = None,
                    opacity: float | None = None, scale: float = 1.0, position: Sequence[float] = (0.0, 0.0, 0.0),
                    cardan: Sequence[float] | None = None) -> dict:

@@ -312,15 +312,15 @@ class Results:
                 put(f"{pre}/force_against", raw["group_impulse_against"][:, k, :] / span[:, None], "N")
             if "group_points" in raw:
                 # the points closed in the last step before each sample, padded to the most any
-                # sample has (NaN, state open)
+                # sample has (zeros, state 0: no point)
                 counts = np.asarray(raw["group_point_count"], dtype=np.int64)
                 flat = np.asarray(raw["group_points"])
                 starts = np.concatenate([[0], np.cumsum(counts.reshape(-1))])[:-1].reshape(counts.shape)
                 for k, g in enumerate(engine.contact_groups()):
                     pre = f"contact/{g['name']}"
                     width = int(counts[:, k].max(initial=0))
-                    pts = np.full((len(counts), width, 3), np.nan)
-                    frc = np.full((len(counts), width, 3), np.nan)
+                    pts = np.zeros((len(counts), width, 3))
+                    frc = np.zeros((len(counts), width, 3))
                     st = np.zeros((len(counts), width), dtype=np.int8)
                     for i in range(len(counts)):
                         c, a = counts[i, k], starts[i, k]
