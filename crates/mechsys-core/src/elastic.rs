@@ -503,3 +503,28 @@ pub fn rnea_terms(model: &crate::model::Model, data: &mut Data, out: &mut [f64])
         w.tmp = tmp;
     }
 }
+
+/// Why the mass matrix may have failed to factor with elastic bodies in the model: the body whose
+/// elastic coordinates have grown past the small-deformation range (or are not finite), named,
+/// for the error message; empty when they look sane.
+pub fn runaway(model: &crate::model::Model, data: &Data) -> String {
+    for (e, w) in model.elastic.iter().zip(&data.elastic) {
+        let big = w.q.iter().fold(0.0f64, |a, v| if v.is_finite() { a.max(v.abs()) } else { f64::INFINITY });
+        // the deflection of the largest node against the body's size
+        let size = e.nodes.iter().map(|n| n.position.norm()).fold(0.0f64, f64::max).max(1e-300);
+        let defl = e
+            .nodes
+            .iter()
+            .map(|n| n.translation.iter().zip(&w.q).fold(Vec3::zeros(), |acc, (t, q)| acc + t * *q).norm())
+            .fold(0.0f64, f64::max);
+        if !big.is_finite() || (!e.nodes.is_empty() && defl > 10.0 * size) {
+            return format!(
+                "; the elastic coordinates of body '{}' have run away (largest {big:.3e}, node deflection {defl:.3e} m \
+                 on a body {size:.3e} m long): the deformation is no longer small, the model diverged (a missing \
+                 geometric stiffness, an instability)",
+                model.bodies[e.body].name
+            );
+        }
+    }
+    String::new()
+}

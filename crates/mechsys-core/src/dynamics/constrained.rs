@@ -88,7 +88,7 @@ fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f6
         super::crba::composite_inertias(model, inertia, s, ic, elastic, |r, c, v| sp.put_mass(r, c, v));
     }
     if !sp.factor_mass() {
-        return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));
+        return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s{}", crate::elastic::runaway(model, data))));
     }
     sp.solve_mass(&mut data.udot);
     sp.gather_g(&data.g);

@@ -384,7 +384,7 @@ impl MoreauJean {
                 });
                 let ok = ws.saddle.factor_mass() && self.sparse.as_mut().is_none_or(|sp| sp.factor.factor());
                 if !ok {
-                    return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s")));
+                    return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s{}", crate::elastic::runaway(model, data))));
                 }
             }
             for v in c.iter_mut() {

@@ -132,7 +132,7 @@ impl<'a> Phase<'a> {
         }
         if !sp.factor_mass() {
             self.a_free = c;
-            return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s")));
+            return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s{}", crate::elastic::runaway(model, data))));
         }
         sp.solve_mass(&mut c);
         if nc > 0 {
