@@ -284,3 +284,45 @@ def test_an_elastic_rod_in_a_slider_crank_sags_as_a_pinned_beam_under_its_own_we
     w, w_ref = ns["static_sag"]()
     np.testing.assert_allclose(w, w_ref, rtol=1e-4)
     assert w > 0
+
+
+def test_an_elastic_overhung_rotor_whirls_as_the_analytic_disc_on_a_massless_shaft():
+    """A disc (5 kg, J_p = m R²/2, J_d = m R²/4) at the end of a light cantilevered shaft spinning
+    about its axis: the beam FE model with the disc as a rigid mass (its gyroscopic coupling and
+    tilt stiffening in the invariants), reduced to 6 modes, linearized about the steady spin.
+    Reference: the 4-DOF disc on a massless shaft, M ẍ + Ω G ẋ + K x = 0 with the cantilever's tip
+    stiffness, in the inertial frame; the elastic coordinates turn with the shaft, so an
+    axisymmetric rotor's forward whirl appears at |ω - Ω| and its backward whirl at ω + Ω."""
+    import warnings
+
+    from mechsys import elastic as el
+
+    length, r_shaft, m_d, r_d, e_mod = 0.4, 0.01, 5.0, 0.1, 210e9
+    jp, jd = 0.5 * m_d * r_d**2, 0.25 * m_d * r_d**2
+    sec = el.BeamSection.circle(r_shaft, E=e_mod, nu=0.3, rho=0.785)  # a shaft of 1e-5 kg
+    fe = el.add_rigid_mass(el.beam_model(sec, length, 8), -1, m_d, (jp, jd, jd))
+    body = el.modal_reduction(fe, 6, fixed={0: "clamped"}, name="rotor")
+    ei = e_mod * sec.Iz
+    k_tip = ei / length**3 * np.array([[12, -6 * length], [-6 * length, 4 * length**2]])
+    stiff = np.zeros((4, 4))
+    stiff[:2, :2] = k_tip
+    stiff[2:, 2:] = k_tip * np.array([[1, -1], [-1, 1]])  # (w, θ_y): θ_y = -w'
+    mass = np.diag([m_d, jd, m_d, jd])
+    torsion = np.sqrt(sec.G * sec.Ip / length / jp) / (2 * np.pi)
+    for spin in (0.0, 200.0, 600.0):
+        gyro = np.zeros((4, 4))
+        gyro[1, 3], gyro[3, 1] = jp * spin, -jp * spin
+        a = np.block([[np.zeros((4, 4)), np.eye(4)], [-np.linalg.solve(mass, stiff), -np.linalg.solve(mass, gyro)]])
+        lam = np.linalg.eigvals(a)
+        w = np.sort(lam.imag[lam.imag > 0])  # backward (lower) and forward of each pair
+        f_rot = np.sort(np.abs(np.array([w[0] + spin, w[1] - spin, w[2] + spin, w[3] - spin]))) / (2 * np.pi)
+        m = ms.Model("rotor")
+        b = m.add_elastic_body("rotor", body)
+        m.add_joint(ms.joints.Revolute("spin", m.ground, b, axis=(1, 0, 0), u0=[spin]))
+        m.add_constraint(ms.constraints.Prescribed("drive", "spin", ms.functions.Ramp(spin)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            f = np.sort(ms.linear.linearize(m).modes().natural_frequency)
+        bending = f[np.abs(f - torsion) > 1e-3 * torsion][:4]
+        np.testing.assert_allclose(bending, f_rot, rtol=2e-5)
+        assert np.min(np.abs(f - torsion)) < 1e-4 * torsion  # the shaft's torsion with the disc

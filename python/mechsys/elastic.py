@@ -337,6 +337,8 @@ class FEModel:
     elements: np.ndarray | None = None
     section: BeamSection | None = None
     rotations: np.ndarray | None = None  # per element 3x3, rows = local axes in the body frame
+    #: rigid masses fixed to nodes (:func:`add_rigid_mass`): (node, second-moment tensor about it)
+    rigid_masses: tuple = ()
 
     @property
     def n_nodes(self) -> int:
@@ -445,6 +447,58 @@ def beam_model(section: BeamSection, length: float, n_elements: int, *, start=(0
         fixed = tuple(6 * i + d for i in range(n_el + 1) for d in (iz, 3 + ix, 3 + iy))
     elements = np.array([[e, e + 1] for e in range(n_el)])
     return FEModel(nodes=nodes, M=M, K=K, mass_points=(np.array(pos), np.array(mass), np.array(interp)), always_fixed=fixed, elements=elements, section=section, rotations=np.repeat(Lam[None], n_el, axis=0))
+
+
+def add_rigid_mass(model: FEModel, node: int, mass: float, inertia=(0.0, 0.0, 0.0)) -> FEModel:
+    """The model with a rigid body (a disc, a hub, a tool) of ``mass`` and principal ``inertia``
+    (Jxx, Jyy, Jzz along the body axes, about the node) fixed to ``node``: added to M at the node's
+    translations and rotations, and as six mass points on the axes around the node (moving with
+    the node's translation and rotation) that carry exactly that mass and inertia into the
+    second-order invariants, so a spinning disc's gyroscopic coupling is in the reduced body."""
+    n = _node_index(node, model.n_nodes, "add_rigid_mass: node")
+    m = _num(mass, "add_rigid_mass: mass")
+    j = np.asarray(inertia, dtype=float)
+    if not (np.isfinite(m) and m > 0):
+        raise ModelError(f"add_rigid_mass: mass must be > 0, got {mass}")
+    if j.shape != (3,) or not np.all(np.isfinite(j)) or np.any(j < 0):
+        raise ModelError(f"add_rigid_mass: inertia must be three principal moments >= 0, got {inertia!r}")
+    # second moments S_a = ∫ a² dm from J: S_x = (J_yy + J_zz - J_xx)/2, ... (triangle inequality)
+    sec = 0.5 * np.array([j[1] + j[2] - j[0], j[0] + j[2] - j[1], j[0] + j[1] - j[2]])
+    if np.any(sec < -1e-12 * max(j.max(), 1e-300)):
+        raise ModelError(f"add_rigid_mass: inertia {tuple(j)} violates the triangle inequality (J_xx <= J_yy + J_zz, ...)")
+    sec = np.maximum(sec, 0.0)
+    ndof = 6 * model.n_nodes
+    M = model.M.copy()
+    dofs = np.arange(6 * n, 6 * n + 6)
+    M[dofs[:3], dofs[:3]] += m
+    M[dofs[3:], dofs[3:]] += j
+    pos, mp, interp = (np.asarray(a) for a in model.mass_points)
+    if sec.sum() > 0:
+        # six points at ±d on the axes: pair a has mass 2 m_a with 2 m_a d² = S_a, Σ 2 m_a = m
+        d = np.sqrt(sec.sum() / m)
+        extra_pos, extra_m, extra_n = [], [], []
+        for a in range(3):
+            for sgn in (1.0, -1.0):
+                off = np.zeros(3)
+                off[a] = sgn * d
+                N = np.zeros((3, ndof))
+                N[:, dofs[:3]] = np.eye(3)
+                N[:, dofs[3:]] = -skew(off)  # u = u_node + θ × off
+                extra_pos.append(model.nodes[n] + off)
+                extra_m.append(sec[a] / (2 * d * d))
+                extra_n.append(N)
+        pos = np.concatenate([pos.reshape(-1, 3), np.array(extra_pos)])
+        mp = np.concatenate([mp.reshape(-1), np.array(extra_m)])
+        interp = np.concatenate([interp.reshape(-1, 3, ndof), np.array(extra_n)])
+    else:
+        N = np.zeros((1, 3, ndof))
+        N[0][:, dofs[:3]] = np.eye(3)
+        pos = np.concatenate([pos.reshape(-1, 3), model.nodes[n][None]])
+        mp = np.concatenate([mp.reshape(-1), [m]])
+        interp = np.concatenate([interp.reshape(-1, 3, ndof), N])
+    return FEModel(nodes=model.nodes, M=M, K=model.K, mass_points=(pos, mp, interp), always_fixed=model.always_fixed,
+                   elements=model.elements, section=model.section, rotations=model.rotations,
+                   rigid_masses=tuple(model.rigid_masses) + ((n, np.diag(sec)),))
 
 
 def fe_model(nodes, M, K, *, node_masses=None, name: str = "fe_model") -> FEModel:
@@ -577,7 +631,7 @@ def modal_reduction(model: FEModel, n_modes: int, *, fixed=None, name: str = "el
     T = np.zeros((6 * model.n_nodes, V.shape[1]))
     T[free] = V
     labels = [f"mode{k + 1}" for k in range(V.shape[1])]
-    return _build(name, model, T, labels, interface=())
+    return _build(name, model, T, labels, interface=(), fixed_dofs=dofs)
 
 
 def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, name: str = "elastic_body") -> "ReducedBody":
@@ -619,12 +673,72 @@ def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, name: 
     return _build(name, model, T, labels, interface=tuple(inodes))
 
 
-def _build(name, model: FEModel, T, labels, interface) -> "ReducedBody":
+def geometric_fields(model: FEModel, T: np.ndarray, fixed_dofs) -> np.ndarray:
+    """The geometric (stress) stiffness of the basis T for the 12 unit body-force fields per unit
+    mass the engine combines (``e_x, e_y, e_z``, then ``e_a s_b``), (12, q, q): each field's
+    static response of the supported beam model gives the elements' axial forces and so K_G
+    (:func:`geometric_stiffness`); a rigid mass fixed to a node adds the work of the field on its
+    points' second-order motion under the node's rotation, ``-(sym(L S) - tr(L S) E)`` on the
+    rotations (S its second-moment tensor): a spinning disc's tilt stiffening (J_p - J_d) Ω²."""
+    if model.elements is None or model.section is None:
+        raise ModelError("geometric_fields: needs a beam model from beam_model")
+    ndof = 6 * model.n_nodes
+    free = np.setdiff1d(np.arange(ndof), np.asarray(list(fixed_dofs), dtype=int))
+    kff = model.K[np.ix_(free, free)]
+    try:
+        cf = linalg.cho_factor(kff)
+    except linalg.LinAlgError:
+        raise ModelError("geometric_fields: the supports do not hold the beam (K singular): a free body's stress "
+                         "state needs inertia relief, which is not done here") from None
+    pos, mp, interp = (np.asarray(a) for a in model.mass_points)
+    s0 = np.cumsum([0.0] + [np.linalg.norm(model.nodes[j] - model.nodes[i]) for i, j in model.elements])
+    ea = model.section.E * model.section.A
+    out = np.zeros((12, T.shape[1], T.shape[1]))
+    for f in range(12):
+        if f < 3:
+            b = np.zeros((len(pos), 3))
+            b[:, f] = 1.0
+            lmat = np.zeros((3, 3))
+        else:
+            a, c = divmod(f - 3, 3)
+            b = np.zeros((len(pos), 3))
+            b[:, a] = pos[:, c]
+            lmat = np.zeros((3, 3))
+            lmat[a, c] = 1.0
+        load = np.einsum("p,pad,pa->d", mp, interp, b)
+        u = np.zeros(ndof)
+        u[free] = linalg.cho_solve(cf, load[free])
+        forces = []
+        for e, (i, j) in enumerate(model.elements):
+            t = model.rotations[e][0]
+            le = np.linalg.norm(model.nodes[j] - model.nodes[i])
+            forces.append(ea * (u[6 * j : 6 * j + 3] - u[6 * i : 6 * i + 3]) @ t / le)
+
+        def axial(sv, forces=forces):
+            k = min(int(np.searchsorted(s0, sv, side="right")) - 1, len(forces) - 1)
+            return forces[max(k, 0)]
+
+        kg = geometric_stiffness(model, axial)
+        for node, second in model.rigid_masses:
+            ls = lmat @ second
+            rot = slice(6 * node + 3, 6 * node + 6)
+            kg[rot, rot] -= 0.5 * (ls + ls.T) - np.trace(ls) * np.eye(3)
+        out[f] = T.T @ kg @ T
+    return 0.5 * (out + out.transpose(0, 2, 1))
+
+
+def _build(name, model: FEModel, T, labels, interface, fixed_dofs=None) -> "ReducedBody":
     """Reduced matrices and inertia invariants of the basis T (6n x q) of the full model."""
     M, K = T.T @ model.M @ T, T.T @ model.K @ T
     inv = _invariants(model.nodes, model.M, model.mass_points, T)
     modes = T.reshape(model.n_nodes, 6, T.shape[1])
-    return ReducedBody(name=name, nodes=model.nodes.copy(), M=0.5 * (M + M.T), K=0.5 * (K + K.T), modes=modes, interface_nodes=tuple(interface), labels=tuple(labels), **inv)
+    geometric = None
+    if fixed_dofs is not None and model.elements is not None and len(fixed_dofs):
+        try:
+            geometric = geometric_fields(model, T, fixed_dofs)
+        except ModelError:
+            geometric = None  # not held by its supports: no stress state without inertia relief
+    return ReducedBody(name=name, nodes=model.nodes.copy(), M=0.5 * (M + M.T), K=0.5 * (K + K.T), modes=modes, interface_nodes=tuple(interface), labels=tuple(labels), geometric=geometric, **inv)
 
 
 def _vee(A):
