@@ -65,6 +65,7 @@ __all__ = [
 ]
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+"""The six nodal degrees of freedom, in the order of `modes` and of the FE matrices."""
 FREQUENCY_WARNING_HZ = 1e7
 """An elastic frequency above this (Hz) gives a warning: usually mm taken for m or g for kg."""
 
