@@ -63,6 +63,7 @@ bench: $(BUILD)
 	$(PY) benches/bearing.py --out docs/benchmarks.md
 	$(PY) benches/planar.py --out docs/benchmarks.md
 	$(PY) benches/viewer.py --out docs/benchmarks.md
+	$(PY) benches/elastic.py --out docs/benchmarks.md
 	$(PY) benches/study.py --out docs/benchmarks.md
 
 clean:
