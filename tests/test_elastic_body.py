@@ -206,69 +206,35 @@ def test_a_spinning_cantilevers_flap_frequencies_rise_as_southwell_says():
 
 
 def test_spin_up_follows_the_reference_and_diverges_without_stiffening():
-    """The spin-up manoeuvre of a flexible beam (10 m, ρA = 1.2 kg/m, EI = 14000 N m², to 6 rad/s
-    in 15 s along a smooth ramp, above the first bending frequency 3.80 rad/s): the in-plane tip
-    deflection of the engine's model against the rotating-frame FE equations
-    M q̈ + (K + Ω²(K_G - M_v)) q = -α f integrated by SciPy; the same model without geometric
-    stiffness runs away (spin softening beats the bending stiffness)."""
+    """The spin-up manoeuvre of examples/spinning_beam.py (a 10 m beam, ρA = 1.2 kg/m,
+    EI = 14000 N m², to 6 rad/s in 15 s along a smooth ramp, above the first bending frequency
+    3.80 rad/s): the in-plane tip deflection of the engine's model against the example's
+    reference, the rotating-frame FE equations M q̈ + (K + Ω²(K_G - M_v)) q = -α f of the beam
+    model integrated by SciPy; the same model without geometric stiffness runs away (spin
+    softening beats the bending stiffness)."""
+    import runpy
     import warnings
+    from pathlib import Path
 
-    from scipy.integrate import solve_ivp
-
-    from mechsys import elastic as el
-    from mechsys.elastic import _rotating_setup, beam_model
-
-    length, rho_a, ei, w_s, t_s = 10.0, 1.2, 14000.0, 6.0, 15.0
-    sec0 = el.BeamSection.rectangle(0.1, 0.01, E=1.0, nu=0.3, rho=rho_a / 1e-3)
-    sec = el.BeamSection.rectangle(0.1, 0.01, E=ei / sec0.Iz, nu=0.3, rho=rho_a / 1e-3)
-    body = el.analytic_beam_body(sec, length, "clamped-free", 4, plane="xy")
-    np.testing.assert_allclose(body.frequencies()[0] * 2 * np.pi, 1.875104068711961**2 * np.sqrt(ei / (rho_a * length**4)), rtol=1e-9)
-
-    def angle(t):
-        if t > t_s:
-            return angle(t_s) + w_s * (t - t_s)
-        return w_s / t_s * (t**2 / 2 + (t_s / (2 * np.pi)) ** 2 * (np.cos(2 * np.pi * t / t_s) - 1))
-
-    def rate(t):
-        return w_s / t_s * (t - t_s / (2 * np.pi) * np.sin(2 * np.pi * t / t_s)) if t <= t_s else w_s
-
-    def accel(t):
-        return w_s / t_s * (1 - np.cos(2 * np.pi * t / t_s)) if t <= t_s else 0.0
-
-    tip = body.modes[-1, 1, :]
+    ex = runpy.run_path(str(Path(__file__).resolve().parents[1] / "examples" / "spinning_beam.py"), run_name="test")
+    body = ex["BEAM"]
+    np.testing.assert_allclose(body.frequencies()[0] * 2 * np.pi, 1.875104068711961**2 * np.sqrt(14000.0 / (1.2 * 10.0**4)),
+                               rtol=1e-9)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = ms.simulate(spinning_beam(body, 0.0, angle=angle), t_end=t_s, integrator=ms.DOPRI5(rtol=1e-9, atol=1e-11),
-                          output_dt=0.1)
-    d = res["body/beam/elastic_q"] @ tip
-    # the reference: the beam FE model in the rotating frame (lag plane), 20 elements
-    mf, kf, gf = _rotating_setup(sec, length, 20, 0.0, "lag", 3)
-    fe = beam_model(sec, length, 20)
-    dofs = [6 * i + k for i in range(1, fe.n_nodes) for k in (1, 5)]
-    pos, mp, interp = fe.mass_points
-    f = (mp * pos[:, 0]) @ interp[:, 1, :][:, dofs]
-    # on its 12 lowest fixed-base modes (the rest, above 2 kHz, only slow the integration down)
-    from scipy.linalg import eigh
-
-    _, v = eigh(kf, mf, subset_by_index=[0, 11])
-    kr, gr, fr = v.T @ kf @ v, v.T @ gf @ v, v.T @ f  # v is M-orthonormal
-    n = v.shape[1]
-
-    def rhs(t, y):
-        return np.concatenate([y[n:], -(kr + rate(t) ** 2 * gr) @ y[:n] - accel(t) * fr])
-
-    sol = solve_ivp(rhs, (0, t_s), np.zeros(2 * n), rtol=1e-10, atol=1e-12, dense_output=True, method="DOP853")
-    ref = v[dofs.index(6 * (fe.n_nodes - 1) + 1)] @ sol.sol(res.t)[:n]
+        res = ms.simulate(ex["model"], **dict(ex["simulation"], output_dt=0.1))
+    d = res["body/beam/elastic_q"] @ ex["TIP"]
+    ref = ex["reference"](res.t)
     assert np.abs(ref).max() > 0.5  # the beam lags by half a metre at the tip
     np.testing.assert_allclose(d, ref, atol=1e-3 * np.abs(ref).max())
     # without geometric stiffness the deflection runs away before the end of the spin-up
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            loose = ms.simulate(spinning_beam(body, 0.0, stiffening=False, angle=angle), t_end=t_s,
-                                integrator=ms.DOPRI5(rtol=1e-9, atol=1e-11), output_dt=0.1)
-            grown = np.abs(loose["body/beam/elastic_q"] @ tip).max()
-        except ms.SolverError:
+            loose = ms.simulate(ex["build"](False), **dict(ex["simulation"], output_dt=0.1))
+            grown = np.abs(loose["body/beam/elastic_q"] @ ex["TIP"]).max()
+        except ms.SolverError as e:
+            assert "'beam' have run away" in str(e)
             grown = np.inf
     assert grown > 20 * np.abs(ref).max()
 

@@ -501,54 +501,62 @@ def _pickled_spec(spec: _Spec) -> bytes:
     return pickle.dumps(spec)
 
 
+def _collect(ex, futures: dict, bar, broken=None) -> list:
+    """Outcomes of the submitted cases as they finish (one bar step each); ``broken`` maps an
+    exception of a dead worker to a failed outcome. On Ctrl-C (or any error here) the cases not
+    started are dropped, not waited for (each future cancelled here: the executor's own
+    cancelling is skipped once it is collected)."""
+    from concurrent.futures import as_completed
+
+    outcomes: list = []
+    try:
+        for fut in as_completed(futures):
+            try:
+                outcomes.append(fut.result())
+            except Exception as e:  # noqa: BLE001 - only a dead worker is turned into an outcome
+                if broken is None or not broken[0](e):
+                    raise
+                outcomes.append(broken[1](futures[fut], e))
+            bar.update(1)
+    except BaseException:
+        for fut in futures:
+            fut.cancel()
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
+    ex.shutdown(wait=True)
+    return outcomes
+
+
 def _run_processes(blob: bytes, cases: list[dict], count: int, bar) -> list:
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
 
     ctx = multiprocessing.get_context("spawn")  # no fork of a process with engine threads
-    outcomes: list = []
     ex = ProcessPoolExecutor(max_workers=count, mp_context=ctx, initializer=_init_worker, initargs=(blob,))
     futures: dict = {}
     try:
         futures = {ex.submit(_run_in_worker, i, c): i for i, c in enumerate(cases)}
-        for fut in as_completed(futures):
-            try:
-                outcomes.append(fut.result())
-            except BrokenProcessPool as e:
-                outcomes.append((futures[fut], "failed", {}, (f"BrokenProcessPool: a worker process died ({e}); a "
-                                 "script that starts a study on processes must do so under if __name__ == '__main__':"),
-                                 math.nan))
-            bar.update(1)
     except BaseException:
-        # Ctrl-C (or any error here): the cases not started are dropped, not waited for (each
-        # future cancelled here: the executor's own cancelling is skipped once it is collected)
-        for fut in futures:
-            fut.cancel()
         ex.shutdown(wait=False, cancel_futures=True)
         raise
-    ex.shutdown(wait=True)
-    return outcomes
+    dead = (lambda e: isinstance(e, BrokenProcessPool),
+            lambda i, e: (i, "failed", {}, (f"BrokenProcessPool: a worker process died ({e}); a script that starts a "
+                                            "study on processes must do so under if __name__ == '__main__':"), math.nan))
+    return _collect(ex, futures, bar, dead)
 
 
 def _run_threads(spec: _Spec, cases: list[dict], count: int, bar) -> list:
-    from concurrent.futures import ThreadPoolExecutor, as_completed
+    from concurrent.futures import ThreadPoolExecutor
 
-    outcomes: list = []
     ex = ThreadPoolExecutor(max_workers=count)
-    futures: list = []
+    futures: dict = {}
     try:
-        futures = [ex.submit(_run_case, spec, i, c) for i, c in enumerate(cases)]
-        for fut in as_completed(futures):
-            outcomes.append(fut.result())
-            bar.update(1)
+        futures = {ex.submit(_run_case, spec, i, c): i for i, c in enumerate(cases)}
     except BaseException:
-        for fut in futures:
-            fut.cancel()
         ex.shutdown(wait=False, cancel_futures=True)
         raise
-    ex.shutdown(wait=True)
-    return outcomes
+    return _collect(ex, futures, bar)
 
 
 def connect(client: Any, timeout: float = CONNECT_TIMEOUT):
