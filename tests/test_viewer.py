@@ -373,3 +373,23 @@ def test_a_run_recorded_without_body_poses_is_drawn_from_its_coordinates():
     assert "body/lower/position" not in sparse
     a, b = viewer.page_data(full), viewer.page_data(sparse)
     np.testing.assert_allclose(arr(b["pose"]), arr(a["pose"]), atol=1e-6)
+
+
+def test_an_elastic_body_is_drawn_by_its_deflected_nodes():
+    """The slider-crank's elastic rod: its node line's displacement at every kept frame is the
+    nodes' translation fields times the recorded elastic coordinates, magnified by a power of ten."""
+    import runpy
+
+    ns = runpy.run_path(str(ROOT / "examples" / "flexible_slider_crank.py"), run_name="x")
+    res = ms.simulate(ns["model"], **dict(ns["simulation"], t_end=0.02, output_dt=1e-3))
+    data = viewer.page_data(res)
+    (e,) = data["elastic"]
+    assert data["bodies"][e["body"]]["name"] == "rod"
+    body = ns["ROD_BODY"]
+    np.testing.assert_allclose(arr(e["nodes"]), body.nodes, atol=1e-7)
+    idx = np.searchsorted(res.t, arr(data["t"]))
+    expect = np.einsum("fk,nck->fnc", res["body/rod/elastic_q"][idx], body.modes[:, :3, :])
+    np.testing.assert_allclose(arr(e["disp"]), expect, atol=1e-9 + 1e-6 * np.abs(expect).max())
+    assert e["scale"] in (1.0, 10.0, 100.0, 1000.0) and e["scale"] * e["largest"] <= 0.05 * data["scene"] + 1e-12
+    # drawn by its node line, not by rods from its centre of mass
+    assert not data["bodies"][e["body"]]["stick"]

@@ -223,3 +223,23 @@ def test_each_showcase_example_gives_a_page_from_mechsys_view(browser, tmp_path,
     p.js("(k) => window.mechsys.setFrame(k)", last)
     name = res.model["bodies"][-1]["name"]
     np.testing.assert_allclose(p.js(f"window.mechsys.bodyPosition('{name}')"), res[f"body/{name}/position"][-1], atol=1e-6)
+
+
+def test_an_elastic_rod_deflects_on_the_page(browser, tmp_path):
+    """The slider-crank's elastic rod: at a scrubbed frame its drawn node line is the undeformed
+    nodes plus the magnified recorded deflection."""
+    ns = runpy.run_path(str(ROOT / "examples" / "flexible_slider_crank.py"), run_name="not_main")
+    res = ms.simulate(ns["model"], **dict(ns["simulation"], t_end=0.03, output_dt=1e-3))
+    p = Page(browser, viewer.to_html(res, tmp_path / "crank.html"))
+    assert p.errors == []
+    assert "elastic deflection ×" in p.page.locator("#info").inner_text()
+    k = p.js("Math.floor(window.mechsys.frames * 0.7)")
+    p.js("(k) => window.mechsys.setFrame(k)", k)
+    t = p.js("window.mechsys.time()")
+    i = int(np.argmin(np.abs(res.t - t)))
+    body = ns["ROD_BODY"]
+    drawn = np.asarray(p.js("window.mechsys.elasticNodes(0)")).reshape(-1, 3)
+    scale = p.js("window.mechsys.elasticScale(0)")
+    expect = body.nodes + scale * np.einsum("k,nck->nc", res["body/rod/elastic_q"][i], body.modes[:, :3, :])
+    np.testing.assert_allclose(drawn, expect, atol=1e-6)
+    assert np.abs(drawn - body.nodes).max() > 1e-4  # it does bend, visibly

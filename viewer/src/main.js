@@ -41,6 +41,28 @@ function main() {
   scene.add(ground.group);
   const triads = [...bodies, ground].flatMap((o) => o.triads);
 
+  // elastic bodies: their node lines, deformed (magnified) with the frames
+  const elastic = (data.elastic || []).map((e) => {
+    const nodes = decode(e.nodes), disp = decode(e.disp);
+    const n = nodes.length / 3;
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.BufferAttribute(new Float32Array(nodes), 3));
+    const group = bodies[e.body].group;
+    const line = new THREE.Line(geo, new THREE.LineBasicMaterial({ color: PALETTE[e.body % PALETTE.length] }));
+    const dots = new THREE.Points(geo, new THREE.PointsMaterial({ color: PALETTE[e.body % PALETTE.length], size: unit * 0.8 }));
+    line.frustumCulled = false;
+    dots.frustumCulled = false;
+    group.add(line, dots);
+    return {
+      scale: e.scale,
+      geo,
+      update(f) {
+        const p = geo.attributes.position.array;
+        for (let k = 0; k < 3 * n; k++) p[k] = nodes[k] + e.scale * disp[f * 3 * n + k];
+        geo.attributes.position.needsUpdate = true;
+      },
+    };
+  });
   const contacts = data.contacts.map((c) => makeContact(c, unit));
   contacts.forEach((c) => scene.add(c.group));
   const trails = data.trails.map((tr, k) => {
@@ -92,8 +114,10 @@ function main() {
   const followSel = document.getElementById('follow');
   data.bodies.forEach((b) => followSel.add(new Option(b.name, b.name, false, b.name === data.follow)));
   const timeLabel = document.getElementById('time');
+  const magnified = elastic.filter((e) => e.scale !== 1).map((e) => e.scale);
   document.getElementById('info').textContent =
-    `${nb} bodies · ${data.contacts.length} contact points · ${nf} of ${data.recorded} frames · ${fmt(duration)} s`;
+    `${nb} bodies · ${data.contacts.length} contact points · ${nf} of ${data.recorded} frames · ${fmt(duration)} s`
+    + (magnified.length ? ` · elastic deflection ×${Math.max(...magnified)}` : '');
   const legend = document.getElementById('legend');
   legend.style.display = data.contacts.length ? '' : 'none';
   legend.innerHTML = data.contacts.length
@@ -118,6 +142,7 @@ function main() {
       bodies[b].group.position.set(pose[o], pose[o + 1], pose[o + 2]);
       bodies[b].group.quaternion.set(pose[o + 4], pose[o + 5], pose[o + 6], pose[o + 3]);
     }
+    elastic.forEach((e) => e.update(f));
     const showContacts = document.getElementById('show-contacts').checked;
     contacts.forEach((c) => c.update(f, showContacts));
     trails.forEach((line) => line.geometry.setDrawRange(0, f + 1));
@@ -236,6 +261,9 @@ function main() {
     // as playback does, from the current time: impacts passed on the way flash
     advanceTo: (time) => setTime(time, false),
     flashCount: () => flashes.length,
+    // node positions of elastic body k's line (body frame, magnified as drawn)
+    elasticNodes: (k) => Array.from(elastic[k].geo.attributes.position.array),
+    elasticScale: (k) => elastic[k].scale,
   };
 }
 

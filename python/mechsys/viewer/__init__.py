@@ -79,6 +79,8 @@ class _Motion:
     results: Any = None
     title: str = ""
     events: list = field(default_factory=list)
+    #: elastic coordinates per elastic body name, (F, n_e)
+    elastic: dict = field(default_factory=dict)
 
 
 def _motion(res) -> _Motion:
@@ -94,7 +96,10 @@ def _motion(res) -> _Motion:
     else:
         raise ResultsError("the results hold neither the bodies' poses (body/*/position, body/*/orientation) nor the "
                            "coordinates (q or every joint/*/q); record them (sensors='body/*') to view this run")
-    return _Motion(t, model, bodies, pos, rot, results=res, title=model.get("name", ""), events=list(res.events))
+    elastic = {b["name"]: np.asarray(res[f"body/{b['name']}/elastic_q"]) for b in model.get("bodies", [])
+               if b.get("elastic") and f"body/{b['name']}/elastic_q" in res}
+    return _Motion(t, model, bodies, pos, rot, results=res, title=model.get("name", ""), events=list(res.events),
+                   elastic=elastic)
 
 
 def _coordinates(res, model_dict: dict):
@@ -169,7 +174,8 @@ def mode_results(lin, mode: int = 0, *, amplitude: float | None = None, cycles: 
     pos, rot = _poses_from_q(desc, q)
     title = (f"{desc.get('name', 'model')}: mode {mode + 1}, f = {modes.natural_frequency[mode]:.4g} Hz, "
              f"zeta = {modes.damping_ratio[mode]:.3g}")
-    m = _Motion(t, desc, [b["name"] for b in desc.get("bodies", [])], pos, rot, title=title)
+    m = _Motion(t, desc, [b["name"] for b in desc.get("bodies", [])], pos, rot, title=title,
+                elastic={e["body"]: q[:, e["iq"]: e["iq"] + e["ne"]] for e in model.build().elastic()})
     m.results = _ModeSignals(t, q, [str(x) for x in lin.names] if lin.names else [f"q{i}" for i in range(q.shape[1])])
     return m
 
@@ -413,8 +419,9 @@ def page_data(source, *, signals: Sequence[str] | None = None, max_frames: int =
     for k, b in enumerate(m.bodies):
         bd = next(x for x in model["bodies"] if x["name"] == b)
         parts = list(shapes.get(b, []))
-        # a body drawn only by point contours (markers) gets its rods too
-        drawn_by_contours = any(not p.get("marker") for p in parts)
+        # a body drawn only by point contours (markers) gets its rods too; an elastic body with
+        # nodes is drawn by its deforming node line instead
+        drawn_by_contours = any(not p.get("marker") for p in parts) or bool((bd.get("elastic") or {}).get("nodes"))
         if not drawn_by_contours:
             parts += _rods(model, b, bd.get("com", [0, 0, 0]), 0.3 * marker)
             from .shapes import _lathe, _sphere_points
@@ -441,6 +448,7 @@ def page_data(source, *, signals: Sequence[str] | None = None, max_frames: int =
     if follow is not None and follow not in m.bodies:
         raise SettingsError(f"follow: no body '{follow}' in the model (bodies: {', '.join(m.bodies) or 'none'})")
 
+    out["elastic"] = _elastic_lines(model, m, idx, scene)
     res = m.results
     out["contacts"] = _contacts(res, model, idx, scene) if res is not None and hasattr(res, "model") else []
     names = [c["name"] for c in out["contacts"]]
@@ -481,6 +489,29 @@ def page_data(source, *, signals: Sequence[str] | None = None, max_frames: int =
             plots.append({"name": name, "unit": res.unit(name), "columns": cols, "t": _b64(td, "float64"),
                           "y": [_b64(np.nan_to_num(yd[:, k], nan=np.nan), "float32") for k in range(yd.shape[1])]})
     out["plots"] = plots
+    return out
+
+
+def _elastic_lines(model: dict, m: _Motion, idx: np.ndarray, scene: float) -> list[dict]:
+    """Per elastic body with nodes: the undeformed node line (body frame) and the node
+    displacements of every kept frame, with a magnification that makes the largest deflection
+    about 5 % of the scene (a power of ten; 1 when the deflection is already that large)."""
+    out = []
+    for b in model.get("bodies", []):
+        el = b.get("elastic") or {}
+        nodes = el.get("nodes") or []
+        if not nodes or b["name"] not in m.elastic or b["name"] not in m.bodies:
+            continue
+        pos0 = np.array([n["position"] for n in nodes], dtype=float)
+        trans = np.array([n["translation"] for n in nodes], dtype=float)  # (n, n_e, 3)
+        qe = np.asarray(m.elastic[b["name"]], dtype=float)[idx]
+        disp = np.einsum("fk,nkc->fnc", qe, trans)
+        big = float(np.abs(disp).max(initial=0.0))
+        scale = 1.0
+        if 0.0 < big < 0.05 * scene:
+            scale = float(10.0 ** np.floor(np.log10(0.05 * scene / big)))
+        out.append({"body": m.bodies.index(b["name"]), "nodes": _b64(pos0, "float32"),
+                    "disp": _b64(_finite(disp), "float32"), "scale": scale, "largest": big})
     return out
 
 
