@@ -237,8 +237,11 @@ pub fn validate(
     symmetric(&k, &format!("{what}.stiffness"))?;
     // generalized eigenvalues of (K, M_ee): ω² > 0 for every mode, else a rigid-body mode (or a
     // mode without stiffness) is left in the elastic basis
-    let l = m_ee.clone().cholesky().expect("positive definite above").l();
-    let li = l.clone().try_inverse().expect("a Cholesky factor of a positive definite matrix");
+    let not_pd = || {
+        crate::error::Error::Model(format!("{what}: the elastic mass matrix (traces of p2) is too ill-conditioned to factor"))
+    };
+    let l = m_ee.clone().cholesky().ok_or_else(not_pd)?.l();
+    let li = l.clone().try_inverse().ok_or_else(not_pd)?;
     let kk = &li * &k * li.transpose();
     let w2 = kk.symmetric_eigen().eigenvalues;
     let (w2min, w2max) = w2.iter().fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(*v), b.max(*v)));
