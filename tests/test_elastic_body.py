@@ -292,3 +292,20 @@ def test_an_elastic_overhung_rotor_whirls_as_the_analytic_disc_on_a_massless_sha
         bending = f[np.abs(f - torsion) > 1e-3 * torsion][:4]
         np.testing.assert_allclose(bending, f_rot, rtol=2e-5)
         assert np.min(np.abs(f - torsion)) < 1e-4 * torsion  # the shaft's torsion with the disc
+
+
+def test_mechsys_info_lists_the_elastic_bodies_with_their_frequencies():
+    import re
+    import runpy
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "spinning_beam.py"
+    out = subprocess.run([sys.executable, "-m", "mechsys", "info", str(path)], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "elastic bodies (1):" in out.stdout
+    line = next(ln for ln in out.stdout.splitlines() if ln.strip().startswith("beam "))
+    f_low, f_high = (float(x) for x in re.search(r"([\d.e+-]+) \.\. ([\d.e+-]+)", line).groups())
+    f = runpy.run_path(str(path), run_name="x")["BEAM"].frequencies()
+    np.testing.assert_allclose([f_low, f_high], [f[0], f[-1]], rtol=1e-3)

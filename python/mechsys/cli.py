@@ -427,6 +427,24 @@ def info(model_file: Path) -> None:
             for j in joints
         ]
         click.echo(_table(["name", "type", "parent -> child", "nq/nu", "iq/iu"], rows))
+    elastic = core.elastic()
+    if elastic:
+        click.echo("")
+        click.echo(f"elastic bodies ({len(elastic)}):")
+        import numpy as np
+
+        rows = []
+        for e in elastic:
+            desc = next(b for b in model.to_dict()["bodies"] if b["name"] == e["body"])["elastic"]
+            k = np.asarray(desc["stiffness"], dtype=float)
+            m_ee = np.array([[np.trace(np.asarray(p2).reshape(3, 3)) for p2 in desc["p2"][r * e["ne"]:(r + 1) * e["ne"]]]
+                             for r in range(e["ne"])])
+            from scipy.linalg import eigh
+
+            f = np.sqrt(np.maximum(eigh(k, m_ee, eigvals_only=True), 0.0)) / (2 * np.pi)
+            rows.append((e["body"], str(e["ne"]), f"{e['iq']}/{e['iu']}", str(len(e["nodes"])),
+                         f"{f[0]:.4g} .. {f[-1]:.4g}", "yes" if desc.get("geometric") else "no"))
+        click.echo(_table(["body", "modes", "iq/iu", "nodes", "frequencies [Hz]", "geometric stiffness"], rows))
     click.echo("")
     click.echo(f"force elements ({len(forces)}):")
     if forces:
