@@ -304,7 +304,7 @@ def test_mechsys_info_lists_the_elastic_bodies_with_their_frequencies():
     out = subprocess.run([sys.executable, "-m", "mechsys", "info", str(path)], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert "elastic bodies (1):" in out.stdout
-    line = next(ln for ln in out.stdout.splitlines() if ln.strip().startswith("beam "))
+    line = next(ln for ln in out.stdout.splitlines() if ln.strip().startswith("beam ") and " .. " in ln)
     parts = line.split()
     k = parts.index("..")
     f_low, f_high = float(parts[k - 1]), float(parts[k + 1])
