@@ -310,3 +310,65 @@ def test_mechsys_info_lists_the_elastic_bodies_with_their_frequencies():
     f_low, f_high = float(parts[k - 1]), float(parts[k + 1])
     f = runpy.run_path(str(path), run_name="x")["BEAM"].frequencies()
     np.testing.assert_allclose([f_low, f_high], [f[0], f[-1]], rtol=1e-3)
+
+
+# ---- loads and constraints at nodes ----------------------------------------------------------
+def planar_cantilever():
+    """A steel strip (1 m, 20 x 10 mm) as beam elements in the x-y plane, clamped at its root; the
+    tip node kept as Craig-Bampton coordinates, so static loads there come out exact."""
+    from mechsys import elastic as el
+
+    sec = el.BeamSection.rectangle(0.02, 0.01, E=210e9, nu=0.3, rho=7850.0)
+    fe = el.beam_model(sec, 1.0, 10, planar=True)
+    return sec, el.craig_bampton(fe, 4, interface=[-1], fixed={0: "clamped"}, name="beam")
+
+
+def test_a_load_at_the_tip_node_bends_the_cantilever_by_p_l3_over_3_e_i():
+    sec, body = planar_cantilever()
+    m = ms.Model("cantilever", planar=True)
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    m.add_force(ms.forces.BodyForce("load", b, force=(0, -50.0, 0), point=b.node(-1)))
+    q = ms.analysis.static_equilibrium(m)["q"]
+    np.testing.assert_allclose(body.modes[-1, 1, :] @ q, -50.0 / (3 * sec.E * sec.Iz), rtol=1e-9)
+    # a point that is not a node moves with the reference frame: the same load there does nothing elastic
+    m2 = ms.Model("cantilever2", planar=True)
+    b2 = m2.add_elastic_body("beam", body)
+    m2.add_joint(ms.joints.Fixed("clamp", m2.ground, b2))
+    m2.add_force(ms.forces.BodyForce("load", b2, force=(0, -50.0, 0), point=(0.95, 0.0, 0.0)))
+    np.testing.assert_allclose(ms.analysis.static_equilibrium(m2)["q"], 0.0, atol=1e-15)
+    with pytest.raises(ms.ModelError, match="no node 99"):
+        b.node(99)
+
+
+def test_a_propped_cantilever_carries_three_eighths_of_its_weight_on_the_prop():
+    """The tip node held on the ground by a point constraint (its rows carry the node's elastic
+    columns): the prop's reaction is 3 w L / 8 under the weight w per length, the tip stays put,
+    and a run keeps the constraint to round-off."""
+    sec, body = planar_cantilever()
+    g = 9.81
+    m = ms.Model("propped", gravity=(0, -g, 0), planar=True)
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    m.add_constraint(ms.constraints.Point("prop", b, m.ground, point1=b.node(-1), point2=(1.0, 0, 0)))
+    eq = ms.analysis.static_equilibrium(m)
+    np.testing.assert_allclose(eq["lambda"]["prop"][1], 3 * sec.rho * sec.A * g / 8, rtol=1e-9)
+    assert abs(body.modes[-1, 1, :] @ eq["q"]) < 1e-15
+    res = ms.simulate(m, t_end=0.05, integrator=ms.DOPRI5(rtol=1e-9, atol=1e-12), output_dt=1e-3)
+    assert np.abs(res["constraint/prop/violation"]).max() < 1e-12
+    assert np.abs(res["body/beam/elastic_q"]).max() > 1e-6  # it does vibrate under its weight
+
+
+def test_a_spring_at_the_tip_node_keeps_the_energy():
+    """A spring from the tip node to the ground, the beam released bent: the spring works on the
+    elastic coordinates, and kinetic + strain + spring energy stays constant."""
+    sec, body = planar_cantilever()
+    m = ms.Model("sprung", planar=True)
+    b = m.add_elastic_body("beam", body, q0=np.r_[np.zeros(4), [0.0, 5e-3, 0.0]][: body.n_coordinates])
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    m.add_force(ms.forces.SpringDamper("tip-spring", b, m.ground, k=2000.0, point1=b.node(-1), point2=(1.0, -0.2, 0.0),
+                                       l0=0.2))
+    res = ms.simulate(m, t_end=0.2, integrator=ms.DOPRI5(rtol=1e-11, atol=1e-13), output_dt=1e-3)
+    e = res["energy/total"]
+    assert np.ptp(e) < 1e-8 * e[0]
+    assert np.ptp(res["force/tip-spring/force"]) > 1.0  # the spring does work

@@ -31,6 +31,24 @@ class Body:
         self.model.add_marker(self.name, name, position, **rotation)
         return self
 
+    def node(self, node) -> tuple:
+        """The undeformed position (body frame) of node ``node`` (index or name ``"n<k>"``) of this
+        elastic body: a point given there (a constraint's or force element's) moves with the node."""
+        desc = next((b for b in self.model._bodies if isinstance(b, dict) and b.get("name") == self.name), None)
+        nodes = ((desc or {}).get("elastic") or {}).get("nodes") or []
+        if not nodes:
+            raise ModelError(f"body '{self.name}': not an elastic body with nodes")
+        if isinstance(node, str):
+            k = next((i for i, n in enumerate(nodes) if n["name"] == node), None)
+        elif isinstance(node, (int, np.integer)) and not isinstance(node, bool) and -len(nodes) <= node < len(nodes):
+            k = int(node) % len(nodes)
+        else:
+            k = None
+        if k is None:
+            raise ModelError(f"body '{self.name}'.node: no node {node!r} (the body has {len(nodes)} nodes, "
+                             f"0..{len(nodes) - 1} or 'n0'..'n{len(nodes) - 1}')")
+        return tuple(float(x) for x in nodes[k]["position"])
+
     def contour(self, contour) -> "Any":
         """This body carrying a contour (see :mod:`mechsys.contours`), for a :class:`mechsys.Contact`."""
         from .contours import Contour, OnBody

@@ -131,6 +131,8 @@ pub struct Data {
     pub gap: crate::contact::gap::GapWork,
     /// kinematics: each elastic body's coordinates, deformed invariants and couplings.
     pub elastic: Vec<crate::elastic::ElasticWork>,
+    /// kinematics: the index into `elastic` of each body that is elastic (nbody).
+    pub body_elastic: Vec<Option<usize>>,
 }
 
 impl Data {
@@ -190,6 +192,7 @@ impl Data {
             element_force: vec![0.0; model.n_force_outputs],
             element_deflection: vec![0.0; model.n_force_outputs],
             elastic: model.elastic.iter().map(crate::elastic::ElasticWork::new).collect(),
+            body_elastic: model.bodies.iter().map(|b| b.elastic).collect(),
             gap: {
                 // the gap functions of contacts and of contacts held closed, by slot
                 let mut f: Vec<(usize, &crate::contact::gap::GapFunction)> =

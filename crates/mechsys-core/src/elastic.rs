@@ -106,10 +106,35 @@ pub struct ElasticWork {
     pub c: Vec<Force>,
     /// Scratch of length n_e.
     pub tmp: Vec<f64>,
+    /// First elastic velocity index (for the generalized forces of loads at nodes).
+    pub iu: usize,
+    /// Undeformed node positions (body frame).
+    pub nodes: Vec<Vec3>,
+    /// Node translations per elastic coordinate, node-major: `phi[n * n_e + k]`.
+    pub phi: Vec<Vec3>,
 }
 
 impl ElasticWork {
-    /// Sized for `e`.
+    /// The node at the body-frame point `p_b` (a point given at a node's position moves with it).
+    #[inline]
+    pub fn node_at(&self, p_b: &Vec3) -> Option<usize> {
+        let tol = 1e-12 * (1.0 + p_b.norm());
+        self.nodes.iter().position(|n| (n - p_b).amax() <= tol)
+    }
+    /// `Σ_k x_k φ_nk` for the coordinates (or rates, accelerations) `x`: the node's deflection.
+    #[inline]
+    pub fn node_field(&self, n: usize, x: &[f64]) -> Vec3 {
+        let ne = x.len();
+        let mut d = Vec3::zeros();
+        for (k, xk) in x.iter().enumerate() {
+            d += self.phi[n * ne + k] * *xk;
+        }
+        d
+    }
+}
+
+impl ElasticWork {
+    /// Sized for `e` (the node tables copied: point kinematics read them from the data alone).
     pub fn new(e: &ElasticBody) -> Self {
         ElasticWork {
             q: e.q0.clone(),
@@ -118,6 +143,9 @@ impl ElasticWork {
             qk: vec![Mat3::zeros(); e.ne],
             c: vec![Force::ZERO; e.ne],
             tmp: vec![0.0; e.ne],
+            iu: e.iu,
+            nodes: e.nodes.iter().map(|n| n.position).collect(),
+            phi: e.nodes.iter().flat_map(|n| n.translation.iter().copied()).collect(),
         }
     }
 }

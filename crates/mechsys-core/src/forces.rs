@@ -165,6 +165,24 @@ fn add_point_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) {
     }
     let p = point_position(data, b, p_b);
     data.f_ext[b] += Force::new(p.cross(f_i), *f_i);
+    add_node_force(data, b, p_b, f_i);
+}
+
+/// A force `f_i` at an elastic node of body b also loads the elastic coordinates, `(A φ_nk)ᵀ f`;
+/// returns its power on the deflection rates (zero elsewhere).
+#[inline]
+fn add_node_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) -> f64 {
+    let Some((k, n)) = crate::kinematics::elastic_node(data, b, p_b) else { return 0.0 };
+    let f_b = data.x_abs[b].a.transpose() * f_i;
+    let w = &data.elastic[k];
+    let ne = w.q.len();
+    let mut power = 0.0;
+    for kk in 0..ne {
+        let g = w.phi[n * ne + kk].dot(&f_b);
+        data.tau_applied[w.iu + kk] += g;
+        power += g * w.qd[kk];
+    }
+    power
 }
 
 /// Adds the wrench of force `f` through the world point `p` plus torque `n` (I components) to body b.
@@ -425,9 +443,10 @@ pub fn evaluate(
                     ForceFrame::Inertial => (force * s, torque * s),
                     ForceFrame::Body => (x.a * force * s, x.a * torque * s),
                 };
-                let w = Force::new(n + x.point_to_parent(point).cross(&f), f);
+                let w = Force::new(n + point_position(data, *body, point).cross(&f), f);
                 p_ext += wrench_power(data, *body, &w);
                 data.f_ext[*body] += w;
+                p_ext += add_node_force(data, *body, point, &f);
                 // recorded: the applied force and the torque (about its point), inertial components
                 for k in 0..3 {
                     data.element_force[o + k] = f[k];

@@ -48,6 +48,7 @@ pub use crate::model::constraint::{Constraint, ConstraintKind, LoopJoint, Reach}
 pub(crate) fn add_point_rows(
     model: &Model,
     s_all: &[[Motion; 6]],
+    el: crate::kinematics::ElasticView<'_>,
     body: usize,
     p: &Vec3,
     sign: f64,
@@ -72,6 +73,8 @@ pub(crate) fn add_point_rows(
         }
         b = j.parent;
     }
+    // at an elastic node: the columns of its deflection too
+    crate::kinematics::add_elastic_point_rows(el, body, p, sign, dir, g, row);
 }
 
 /// At most this many rows per constraint kind.
@@ -88,6 +91,9 @@ struct BodyRows {
     b: [f64; MAX_ROWS],
     w1: [Force; MAX_ROWS],
     w2: [Force; MAX_ROWS],
+    /// The world points the rows' forces act at on body1 and body2, when every row is a force
+    /// there (point kinds): an elastic node there adds its deflection's columns.
+    points: Option<(Vec3, Vec3)>,
 }
 
 impl BodyRows {
@@ -100,6 +106,7 @@ impl BodyRows {
             b: [0.0; MAX_ROWS],
             w1: [Force::ZERO; MAX_ROWS],
             w2: [Force::ZERO; MAX_ROWS],
+            points: None,
         }
     }
     /// A row with violation `phi`, wrench `w1` on body1 and `w2` on body2.
@@ -255,6 +262,7 @@ fn body_rows(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks) -> Result<
             for e in [ex, ey, ez] {
                 r.push(e.dot(&(w1 - w2)), force_at(&w1, &e), force_at(&w2, &e));
             }
+            r.points = Some((w1, w2));
             r
         }
         ConstraintKind::PrescribedBody { body, frame, position, orientation } => {
@@ -675,6 +683,11 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 data.b[r + k] = b;
                 add_wrench_row(model, &data.s, rows.body1, &w1, 1.0, &mut data.g, r + k);
                 add_wrench_row(model, &data.s, rows.body2, &w2, -1.0, &mut data.g, r + k);
+                if let Some((p1, p2)) = rows.points {
+                    let view = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+                    crate::kinematics::add_elastic_point_rows(view, rows.body1, &p1, 1.0, Some(&w1.f), &mut data.g, r + k);
+                    crate::kinematics::add_elastic_point_rows(view, rows.body2, &p2, -1.0, Some(&w2.f), &mut data.g, r + k);
+                }
             }
             continue;
         }
@@ -686,8 +699,8 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     data.phi[r + k] = d[k];
                     data.b[r + k] = 0.0;
                 }
-                add_point_rows(model, &data.s, *body1, &w1, 1.0, None, &mut data.g, r);
-                add_point_rows(model, &data.s, *body2, &w2, -1.0, None, &mut data.g, r);
+                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body1, &w1, 1.0, None, &mut data.g, r);
+                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body2, &w2, -1.0, None, &mut data.g, r);
             }
             ConstraintKind::Distance { body1, p1, body2, p2, length } => {
                 let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
@@ -702,8 +715,8 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 let e = d / l;
                 data.phi[r] = l - length;
                 data.b[r] = 0.0;
-                add_point_rows(model, &data.s, *body1, &w1, 1.0, Some(&e), &mut data.g, r);
-                add_point_rows(model, &data.s, *body2, &w2, -1.0, Some(&e), &mut data.g, r);
+                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body1, &w1, 1.0, Some(&e), &mut data.g, r);
+                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body2, &w2, -1.0, Some(&e), &mut data.g, r);
             }
             ConstraintKind::Contact { body1, body2, pair, .. } => {
                 // g_N = 0 (holonomic), then ġ_T = 0 along each friction direction (rolling)
@@ -712,8 +725,8 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 for (j, e) in std::iter::once(&k.n).chain(tg.iter()).take(rows).enumerate() {
                     data.phi[r + j] = if j == 0 { k.g } else { 0.0 };
                     data.b[r + j] = 0.0;
-                    add_point_rows(model, &data.s, *body1, &k.p1, 1.0, Some(e), &mut data.g, r + j);
-                    add_point_rows(model, &data.s, *body2, &k.p2, -1.0, Some(e), &mut data.g, r + j);
+                    add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body1, &k.p1, 1.0, Some(e), &mut data.g, r + j);
+                    add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body2, &k.p2, -1.0, Some(e), &mut data.g, r + j);
                 }
             }
             ConstraintKind::Gap { function, slot, .. } => {

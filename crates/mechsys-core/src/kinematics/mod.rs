@@ -190,28 +190,98 @@ pub fn accelerations(model: &Model, data: &mut Data, udot: &[f64]) {
     }
 }
 
-/// Absolute position (I components) of a point `p_b` fixed on body `body`.
+/// The elastic node at the body-frame point `p_b` of `body`, if the body is elastic and the point
+/// is at a node: (elastic index, node index). A point at a node moves with the node's translation
+/// (eq. 2.133); any other point of an elastic body moves with its reference frame.
 #[inline]
-pub fn point_position(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
-    data.x_abs[body].point_to_parent(p_b)
+pub fn elastic_node(data: &Data, body: usize, p_b: &Vec3) -> Option<(usize, usize)> {
+    let k = data.body_elastic.get(body).copied().flatten()?;
+    data.elastic[k].node_at(p_b).map(|n| (k, n))
 }
 
-/// Absolute velocity (I components) of a body-fixed point (eq. 2.28 with ṙ = 0).
+/// Absolute position (I components) of a point `p_b` fixed on body `body` (at an elastic node:
+/// deflected with it).
+#[inline]
+pub fn point_position(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
+    match elastic_node(data, body, p_b) {
+        Some((k, n)) => {
+            let w = &data.elastic[k];
+            data.x_abs[body].point_to_parent(&(p_b + w.node_field(n, &w.q)))
+        }
+        None => data.x_abs[body].point_to_parent(p_b),
+    }
+}
+
+/// Absolute velocity (I components) of a body-fixed point (eq. 2.28 with ṙ = 0; at an elastic
+/// node plus its deflection rate, eq. 2.191).
 #[inline]
 pub fn point_velocity(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     let v = &data.v[body];
-    v.v + v.w.cross(&point_position(data, body, p_b))
+    let rigid = v.v + v.w.cross(&point_position(data, body, p_b));
+    match elastic_node(data, body, p_b) {
+        Some((k, n)) => rigid + data.x_abs[body].a * data.elastic[k].node_field(n, &data.elastic[k].qd),
+        None => rigid,
+    }
 }
 
 /// Absolute (classical) acceleration, I components, of a body-fixed point (eq. 2.41 with
-/// ṙ = r̈ = 0). Requires [`accelerations`] without the gravity offset.
+/// ṙ = r̈ = 0; at an elastic node with its relative acceleration and Coriolis term).
+/// Requires [`accelerations`] without the gravity offset.
 #[inline]
 pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     let (v, a) = (&data.v[body], &data.a[body]);
     let p = point_position(data, body, p_b);
     let vp = v.v + v.w.cross(&p);
     // spatial → classical: a_P = a_O + ω̇ × p + ω × v_P
-    a.v + a.w.cross(&p) + v.w.cross(&vp)
+    let rigid = a.v + a.w.cross(&p) + v.w.cross(&vp);
+    match elastic_node(data, body, p_b) {
+        Some((k, n)) => {
+            let (w, am) = (&data.elastic[k], &data.x_abs[body].a);
+            let rel_v = am * w.node_field(n, &w.qd);
+            // ω × (A d) in v_P already; d/dt adds ω × A ḋ, and A d̈ + ω × A ḋ from the relative motion
+            rigid + am * w.node_field(n, &w.qdd) + v.w.cross(&rel_v) * 2.0
+        }
+        None => rigid,
+    }
+}
+
+/// What the elastic point rows read from the [`Data`]: placements, elastic works, body → elastic.
+pub type ElasticView<'a> = (&'a [crate::spatial::Pose], &'a [crate::elastic::ElasticWork], &'a [Option<usize>]);
+
+/// Adds `sign · dirᵀ` (or all three rows with `dir` None) of the elastic columns `A φ_nk` of the
+/// world point `p` on `body` into row `row` of `g`, when `p` is an elastic node of the body.
+pub fn add_elastic_point_rows(
+    el: ElasticView<'_>,
+    body: usize,
+    p: &Vec3,
+    sign: f64,
+    dir: Option<&Vec3>,
+    g: &mut DMatrix<f64>,
+    row: usize,
+) {
+    let (x_abs, elastic, body_elastic) = el;
+    let Some(k) = body_elastic.get(body).copied().flatten() else { return };
+    let w = &elastic[k];
+    let x = &x_abs[body];
+    // the node whose deflected world position is p
+    let tol = 1e-12 * (1.0 + p.norm());
+    let Some(n) = (0..w.nodes.len())
+        .find(|&n| (x.point_to_parent(&(w.nodes[n] + w.node_field(n, &w.q))) - p).amax() <= tol)
+    else {
+        return;
+    };
+    let ne = w.q.len();
+    for kk in 0..ne {
+        let col = x.a * w.phi[n * ne + kk] * sign;
+        match dir {
+            Some(d) => g[(row, w.iu + kk)] += d.dot(&col),
+            None => {
+                for r in 0..3 {
+                    g[(row + r, w.iu + kk)] += col[r];
+                }
+            }
+        }
+    }
 }
 
 /// Jacobians of a body-fixed point (translational `jt`, 3 × nu) and of the body's angular velocity
@@ -241,6 +311,7 @@ pub fn point_jacobian(
         }
         b = j.parent;
     }
+    add_elastic_point_rows((&data.x_abs, &data.elastic, &data.body_elastic), body, &p, 1.0, None, jt, 0);
 }
 
 pub mod path;

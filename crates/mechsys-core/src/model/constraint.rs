@@ -314,6 +314,11 @@ impl ConstraintKind {
 
 /// Velocity indices of a joint-space path: the velocities of the joints from `body` to the root.
 fn path_velocities(model: &Model, body: usize, out: &mut Vec<usize>) {
+    // an elastic body's points at nodes move with its elastic coordinates too
+    if let Some(k) = model.bodies[body].elastic {
+        let e = &model.elastic[k];
+        out.extend(e.iu..e.iu + e.ne);
+    }
     let mut b = body;
     while b != 0 {
         let j = &model.joints[b - 1];

@@ -197,8 +197,8 @@ impl<'a> Phase<'a> {
             return;
         }
         let k = &kin[pt].point;
-        crate::constraints::add_point_rows(model, &data.s, con.body1, &k.p1, 1.0, Some(dir), m, r);
-        crate::constraints::add_point_rows(model, &data.s, con.body2, &k.p2, -1.0, Some(dir), m, r);
+        crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), con.body1, &k.p1, 1.0, Some(dir), m, r);
+        crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), con.body2, &k.p2, -1.0, Some(dir), m, r);
     }
 
     /// World tangent direction of (t1, t2) components `c` at point `pt`.
