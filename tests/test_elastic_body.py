@@ -372,3 +372,15 @@ def test_a_spring_at_the_tip_node_keeps_the_energy():
     e = res["energy/total"]
     assert np.ptp(e) < 1e-8 * e[0]
     assert np.ptp(res["force/tip-spring/force"]) > 1.0  # the spring does work
+
+
+@pytest.mark.parametrize("integrator, tol", [(ms.RK4(dt=1e-4), 1e-9), (ms.Radau5(rtol=1e-8, atol=1e-10), 1e-8),
+                                             (ms.MoreauJean(dt=1e-4), 2e-5), (ms.EventDriven(), 1e-9)],
+                         ids=["rk4", "radau5", "moreau_jean", "event_driven"])
+def test_every_integrator_runs_the_flexible_arm_to_the_same_state(integrator, tol):
+    m = flexible_arm(arm_mass=0.5)
+    kw = dict(t_end=0.5, output_dt=0.01, q0={"j2": 0.8}, u0={"j1": 1.5})
+    ref = ms.simulate(m, integrator=ms.DOPRI5(rtol=1e-11, atol=1e-12), **kw)
+    res = ms.simulate(m, integrator=integrator, **kw)
+    np.testing.assert_allclose(res["q"][-1], ref["q"][-1], atol=tol)
+    assert np.abs(res["body/rod/elastic_q"]).max() > 1e-3
