@@ -211,7 +211,50 @@ def _load_toml(path: Path) -> tuple[Model, Any]:
         raise ModelError(f"{where}: a callback needs a Python callable, which a TOML file cannot hold; "
                          "use a function given by values (constant, ramp, harmonic, table) or a .py model file")
     _resolve_meshes(data, path.parent)
+    _resolve_elastic(data, path.parent)
     return Model.from_dict(data), sim
+
+
+def _resolve_elastic(data: dict, folder: Path) -> None:
+    """Elastic bodies given by a reduced-body file (``elastic = { file = "blade.npz", ... }``,
+    relative to the model file; the layout of :func:`mechsys.elastic.save_reduced`) in place: the
+    engine's invariants, and the body's mass, centre of mass and inertia from the file unless
+    given. Options: ``rayleigh = [alpha, beta]`` or ``modal = zeta``, ``stiffening`` (default
+    true), ``q0``, ``u0``. Errors name the body's key path and the file."""
+    bodies = data.get("bodies", [])
+    for i, b in enumerate(bodies if isinstance(bodies, list) else []):
+        if not isinstance(b, dict) or not isinstance(b.get("elastic"), dict) or "file" not in b["elastic"]:
+            continue
+        where = f"bodies[{i}] '{b.get('name', '?')}'.elastic"
+        spec = dict(b["elastic"])
+        extra = set(spec) - {"file", "rayleigh", "modal", "stiffening", "q0", "u0"}
+        if extra:
+            raise ModelError(f"{where}: unknown key(s) {', '.join(sorted(extra))} with a file (expected file, rayleigh, "
+                             "modal, stiffening, q0, u0)")
+        file = spec.pop("file")
+        if not isinstance(file, str):
+            raise ModelError(f"{where}.file: expected a file name, got {_tname(file)}")
+        from .elastic import load_reduced
+
+        try:
+            reduced = load_reduced(folder / file, name=b.get("name"))
+        except ModelError as e:
+            raise ModelError(f"{where}.file: {e}") from None
+        scratch = Model("scratch")
+        stiff = spec.get("stiffening", True)
+        if not isinstance(stiff, bool):
+            raise ModelError(f"{where}.stiffening: expected true or false, got {stiff!r}")
+        try:
+            handle = scratch.add_elastic_body(str(b.get("name", "body")), reduced, rayleigh=spec.get("rayleigh"),
+                                              modal=spec.get("modal"), stiffening=stiff, q0=spec.get("q0"),
+                                              u0=spec.get("u0"))
+        except ModelError as e:
+            raise ModelError(f"{where}: {e}") from None
+        made = scratch._bodies[-1]
+        b["elastic"] = made["elastic"]
+        for key in ("mass", "inertia", "com"):
+            b.setdefault(key, made[key])
+        del handle
 
 
 def _resolve_meshes(data: dict, folder: Path) -> None:

@@ -170,6 +170,10 @@ class Results:
                 put(f"body/{e['body']}/elastic_udot", raw["udot"][:, su], "1/s^2", ecols)
             qe = np.asarray(raw["q"][:, sl])
             put(f"body/{e['body']}/strain_energy", 0.5 * np.einsum("ti,ij,tj->t", qe, np.asarray(e["stiffness"]), qe), "J")
+            if e.get("nodes"):
+                # each node's deflection from its undeformed place, body frame (n, nodes, 3)
+                put(f"body/{e['body']}/node_deflection",
+                    np.einsum("tk,nkc->tnc", qe, np.asarray(e["node_translation"], dtype=float)), "m")
         for j in joints:
             uq, uu, ua = _JOINT_UNITS.get(j["type"], ("", "", ""))
             if j["nq"] == 0:
@@ -807,7 +811,7 @@ def signal_universe(engine) -> list[str]:
     for b in engine.bodies():
         n = b["name"]
         if n in elastic_bodies:
-            names += [f"body/{n}/{x}" for x in ("elastic_q", "elastic_u", "elastic_udot", "strain_energy")]
+            names += [f"body/{n}/{x}" for x in ("elastic_q", "elastic_u", "elastic_udot", "strain_energy", "node_deflection")]
         names += [f"body/{n}/{x}" for x in ("position", "orientation", "velocity", "angular_velocity", "acceleration",
                                              "angular_acceleration", "mass", "kinetic_energy", "com_position",
                                              "com_velocity", "com_acceleration")]

@@ -98,6 +98,10 @@ impl PyModel {
             d.set_item("nodes", e.nodes.iter().map(|n| n.name.clone()).collect::<Vec<_>>())?;
             let k: Vec<Vec<f64>> = (0..e.ne).map(|r| (0..e.ne).map(|c| e.k[(r, c)]).collect()).collect();
             d.set_item("stiffness", k)?;
+            // per node, per coordinate, the translation (body frame)
+            let t: Vec<Vec<Vec<f64>>> =
+                e.nodes.iter().map(|n| n.translation.iter().map(|v| vec![v.x, v.y, v.z]).collect()).collect();
+            d.set_item("node_translation", t)?;
             out.push(d);
         }
         Ok(out)
