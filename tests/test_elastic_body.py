@@ -427,3 +427,17 @@ integrator = { type = "dopri5", rtol = 1e-10, atol = 1e-13 }
     r = subprocess.run([sys.executable, "-m", "mechsys", "run", str(tmp_path / "bad.toml")], capture_output=True, text=True,
                        timeout=120)
     assert r.returncode == 2 and "bodies[0] 'blade'.elastic.file" in r.stderr and "nothere.npz" in r.stderr
+
+
+def test_a_moment_at_the_tip_node_turns_it_by_m_l_over_e_i():
+    """A torque at the tip node loads the elastic coordinates through the node's small rotation
+    (eq. 2.134): the tip turns by M L / (E I) and deflects by M L² / (2 E I)."""
+    sec, body = planar_cantilever()
+    m = ms.Model("moment", planar=True)
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    m.add_force(ms.forces.BodyForce("moment", b, torque=(0, 0, 20.0), point=b.node(-1)))
+    q = ms.analysis.static_equilibrium(m)["q"]
+    ei = sec.E * sec.Iz
+    np.testing.assert_allclose(body.modes[-1, 5, :] @ q, 20.0 / ei, rtol=1e-9)
+    np.testing.assert_allclose(body.modes[-1, 1, :] @ q, 20.0 / (2 * ei), rtol=1e-9)

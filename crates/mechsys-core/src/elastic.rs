@@ -112,6 +112,8 @@ pub struct ElasticWork {
     pub nodes: Vec<Vec3>,
     /// Node translations per elastic coordinate, node-major: `phi[n * n_e + k]`.
     pub phi: Vec<Vec3>,
+    /// Node small rotations per elastic coordinate (eq. 2.134), node-major (zero where not given).
+    pub psi: Vec<Vec3>,
 }
 
 impl ElasticWork {
@@ -146,6 +148,11 @@ impl ElasticWork {
             iu: e.iu,
             nodes: e.nodes.iter().map(|n| n.position).collect(),
             phi: e.nodes.iter().flat_map(|n| n.translation.iter().copied()).collect(),
+            psi: e
+                .nodes
+                .iter()
+                .flat_map(|n| (0..e.ne).map(move |k| n.rotation.get(k).copied().unwrap_or_else(Vec3::zeros)))
+                .collect(),
         }
     }
 }

@@ -168,6 +168,26 @@ fn add_point_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) {
     add_node_force(data, b, p_b, f_i);
 }
 
+/// A torque `n_i` at an elastic node of body b also loads the elastic coordinates through the
+/// node's small rotations, `(A ψ_nk)ᵀ n`; returns its power on the rotation rates.
+#[inline]
+fn add_node_torque(data: &mut Data, b: usize, p_b: &Vec3, n_i: &Vec3) -> f64 {
+    if n_i.norm_squared() == 0.0 {
+        return 0.0;
+    }
+    let Some((k, n)) = crate::kinematics::elastic_node(data, b, p_b) else { return 0.0 };
+    let n_b = data.x_abs[b].a.transpose() * n_i;
+    let w = &data.elastic[k];
+    let ne = w.q.len();
+    let mut power = 0.0;
+    for kk in 0..ne {
+        let g = w.psi[n * ne + kk].dot(&n_b);
+        data.tau_applied[w.iu + kk] += g;
+        power += g * w.qd[kk];
+    }
+    power
+}
+
 /// A force `f_i` at an elastic node of body b also loads the elastic coordinates, `(A φ_nk)ᵀ f`;
 /// returns its power on the deflection rates (zero elsewhere).
 #[inline]
@@ -447,6 +467,7 @@ pub fn evaluate(
                 p_ext += wrench_power(data, *body, &w);
                 data.f_ext[*body] += w;
                 p_ext += add_node_force(data, *body, point, &f);
+                p_ext += add_node_torque(data, *body, point, &n);
                 // recorded: the applied force and the torque (about its point), inertial components
                 for k in 0..3 {
                     data.element_force[o + k] = f[k];
