@@ -168,37 +168,34 @@ fn add_point_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) {
     add_node_force(data, b, p_b, f_i);
 }
 
-/// A torque `n_i` at an elastic node of body b also loads the elastic coordinates through the
-/// node's small rotations, `(A ψ_nk)ᵀ n`; returns its power on the rotation rates.
-#[inline]
-fn add_node_torque(data: &mut Data, b: usize, p_b: &Vec3, n_i: &Vec3) -> f64 {
-    if n_i.norm_squared() == 0.0 {
-        return 0.0;
-    }
-    let Some((k, n)) = crate::kinematics::elastic_node(data, b, p_b) else { return 0.0 };
-    let n_b = data.x_abs[b].a.transpose() * n_i;
-    let w = &data.elastic[k];
-    let ne = w.q.len();
-    let mut power = 0.0;
-    for kk in 0..ne {
-        let g = w.psi[n * ne + kk].dot(&n_b);
-        data.tau_applied[w.iu + kk] += g;
-        power += g * w.qd[kk];
-    }
-    power
-}
-
 /// A force `f_i` at an elastic node of body b also loads the elastic coordinates, `(A φ_nk)ᵀ f`;
 /// returns its power on the deflection rates (zero elsewhere).
 #[inline]
 fn add_node_force(data: &mut Data, b: usize, p_b: &Vec3, f_i: &Vec3) -> f64 {
+    add_node_load(data, b, p_b, f_i, false)
+}
+
+/// A torque `n_i` at an elastic node of body b loads the elastic coordinates through the node's
+/// small rotations, `(A ψ_nk)ᵀ n`; returns its power on the rotation rates.
+#[inline]
+fn add_node_torque(data: &mut Data, b: usize, p_b: &Vec3, n_i: &Vec3) -> f64 {
+    add_node_load(data, b, p_b, n_i, true)
+}
+
+/// The generalized elastic forces of a force (`rotation` false: through the node's translations φ)
+/// or a torque (true: through its small rotations ψ) at the node at `p_b`, and their power.
+fn add_node_load(data: &mut Data, b: usize, p_b: &Vec3, load_i: &Vec3, rotation: bool) -> f64 {
+    if load_i.norm_squared() == 0.0 {
+        return 0.0;
+    }
     let Some((k, n)) = crate::kinematics::elastic_node(data, b, p_b) else { return 0.0 };
-    let f_b = data.x_abs[b].a.transpose() * f_i;
+    let load_b = data.x_abs[b].a.transpose() * load_i;
     let w = &data.elastic[k];
     let ne = w.q.len();
+    let fields = if rotation { &w.psi } else { &w.phi };
     let mut power = 0.0;
     for kk in 0..ne {
-        let g = w.phi[n * ne + kk].dot(&f_b);
+        let g = fields[n * ne + kk].dot(&load_b);
         data.tau_applied[w.iu + kk] += g;
         power += g * w.qd[kk];
     }
