@@ -441,3 +441,19 @@ def test_a_moment_at_the_tip_node_turns_it_by_m_l_over_e_i():
     ei = sec.E * sec.Iz
     np.testing.assert_allclose(body.modes[-1, 5, :] @ q, 20.0 / ei, rtol=1e-9)
     np.testing.assert_allclose(body.modes[-1, 1, :] @ q, 20.0 / (2 * ei), rtol=1e-9)
+
+
+def test_mode_shapes_are_drawn_at_their_frequencies(tmp_path):
+    from mechsys import elastic as el
+
+    sec = el.BeamSection.rectangle(0.02, 0.01, E=210e9, nu=0.3, rho=7850.0)
+    body = el.analytic_beam_body(sec, 1.0, "clamped-free", 3, plane="xy", name="blade")
+    fig = body.plot_modes((0, 1), out=tmp_path / "modes.png")
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    f = body.frequencies()
+    assert labels[1] == f"mode 1: {f[0]:.4g} Hz" and labels[2] == f"mode 2: {f[1]:.4g} Hz"
+    line = fig.axes[0].get_lines()[1]
+    assert abs(np.abs(line.get_ydata()).max() - 0.1) < 1e-12  # scaled to a tenth of the 1 m blade
+    assert (tmp_path / "modes.png").stat().st_size > 10_000
+    with pytest.raises(ms.ModelError, match="no mode 7"):
+        body.plot_modes(7)

@@ -1006,6 +1006,42 @@ class ReducedBody:
         mv = self.M @ V
         return mv @ np.diag(2.0 * z * np.sqrt(np.maximum(w2, 0.0))) @ mv.T
 
+    def plot_modes(self, modes=(0, 1, 2), out=None, scale: float | None = None):
+        """Draws mode shapes over the undeformed nodes (matplotlib, a view of the two body axes the
+        nodes and deflections spread over most): each mode scaled so its largest node deflection is
+        ``scale`` (default a tenth of the body's size), labelled with its frequency. Writes ``out``
+        (.png, .svg, .pdf) when given; returns the figure."""
+        import matplotlib
+
+        if out is not None:
+            matplotlib.use("Agg", force=False)
+        import matplotlib.pyplot as plt
+
+        idx = [int(k) for k in np.atleast_1d(modes)]
+        bad = [k for k in idx if not 0 <= k < self.n_coordinates]
+        if bad:
+            raise ModelError(f"elastic body {self.name!r}: no mode {bad[0]} (the body has {self.n_coordinates}, 0..{self.n_coordinates - 1})")
+        w2, v = linalg.eigh(self.K, self.M)
+        size = float(np.ptp(self.nodes, axis=0).max()) or 1.0
+        s = 0.1 * size if scale is None else float(scale)
+        shapes = [np.einsum("nck,k->nc", self.modes[:, :3, :], v[:, k]) for k in idx]
+        spread = np.ptp(self.nodes, axis=0) + sum(np.abs(d).max(axis=0) for d in shapes)
+        a, b = (int(i) for i in np.sort(np.argsort(-spread)[:2]))
+        fig, ax = plt.subplots(figsize=(7, 4))
+        ax.plot(self.nodes[:, a], self.nodes[:, b], "k.-", lw=0.8, label="undeformed")
+        for k, d in zip(idx, shapes):
+            big = np.abs(d).max() or 1.0
+            p = self.nodes + d * (s / big)
+            ax.plot(p[:, a], p[:, b], "o-", ms=3, label=f"mode {k + 1}: {np.sqrt(max(w2[k], 0.0)) / (2 * np.pi):.4g} Hz")
+        ax.set_xlabel(f"{'xyz'[a]} (m)")
+        ax.set_ylabel(f"{'xyz'[b]} (m)")
+        ax.set_title(f"{self.name}: mode shapes (largest deflection {s:.3g} m)")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        if out is not None:
+            fig.savefig(out, dpi=120)
+        return fig
+
     def kinetic_energy(self, v, omega, q=None, qdot=None) -> float:
         """T = ½ xᵀ M(q) x with x = (v, ω, q̇) (eq. 2.192 with the Ritz separation); v, ω of the
         body frame in body coordinates."""
