@@ -357,6 +357,11 @@ def test_a_propped_cantilever_carries_three_eighths_of_its_weight_on_the_prop():
     res = ms.simulate(m, t_end=0.05, integrator=ms.DOPRI5(rtol=1e-9, atol=1e-12), output_dt=1e-3)
     assert np.abs(res["constraint/prop/violation"]).max() < 1e-12
     assert np.abs(res["body/beam/elastic_q"]).max() > 1e-6  # it does vibrate under its weight
+    # started at rest in the equilibrium: the clamp carries the other 5/8 of the weight (its
+    # reaction from the Newton-Euler pass with the elastic body's terms)
+    rest = ms.simulate(m, t_end=1e-3, integrator=ms.DOPRI5(rtol=1e-10, atol=1e-14), output_dt=1e-3, q0=eq["q"])
+    np.testing.assert_allclose(np.abs(rest["joint/clamp/reaction_force"][0, 1]), 5 * sec.rho * sec.A * g / 8, rtol=1e-6)
+    assert np.abs(rest["body/beam/elastic_u"]).max() < 1e-9
 
 
 def test_a_spring_at_the_tip_node_keeps_the_energy():
