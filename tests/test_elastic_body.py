@@ -462,3 +462,23 @@ def test_mode_shapes_are_drawn_at_their_frequencies(tmp_path):
     assert (tmp_path / "modes.png").stat().st_size > 10_000
     with pytest.raises(ms.ModelError, match="no mode 7"):
         body.plot_modes(7)
+
+
+def test_an_elastic_tip_resting_on_a_stop_carries_three_eighths_of_the_weight():
+    """A point contour at the tip node touches a rigid stop level with the clamp: once the beam
+    has settled on it the contact force is the propped cantilever's 3 w L / 8, in both contact
+    schemes (event-driven to the transition tolerance, Moreau-Jean to its step)."""
+    sec, body = planar_cantilever()
+    g = 9.81
+    m = ms.Model("stop", gravity=(0, -g, 0), planar=True)
+    b = m.add_elastic_body("beam", body, modal=0.2)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    m.add_contact(ms.Contact("stop", b.contour(ms.contours.Point(b.node(-1))),
+                             m.ground.contour(ms.contours.Line(point=(1.0, 0, 0), normal=(0, 1, 0)))))
+    w = sec.rho * sec.A * g
+    ed = ms.simulate(m, t_end=1.5, integrator=ms.EventDriven(), output_dt=1e-3)
+    np.testing.assert_allclose(ed["contact/stop/lambda_n"][-1], 3 * w / 8, rtol=1e-8)
+    assert abs(ed["contact/stop/g_n"][-1]) < 1e-12
+    assert any(e["event"] == "close" or e["event"] == "impact" for e in ed.events)
+    mj = ms.simulate(m, t_end=1.5, integrator=ms.MoreauJean(dt=1e-4), output_dt=1e-3)
+    np.testing.assert_allclose(mj["contact/stop/lambda_n"][-1], 3 * w / 8, rtol=1e-2)

@@ -213,7 +213,13 @@ pub fn contact_point_kinematics(
 ) -> Result<()> {
     match con.gap() {
         None => {
-            let (b1, b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
+            let (mut b1, mut b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
+            if !data.elastic.is_empty() {
+                if let Some([c1, c2]) = con.contours() {
+                    node_motion(data, con.body1, c1, &mut b1);
+                    node_motion(data, con.body2, c2, &mut b2);
+                }
+            }
             contact_kinematics_warm(con.pair().expect("a contour contact"), &b1, &b2, out, search)
         }
         Some((f, slot)) => f.evaluate(t, q, u, cb, &mut data.gap, slot, true, &mut out[0]).map_err(|e| match e {
@@ -221,6 +227,25 @@ pub fn contact_point_kinematics(
             other => other,
         }),
     }
+}
+
+/// A point contour at a node of an elastic body moves with the node (eq. 2.133): its body's
+/// motion is replaced by that of a frame carried along with the node's deflection d, placed at
+/// `r + A d`, moving with `v + A ḋ` and accelerating with `a + A d̈ + ω × A ḋ` (so the point's
+/// classical acceleration gets the relative and Coriolis terms `A d̈ + 2 ω × A ḋ`).
+fn node_motion(data: &Data, body: usize, contour: &crate::contact::Contour, m: &mut BodyMotion) {
+    let p_b = match contour {
+        crate::contact::Contour::Point { p } => *p,
+        crate::contact::Contour::Point2 { p } => Vec3::new(p.x, p.y, 0.0),
+        _ => return,
+    };
+    let Some((k, n)) = crate::kinematics::elastic_node(data, body, &p_b) else { return };
+    let w = &data.elastic[k];
+    let a = m.pose.a;
+    let (d, dd, ddd) = (a * w.node_field(n, &w.q), a * w.node_field(n, &w.qd), a * w.node_field(n, &w.qdd));
+    m.pose.r += d;
+    m.acc.v += ddd + m.twist.w.cross(&dd);
+    m.twist.v += dd;
 }
 
 /// An error of contact `name`'s kinematics at time `t` as the integrators report it: a solver

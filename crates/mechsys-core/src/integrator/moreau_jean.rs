@@ -471,7 +471,7 @@ impl MoreauJean {
                 sp.clear();
                 for a in &self.act {
                     let k = &a.point;
-                    sp.add_contact(model, &data.s, a.b1, &k.p1, a.b2, &k.p2, &[k.n, k.t1, k.t2]);
+                    sp.add_contact(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), a.b1, &k.p1, a.b2, &k.p2, &[k.n, k.t1, k.t2]);
                 }
                 sp.delassus();
                 let Delassus::Blocks(bw) = &mut self.problem.w else { unreachable!("block Delassus") };

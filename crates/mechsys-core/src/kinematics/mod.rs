@@ -245,6 +245,17 @@ pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     }
 }
 
+/// The elastic node of `body` whose deflected world place is the world point `p`: (elastic index,
+/// node index), None when `body` is rigid or `p` is no node.
+pub fn elastic_point_at(el: ElasticView<'_>, body: usize, p: &Vec3) -> Option<(usize, usize)> {
+    let (x_abs, elastic, body_elastic) = el;
+    let k = body_elastic.get(body).copied().flatten()?;
+    let (w, x) = (&elastic[k], &x_abs[body]);
+    let tol = 1e-12 * (1.0 + p.norm());
+    let n = (0..w.nodes.len()).find(|&n| (x.point_to_parent(&(w.nodes[n] + w.node_field(n, &w.q))) - p).amax() <= tol)?;
+    Some((k, n))
+}
+
 /// What the elastic point rows read from the [`Data`]: placements, elastic works, body → elastic.
 pub type ElasticView<'a> = (&'a [crate::spatial::Pose], &'a [crate::elastic::ElasticWork], &'a [Option<usize>]);
 
@@ -259,17 +270,8 @@ pub fn add_elastic_point_rows(
     g: &mut DMatrix<f64>,
     row: usize,
 ) {
-    let (x_abs, elastic, body_elastic) = el;
-    let Some(k) = body_elastic.get(body).copied().flatten() else { return };
-    let w = &elastic[k];
-    let x = &x_abs[body];
-    // the node whose deflected world position is p
-    let tol = 1e-12 * (1.0 + p.norm());
-    let Some(n) = (0..w.nodes.len())
-        .find(|&n| (x.point_to_parent(&(w.nodes[n] + w.node_field(n, &w.q))) - p).amax() <= tol)
-    else {
-        return;
-    };
+    let Some((k, n)) = elastic_point_at(el, body, p) else { return };
+    let (w, x) = (&el.1[k], &el.0[body]);
     let ne = w.q.len();
     for kk in 0..ne {
         let col = x.a * w.phi[n * ne + kk] * sign;

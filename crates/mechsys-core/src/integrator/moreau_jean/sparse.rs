@@ -165,6 +165,11 @@ impl SparseRows {
                 x = j.parent;
             }
             body_runs[s0..].reverse();
+            // an elastic body's coordinates come after every joint's: its last run
+            if let Some(k) = model.bodies[b].elastic {
+                let e = &model.elastic[k];
+                body_runs.push((e.iu, e.ne));
+            }
             body_runs_ptr[b + 1] = body_runs.len();
             buf.clear();
             let mut x = b;
@@ -222,6 +227,7 @@ impl SparseRows {
         &mut self,
         model: &Model,
         s_all: &[[Motion; 6]],
+        el: crate::kinematics::ElasticView<'_>,
         b1: usize,
         p1: &Vec3,
         b2: usize,
@@ -271,6 +277,18 @@ impl SparseRows {
                     }
                 }
                 b = j.parent;
+            }
+            // a point at an elastic node: the node's deflection columns (one row at a time)
+            if let Some((k, n)) = crate::kinematics::elastic_point_at(el, body, p) {
+                let (w, a) = (&el.1[k], &el.0[body].a);
+                let ne = w.q.len();
+                for kk in 0..ne {
+                    let c = a * w.phi[n * ne + kk];
+                    let e = w0 + self.pos[w.iu + kk] * d;
+                    for r in 0..d {
+                        self.w[e + r] += sign * dirs[r].dot(&c);
+                    }
+                }
             }
         }
         // y = D^{-1/2} L⁻ᵀ w on the pattern, leaves first
