@@ -446,6 +446,11 @@ def test_a_moment_at_the_tip_node_turns_it_by_m_l_over_e_i():
     ei = sec.E * sec.Iz
     np.testing.assert_allclose(body.modes[-1, 5, :] @ q, 20.0 / ei, rtol=1e-9)
     np.testing.assert_allclose(body.modes[-1, 1, :] @ q, 20.0 / (2 * ei), rtol=1e-9)
+    # the node signals at that state: the tip's rotation about z and its deflection along y
+    res = ms.simulate(m, t_end=1e-4, integrator=ms.DOPRI5(rtol=1e-10, atol=1e-14), output_dt=1e-4, q0=q)
+    assert res.unit("body/beam/node_rotation") == "rad"
+    np.testing.assert_allclose(res["body/beam/node_rotation"][0, -1], [0, 0, 20.0 / ei], atol=1e-12)
+    np.testing.assert_allclose(res["body/beam/node_deflection"][0, -1], [0, 20.0 / (2 * ei), 0], atol=1e-12)
 
 
 def test_mode_shapes_are_drawn_at_their_frequencies(tmp_path):

@@ -174,6 +174,8 @@ class Results:
                 # each node's deflection from its undeformed place, body frame (n, nodes, 3)
                 put(f"body/{e['body']}/node_deflection",
                     np.einsum("tk,nkc->tnc", qe, np.asarray(e["node_translation"], dtype=float)), "m")
+                put(f"body/{e['body']}/node_rotation",
+                    np.einsum("tk,nkc->tnc", qe, np.asarray(e["node_rotation"], dtype=float)), "rad")
         for j in joints:
             uq, uu, ua = _JOINT_UNITS.get(j["type"], ("", "", ""))
             if j["nq"] == 0:
@@ -811,7 +813,8 @@ def signal_universe(engine) -> list[str]:
     for b in engine.bodies():
         n = b["name"]
         if n in elastic_bodies:
-            names += [f"body/{n}/{x}" for x in ("elastic_q", "elastic_u", "elastic_udot", "strain_energy", "node_deflection")]
+            names += [f"body/{n}/{x}" for x in ("elastic_q", "elastic_u", "elastic_udot", "strain_energy", "node_deflection",
+                                                 "node_rotation")]
         names += [f"body/{n}/{x}" for x in ("position", "orientation", "velocity", "angular_velocity", "acceleration",
                                              "angular_acceleration", "mass", "kinetic_energy", "com_position",
                                              "com_velocity", "com_acceleration")]

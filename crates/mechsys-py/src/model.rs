@@ -102,6 +102,13 @@ impl PyModel {
             let t: Vec<Vec<Vec<f64>>> =
                 e.nodes.iter().map(|n| n.translation.iter().map(|v| vec![v.x, v.y, v.z]).collect()).collect();
             d.set_item("node_translation", t)?;
+            // and the small rotation (eq. 2.134), zero where the body gives none
+            let r: Vec<Vec<Vec<f64>>> = e
+                .nodes
+                .iter()
+                .map(|n| (0..e.ne).map(|k| n.rotation.get(k).map_or(vec![0.0; 3], |v| vec![v.x, v.y, v.z])).collect())
+                .collect();
+            d.set_item("node_rotation", r)?;
             out.push(d);
         }
         Ok(out)
