@@ -288,7 +288,7 @@ def test_mesh_input_errors_name_the_contour_and_the_file(tmp_path, monkeypatch):
         ms.contours.Mesh.from_file(tmp_path / "sq.stl")
 
 
-MODEL = """
+BALL = """
 name = "marble"
 gravity = [0, 0, -9.81]
 
@@ -303,7 +303,9 @@ type = "free"
 parent = "ground"
 child = "ball"
 q0 = [0.6, 0.3, 0.1, 1, 0, 0, 0]
+"""
 
+MODEL = BALL + """
 [[contacts]]
 name = "floor"
 body1 = "ball"
@@ -355,22 +357,7 @@ def test_model_files_take_a_mesh_file_or_inline_triangles(tmp_path):
         ms.Model.from_dict(desc).build()
 
 
-GROUP_MODEL = """
-name = "group"
-gravity = [0, 0, -9.81]
-
-[[bodies]]
-name = "ball"
-mass = 1.0
-inertia = [0.001, 0.001, 0.001]
-
-[[joints]]
-name = "free"
-type = "free"
-parent = "ground"
-child = "ball"
-q0 = [0.6, 0.3, 0.1, 1, 0, 0, 0]
-
+GROUP_MODEL = BALL.replace('"marble"', '"group"') + """
 [[contact_groups]]
 name = "balls"
 members = [{ body = "ball", contour = { type = "sphere", radius = 0.05 } }]

@@ -209,8 +209,8 @@ def two_rods():
     m = ms.Model("double", gravity=(0, -G, 0))
     a = m.add_body("upper", 1.0, [1e-4, 1 / 12, 1 / 12], com=(0.5, 0, 0))
     b = m.add_body("lower", 1.0, [1e-4, 1 / 12, 1 / 12], com=(0.5, 0, 0))
-    m.add_joint(ms.joints.Revolute("shoulder", "ground", "upper", axis=(0, 0, 1), q0=[-np.pi / 2]))
-    m.add_joint(ms.joints.Revolute("elbow", "upper", "lower", axis=(0, 0, 1), parent_frame=ms.Frame(position=(1, 0, 0))))
+    m.add_joint(ms.joints.Revolute("shoulder", m.ground, a, axis=(0, 0, 1), q0=[-np.pi / 2]))
+    m.add_joint(ms.joints.Revolute("elbow", a, b, axis=(0, 0, 1), parent_frame=ms.Frame(position=(1, 0, 0))))
     return m
 
 

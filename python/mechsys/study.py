@@ -24,7 +24,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from .errors import MechsysError, ModelError, ResultsError, SettingsError
+from .errors import MechsysError, ResultsError, SettingsError
 from .model import Model
 
 

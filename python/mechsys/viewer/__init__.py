@@ -40,7 +40,6 @@ from .shapes import contour_parts, extent_of
 __all__ = ["page_data", "to_html", "view", "mode_results", "bundle_path"]
 
 _BUNDLE = Path(__file__).parent / "_bundle"
-_STATE_NAMES = ["open", "stick", "slip"]
 _MAX_GROUP_SLOTS = 400  # contact points drawn per group and frame
 
 

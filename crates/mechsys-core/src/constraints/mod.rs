@@ -61,15 +61,7 @@ pub(crate) fn add_point_rows(
         let j = &model.joints[b - 1];
         for k in 0..j.nu() {
             let s = &s_all[b][k];
-            let v = (s.v + s.w.cross(p)) * sign;
-            match dir {
-                Some(d) => g[(row, j.iu + k)] += d.dot(&v),
-                None => {
-                    for r in 0..3 {
-                        g[(row + r, j.iu + k)] += v[r];
-                    }
-                }
-            }
+            crate::kinematics::add_column(g, row, j.iu + k, &((s.v + s.w.cross(p)) * sign), dir);
         }
         b = j.parent;
     }

@@ -256,6 +256,20 @@ pub fn elastic_point_at(el: ElasticView<'_>, body: usize, p: &Vec3) -> Option<(u
     Some((k, n))
 }
 
+/// Adds the velocity column `v` (3 rows) of velocity `col` to `g`: projected on `dir` into row
+/// `row`, or as the three rows from `row` when `dir` is None.
+#[inline]
+pub(crate) fn add_column(g: &mut DMatrix<f64>, row: usize, col: usize, v: &Vec3, dir: Option<&Vec3>) {
+    match dir {
+        Some(d) => g[(row, col)] += d.dot(v),
+        None => {
+            for r in 0..3 {
+                g[(row + r, col)] += v[r];
+            }
+        }
+    }
+}
+
 /// What the elastic point rows read from the [`Data`]: placements, elastic works, body → elastic.
 pub type ElasticView<'a> = (&'a [crate::spatial::Pose], &'a [crate::elastic::ElasticWork], &'a [Option<usize>]);
 
@@ -274,15 +288,7 @@ pub fn add_elastic_point_rows(
     let (w, x) = (&el.1[k], &el.0[body]);
     let ne = w.q.len();
     for kk in 0..ne {
-        let col = x.a * w.phi[n * ne + kk] * sign;
-        match dir {
-            Some(d) => g[(row, w.iu + kk)] += d.dot(&col),
-            None => {
-                for r in 0..3 {
-                    g[(row + r, w.iu + kk)] += col[r];
-                }
-            }
-        }
+        add_column(g, row, w.iu + kk, &(x.a * w.phi[n * ne + kk] * sign), dir);
     }
 }
 
