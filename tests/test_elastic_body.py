@@ -501,3 +501,89 @@ def test_an_elastic_tip_resting_on_a_stop_carries_three_eighths_of_the_weight():
     assert any(e["event"] == "close" or e["event"] == "impact" for e in ed.events)
     mj = ms.simulate(m, t_end=1.5, integrator=ms.MoreauJean(dt=1e-4), output_dt=1e-3)
     np.testing.assert_allclose(mj["contact/stop/lambda_n"][-1], 3 * w / 8, rtol=1e-2)
+
+
+# ---- loop joints at nodes ---------------------------------------------------------------------
+def test_a_bracket_welded_to_the_tip_node_bends_and_turns_it_as_force_and_moment_would():
+    """A rigid bracket welded (LoopFixed) to the cantilever's tip node, loaded at its far end a
+    distance e beyond the tip: the weld passes the force P and the moment P e into the beam, whose
+    tip deflects by P L³/(3EI) + P e L²/(2EI) and turns by P L²/(2EI) + P e L/(EI) (the weld's
+    rows carry the node's deflection and rotation columns). P is small enough (tip rotation 2e-4)
+    that the bracket's turn, which shortens the lever by θ²/2, stays below the tolerance."""
+    sec, body = planar_cantilever()
+    P, e, L = 0.4, 0.3, 1.0
+    m = ms.Model("bracket", planar=True, gravity=(0, 0, 0))
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    arm = m.add_body("bracket", 0.5, [1e-3, 1e-3, 1e-3], com=(e / 2, 0, 0))
+    m.add_joint(ms.joints.Planar("float", m.ground, arm, q0=[L, 0.0, 0.0]))
+    m.add_constraint(ms.constraints.LoopFixed("weld", b, arm, frame1=b.node(-1)))
+    m.add_force(ms.forces.BodyForce("load", arm, force=(0, -P, 0), point=(e, 0, 0)))
+    eq = ms.analysis.static_equilibrium(m)
+    ne = body.n_coordinates
+    qe = eq["q"][-ne:]
+    ei = sec.E * sec.Iz
+    np.testing.assert_allclose(body.modes[-1, 1, :] @ qe, -(P * L**3 / (3 * ei) + P * e * L**2 / (2 * ei)), rtol=1e-7)
+    np.testing.assert_allclose(body.modes[-1, 5, :] @ qe, -(P * L**2 / (2 * ei) + P * e * L / ei), rtol=1e-7)
+    # the bracket went with the node: its angle is the tip's rotation, its origin the tip's place
+    q_float = eq["q"][:3]
+    np.testing.assert_allclose(q_float[2], body.modes[-1, 5, :] @ qe, rtol=1e-8)
+    np.testing.assert_allclose(q_float[1], body.modes[-1, 1, :] @ qe, rtol=1e-8)
+
+
+def test_a_hinge_at_the_tip_node_passes_the_force_but_no_moment():
+    """The same bracket on a hinge (LoopRevolute) at the tip node, held level by a vertical prop at its
+    far end: the tip carries P/2 and no moment, P L³/(6EI) of deflection."""
+    sec, body = planar_cantilever()
+    P, e, L = 0.4, 0.3, 1.0
+    m = ms.Model("hinged", planar=True, gravity=(0, 0, 0))
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    arm = m.add_body("bracket", 0.5, [1e-3, 1e-3, 1e-3], com=(e / 2, 0, 0))
+    m.add_joint(ms.joints.Planar("float", m.ground, arm, q0=[L, 0.0, 0.0]))
+    m.add_constraint(ms.constraints.LoopRevolute("hinge", b, arm, frame1=b.node(-1)))
+    m.add_constraint(ms.constraints.PointOnLine("prop", arm, m.ground, point1=(e, 0, 0), point2=(L + e, 0, 0),
+                                                direction=(1, 0, 0)))
+    m.add_force(ms.forces.BodyForce("load", arm, force=(0, -P, 0), point=(e / 2, 0, 0)))
+    qe = ms.analysis.static_equilibrium(m)["q"][-body.n_coordinates:]
+    ei = sec.E * sec.Iz
+    np.testing.assert_allclose(body.modes[-1, 1, :] @ qe, -(P / 2) * L**3 / (3 * ei), rtol=1e-7)
+
+
+def test_a_tree_joint_at_a_deflecting_node_is_refused_with_the_loop_joint_named():
+    sec, body = planar_cantilever()
+    m = ms.Model("tree_at_node", planar=True)
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    tip = m.add_body("tip", 1.0, [1e-3] * 3)
+    m.add_joint(ms.joints.Revolute("hinge", b, tip, axis=(0, 0, 1), parent_frame=ms.Frame(position=b.node(-1))))
+    with pytest.raises(ms.ModelError, match=r"joint 'hinge'.*node 'n10' of elastic body 'beam'.*loop joint"):
+        m.build()
+
+
+def test_a_flexible_pendulum_with_a_bob_welded_off_axis_keeps_its_energy():
+    """A 3-D flexible pendulum: a cantilevered strip on a hinge, a rigid bob welded to its tip node
+    with its centre of mass off the beam's axis, gravity slanted so the strip bends both ways
+    (torsion is held: beam nodes carry no rotary inertia, so a twist alone has no mass).
+    The bob floats on a free joint and follows the node only through the weld's rows, so any slip
+    between those rows' Jacobian (the node's J_l ψ columns) and their velocity-product terms would
+    pump energy in or out: kinetic + potential + strain energy stays constant, the weld closed."""
+    from mechsys import elastic as el
+
+    sec = el.BeamSection.rectangle(0.02, 0.012, E=70e9, nu=0.33, rho=2700.0)
+    fixed = {0: "clamped", **{i: "rx" for i in range(1, 9)}}
+    body = el.craig_bampton(el.beam_model(sec, 1.0, 8), 4, interface=[-1], fixed=fixed, name="strip")
+    m = ms.Model("welded_bob", gravity=(0, -9.81, 3.0))
+    b = m.add_elastic_body("strip", body)
+    m.add_joint(ms.joints.Revolute("hinge", m.ground, b, axis=(0, 0, 1)))
+    bob = m.add_body("bob", 0.8, [2e-3, 3e-3, 4e-3], com=(0.05, 0.02, 0.08))
+    m.add_joint(ms.joints.Free("float", m.ground, bob, q0=[1.0, 0, 0, 1, 0, 0, 0]))
+    m.add_constraint(ms.constraints.LoopFixed("weld", b, bob, frame1=b.node(-1)))
+    res = ms.simulate(m, t_end=0.15, integrator=ms.DOPRI5(rtol=1e-11, atol=1e-13), output_dt=1e-3)
+    e = res["energy/total"]
+    swing = np.ptp(res["energy/kinetic"])
+    assert swing > 1.0  # it falls
+    assert np.ptp(e) < 1e-7 * swing, np.ptp(e) / swing
+    assert np.abs(res["constraint/weld/violation"]).max() < 1e-9
+    rot = res["body/strip/node_rotation"][:, -1]
+    assert np.abs(rot[:, 1]).max() > 1e-4 and np.abs(rot[:, 2]).max() > 1e-4  # bent in and out of plane

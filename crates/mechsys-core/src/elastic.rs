@@ -133,6 +133,16 @@ impl ElasticWork {
         }
         d
     }
+    /// `Σ_k x_k ψ_nk`: the node's small rotation (eq. 2.134) of the coordinates `x`, body frame.
+    #[inline]
+    pub fn node_rotation(&self, n: usize, x: &[f64]) -> Vec3 {
+        let ne = x.len();
+        let mut d = Vec3::zeros();
+        for (k, xk) in x.iter().enumerate() {
+            d += self.psi[n * ne + k] * *xk;
+        }
+        d
+    }
 }
 
 impl ElasticWork {

@@ -189,8 +189,12 @@ fn add_node_load(data: &mut Data, b: usize, p_b: &Vec3, load_i: &Vec3, rotation:
         return 0.0;
     }
     let Some((k, n)) = crate::kinematics::elastic_node(data, b, p_b) else { return 0.0 };
-    let load_b = data.x_abs[b].a.transpose() * load_i;
     let w = &data.elastic[k];
+    let mut load_b = data.x_abs[b].a.transpose() * load_i;
+    if rotation {
+        // the node turns as exp(θ̃) at the rate J_l(θ) θ̇ (as its frames do, kinematics::frame_motion)
+        load_b = crate::math::rotation::so3_left_jacobian(&w.node_rotation(n, &w.q)).transpose() * load_b;
+    }
     let ne = w.q.len();
     let fields = if rotation { &w.psi } else { &w.phi };
     let mut power = 0.0;

@@ -35,7 +35,7 @@ use nalgebra::DMatrix;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::{Callbacks, VelocityArray};
-use crate::kinematics::{point_acceleration, point_position, point_velocity};
+use crate::kinematics::{frame_motion, point_acceleration, point_position, point_velocity, FrameMotion};
 use crate::math::{Mat3, Vec3};
 use crate::model::{Model, TimeFunction};
 use crate::spatial::{Force, Motion, Pose};
@@ -86,6 +86,9 @@ struct BodyRows {
     /// The world points the rows' forces act at on body1 and body2, when every row is a force
     /// there (point kinds): an elastic node there adds its deflection's columns.
     points: Option<(Vec3, Vec3)>,
+    /// The elastic nodes the rows' frames sit at on body1 and body2 (loop joints): their
+    /// deflections and small rotations add columns.
+    nodes: [Option<(usize, usize)>; 2],
 }
 
 impl BodyRows {
@@ -99,6 +102,7 @@ impl BodyRows {
             w1: [Force::ZERO; MAX_ROWS],
             w2: [Force::ZERO; MAX_ROWS],
             points: None,
+            nodes: [None, None],
         }
     }
     /// A row with violation `phi`, wrench `w1` on body1 and `w2` on body2.
@@ -107,6 +111,17 @@ impl BodyRows {
         self.w1[self.n] = w1;
         self.w2[self.n] = w2;
         self.n += 1;
+    }
+}
+
+/// The elastic columns of one row whose frames sit at elastic nodes (loop joints).
+#[inline]
+fn add_node_rows(data: &mut Data, rows: &BodyRows, w1: &Force, w2: &Force, row: usize) {
+    for (node, body, w, sign) in [(rows.nodes[0], rows.body1, w1, 1.0), (rows.nodes[1], rows.body2, w2, -1.0)] {
+        if let Some(node) = node {
+            let view = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+            crate::kinematics::add_node_wrench_row(view, node, body, w, sign, &mut data.g, row);
+        }
     }
 }
 
@@ -172,23 +187,10 @@ fn vee_rate_matrix(m: &Mat3) -> Mat3 {
     (Mat3::identity() * m.trace() - m) * 0.5
 }
 
-/// World placements of the two frames of a loop joint.
-#[inline]
-fn loop_frames(data: &Data, body1: usize, f1: &Pose, body2: usize, f2: &Pose) -> (Pose, Pose) {
-    (data.x_abs[body1].compose(f1), data.x_abs[body2].compose(f2))
-}
-
 /// World direction of axis `k` of a placed frame.
 #[inline]
 fn frame_axis(x: &Pose, k: usize) -> Vec3 {
     x.a.column(k).into_owned()
-}
-
-/// Velocity of the material point of `body` at the world point `p`.
-#[inline]
-fn velocity_at(data: &Data, body: usize, p: &Vec3) -> Vec3 {
-    let v = &data.v[body];
-    v.v + v.w.cross(p)
 }
 
 /// A row `Φ = a·b` with `a` fixed in body1 and `b` fixed in body2:
@@ -199,12 +201,12 @@ fn push_perpendicular(r: &mut BodyRows, a: &Vec3, b: &Vec3) {
     r.push(a.dot(b), m, m);
 }
 
-/// Velocity-product part of `d²(a·b)/dt²` for `a` fixed in `body1`, `b` fixed in `body2`:
+/// Velocity-product part of `d²(a·b)/dt²` for `a` fixed in frame 1, `b` fixed in frame 2:
 /// `ä·b + 2 ȧ·ḃ + a·b̈`.
 #[inline]
-fn perpendicular_rate(data: &Data, body1: usize, a: &Vec3, body2: usize, b: &Vec3) -> f64 {
-    let (ad, add) = fixed_vector_rates(data, body1, a);
-    let (bd, bdd) = fixed_vector_rates(data, body2, b);
+fn perpendicular_rate(m1: &FrameMotion, a: &Vec3, m2: &FrameMotion, b: &Vec3) -> f64 {
+    let (ad, add) = m1.vector_rates(a);
+    let (bd, bdd) = m2.vector_rates(b);
     add.dot(b) + 2.0 * ad.dot(&bd) + a.dot(&bdd)
 }
 
@@ -303,7 +305,9 @@ fn body_rows(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks) -> Result<
         }
         ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
             let mut r = BodyRows::new(*body1, *body2);
-            let (x1, x2) = loop_frames(data, *body1, f1, *body2, f2);
+            let (m1, m2) = (frame_motion(data, *body1, f1), frame_motion(data, *body2, f2));
+            let (x1, x2) = (m1.x, m2.x);
+            r.nodes = [m1.node, m2.node];
             let d = x1.r - x2.r;
             match offset_axes(*joint) {
                 None => {
@@ -413,9 +417,9 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
             }
         }
         ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
-            let (x1, x2) = loop_frames(data, *body1, f1, *body2, f2);
-            let (b1, b2) = (*body1, *body2);
-            let ddd = acceleration_at(data, b1, &x1.r) - acceleration_at(data, b2, &x2.r);
+            let (m1, m2) = (frame_motion(data, *body1, f1), frame_motion(data, *body2, f2));
+            let (x1, x2) = (m1.x, m2.x);
+            let ddd = m1.acceleration_at(&x1.r) - m2.acceleration_at(&x2.r);
             let mut k = match offset_axes(*joint) {
                 None => {
                     out[..3].copy_from_slice(ddd.as_slice());
@@ -424,10 +428,10 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
                 Some(axes) => {
                     // Φ = n·d with n fixed in body2: Φ̈ = n̈·d + 2 ṅ·ḋ + n·d̈
                     let d = x1.r - x2.r;
-                    let dd = velocity_at(data, b1, &x1.r) - velocity_at(data, b2, &x2.r);
+                    let dd = m1.velocity_at(&x1.r) - m2.velocity_at(&x2.r);
                     for (i, &ax) in axes.iter().enumerate() {
                         let n = frame_axis(&x2, ax);
-                        let (nd, ndd) = fixed_vector_rates(data, b2, &n);
+                        let (nd, ndd) = m2.vector_rates(&n);
                         out[i] = ndd.dot(&d) + 2.0 * nd.dot(&dd) + n.dot(&ddd);
                     }
                     axes.len()
@@ -438,19 +442,19 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
                 LoopJoint::Revolute | LoopJoint::Cylindrical | LoopJoint::Planar => {
                     let z1 = frame_axis(&x1, 2);
                     for ax in 0..2 {
-                        out[k] = perpendicular_rate(data, b1, &z1, b2, &frame_axis(&x2, ax));
+                        out[k] = perpendicular_rate(&m1, &z1, &m2, &frame_axis(&x2, ax));
                         k += 1;
                     }
                 }
                 LoopJoint::Universal => {
-                    out[k] = perpendicular_rate(data, b1, &frame_axis(&x1, 0), b2, &frame_axis(&x2, 1));
+                    out[k] = perpendicular_rate(&m1, &frame_axis(&x1, 0), &m2, &frame_axis(&x2, 1));
                 }
                 LoopJoint::Fixed | LoopJoint::Prismatic => {
                     // Φ̇ = E(R) w, w = A₂ᵀ ω_rel; Ṙ = w̃ R, ẇ = A₂ᵀ (ω̇_rel - ω₂ × ω_rel)
                     let rel = x2.a.transpose() * x1.a;
-                    let (w1, w2) = (data.v[b1].w, data.v[b2].w);
+                    let (w1, w2) = (m1.v.w, m2.v.w);
                     let wrel = w1 - w2;
-                    let arel = data.a[b1].w - data.a[b2].w;
+                    let arel = m1.a.w - m2.a.w;
                     let a2t = x2.a.transpose();
                     let w = a2t * wrel;
                     let wd = a2t * (arel - w2.cross(&wrel));
@@ -680,6 +684,7 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     crate::kinematics::add_elastic_point_rows(view, rows.body1, &p1, 1.0, Some(&w1.f), &mut data.g, r + k);
                     crate::kinematics::add_elastic_point_rows(view, rows.body2, &p2, -1.0, Some(&w2.f), &mut data.g, r + k);
                 }
+                add_node_rows(data, &rows, &w1, &w2, r + k);
             }
             continue;
         }
@@ -780,6 +785,7 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     data.b[r + k] = rows.b[k];
                     add_wrench_row(model, &data.s, rows.body1, &rows.w1[k], 1.0, &mut data.g, r + k);
                     add_wrench_row(model, &data.s, rows.body2, &rows.w2[k], -1.0, &mut data.g, r + k);
+                    add_node_rows(data, &rows, &rows.w1[k], &rows.w2[k], r + k);
                 }
             }
         }

@@ -245,6 +245,93 @@ pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     }
 }
 
+/// A frame on a body in motion: its world placement, twist and (spatial, about the origin)
+/// acceleration. On a rigid body, or away from an elastic body's nodes, these are the body's; at
+/// an elastic node the frame also moves with the node's deflection and turns by its small rotation
+/// `θ = Σ q_k ψ_k` (eq. 2.134), placed as `exp(θ̃)` so that its angular velocity `A J_l(θ) θ̇` is
+/// the exact rate of its orientation (J_l the left Jacobian of SO(3)).
+#[derive(Debug, Clone, Copy)]
+pub struct FrameMotion {
+    /// World placement of the frame.
+    pub x: Pose,
+    /// Twist (world components, linear part at the origin).
+    pub v: Motion,
+    /// Acceleration (spatial, as `Data::a`).
+    pub a: Motion,
+    /// The elastic node it sits at: (elastic index, node index).
+    pub node: Option<(usize, usize)>,
+}
+
+impl FrameMotion {
+    /// Velocity of the frame's material point at the world point `p`.
+    #[inline]
+    pub fn velocity_at(&self, p: &Vec3) -> Vec3 {
+        self.v.v + self.v.w.cross(p)
+    }
+    /// Classical acceleration of the frame's material point at the world point `p`.
+    #[inline]
+    pub fn acceleration_at(&self, p: &Vec3) -> Vec3 {
+        self.a.v + self.a.w.cross(p) + self.v.w.cross(&self.velocity_at(p))
+    }
+    /// First and second time derivatives of a world vector `n` fixed in the frame.
+    #[inline]
+    pub fn vector_rates(&self, n: &Vec3) -> (Vec3, Vec3) {
+        let nd = self.v.w.cross(n);
+        (nd, self.a.w.cross(n) + self.v.w.cross(&nd))
+    }
+}
+
+/// The motion of frame `f` (body frame) of `body`, at the stage `data` holds (its accelerations
+/// from [`accelerations`]).
+pub fn frame_motion(data: &Data, body: usize, f: &Pose) -> FrameMotion {
+    let xb = &data.x_abs[body];
+    let Some((k, n)) = elastic_node(data, body, &f.r) else {
+        return FrameMotion { x: xb.compose(f), v: data.v[body], a: data.a[body], node: None };
+    };
+    use crate::math::rotation::{rotvec_to_matrix, so3_left_jacobian, so3_left_jacobian_rate};
+    let w = &data.elastic[k];
+    let (th, thd, thdd) = (w.node_rotation(n, &w.q), w.node_rotation(n, &w.qd), w.node_rotation(n, &w.qdd));
+    let jl = so3_left_jacobian(&th);
+    let (vb, ab) = (&data.v[body], &data.a[body]);
+    let p = point_position(data, body, &f.r);
+    let vp = point_velocity(data, body, &f.r);
+    let ap = point_acceleration(data, body, &f.r);
+    let w_rel = xb.a * (jl * thd);
+    let om = vb.w + w_rel;
+    let al = ab.w + vb.w.cross(&w_rel) + xb.a * (jl * thdd + so3_left_jacobian_rate(&th, &thd));
+    FrameMotion {
+        x: Pose { a: xb.a * rotvec_to_matrix(&th) * f.a, r: p },
+        v: Motion { w: om, v: vp - om.cross(&p) },
+        a: Motion { w: al, v: ap - al.cross(&p) - om.cross(&vp) },
+        node: Some((k, n)),
+    }
+}
+
+/// Adds `sign · S_k·W` for every elastic coordinate k of the node a frame sits at into row `row`
+/// of `g`, with `S_k` the node's twist per unit rate (world, about the origin) and `W` a world
+/// wrench about the origin acting on the frame.
+pub fn add_node_wrench_row(
+    view: ElasticView<'_>,
+    node: (usize, usize),
+    body: usize,
+    w: &crate::spatial::Force,
+    sign: f64,
+    g: &mut DMatrix<f64>,
+    row: usize,
+) {
+    let (k, n) = node;
+    let (el, xb) = (&view.1[k], &view.0[body]);
+    let ne = el.q.len();
+    let p = xb.point_to_parent(&(el.nodes[n] + el.node_field(n, &el.q)));
+    let rot = xb.a * crate::math::rotation::so3_left_jacobian(&el.node_rotation(n, &el.q));
+    // the moment about the node
+    let m = w.n - p.cross(&w.f);
+    for kk in 0..ne {
+        let (om, vp) = (rot * el.psi[n * ne + kk], xb.a * el.phi[n * ne + kk]);
+        g[(row, el.iu + kk)] += sign * (om.dot(&m) + vp.dot(&w.f));
+    }
+}
+
 /// The elastic node of `body` whose deflected world place is the world point `p`: (elastic index,
 /// node index), None when `body` is rigid or `p` is no node.
 pub fn elastic_point_at(el: ElasticView<'_>, body: usize, p: &Vec3) -> Option<(usize, usize)> {

@@ -502,6 +502,48 @@ pub fn rotvec_to_matrix(rotvec: &Vec3) -> Mat3 {
     Mat3::identity() + v * sinc(theta) + v * v * (0.5 * h * h)
 }
 
+/// The coefficients `a = (1 − cos φ)/φ²`, `b = (φ − sin φ)/φ³` of the left Jacobian and their
+/// derivatives divided by φ, `a'(φ)/φ` and `b'(φ)/φ` (series below φ = 0.1, where the closed
+/// forms cancel).
+fn so3_jacobian_coefficients(phi: f64) -> [f64; 4] {
+    let p2 = phi * phi;
+    if phi < 0.1 {
+        let p4 = p2 * p2;
+        [
+            0.5 - p2 / 24.0 + p4 / 720.0 - p4 * p2 / 40320.0,
+            1.0 / 6.0 - p2 / 120.0 + p4 / 5040.0 - p4 * p2 / 362880.0,
+            -1.0 / 12.0 + p2 / 180.0 - p4 / 6720.0,
+            -1.0 / 60.0 + p2 / 1260.0 - p4 / 60480.0,
+        ]
+    } else {
+        let (s, c) = phi.sin_cos();
+        let (p3, p4) = (p2 * phi, p2 * p2);
+        [
+            (1.0 - c) / p2,
+            (phi - s) / p3,
+            s / p3 - 2.0 * (1.0 - c) / p4,
+            (1.0 - c) / p4 - 3.0 * (phi - s) / (p4 * phi),
+        ]
+    }
+}
+
+/// The left Jacobian of SO(3): `exp(θ̃)` turns with angular velocity `J_l(θ) θ̇` (components on
+/// the side it maps to), `J_l = I + a θ̃ + b θ̃²`.
+pub fn so3_left_jacobian(theta: &Vec3) -> Mat3 {
+    let [a, b, _, _] = so3_jacobian_coefficients(theta.norm());
+    let t = tilde(theta);
+    Mat3::identity() + t * a + t * t * b
+}
+
+/// `J̇_l θ̇`, the part of the angular acceleration of `exp(θ̃)` that is not `J_l θ̈`:
+/// `ȧ θ × θ̇ + ḃ θ × (θ × θ̇) + b θ̇ × (θ × θ̇)`, with `ȧ = a'(φ) θ·θ̇/φ` (likewise ḃ).
+pub fn so3_left_jacobian_rate(theta: &Vec3, theta_d: &Vec3) -> Vec3 {
+    let [_, b, ca, cb] = so3_jacobian_coefficients(theta.norm());
+    let tt = theta.dot(theta_d);
+    let c = theta.cross(theta_d);
+    c * (ca * tt) + theta.cross(&c) * (cb * tt) + theta_d.cross(&c) * b
+}
+
 /// Rotation vector `axis · angle`, angle ∈ [0, π], of a rotation matrix `A_IB`.
 ///
 /// Goes through Shepperd's quaternion, so it is accurate near the identity and near half turns;
@@ -728,6 +770,37 @@ pub fn cardan_rates_from_omega_body(angles: [f64; 3], omega_b: &Vec3) -> Result<
 
 #[cfg(test)]
 pub(crate) mod tests {
+
+    /// `J_l(θ) θ̇` is the angular velocity of `exp(θ̃)` and `J̇_l θ̇` the rest of its rate: both
+    /// against central differences of the rotation matrix, small and large angles.
+    #[test]
+    fn so3_left_jacobian_and_rate_match_differences() {
+        for (theta0, thetad, thetadd) in [
+            (Vec3::new(0.3, -0.7, 1.1), Vec3::new(0.9, 0.4, -0.5), Vec3::new(-0.2, 0.6, 0.3)),
+            (Vec3::new(2e-3, -1e-3, 4e-3), Vec3::new(0.9, 0.4, -0.5), Vec3::new(0.5, -0.1, 0.8)),
+            (Vec3::new(0.05, 0.02, -0.06), Vec3::new(-0.3, 0.8, 0.1), Vec3::new(0.0, 0.0, 0.0)),
+        ] {
+            let at = |t: f64| theta0 + thetad * t + thetadd * (0.5 * t * t);
+            let omega = |t: f64| {
+                let h = 1e-6;
+                let rd = (rotvec_to_matrix(&at(t + h)) - rotvec_to_matrix(&at(t - h))) / (2.0 * h);
+                let w = rd * rotvec_to_matrix(&at(t)).transpose();
+                Vec3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5
+            };
+            let w = so3_left_jacobian(&theta0) * thetad;
+            assert!((w - omega(0.0)).norm() < 1e-8, "{w} vs {}", omega(0.0));
+            let h = 1e-4;
+            let wd_fd = (omega(h) - omega(-h)) / (2.0 * h);
+            let wd = so3_left_jacobian(&theta0) * thetadd + so3_left_jacobian_rate(&theta0, &thetad);
+            assert!((wd - wd_fd).norm() < 1e-5, "{wd} vs {wd_fd}");
+        }
+        // across the series/closed-form switch the coefficients agree
+        let (lo, hi) = (so3_jacobian_coefficients(0.1 - 1e-12), so3_jacobian_coefficients(0.1 + 1e-12));
+        for k in 0..4 {
+            assert!((lo[k] - hi[k]).abs() < 1e-11, "coefficient {k}: {} vs {}", lo[k], hi[k]);
+        }
+    }
+
     use super::*;
     use crate::math::untilde;
     use nalgebra::{SMatrix, Vector4};

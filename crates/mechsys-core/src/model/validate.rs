@@ -657,6 +657,30 @@ impl Model {
             }
         }
 
+        // a tree joint rides on its parent's reference frame: at a node that deflects it would
+        // silently leave the node behind, so it must be a loop joint there (which follows the node)
+        for (ji, j) in joints.iter().enumerate() {
+            let Some(ke) = bodies[j.parent].elastic else { continue };
+            let e = &elastic[ke];
+            let p = &j.parent_frame.r;
+            let tol = 1e-12 * (1.0 + p.norm());
+            if let Some(node) = e.nodes.iter().find(|n| (n.position - p).amax() <= tol) {
+                let moves = node.translation.iter().chain(&node.rotation).any(|v| v.amax() > 0.0);
+                crate::ensure!(
+                    !moves,
+                    Model,
+                    "joint '{}': its parent frame is at node '{}' of elastic body '{}', which deflects; a tree joint \
+                     moves with the body's reference frame only. Give body '{}' a free (or planar) joint and attach it \
+                     there with a loop joint (constraints.LoopRevolute, LoopFixed, ... with frame1 at the node), which \
+                     follows the node's deflection and rotation",
+                    j.name,
+                    node.name,
+                    bodies[j.parent].name,
+                    bodies[ji + 1].name
+                );
+            }
+        }
+
         // ---- force elements ------------------------------------------------------------------------
         let body = |n: &str, what: &str| -> Result<usize> {
             names.get(n).map(|&i| new_index[i]).ok_or_else(|| err(format!("{what}: unknown body '{n}'")))
