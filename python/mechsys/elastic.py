@@ -982,7 +982,29 @@ class ReducedBody:
         }
         if self.geometric is not None:
             out["geometric"] = np.asarray(self.geometric).tolist()
+        rotary = self._rotary_inertia()
+        if rotary is not None:
+            out["s_r"], out["m_rr"] = rotary[0].T.tolist(), rotary[1].tolist()
         return out
+
+    def _rotary_inertia(self):
+        """(S_r (3, q), M_rr (q, q)): what M and C_r hold beyond the mass points' translations — the
+        rotary inertia of the sections (a shaft's torsion), None when there is none. M_rr = M − tr P2,
+        S_r = C_r − ∫ r × Φ dm over the mass points."""
+        tr = np.einsum("klaa->kl", np.asarray(self.P2))
+        m_rr = 0.5 * ((self.M - tr) + (self.M - tr).T)
+        p1 = np.asarray(self.P1)
+        s_r = np.asarray(self.Cr) - np.stack([p1[:, 1, 2] - p1[:, 2, 1], p1[:, 2, 0] - p1[:, 0, 2], p1[:, 0, 1] - p1[:, 1, 0]])
+        scale = np.abs(self.M).max()
+        if np.abs(m_rr).max() <= 1e-10 * scale and np.abs(s_r).max() <= 1e-10 * np.abs(self.Cr).max(initial=scale):
+            return None
+        ev = np.linalg.eigvalsh(m_rr)
+        if ev[0] < -1e-8 * scale:
+            # the mass points and M disagree beyond rotary inertia (lumped points, consistent M)
+            warnings.warn(f"elastic body {self.name!r}: M differs from the mass points' translational mass by an indefinite "
+                          f"part (eigenvalue {ev[0]:.3g}); the engine uses the mass points' M only", stacklevel=3)
+            return None
+        return s_r, m_rr
 
     def inertia_about_center(self) -> np.ndarray:
         """The undeformed inertia tensor about the centre of mass (body axes)."""

@@ -17,9 +17,11 @@
 //! In world spatial components about the origin (the engine's convention) the body contributes
 //!
 //! - the deformed rigid inertia `I(q_e)` of the reference twist `V = (ω, v_O)`,
-//! - the coupling `C_k = (∫ x × AΦ_k dm, A S_t,k)`: `T = ½VᵀIV + Vᵀ C q̇_e + ½ q̇_eᵀ M_ee q̇_e`,
+//! - the coupling `C_k = (∫ x × AΦ_k dm + A S_r,k, A S_t,k)`: `T = ½VᵀIV + Vᵀ C q̇_e + ½ q̇_eᵀ M_ee q̇_e`,
+//!   where `S_r,k = ∫ J ψ_k` and `M_ee`'s part `∫ ψ_kᵀ J ψ_l` come from the mass elements' own rotary
+//!   inertia J turning by the small rotations ψ (a shaft's torsion: optional, given by the body),
 //! - the Newton–Euler force `f = I a + V ×* I V + F_c + C q̈_e` with the Coriolis force of the
-//!   elastic velocities `F_c = ∫ (x × 2ω×AΦq̇, 2ω×AΦq̇) dm`,
+//!   elastic velocities `F_c = ∫ (x × 2ω×AΦq̇, 2ω×AΦq̇) dm + (ω × A S_r q̇, 0)`,
 //! - the elastic equations `Cᵀ (a - g) + M_ee q̈_e + b_e + K q_e + D q̇_e + K_g q_e = Q_e`, where
 //!   `b_e,k = (A S_t,k)·(ω × v_B) + tr(ω̃_B² Q_k) + 2 Σ_l q̇_l ω_B · ∫ Φ_l × Φ_k dm` collects
 //!   the centrifugal and Coriolis terms of the reference motion, `v_B` the velocity of B's origin.
@@ -69,13 +71,15 @@ pub struct ElasticBody {
     pub r0r0: Mat3,
     /// `S_t,k = ∫ Φ_k dm`.
     pub s_t: Vec<Vec3>,
+    /// `∫ J ψ_k`: the rotary inertia's coupling of mode k with the reference rotation (body frame).
+    pub s_r: Vec<Vec3>,
     /// `P1_k = ∫ r0 Φ_kᵀ dm`.
     pub p1: Vec<Mat3>,
     /// `P2_kl = ∫ Φ_k Φ_lᵀ dm`, at `k * ne + l`.
     pub p2: Vec<Mat3>,
     /// `∫ Φ_l × Φ_k dm` (the axial vector of `P2_lk`), at `l * ne + k`.
     pub cross: Vec<Vec3>,
-    /// Elastic mass matrix `tr P2_kl`.
+    /// Elastic mass matrix `tr P2_kl` (plus the rotary mass `∫ ψ_kᵀ J ψ_l`).
     pub m_ee: DMatrix<f64>,
     /// Stiffness.
     pub k: DMatrix<f64>,
@@ -271,12 +275,35 @@ pub fn validate(
             m_ee[(k, l)] = p2[k * ne + l].trace();
         }
     }
+    // the mass elements' own rotary inertia (a twist of a shaft's axis carries no translation)
+    let s_r = match &d.s_r {
+        Some(v) => {
+            crate::ensure!(v.len() == ne, Model, "{what}.s_r: expected {ne} vectors (one per mode), got {}", v.len());
+            for (k, x) in v.iter().enumerate() {
+                finite(x, format!("{what}.s_r[{k}]"))?;
+            }
+            v.iter().map(|x| Vec3::from(*x)).collect()
+        }
+        None => vec![Vec3::zeros(); ne],
+    };
+    if let Some(rows) = &d.m_rr {
+        let m_rr = square(rows, ne, &format!("{what}.m_rr"))?;
+        symmetric(&m_rr, &format!("{what}.m_rr"))?;
+        let rmin = smallest_eigenvalue(&m_rr);
+        crate::ensure!(
+            rmin >= -1e-9 * m_rr.amax().max(m_ee.amax()),
+            Model,
+            "{what}.m_rr: the rotary mass must be positive semi-definite (smallest eigenvalue {rmin:.3e})"
+        );
+        m_ee += m_rr;
+    }
     let m_min = smallest_eigenvalue(&m_ee);
     crate::ensure!(
         m_min > 1e-12 * m_ee.amax().max(f64::MIN_POSITIVE),
         Model,
-        "{what}: the elastic mass matrix (traces of p2) is not positive definite (smallest eigenvalue {m_min:.3e}): \
-         the shape functions are linearly dependent or zero"
+        "{what}: the elastic mass matrix (traces of p2, plus m_rr) is not positive definite (smallest eigenvalue \
+         {m_min:.3e}): the shape functions are linearly dependent or zero, or a mode moves only mass without \
+         translation (a twist about an axis of mass points) and its rotary mass m_rr is not given"
     );
     let k = square(&d.stiffness, ne, &format!("{what}.stiffness"))?;
     symmetric(&k, &format!("{what}.stiffness"))?;
@@ -381,6 +408,7 @@ pub fn validate(
         ne,
         r0r0,
         s_t: d.s_t.iter().map(|v| Vec3::from(*v)).collect(),
+        s_r,
         p1: d.p1.iter().map(mat3).collect(),
         p2,
         cross,
@@ -420,7 +448,7 @@ pub fn deform(e: &ElasticBody, data: &mut Data, k_e: usize, mass: f64, com: &Vec
     // C_k = (r × A S_t,k + A ∫ s × Φ_k dm, A S_t,k)
     for k in 0..ne {
         let lin = x.a * e.s_t[k];
-        w.c[k] = Force::new(x.r.cross(&lin) + x.a * axial(&w.qk[k]), lin);
+        w.c[k] = Force::new(x.r.cross(&lin) + x.a * (axial(&w.qk[k]) + e.s_r[k]), lin);
     }
 }
 
@@ -432,16 +460,19 @@ pub fn coriolis_force(e: &ElasticBody, w: &ElasticWork, x: &crate::spatial::Pose
     // Σ_l q̇_l (r × (ω × A S_t,l) + A (ω_B tr Q_l - Q_lᵀ ω_B)) and Σ_l q̇_l ω × A S_t,l, doubled
     let mut st_qd = Vec3::zeros();
     let mut ang_b = Vec3::zeros();
+    let mut sr_qd = Vec3::zeros();
     for l in 0..e.ne {
         let qd = w.qd[l];
         if qd == 0.0 {
             continue;
         }
         st_qd += e.s_t[l] * qd;
+        sr_qd += e.s_r[l] * qd;
         ang_b += (om_b * w.qk[l].trace() - w.qk[l].transpose() * om_b) * qd;
     }
     let lin = om.cross(&(x.a * st_qd));
-    Force::new((x.r.cross(&lin) + x.a * ang_b) * 2.0, lin * 2.0)
+    // the rotary inertia's angular momentum A ∫ J ψ q̇ turns with the body: ω × (A S_r q̇), once
+    Force::new((x.r.cross(&lin) + x.a * ang_b) * 2.0 + om.cross(&(x.a * sr_qd)), lin * 2.0)
 }
 
 /// The velocity-dependent terms of the elastic equations, `b_e`, into `out` (length n_e).

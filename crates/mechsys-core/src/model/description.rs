@@ -427,6 +427,14 @@ pub struct ElasticDescription {
     pub p1: Vec<[f64; 9]>,
     /// `∫ Φ_k Φ_lᵀ dm` per pair, 3 × 3 row-major, at `k n_e + l` (n_e²).
     pub p2: Vec<[f64; 9]>,
+    /// Rotary inertia of the mass elements themselves (section torsion, rotary inertia), which
+    /// the translations of `p1`, `p2` do not carry: `∫ J ψ_k` per mode (n_e vectors, the coupling
+    /// with the reference rotation); none by default.
+    #[serde(default)]
+    pub s_r: Option<Vec<[f64; 3]>>,
+    /// Their elastic mass `∫ ψ_kᵀ J ψ_l` (n_e × n_e, added to the traces of `p2`); none by default.
+    #[serde(default)]
+    pub m_rr: Option<Vec<Vec<f64>>>,
     /// Stiffness matrix (n_e × n_e).
     pub stiffness: Vec<Vec<f64>>,
     /// Damping matrix (n_e × n_e); none by default.
