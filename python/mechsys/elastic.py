@@ -609,13 +609,18 @@ def _sign_fix(V):
     return V
 
 
-def modal_reduction(model: FEModel, n_modes: int, *, fixed=None, name: str = "elastic_body") -> "ReducedBody":
+def modal_reduction(model: FEModel, n_modes: int, *, fixed=None, held=None, name: str = "elastic_body") -> "ReducedBody":
     """Modal truncation: the n_modes lowest elastic modes of (K, M) with ``fixed`` DOFs held,
     mass-normalized (M = I, K = diag ω²). Rigid-body motions the supports allow (e.g. all six
     for a free–free body) are recognized from the geometry and left out of the elastic basis.
 
     ``fixed`` maps node index (negative counts from the end) to 'clamped', 'pinned' (the three
     translations) or a list of DOF names from :data:`DOF_NAMES`.
+
+    ``held`` (same form) names where the model's joints hold the body, for the stress state of the
+    geometric stiffness (:func:`geometric_fields`): the body forces' reactions flow there. By
+    default the fixed DOFs; where they leave rigid motions free (a free–free basis), inertia relief
+    (right for a free-flying body; a free–free basis on a joint at its centre wants ``held``).
     """
     dofs = _fixed_dofs(model, fixed, f"elastic body {name!r}")
     free = np.setdiff1d(np.arange(6 * model.n_nodes), dofs)
@@ -632,10 +637,11 @@ def modal_reduction(model: FEModel, n_modes: int, *, fixed=None, name: str = "el
     T = np.zeros((6 * model.n_nodes, V.shape[1]))
     T[free] = V
     labels = [f"mode{k + 1}" for k in range(V.shape[1])]
-    return _build(name, model, T, labels, interface=(), fixed_dofs=dofs)
+    stress = dofs if held is None else sorted(set(dofs) | set(_fixed_dofs(model, held, f"elastic body {name!r} held")))
+    return _build(name, model, T, labels, interface=(), fixed_dofs=stress)
 
 
-def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, name: str = "elastic_body") -> "ReducedBody":
+def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, held=None, name: str = "elastic_body") -> "ReducedBody":
     """Craig–Bampton reduction: the free DOFs of the ``interface`` nodes are kept as coordinates
     (static constraint modes Ψ = −K_ii⁻¹ K_ib: unit displacement of one interface DOF, the others
     held, interior relaxed) plus ``n_modes`` fixed-interface normal modes of (K_ii, M_ii).
@@ -643,7 +649,7 @@ def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, name: 
 
     For a floating-frame body the frame's reference conditions go into ``fixed``; interface
     DOFs that leave a rigid-body motion free make K singular and are refused by
-    :class:`ReducedBody`.
+    :class:`ReducedBody`. ``held``: as for :func:`modal_reduction` (the geometric stiffness).
     """
     what = f"elastic body {name!r}"
     dofs = _fixed_dofs(model, fixed, what)
@@ -671,26 +677,56 @@ def craig_bampton(model: FEModel, n_modes: int, interface, *, fixed=None, name: 
     T[ii, int(n_modes) :] = Psi
     T[b, int(n_modes) :] = np.eye(len(b))
     labels = [f"mode{k + 1}" for k in range(int(n_modes))] + [f"n{d // 6}.{DOF_NAMES[d % 6]}" for d in b]
-    return _build(name, model, T, labels, interface=tuple(inodes))
+    stress = dofs if held is None else sorted(set(dofs) | set(_fixed_dofs(model, held, what + " held")))
+    return _build(name, model, T, labels, interface=tuple(inodes), fixed_dofs=stress)
 
 
 def geometric_fields(model: FEModel, T: np.ndarray, fixed_dofs) -> np.ndarray:
     """The geometric (stress) stiffness of the basis T for the 12 unit body-force fields per unit
     mass the engine combines (``e_x, e_y, e_z``, then ``e_a s_b``), (12, q, q): each field's
     static response of the supported beam model gives the elements' axial forces and so K_G
+    (with inertia relief where the supports leave rigid motions free: a free-flying or a pinned
+    body is stressed by the part of each field its rigid acceleration does not take up)
     (:func:`geometric_stiffness`); a rigid mass fixed to a node adds the work of the field on its
     points' second-order motion under the node's rotation, ``-(sym(L S) - tr(L S) E)`` on the
     rotations (S its second-moment tensor): a spinning disc's tilt stiffening (J_p - J_d) Ω²."""
     if model.elements is None or model.section is None:
         raise ModelError("geometric_fields: needs a beam model from beam_model")
     ndof = 6 * model.n_nodes
-    free = np.setdiff1d(np.arange(ndof), np.asarray(list(fixed_dofs), dtype=int))
+    fixed = sorted(int(d) for d in fixed_dofs)
+    # inertia relief: where the supports leave rigid motions free (a free-free body), each field
+    # accelerates the body rigidly and only its self-equilibrated rest, f - M Γ a, stresses it;
+    # that rest is then carried on a statically determinate set of extra supports, whose
+    # reactions are zero, so the stress does not depend on which DOFs they are
+    G = _rigid_modes(model.nodes)
+    scale = max(1.0, np.abs(model.nodes).max())
+    if fixed:
+        _, sv, vt = np.linalg.svd(G[fixed])
+        rank = int(np.sum(sv > 1e-9 * scale))
+        Ga = G @ vt[rank:].T
+    else:
+        Ga = G
+    relief = None
+    if Ga.shape[1]:
+        mg = Ga.T @ model.M @ Ga
+        relief = model.M @ Ga @ np.linalg.solve(mg, Ga.T)
+        order = [6 * i + d for i in (0, model.n_nodes - 1, *range(1, model.n_nodes - 1)) for d in range(6)]
+        held = list(fixed)
+        for d in order:
+            if d in held:
+                continue
+            if _n_admissible_rigid(model, held + [d]) < _n_admissible_rigid(model, held):
+                held.append(d)
+            if _n_admissible_rigid(model, held) == 0:
+                break
+        fixed = sorted(held)
+    free = np.setdiff1d(np.arange(ndof), np.asarray(fixed, dtype=int))
     kff = model.K[np.ix_(free, free)]
     try:
         cf = linalg.cho_factor(kff)
     except linalg.LinAlgError:
-        raise ModelError("geometric_fields: the supports do not hold the beam (K singular): a free body's stress "
-                         "state needs inertia relief, which is not done here") from None
+        raise ModelError("geometric_fields: the beam model is not held even with inertia-relief supports (K singular): "
+                         "is it in one piece?") from None
     pos, mp, interp = (np.asarray(a) for a in model.mass_points)
     s0 = np.cumsum([0.0] + [np.linalg.norm(model.nodes[j] - model.nodes[i]) for i, j in model.elements])
     ea = model.section.E * model.section.A
@@ -707,6 +743,8 @@ def geometric_fields(model: FEModel, T: np.ndarray, fixed_dofs) -> np.ndarray:
             lmat = np.zeros((3, 3))
             lmat[a, c] = 1.0
         load = np.einsum("p,pad,pa->d", mp, interp, b)
+        if relief is not None:
+            load = load - relief @ load
         u = np.zeros(ndof)
         u[free] = linalg.cho_solve(cf, load[free])
         forces = []
@@ -734,11 +772,8 @@ def _build(name, model: FEModel, T, labels, interface, fixed_dofs=None) -> "Redu
     inv = _invariants(model.nodes, model.M, model.mass_points, T)
     modes = T.reshape(model.n_nodes, 6, T.shape[1])
     geometric = None
-    if fixed_dofs is not None and model.elements is not None and len(fixed_dofs):
-        try:
-            geometric = geometric_fields(model, T, fixed_dofs)
-        except ModelError:
-            geometric = None  # not held by its supports: no stress state without inertia relief
+    if fixed_dofs is not None and model.elements is not None and model.section is not None:
+        geometric = geometric_fields(model, T, fixed_dofs)
     return ReducedBody(name=name, nodes=model.nodes.copy(), M=0.5 * (M + M.T), K=0.5 * (K + K.T), modes=modes, interface_nodes=tuple(interface), labels=tuple(labels), geometric=geometric, **inv)
 
 
