@@ -574,7 +574,8 @@ def test_a_flexible_pendulum_with_a_bob_welded_off_axis_keeps_its_energy():
     sec = el.BeamSection.rectangle(0.02, 0.012, E=70e9, nu=0.33, rho=2700.0)
     body = el.craig_bampton(el.beam_model(sec, 1.0, 8), 4, interface=[-1], fixed={0: "clamped"}, name="strip")
     m = ms.Model("welded_bob", gravity=(0, -9.81, 3.0))
-    b = m.add_elastic_body("strip", body)
+    # without the geometric stiffness: its stress state follows the swing and is no potential
+    b = m.add_elastic_body("strip", body, stiffening=False)
     m.add_joint(ms.joints.Revolute("hinge", m.ground, b, axis=(0, 0, 1)))
     bob = m.add_body("bob", 0.8, [2e-3, 3e-3, 4e-3], com=(0.05, 0.02, 0.08))
     m.add_joint(ms.joints.Free("float", m.ground, bob, q0=[1.0, 0, 0, 1, 0, 0, 0]))
