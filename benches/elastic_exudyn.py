@@ -26,7 +26,9 @@ reference run — mechsys DOPRI5 at rtol 1e-10 — relative to the peak tip defl
 of the two codes: that reference against Exudyn's TrapezoidalIndex2 at h = 1e-5, 5e-6, 2.5e-6 —
 the deviation shrinks with Exudyn's step if both solve the same equations (the pendulum's release
 excites the 540–630 Hz modes, whose phase error in the trapezoidal rule is still tenths of a
-radian after 1 s at h = 1e-5).
+radian after 1 s at h = 1e-5). Known: under gravity the hinge angles of the two codes differ by
+a few 1e-6 rad that does not shrink with Exudyn's step, while a free spin without gravity agrees
+to 1e-11 rad — the two codes' gravity loads differ at that level (not pinned down further).
 
 Integrators: mechsys RK4 and DOPRI5; Exudyn's implicit TrapezoidalIndex2 and GeneralizedAlpha
 (its default ρ∞ = 0.9) at fixed steps, with Exudyn's default Newton settings. Exudyn's explicit solvers
@@ -253,8 +255,10 @@ def main(argv=None) -> int:
                  f"{_exudyn_version()}. The same space-truss boom ({boom.n_nodes} nodes, {len(boom.bars)} bars, "
                  f"{boom.mass:.2f} kg, {N_MODES} clamped modes, {f_ms[0]:.1f}–{f_ms[-1]:.0f} Hz; Exudyn's own modes "
                  f"{f_ex[0]:.1f}–{f_ex[-1]:.0f} Hz) in both codes, {T_END:g} s simulated; min (median) over {a.repeat} "
-                 f"run(s). Accuracy against mechsys DOPRI5 at rtol 1e-10. Exudyn's explicit solvers cannot hold the "
-                 f"hinge (see the script's docstring), so each code runs its own integrators.")
+                 f"run(s). Accuracy: largest deviation over the 5 ms outputs from mechsys DOPRI5 at rtol 1e-10. Exudyn's "
+                 f"explicit solvers cannot hold the hinge (see the script's docstring), so each code runs its own "
+                 f"integrators. The spin-up's prescribed angle is a Python function in both codes (mechsys "
+                 f"differentiates it by central differences, Exudyn takes angle and rate as two user functions).")
         for case, (peak, agree, rows) in sections.items():
             L += ["", f"**{case}** — peak tip deflection {peak * 1e3:.4f} mm. Agreement of the two codes (Exudyn "
                       f"TrapezoidalIndex2 against the mechsys reference as Exudyn's step shrinks): "
@@ -263,7 +267,7 @@ def main(argv=None) -> int:
             L.append("|---|---|---|---|---|---|---|")
             for code, label, tmin, tmed, steps, etip, eang in rows:
                 L.append(f"| {code} | {label} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {fmt_time(tmin / T_END)} | {steps} | "
-                         f"{etip * 100:.3f} | {eang:.1e} |")
+                         f"{etip * 100:.2g} | {eang:.1e} |")
             L += ["", _ratio_line(rows)]
         write_doc(a.out, "\n".join(L), "<!-- elastic_exudyn.py:begin -->", "<!-- elastic_exudyn.py:end -->")
         print(f"wrote {a.out}")
@@ -276,7 +280,7 @@ def _ratio_line(rows) -> str:
     ours = [r for r in rows if r[0] == "mechsys"]
     parts = []
     for e in ex:
-        ok = [r for r in ours if r[5] <= max(e[5], 1e-4)]
+        ok = [r for r in ours if r[5] <= e[5]]
         if ok:
             best = min(ok, key=lambda r: r[2])
             parts.append(f"Exudyn {e[1]} / mechsys {best[1]} (at least as accurate): **{e[2] / best[2]:.1f}×**")

@@ -505,24 +505,30 @@ def test_an_elastic_tip_resting_on_a_stop_carries_three_eighths_of_the_weight():
 
 
 # ---- loop joints at nodes ---------------------------------------------------------------------
+def bracket_at_the_tip(joint, P, e, L=1.0):
+    """The planar cantilever with a rigid bracket (a planar joint of its own) joined to its tip
+    node by ``joint`` (a loop-joint class), loaded by P downward a distance ``e`` beyond the tip."""
+    sec, body = planar_cantilever()
+    m = ms.Model("bracket", planar=True, gravity=(0, 0, 0))
+    b = m.add_elastic_body("beam", body)
+    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
+    arm = m.add_body("bracket", 0.5, [1e-3, 1e-3, 1e-3], com=(0.15, 0, 0))
+    m.add_joint(ms.joints.Planar("float", m.ground, arm, q0=[L, 0.0, 0.0]))
+    m.add_constraint(joint("joint", b, arm, frame1=b.node(-1)))
+    m.add_force(ms.forces.BodyForce("load", arm, force=(0, -P, 0), point=(e, 0, 0)))
+    return sec, body, m, arm
+
+
 def test_a_bracket_welded_to_the_tip_node_bends_and_turns_it_as_force_and_moment_would():
     """A rigid bracket welded (LoopFixed) to the cantilever's tip node, loaded at its far end a
     distance e beyond the tip: the weld passes the force P and the moment P e into the beam, whose
     tip deflects by P L³/(3EI) + P e L²/(2EI) and turns by P L²/(2EI) + P e L/(EI) (the weld's
     rows carry the node's deflection and rotation columns). P is small enough (tip rotation 2e-4)
     that the bracket's turn, which shortens the lever by θ²/2, stays below the tolerance."""
-    sec, body = planar_cantilever()
     P, e, L = 0.4, 0.3, 1.0
-    m = ms.Model("bracket", planar=True, gravity=(0, 0, 0))
-    b = m.add_elastic_body("beam", body)
-    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
-    arm = m.add_body("bracket", 0.5, [1e-3, 1e-3, 1e-3], com=(e / 2, 0, 0))
-    m.add_joint(ms.joints.Planar("float", m.ground, arm, q0=[L, 0.0, 0.0]))
-    m.add_constraint(ms.constraints.LoopFixed("weld", b, arm, frame1=b.node(-1)))
-    m.add_force(ms.forces.BodyForce("load", arm, force=(0, -P, 0), point=(e, 0, 0)))
+    sec, body, m, _ = bracket_at_the_tip(ms.constraints.LoopFixed, P, e, L)
     eq = ms.analysis.static_equilibrium(m)
-    ne = body.n_coordinates
-    qe = eq["q"][-ne:]
+    qe = eq["q"][-body.n_coordinates:]
     ei = sec.E * sec.Iz
     np.testing.assert_allclose(body.modes[-1, 1, :] @ qe, -(P * L**3 / (3 * ei) + P * e * L**2 / (2 * ei)), rtol=1e-7)
     np.testing.assert_allclose(body.modes[-1, 5, :] @ qe, -(P * L**2 / (2 * ei) + P * e * L / ei), rtol=1e-7)
@@ -534,18 +540,11 @@ def test_a_bracket_welded_to_the_tip_node_bends_and_turns_it_as_force_and_moment
 
 def test_a_hinge_at_the_tip_node_passes_the_force_but_no_moment():
     """The same bracket on a hinge (LoopRevolute) at the tip node, held level by a vertical prop at its
-    far end: the tip carries P/2 and no moment, P L³/(6EI) of deflection."""
-    sec, body = planar_cantilever()
+    far end and loaded at its middle: the tip carries P/2 and no moment, P L³/(6EI) of deflection."""
     P, e, L = 0.4, 0.3, 1.0
-    m = ms.Model("hinged", planar=True, gravity=(0, 0, 0))
-    b = m.add_elastic_body("beam", body)
-    m.add_joint(ms.joints.Fixed("clamp", m.ground, b))
-    arm = m.add_body("bracket", 0.5, [1e-3, 1e-3, 1e-3], com=(e / 2, 0, 0))
-    m.add_joint(ms.joints.Planar("float", m.ground, arm, q0=[L, 0.0, 0.0]))
-    m.add_constraint(ms.constraints.LoopRevolute("hinge", b, arm, frame1=b.node(-1)))
+    sec, body, m, arm = bracket_at_the_tip(ms.constraints.LoopRevolute, P, e / 2, L)
     m.add_constraint(ms.constraints.PointOnLine("prop", arm, m.ground, point1=(e, 0, 0), point2=(L + e, 0, 0),
                                                 direction=(1, 0, 0)))
-    m.add_force(ms.forces.BodyForce("load", arm, force=(0, -P, 0), point=(e / 2, 0, 0)))
     qe = ms.analysis.static_equilibrium(m)["q"][-body.n_coordinates:]
     ei = sec.E * sec.Iz
     np.testing.assert_allclose(body.modes[-1, 1, :] @ qe, -(P / 2) * L**3 / (3 * ei), rtol=1e-7)
@@ -641,6 +640,22 @@ def test_a_twisted_shaft_released_on_its_bearing_keeps_energy_and_angular_moment
     assert np.abs(res["momentum/angular"][:, 0]).max() < 1e-10 * sec.rho * sec.Ip * np.abs(res["joint/bearing/u"]).max()
 
 
+def free_flap_frequencies(fe, axial, n=2):
+    """The lowest flap (z) bending frequencies (Hz) of a beam model along x under the axial force
+    ``axial(s)``: its flap DOFs (uz, ry), the two rigid flap motions projected out M-orthogonally
+    (the motions of a free-free basis), K + K_G(axial) against M."""
+    from mechsys import elastic as el
+
+    dofs = [6 * i + d for i in range(fe.n_nodes) for d in (2, 4)]
+    rigid = np.zeros((len(dofs), 2))
+    rigid[0::2, 0] = 1.0  # uz
+    rigid[0::2, 1], rigid[1::2, 1] = -fe.nodes[:, 0], 1.0  # a turn about y: uz = -x θ, ry = θ
+    Mf, Kf = fe.M[np.ix_(dofs, dofs)], fe.K[np.ix_(dofs, dofs)]
+    Gf = el.geometric_stiffness(fe, axial)[np.ix_(dofs, dofs)]
+    N = sp_linalg.null_space(rigid.T @ Mf)
+    return np.sqrt(sp_linalg.eigh(N.T @ (Kf + Gf) @ N, N.T @ Mf @ N, eigvals_only=True)[:n]) / (2 * np.pi)
+
+
 def test_a_free_free_rod_spun_about_its_centre_stiffens_by_inertia_relief():
     """A free-free strip (12 free-free modes, no support: its geometric stiffness comes from the
     inertia-relieved fields) spun about z through its centre: the flap frequencies against the
@@ -660,19 +675,8 @@ def test_a_free_free_rod_spun_about_its_centre_stiffens_by_inertia_relief():
         warnings.simplefilter("ignore")
         f = np.sort(ms.linear.linearize(spinning_beam(body, spin)).modes().natural_frequency)[:2]
         f0 = np.sort(ms.linear.linearize(spinning_beam(body, spin, False)).modes().natural_frequency)[:2]
-    # reference: flap DOFs (uz, ry) of every node, the two rigid flap motions projected out
-    n = fe.n_nodes
-    dofs = [6 * i + d for i in range(n) for d in (2, 4)]
-    x = fe.nodes[:, 0]
-    rigid = np.zeros((2 * n, 2))
-    rigid[0::2, 0] = 1.0  # uz
-    rigid[0::2, 1], rigid[1::2, 1] = -x, 1.0  # a turn about y: uz = -x θ, ry = θ
-    Mf, Kf = fe.M[np.ix_(dofs, dofs)], fe.K[np.ix_(dofs, dofs)]
     rA = sec.rho * sec.A
-    Gf = el.geometric_stiffness(fe, lambda s: 0.5 * rA * spin**2 * (L**2 / 4 - (s - L / 2) ** 2))[np.ix_(dofs, dofs)]
-    N = sp_linalg.null_space(rigid.T @ Mf)
-    w2 = sp_linalg.eigh(N.T @ (Kf + Gf) @ N, N.T @ Mf @ N, eigvals_only=True)
-    ref = np.sqrt(w2[:2]) / (2 * np.pi)
+    ref = free_flap_frequencies(fe, lambda s: 0.5 * rA * spin**2 * (L**2 / 4 - (s - L / 2) ** 2))
     np.testing.assert_allclose(f, ref, rtol=1e-3)
     assert f[0] > 1.2 * f0[0]
     # a free body: the uniform fields (gravity) only accelerate it, they stress nothing
@@ -706,15 +710,6 @@ def test_a_free_free_basis_held_at_its_centre_off_the_axis_carries_the_hubs_pull
             return rA * spin**2 * (R * (L / 2 - x) + 0.5 * (L**2 / 4 - x**2))
         return rA * spin**2 * (-R * (x + L / 2) + 0.5 * (L**2 / 4 - x**2))
 
-    n = fe.n_nodes
-    dofs = [6 * i + d for i in range(n) for d in (2, 4)]
-    x = fe.nodes[:, 0]
-    rigid = np.zeros((2 * n, 2))
-    rigid[0::2, 0] = 1.0
-    rigid[0::2, 1], rigid[1::2, 1] = -x, 1.0
-    Mf, Kf = fe.M[np.ix_(dofs, dofs)], fe.K[np.ix_(dofs, dofs)]
-    Gf = el.geometric_stiffness(fe, axial)[np.ix_(dofs, dofs)]
-    N = sp_linalg.null_space(rigid.T @ Mf)
-    ref = np.sqrt(sp_linalg.eigh(N.T @ (Kf + Gf) @ N, N.T @ Mf @ N, eigvals_only=True)[:2]) / (2 * np.pi)
+    ref = free_flap_frequencies(fe, axial)
     np.testing.assert_allclose(f, ref, rtol=1e-3)
     assert abs(f_rel[1] - ref[1]) > 3e-3 * ref[1]  # relief alone is not this body's stress state

@@ -96,8 +96,10 @@ def test_clamped_frequencies_are_the_full_eigenvalues(boom):
 def test_pendulum_agrees_with_exudyns_reduced_order_ffrf(boom):
     """The boom hinged at its root, released horizontal under gravity: mechsys against Exudyn's
     ObjectFFRFreducedOrder (its TrapezoidalIndex2 at a fine step) with the same 4 clamped modes,
-    0.2 s. Both solve the same equations: the hinge angles agree to 1e-6 rad and the tip
-    deflections (in the root-section frame, up to 0.06 mm) to 1 % of their peak."""
+    0.2 s. The tip deflections (root-section frame, up to 0.05 mm) agree to 0.13 % of their peak
+    at Exudyn's step 1e-5, shrinking as h² (0.73 % at 2e-5, 0.025 % at 5e-6); the hinge angles
+    to 3e-7 rad, a floor that does not shrink with the step and is absent without gravity (a
+    free spin agrees to 1e-11 rad): the two codes' gravity loads differ at that level."""
     pytest.importorskip("exudyn")
     import elastic_exudyn as bench
 
@@ -110,4 +112,4 @@ def test_pendulum_agrees_with_exudyns_reduced_order_ffrf(boom):
     assert abs(ours[1][-1]) > 0.15  # it swings: 0.2 s of a 1 m pendulum from the horizontal
     assert np.abs(ours[2]).max() > 3e-5
     assert angle_err < 1e-6
-    assert tip_err < 0.01
+    assert tip_err < 0.005

@@ -35,7 +35,7 @@ use nalgebra::DMatrix;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::{Callbacks, VelocityArray};
-use crate::kinematics::{frame_motion, point_acceleration, point_position, point_velocity, FrameMotion};
+use crate::kinematics::{frame_motion, point_acceleration, point_position, point_velocity, BodyMotion};
 use crate::math::{Mat3, Vec3};
 use crate::model::{Model, TimeFunction};
 use crate::spatial::{Force, Motion, Pose};
@@ -166,15 +166,6 @@ fn acceleration_at(data: &Data, body: usize, p: &Vec3) -> Vec3 {
     a.v + a.w.cross(p) + v.w.cross(&(v.v + v.w.cross(p)))
 }
 
-/// First and second time derivatives (velocity-product part) of a world vector `n` fixed in
-/// `body`: `ṅ = ω × n`, `n̈ = ω̇ × n + ω × ṅ`.
-#[inline]
-fn fixed_vector_rates(data: &Data, body: usize, n: &Vec3) -> (Vec3, Vec3) {
-    let (w, al) = (data.v[body].w, data.a[body].w);
-    let nd = w.cross(n);
-    (nd, al.cross(n) + w.cross(&nd))
-}
-
 /// `vee` of the skew-symmetric part: `½ vee(M - Mᵀ)`.
 #[inline]
 fn skew_vee(m: &Mat3) -> Vec3 {
@@ -204,7 +195,7 @@ fn push_perpendicular(r: &mut BodyRows, a: &Vec3, b: &Vec3) {
 /// Velocity-product part of `d²(a·b)/dt²` for `a` fixed in frame 1, `b` fixed in frame 2:
 /// `ä·b + 2 ȧ·ḃ + a·b̈`.
 #[inline]
-fn perpendicular_rate(m1: &FrameMotion, a: &Vec3, m2: &FrameMotion, b: &Vec3) -> f64 {
+fn perpendicular_rate(m1: &BodyMotion, a: &Vec3, m2: &BodyMotion, b: &Vec3) -> f64 {
     let (ad, add) = m1.vector_rates(a);
     let (bd, bdd) = m2.vector_rates(b);
     add.dot(b) + 2.0 * ad.dot(&bd) + a.dot(&bdd)
@@ -305,9 +296,9 @@ fn body_rows(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks) -> Result<
         }
         ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
             let mut r = BodyRows::new(*body1, *body2);
-            let (m1, m2) = (frame_motion(data, *body1, f1), frame_motion(data, *body2, f2));
-            let (x1, x2) = (m1.x, m2.x);
-            r.nodes = [m1.node, m2.node];
+            let ((m1, n1), (m2, n2)) = (frame_motion(data, *body1, f1), frame_motion(data, *body2, f2));
+            let (x1, x2) = (m1.pose, m2.pose);
+            r.nodes = [n1, n2];
             let d = x1.r - x2.r;
             match offset_axes(*joint) {
                 None => {
@@ -404,7 +395,7 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
             let a2 = data.x_abs[*body2].a;
             let mut one = |k: usize, nb: &Vec3| {
                 let nw = a2 * nb;
-                let (nd, ndd) = fixed_vector_rates(data, *body2, &nw);
+                let (nd, ndd) = BodyMotion::from_data(data, *body2).vector_rates(&nw);
                 out[k] = ndd.dot(&d) + 2.0 * nd.dot(&dd) + nw.dot(&ddd);
             };
             match &c.kind {
@@ -417,9 +408,9 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
             }
         }
         ConstraintKind::Loop { joint, body1, f1, body2, f2 } => {
-            let (m1, m2) = (frame_motion(data, *body1, f1), frame_motion(data, *body2, f2));
-            let (x1, x2) = (m1.x, m2.x);
-            let ddd = m1.acceleration_at(&x1.r) - m2.acceleration_at(&x2.r);
+            let ((m1, _), (m2, _)) = (frame_motion(data, *body1, f1), frame_motion(data, *body2, f2));
+            let (x1, x2) = (m1.pose, m2.pose);
+            let ddd = m1.point_acceleration(&x1.r) - m2.point_acceleration(&x2.r);
             let mut k = match offset_axes(*joint) {
                 None => {
                     out[..3].copy_from_slice(ddd.as_slice());
@@ -428,7 +419,7 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
                 Some(axes) => {
                     // Φ = n·d with n fixed in body2: Φ̈ = n̈·d + 2 ṅ·ḋ + n·d̈
                     let d = x1.r - x2.r;
-                    let dd = m1.velocity_at(&x1.r) - m2.velocity_at(&x2.r);
+                    let dd = m1.point_velocity(&x1.r) - m2.point_velocity(&x2.r);
                     for (i, &ax) in axes.iter().enumerate() {
                         let n = frame_axis(&x2, ax);
                         let (nd, ndd) = m2.vector_rates(&n);
@@ -452,9 +443,9 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
                 LoopJoint::Fixed | LoopJoint::Prismatic => {
                     // Φ̇ = E(R) w, w = A₂ᵀ ω_rel; Ṙ = w̃ R, ẇ = A₂ᵀ (ω̇_rel - ω₂ × ω_rel)
                     let rel = x2.a.transpose() * x1.a;
-                    let (w1, w2) = (m1.v.w, m2.v.w);
+                    let (w1, w2) = (m1.twist.w, m2.twist.w);
                     let wrel = w1 - w2;
-                    let arel = m1.a.w - m2.a.w;
+                    let arel = m1.acc.w - m2.acc.w;
                     let a2t = x2.a.transpose();
                     let w = a2t * wrel;
                     let wd = a2t * (arel - w2.cross(&wrel));
@@ -467,7 +458,7 @@ fn body_rows_rate(c: &Constraint, data: &Data, t: f64, cb: &dyn Callbacks, out: 
         ConstraintKind::KnifeEdge { body, p, e } => {
             // d/dt (e·v_P) = ė·v_P + e·a_P
             let ew = data.x_abs[*body].a * e;
-            let (ed, _) = fixed_vector_rates(data, *body, &ew);
+            let (ed, _) = BodyMotion::from_data(data, *body).vector_rates(&ew);
             out[0] = ed.dot(&point_velocity(data, *body, p)) + ew.dot(&point_acceleration(data, *body, p));
         }
         ConstraintKind::RollingDisc { body, center, axis, radius } => {

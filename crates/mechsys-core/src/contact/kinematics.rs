@@ -41,45 +41,11 @@ use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::math::Vec3;
 use crate::model::contact::Contact;
-use crate::spatial::{Motion, Pose};
 
 use super::narrow::warm::SearchHint;
 use super::narrow::{ContactPair, ContactPoint};
 
-/// Placement, twist and spatial acceleration of a body, world convention (about the origin).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BodyMotion {
-    /// Placement `A_IB`, `r`.
-    pub pose: Pose,
-    /// Twist `(ω, v)`: the material point at world `x` moves with `v + ω × x`.
-    pub twist: Motion,
-    /// Spatial acceleration `(α, a)`: full, or the velocity-product part for `w̄`.
-    pub acc: Motion,
-}
-
-impl BodyMotion {
-    /// The ground: identity placement, at rest.
-    pub const GROUND: BodyMotion = BodyMotion { pose: Pose::IDENTITY, twist: Motion::ZERO, acc: Motion::ZERO };
-
-    /// Body `body` from the workspace: `x_abs`, `v`, and `a` as the last
-    /// [`crate::kinematics::accelerations`] left it (with `u̇ = 0` and `a[0] = 0` that is the
-    /// velocity-product part).
-    pub fn from_data(data: &Data, body: usize) -> BodyMotion {
-        BodyMotion { pose: data.x_abs[body], twist: data.v[body], acc: data.a[body] }
-    }
-
-    /// Velocity of the material point at world `p`.
-    #[inline]
-    pub fn point_velocity(&self, p: &Vec3) -> Vec3 {
-        self.twist.v + self.twist.w.cross(p)
-    }
-
-    /// Acceleration of the material point at world `p` (eq. 2.41 with ṙ = r̈ = 0).
-    #[inline]
-    pub fn point_acceleration(&self, p: &Vec3) -> Vec3 {
-        self.acc.v + self.acc.w.cross(p) + self.twist.w.cross(&self.point_velocity(p))
-    }
-}
+pub use crate::kinematics::BodyMotion;
 
 /// Relative kinematics of one candidate.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

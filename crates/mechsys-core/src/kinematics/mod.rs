@@ -245,48 +245,58 @@ pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
     }
 }
 
-/// A frame on a body in motion: its world placement, twist and (spatial, about the origin)
-/// acceleration. On a rigid body, or away from an elastic body's nodes, these are the body's; at
-/// an elastic node the frame also moves with the node's deflection and turns by its small rotation
-/// `θ = Σ q_k ψ_k` (eq. 2.134), placed as `exp(θ̃)` so that its angular velocity `A J_l(θ) θ̇` is
-/// the exact rate of its orientation (J_l the left Jacobian of SO(3)).
-#[derive(Debug, Clone, Copy)]
-pub struct FrameMotion {
-    /// World placement of the frame.
-    pub x: Pose,
-    /// Twist (world components, linear part at the origin).
-    pub v: Motion,
-    /// Acceleration (spatial, as `Data::a`).
-    pub a: Motion,
-    /// The elastic node it sits at: (elastic index, node index).
-    pub node: Option<(usize, usize)>,
+/// Placement, twist and spatial acceleration of a body, world convention (about the origin).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyMotion {
+    /// Placement `A_IB`, `r`.
+    pub pose: Pose,
+    /// Twist `(ω, v)`: the material point at world `x` moves with `v + ω × x`.
+    pub twist: Motion,
+    /// Spatial acceleration `(α, a)`: full, or the velocity-product part for `w̄`.
+    pub acc: Motion,
 }
 
-impl FrameMotion {
-    /// Velocity of the frame's material point at the world point `p`.
-    #[inline]
-    pub fn velocity_at(&self, p: &Vec3) -> Vec3 {
-        self.v.v + self.v.w.cross(p)
+impl BodyMotion {
+    /// The ground: identity placement, at rest.
+    pub const GROUND: BodyMotion = BodyMotion { pose: Pose::IDENTITY, twist: Motion::ZERO, acc: Motion::ZERO };
+
+    /// Body `body` from the workspace: `x_abs`, `v`, and `a` as the last
+    /// [`crate::kinematics::accelerations`] left it (with `u̇ = 0` and `a[0] = 0` that is the
+    /// velocity-product part).
+    pub fn from_data(data: &Data, body: usize) -> BodyMotion {
+        BodyMotion { pose: data.x_abs[body], twist: data.v[body], acc: data.a[body] }
     }
-    /// Classical acceleration of the frame's material point at the world point `p`.
+
+    /// Velocity of the material point at world `p`.
     #[inline]
-    pub fn acceleration_at(&self, p: &Vec3) -> Vec3 {
-        self.a.v + self.a.w.cross(p) + self.v.w.cross(&self.velocity_at(p))
+    pub fn point_velocity(&self, p: &Vec3) -> Vec3 {
+        self.twist.v + self.twist.w.cross(p)
     }
-    /// First and second time derivatives of a world vector `n` fixed in the frame.
+
+    /// Acceleration of the material point at world `p` (eq. 2.41 with ṙ = r̈ = 0).
+    #[inline]
+    pub fn point_acceleration(&self, p: &Vec3) -> Vec3 {
+        self.acc.v + self.acc.w.cross(p) + self.twist.w.cross(&self.point_velocity(p))
+    }
+
+    /// First and second time derivatives of a world vector `n` fixed in the body.
     #[inline]
     pub fn vector_rates(&self, n: &Vec3) -> (Vec3, Vec3) {
-        let nd = self.v.w.cross(n);
-        (nd, self.a.w.cross(n) + self.v.w.cross(&nd))
+        let nd = self.twist.w.cross(n);
+        (nd, self.acc.w.cross(n) + self.twist.w.cross(&nd))
     }
 }
 
 /// The motion of frame `f` (body frame) of `body`, at the stage `data` holds (its accelerations
-/// from [`accelerations`]).
-pub fn frame_motion(data: &Data, body: usize, f: &Pose) -> FrameMotion {
+/// from [`accelerations`]), and the elastic node it sits at, (elastic index, node index). On a
+/// rigid body, or away from an elastic body's nodes, the body's motion with the frame's placement;
+/// at a node the frame also moves with the node's deflection and turns by its small rotation
+/// `θ = Σ q_k ψ_k` (eq. 2.134), placed as `exp(θ̃)` so that its angular velocity `A J_l(θ) θ̇` is
+/// the exact rate of its orientation (J_l the left Jacobian of SO(3)).
+pub fn frame_motion(data: &Data, body: usize, f: &Pose) -> (BodyMotion, Option<(usize, usize)>) {
     let xb = &data.x_abs[body];
     let Some((k, n)) = elastic_node(data, body, &f.r) else {
-        return FrameMotion { x: xb.compose(f), v: data.v[body], a: data.a[body], node: None };
+        return (BodyMotion { pose: xb.compose(f), twist: data.v[body], acc: data.a[body] }, None);
     };
     use crate::math::rotation::{rotvec_to_matrix, so3_left_jacobian, so3_left_jacobian_rate};
     let w = &data.elastic[k];
@@ -299,12 +309,12 @@ pub fn frame_motion(data: &Data, body: usize, f: &Pose) -> FrameMotion {
     let w_rel = xb.a * (jl * thd);
     let om = vb.w + w_rel;
     let al = ab.w + vb.w.cross(&w_rel) + xb.a * (jl * thdd + so3_left_jacobian_rate(&th, &thd));
-    FrameMotion {
-        x: Pose { a: xb.a * rotvec_to_matrix(&th) * f.a, r: p },
-        v: Motion { w: om, v: vp - om.cross(&p) },
-        a: Motion { w: al, v: ap - al.cross(&p) - om.cross(&vp) },
-        node: Some((k, n)),
-    }
+    let m = BodyMotion {
+        pose: Pose { a: xb.a * rotvec_to_matrix(&th) * f.a, r: p },
+        twist: Motion { w: om, v: vp - om.cross(&p) },
+        acc: Motion { w: al, v: ap - al.cross(&p) - om.cross(&vp) },
+    };
+    (m, Some((k, n)))
 }
 
 /// Adds `sign · S_k·W` for every elastic coordinate k of the node a frame sits at into row `row`

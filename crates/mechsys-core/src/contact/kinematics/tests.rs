@@ -9,6 +9,7 @@ use crate::contact::test_util::{close, curve_joints, random_poses, rot, sample, 
 use crate::contact::{Contour, ContourKind};
 use crate::geometry::curve::Vec2;
 use crate::math::Mat3;
+use crate::spatial::{Motion, Pose};
 
 fn kin(pair: &ContactPair, b1: &BodyMotion, b2: &BodyMotion) -> Vec<ContactKinematics> {
     let mut out = vec![ContactKinematics::default(); pair.candidates()];
