@@ -13,7 +13,7 @@ all: build
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin playwright mujoco mkdocs "mkdocstrings[python]"
+	$(PY) -m pip install --quiet "maturin>=1.7,<2" numpy scipy matplotlib h5py click tqdm trimesh yourdfpy pytest sympy pandas xarray pin playwright mujoco exudyn mkdocs "mkdocstrings[python]"
 	$(PY) -m pip install --quiet "dask[distributed]"  # parameter studies on a Dask cluster (tests/test_study.py)
 	touch $(STAMP)
 
@@ -64,6 +64,7 @@ bench: $(BUILD)
 	$(PY) benches/planar.py --out docs/benchmarks.md
 	$(PY) benches/viewer.py --out docs/benchmarks.md
 	$(PY) benches/elastic.py --out docs/benchmarks.md
+	$(PY) benches/elastic_exudyn.py --out docs/benchmarks.md
 	$(PY) benches/study.py --out docs/benchmarks.md
 
 clean:
