@@ -422,6 +422,8 @@ pub struct MultibodySystem<'a> {
     slipped: Vec<bool>,
     /// Near-singular passages met so far.
     pub warnings: Vec<String>,
+    /// Offsets of the unit quaternions in y (spherical and free joints), stepped on the group.
+    quats: Vec<usize>,
 }
 
 impl<'a> MultibodySystem<'a> {
@@ -448,6 +450,7 @@ impl<'a> MultibodySystem<'a> {
             last_u: Vec::with_capacity(model.nu),
             slipped: vec![false; model.n_sliders],
             warnings: Vec::new(),
+            quats: quaternion_offsets(model),
         }
     }
 
@@ -851,9 +854,12 @@ impl OdeSystem for MultibodySystem<'_> {
         }
         Ok(())
     }
+    fn quaternions(&self) -> &[usize] {
+        &self.quats
+    }
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        // (no renormalization: the schemes step the quaternions on the rotation group)
         let (nq, nu) = (self.model.nq, self.model.nu);
-        self.model.normalize(&mut y[..nq]);
         if self.model.nc > 0 && self.stabilization == Stabilization::Projection {
             let (q, rest) = y.split_at_mut(nq);
             crate::dynamics::constrained::project(
@@ -868,6 +874,20 @@ impl OdeSystem for MultibodySystem<'_> {
         }
         Ok(())
     }
+}
+
+/// Offsets in q (and so in y = [q, u, ...]) of the quaternions of the spherical and free joints.
+pub fn quaternion_offsets(model: &Model) -> Vec<usize> {
+    let mut v = Vec::new();
+    for j in &model.joints {
+        match j.kind {
+            crate::model::JointKind::Spherical => v.push(j.iq),
+            crate::model::JointKind::Free => v.push(j.iq + 3),
+            _ => {}
+        }
+    }
+    v.sort_unstable();
+    v
 }
 
 /// Quaternion [w, x, y, z] of a rotation matrix (Shepperd's method, robust for all rotations).
