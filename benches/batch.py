@@ -93,7 +93,7 @@ def main(argv=None) -> int:
     t_ms, med_ms, batch = timed(run_ms, a.repeat)
     assert batch.q.shape == (a.n, n_steps + 1, 7)
     # one case alone, for the serial cost and the bit-for-bit check
-    single = ms.simulate(model, T_END, integ, q0=x0[0, :7], u0=x0[0, 7:], sensors=["joint/*/q"])
+    single = ms.simulate(model, T_END, integ, q0=x0[0, :7], u0=x0[0, 7:])
     assert np.array_equal(single["q"], batch.q[0])
     t_one, _, _ = timed(lambda: ms.simulate(model, T_END, integ, q0=x0[0, :7], u0=x0[0, 7:], sensors=["joint/*/q"]),
                         a.repeat)
@@ -131,7 +131,7 @@ def main(argv=None) -> int:
         mj_version = None
 
     lines = [
-        f"1000-rollout batch of the 7-DOF arm (the limp arm of examples/arm7.py: dampers and gravity, no drive), "
+        f"{a.n}-rollout batch of the 7-DOF arm (the limp arm of examples/arm7.py: dampers and gravity, no drive), "
         f"{a.n} rollouts of {T_END:g} s at dt = {DT:g} (RK4 in both), {a.threads} threads; "
         f"machine: {mach['nproc']} × {mach['cpu']}, load average at start {mach['load'][0]:.2f}; "
         f"MuJoCo {mj_version or 'not installed'}. Reproduce: `.venv/bin/python benches/batch.py --out docs/benchmarks.md`.",
