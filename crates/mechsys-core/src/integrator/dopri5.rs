@@ -71,10 +71,6 @@ pub(crate) struct Step {
 }
 
 impl Step {
-    pub fn new(n: usize) -> Self {
-        Self::on_group(Chart::new(n, &[]), n)
-    }
-
     /// A step on the state of `n` components laid out by `chart`.
     pub fn on_group(chart: Chart, n: usize) -> Self {
         let nl = chart.local_dim();
@@ -233,7 +229,7 @@ impl Step {
     }
 
     /// Hairer's starting step ([`starting_step_on`]) in the step's coordinates.
-    fn starting_step<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64], rtol: f64, atol: f64, hmax: f64) -> Result<f64> {
+    pub(crate) fn starting_step<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64], rtol: f64, atol: f64, hmax: f64) -> Result<f64> {
         let (k0, rest) = self.k.split_at_mut(1);
         if self.chart.is_flat() {
             return starting_step(sys, t, y, &k0[0], rtol, atol, hmax, (&mut self.tmp, &mut rest[0]));
