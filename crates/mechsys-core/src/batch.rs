@@ -24,6 +24,23 @@ pub fn default_threads() -> usize {
 /// The models must need no user callbacks (those run in the Python interpreter, one at a time).
 pub fn simulate_batch(cases: &[(&Model, Settings)], threads: usize) -> Result<Vec<Result<Recording>>> {
     let threads = if threads == 0 { default_threads() } else { threads };
+    // every case's results are held at once: their sum against the memory budget (each run
+    // checks only its own; a case with settings that give no count fails on its own)
+    let bytes: f64 = cases
+        .iter()
+        .map(|(m, s)| crate::simulate::sample_size(m, s))
+        .map(|(n, w)| 8.0 * n * w)
+        .filter(|b| b.is_finite() && *b > 0.0)
+        .sum();
+    let budget = crate::resources::memory_budget();
+    crate::ensure!(
+        bytes < budget,
+        Settings,
+        "simulate_batch: {} cases would record about {bytes:.3e} bytes of results, more than the {budget:.3e} bytes \
+         this batch may use (half the memory available); run fewer cases at once, a larger output_dt, or sensors= \
+         to record less",
+        cases.len()
+    );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .thread_name(|i| format!("mechsys-batch-{i}"))
@@ -82,6 +99,21 @@ mod tests {
         }
         // and the cases differ (the test would pass on identical cases otherwise)
         assert_ne!(serial[1].q, serial[2].q);
+    }
+
+    #[test]
+    fn a_batch_too_large_for_memory_is_refused_before_it_runs() {
+        let model = crate::fixtures::chain(2, "revolute");
+        let mut s = settings(0.0);
+        s.q0 = None;
+        // each case alone fits (0.4 of the budget), four together do not
+        let (_, width) = crate::simulate::sample_size(&model, &s);
+        s.output_dt = 1e-3;
+        s.t_end = 0.4 * crate::resources::memory_budget() / (8.0 * width) * s.output_dt;
+        s.integrator = IntegratorKind::Rk4 { dt: 1e-3 };
+        let cases: Vec<(&Model, Settings)> = (0..4).map(|_| (&model, s.clone())).collect();
+        let err = simulate_batch(&cases, 1).unwrap_err().to_string();
+        assert!(err.contains("4 cases") && err.contains("bytes"), "{err}");
     }
 
     #[test]

@@ -989,16 +989,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
     }
     // the samples' memory, estimated before anything is allocated (in f64: a huge span must not
     // wrap the count to zero)
-    let samples = ((span / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
-    let bodies = s.record.bodies.as_ref().map_or(model.nbodies() - 1, |b| b.len()) as f64;
-    let width = 1.0
-        + 2.0 * model.nq as f64
-        + 3.0 * model.nu as f64
-        + 23.0 * bodies
-        + 3.0 * model.nc as f64
-        + 2.0 * model.n_force_outputs as f64
-        + 17.0 * model.n_contact_points as f64
-        + 10.0;
+    let (samples, width) = sample_size(model, s);
     let bytes = samples * width * 8.0;
     let budget = crate::resources::memory_budget();
     crate::ensure!(
@@ -1060,6 +1051,22 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         None => y[model.nq..model.nq + model.nu].copy_from_slice(&model.u0()),
     }
     Ok((t_out, y))
+}
+
+/// The number of samples a run records and the values per sample (an estimate of its results'
+/// size, made before anything is allocated; in f64 so that a huge span cannot wrap the count).
+pub fn sample_size(model: &Model, s: &Settings) -> (f64, f64) {
+    let samples = (((s.t_end - s.t0) / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    let bodies = s.record.bodies.as_ref().map_or(model.nbodies() - 1, |b| b.len()) as f64;
+    let width = 1.0
+        + 2.0 * model.nq as f64
+        + 3.0 * model.nu as f64
+        + 23.0 * bodies
+        + 3.0 * model.nc as f64
+        + 2.0 * model.n_force_outputs as f64
+        + 17.0 * model.n_contact_points as f64
+        + 10.0;
+    (samples, width)
 }
 
 /// Runs a simulation and records all signals.
