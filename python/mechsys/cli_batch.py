@@ -59,12 +59,14 @@ def batch_cmd(model_file: Path, states_file: Path | None, values_file: Path | No
 
     from . import simulate_batch
     from .cli import _safe_name, _split_signals
-    from .files import check_outputs
+    from .files import check_outputs, write_atomically
     from .modelfile import load_model, simulation_kwargs
 
     if states_file is None and values_file is None:
         raise _error("give the cases with --states FILE and/or --values FILE")
     states = _load_states(states_file) if states_file is not None else None
+    if states is not None and states.ndim != 2:
+        raise _error(f"--states {states_file}: expected one row [q, u] per case (a 2-d array), got shape {states.shape}")
     values = None
     if values_file is not None:
         try:
@@ -92,8 +94,11 @@ def batch_cmd(model_file: Path, states_file: Path | None, values_file: Path | No
     # every recorded signal the --sensors asked for (patterns resolved by the selection)
     for name in res.names() if chosen else []:
         arrays["signal:" + name] = res[name]
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez(out_path, **arrays)
+    def save(tmp: Path) -> None:
+        with open(tmp, "wb") as f:  # a file object: np.savez would append .npz to the temporary name
+            np.savez(f, **arrays)
+
+    write_atomically(out_path, save)
     failed = [i for i, e in enumerate(res.errors) if e is not None]
     for i in failed:
         click.echo(f"failed: {res.errors[i]}", err=True)
