@@ -148,3 +148,21 @@ def test_cli_batch_writes_stacked_states(tmp_path):
                           "--t-end", "0.2"], capture_output=True, text=True, cwd=ROOT)
     assert bad.returncode != 0 and "nope.npy" in bad.stderr
     json.dumps(r.stdout)  # plain text
+
+
+def test_cancelling_stops_every_case_at_its_next_sample():
+    """The engine side of Ctrl-C: a cancelled progress handle stops each case at its first sample
+    (what ms.simulate_batch does on KeyboardInterrupt before raising it)."""
+    import json as _json
+
+    from mechsys import _core
+    from mechsys.simulate import _settings
+
+    m = pendulum_chain()
+    prog = _core.Progress()
+    prog.cancel()
+    s = _settings(m, 5.0, ms.RK4(1e-3), 0.01, None, None, 0.0)
+    out = _core.simulate_batch([m.build()], [_json.dumps(s)] * 3, 2, prog)
+    assert len(out) == 3
+    for raw, err in out:
+        assert err is None and "cancelled" in raw["cancelled"] and len(raw["t"]) <= 1

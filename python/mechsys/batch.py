@@ -184,7 +184,34 @@ def simulate_batch(
             except Exception as e:  # noqa: BLE001 - kept per case
                 errors[i] = type(e)(f"case {i}: {e}")
     else:
-        for i, (raw, err) in enumerate(_core.simulate_batch(cores, texts, int(threads))):
+        # in a worker thread, so that Ctrl-C here cancels the engine's cases (each stops at its
+        # next sample) instead of waiting for the whole batch
+        import threading
+
+        from .simulate import _wait
+
+        prog = _core.Progress()
+        out: list = []
+        failed: list[BaseException] = []
+        done = threading.Event()
+
+        def run():
+            try:
+                out.extend(_core.simulate_batch(cores, texts, int(threads), prog))
+            except BaseException as e:  # noqa: BLE001 - re-raised in the calling thread
+                failed.append(e)
+            finally:
+                done.set()
+
+        worker = threading.Thread(target=run, name="mechsys-simulate-batch")
+        worker.start()
+        interrupted = _wait(done, prog, 0, False)
+        worker.join()
+        if interrupted:
+            raise KeyboardInterrupt("simulate_batch cancelled")
+        if failed:
+            raise failed[0]
+        for i, (raw, err) in enumerate(out):
             raws[i], errors[i] = raw, err
     if on_error == "raise":
         first = next((e for e in errors if e is not None), None)

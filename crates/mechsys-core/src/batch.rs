@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::forces::NoCallbacks;
 use crate::model::Model;
-use crate::simulate::{simulate, Recording, Settings};
+use crate::simulate::{simulate, Progress, Recording, Settings};
 
 /// The number of threads a batch uses when none is given: the machine's cores.
 pub fn default_threads() -> usize {
@@ -22,7 +22,13 @@ pub fn default_threads() -> usize {
 /// Runs every case `(model, settings)` on `threads` threads (0: all cores); the results come back
 /// in the cases' order, each its own `Ok(recording)` or `Err` (whose message names the case).
 /// The models must need no user callbacks (those run in the Python interpreter, one at a time).
-pub fn simulate_batch(cases: &[(&Model, Settings)], threads: usize) -> Result<Vec<Result<Recording>>> {
+/// `progress`, shared by all cases, cancels them: each stops at its next sample with the samples
+/// so far (its recording marked cancelled), the cases not yet begun at their first.
+pub fn simulate_batch(
+    cases: &[(&Model, Settings)],
+    threads: usize,
+    progress: Option<&Progress>,
+) -> Result<Vec<Result<Recording>>> {
     let threads = if threads == 0 { default_threads() } else { threads };
     // every case's results are held at once: their sum against the memory budget (each run
     // checks only its own; a case with settings that give no count fails on its own)
@@ -47,7 +53,7 @@ pub fn simulate_batch(cases: &[(&Model, Settings)], threads: usize) -> Result<Ve
         .build()
         .map_err(|e| Error::Settings(format!("threads: cannot start {threads} threads ({e})")))?;
     let run = |(i, (model, settings)): (usize, &(&Model, Settings))| {
-        simulate(model, settings, &NoCallbacks, None).map_err(|e| name_case(i, e))
+        simulate(model, settings, &NoCallbacks, progress).map_err(|e| name_case(i, e))
     };
     // one case per task: cases differ in cost (stiff or contact-rich ones), so the pool balances
     Ok(pool.install(|| cases.par_iter().enumerate().with_max_len(1).map(run).collect()))
@@ -89,7 +95,7 @@ mod tests {
         let cases: Vec<(&Model, Settings)> = (0..12).map(|k| (&model, settings(0.1 * k as f64))).collect();
         let serial: Vec<Recording> = cases.iter().map(|(m, s)| simulate(m, s, &NoCallbacks, None).unwrap()).collect();
         for threads in [1, 2, 3] {
-            let batch = simulate_batch(&cases, threads).unwrap();
+            let batch = simulate_batch(&cases, threads, None).unwrap();
             for (k, (b, s)) in batch.iter().zip(&serial).enumerate() {
                 let b = b.as_ref().unwrap();
                 assert_eq!(b.q, s.q, "case {k}, {threads} threads: q");
@@ -112,8 +118,20 @@ mod tests {
         s.t_end = 0.4 * crate::resources::memory_budget() / (8.0 * width) * s.output_dt;
         s.integrator = IntegratorKind::Rk4 { dt: 1e-3 };
         let cases: Vec<(&Model, Settings)> = (0..4).map(|_| (&model, s.clone())).collect();
-        let err = simulate_batch(&cases, 1).unwrap_err().to_string();
+        let err = simulate_batch(&cases, 1, None).unwrap_err().to_string();
         assert!(err.contains("4 cases") && err.contains("bytes"), "{err}");
+    }
+
+    #[test]
+    fn a_cancelled_batch_returns_what_each_case_had() {
+        let model = crate::fixtures::chain(2, "revolute");
+        let cases: Vec<(&Model, Settings)> = (0..3).map(|k| (&model, settings(0.1 * k as f64))).collect();
+        let p = Progress::default();
+        p.cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+        for r in simulate_batch(&cases, 2, Some(&p)).unwrap() {
+            let r = r.unwrap();
+            assert!(r.cancelled.is_some() && r.t.len() <= 1, "{:?}", r.cancelled);
+        }
     }
 
     #[test]
@@ -128,7 +146,7 @@ mod tests {
             s
         };
         let cases = vec![(&model, good.clone()), (&model, bad), (&model, good)];
-        let out = simulate_batch(&cases, 2).unwrap();
+        let out = simulate_batch(&cases, 2, None).unwrap();
         assert!(out[0].is_ok() && out[2].is_ok());
         let msg = out[1].as_ref().unwrap_err().to_string();
         assert!(msg.contains("case 1") && msg.contains("dt"), "{msg}");

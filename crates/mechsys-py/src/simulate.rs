@@ -243,13 +243,15 @@ fn parse_settings(settings_json: &str) -> PyResult<Settings> {
 /// case i is `models[i]` (or the one model) with `settings_json[i]`. The models must need no
 /// callbacks. Returns one `(dict, None)` per case that ran (the dict as from `simulate`) or
 /// `(None, exception)` for a case that failed (its message starts with `case i:`).
+/// `progress`: cancelling it stops every case at its next sample (each then has `cancelled`).
 #[pyfunction]
-#[pyo3(signature = (models, settings_json, threads = 0))]
+#[pyo3(signature = (models, settings_json, threads = 0, progress = None))]
 fn simulate_batch<'py>(
     py: Python<'py>,
     models: Vec<PyRef<'py, PyModel>>,
     settings_json: Vec<String>,
     threads: usize,
+    progress: Option<&PyProgress>,
 ) -> PyResult<Bound<'py, pyo3::types::PyList>> {
     if models.len() != 1 && models.len() != settings_json.len() {
         return Err(settings(format!(
@@ -264,7 +266,10 @@ fn simulate_batch<'py>(
         let m: &mechsys_core::model::Model = &models[if models.len() == 1 { 0 } else { i }].model;
         cases.push((m, s));
     }
-    let out = py.allow_threads(|| mechsys_core::batch::simulate_batch(&cases, threads)).map_err(PyMechsysError::from)?;
+    let prog = progress.map(|p| p.inner.clone());
+    let out = py
+        .allow_threads(|| mechsys_core::batch::simulate_batch(&cases, threads, prog.as_deref()))
+        .map_err(PyMechsysError::from)?;
     let list = pyo3::types::PyList::empty(py);
     for (i, r) in out.into_iter().enumerate() {
         match r {
