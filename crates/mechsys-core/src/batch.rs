@@ -124,7 +124,7 @@ mod tests {
 
     #[test]
     fn a_cancelled_batch_returns_what_each_case_had() {
-        let model = crate::fixtures::chain(2, "revolute");
+        let model = crate::fixtures::chain(4, "revolute");
         let cases: Vec<(&Model, Settings)> = (0..3).map(|k| (&model, settings(0.1 * k as f64))).collect();
         let p = Progress::default();
         p.cancel.store(true, std::sync::atomic::Ordering::Relaxed);
