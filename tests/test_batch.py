@@ -144,6 +144,14 @@ def test_cli_batch_writes_stacked_states(tmp_path):
     ref = ms.simulate(pendulum_chain(), t_end=0.2, integrator=ms.RK4(1e-3), output_dt=0.01, q0=x0[3, :3], u0=x0[3, 3:])
     assert np.array_equal(data["q"][3], ref["q"])
     assert "4 cases" in r.stdout
+    with_signal = subprocess.run([sys.executable, "-m", "mechsys", "batch", str(model_file), "--states",
+                                  str(tmp_path / "states.npy"), "--t-end", "0.1", "--dt", "1e-3", "--output-dt", "0.01",
+                                  "--sensors", "energy/total", "--out", str(tmp_path / "e.npz")],
+                                 capture_output=True, text=True, cwd=ROOT)
+    assert with_signal.returncode == 0, with_signal.stderr
+    e = np.load(tmp_path / "e.npz")
+    assert sorted(e.files) == ["q", "signal:energy/total", "t", "u"]
+    assert e["signal:energy/total"].shape == (4, 11)
     bad = subprocess.run([sys.executable, "-m", "mechsys", "batch", str(model_file), "--states", str(tmp_path / "nope.npy"),
                           "--t-end", "0.2"], capture_output=True, text=True, cwd=ROOT)
     assert bad.returncode != 0 and "nope.npy" in bad.stderr

@@ -93,7 +93,8 @@ def batch_cmd(model_file: Path, states_file: Path | None, values_file: Path | No
     arrays = {"t": res.t, "q": res.q, "u": res.u}
     # every recorded signal the --sensors asked for (patterns resolved by the selection)
     for name in res.names() if chosen else []:
-        arrays["signal:" + name] = res[name]
+        if name != "t":
+            arrays["signal:" + name] = res[name]
     def save(tmp: Path) -> None:
         with open(tmp, "wb") as f:  # a file object: np.savez would append .npz to the temporary name
             np.savez(f, **arrays)
