@@ -27,6 +27,7 @@ from .study import Study, StudyError, study
 from .urdf import load_urdf
 from .viewer import view
 from .mjcf import load_mjcf
+from .batch import BatchResults, simulate_batch
 
 
 def plot(results, signals, out=None, **kwargs):
@@ -42,6 +43,8 @@ __all__ = [
     "Body",
     "Frame",
     "simulate",
+    "simulate_batch",
+    "BatchResults",
     "study",
     "Study",
     "StudyError",

@@ -736,6 +736,10 @@ from .cli_study import study_cmd  # noqa: E402  (parameter studies, mechsys stud
 
 cli.add_command(study_cmd)
 
+from .cli_batch import batch_cmd  # noqa: E402  (batch simulation, mechsys batch)
+
+cli.add_command(batch_cmd)
+
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``mechsys`` console script; returns the exit status."""

@@ -13,6 +13,7 @@
 // together with the out-of-range values; both lints would make those places less clear.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod batch;
 pub mod constraints;
 pub mod contact;
 pub mod data;

@@ -422,6 +422,8 @@ pub struct MultibodySystem<'a> {
     slipped: Vec<bool>,
     /// Near-singular passages met so far.
     pub warnings: Vec<String>,
+    /// Offsets of the unit quaternions in y (spherical and free joints), stepped on the group.
+    quats: Vec<usize>,
 }
 
 impl<'a> MultibodySystem<'a> {
@@ -448,6 +450,7 @@ impl<'a> MultibodySystem<'a> {
             last_u: Vec::with_capacity(model.nu),
             slipped: vec![false; model.n_sliders],
             warnings: Vec::new(),
+            quats: quaternion_offsets(model),
         }
     }
 
@@ -851,9 +854,12 @@ impl OdeSystem for MultibodySystem<'_> {
         }
         Ok(())
     }
+    fn quaternions(&self) -> &[usize] {
+        &self.quats
+    }
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        // (no renormalization: the schemes step the quaternions on the rotation group)
         let (nq, nu) = (self.model.nq, self.model.nu);
-        self.model.normalize(&mut y[..nq]);
         if self.model.nc > 0 && self.stabilization == Stabilization::Projection {
             let (q, rest) = y.split_at_mut(nq);
             crate::dynamics::constrained::project(
@@ -868,6 +874,20 @@ impl OdeSystem for MultibodySystem<'_> {
         }
         Ok(())
     }
+}
+
+/// Offsets in q (and so in y = [q, u, ...]) of the quaternions of the spherical and free joints.
+pub fn quaternion_offsets(model: &Model) -> Vec<usize> {
+    let mut v = Vec::new();
+    for j in &model.joints {
+        match j.kind {
+            crate::model::JointKind::Spherical => v.push(j.iq),
+            crate::model::JointKind::Free => v.push(j.iq + 3),
+            _ => {}
+        }
+    }
+    v.sort_unstable();
+    v
 }
 
 /// Quaternion [w, x, y, z] of a rotation matrix (Shepperd's method, robust for all rotations).
@@ -969,16 +989,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
     }
     // the samples' memory, estimated before anything is allocated (in f64: a huge span must not
     // wrap the count to zero)
-    let samples = ((span / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
-    let bodies = s.record.bodies.as_ref().map_or(model.nbodies() - 1, |b| b.len()) as f64;
-    let width = 1.0
-        + 2.0 * model.nq as f64
-        + 3.0 * model.nu as f64
-        + 23.0 * bodies
-        + 3.0 * model.nc as f64
-        + 2.0 * model.n_force_outputs as f64
-        + 17.0 * model.n_contact_points as f64
-        + 10.0;
+    let (samples, width) = sample_size(model, s);
     let bytes = samples * width * 8.0;
     let budget = crate::resources::memory_budget();
     crate::ensure!(
@@ -1040,6 +1051,22 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(Vec<f64>, Vec<f64>)> {
         None => y[model.nq..model.nq + model.nu].copy_from_slice(&model.u0()),
     }
     Ok((t_out, y))
+}
+
+/// The number of samples a run records and the values per sample (an estimate of its results'
+/// size, made before anything is allocated; in f64 so that a huge span cannot wrap the count).
+pub fn sample_size(model: &Model, s: &Settings) -> (f64, f64) {
+    let samples = (((s.t_end - s.t0) / s.output_dt) * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    let bodies = s.record.bodies.as_ref().map_or(model.nbodies() - 1, |b| b.len()) as f64;
+    let width = 1.0
+        + 2.0 * model.nq as f64
+        + 3.0 * model.nu as f64
+        + 23.0 * bodies
+        + 3.0 * model.nc as f64
+        + 2.0 * model.n_force_outputs as f64
+        + 17.0 * model.n_contact_points as f64
+        + 10.0;
+    (samples, width)
 }
 
 /// Runs a simulation and records all signals.

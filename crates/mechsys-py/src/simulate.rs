@@ -219,18 +219,73 @@ fn simulate<'py>(
     callbacks: Option<Vec<PyObject>>,
     progress: Option<&PyProgress>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let de = &mut serde_json::Deserializer::from_str(settings_json);
-    let s: Settings = serde_path_to_error::deserialize(de).map_err(|e| {
-        let m = e.inner().to_string();
-        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
-        settings(format!("settings.{}: {m}", e.path()))
-    })?;
+    let s = parse_settings(settings_json)?;
     let cb = PyCallbacks::for_model(model, callbacks)?;
     let prog = progress.map(|p| p.inner.clone());
     let m = &model.model;
     let rec = py
         .allow_threads(|| mechsys_core::simulate::simulate(m, &s, &cb, prog.as_deref()))
         .map_err(PyMechsysError::from)?;
+    recording_dict(py, m, rec)
+}
+
+/// Reads the settings of a run from JSON, naming the offending key.
+fn parse_settings(settings_json: &str) -> PyResult<Settings> {
+    let de = &mut serde_json::Deserializer::from_str(settings_json);
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let m = e.inner().to_string();
+        let m = m.split(" at line ").next().unwrap_or(&m).to_string();
+        settings(format!("settings.{}: {m}", e.path()))
+    })
+}
+
+/// Runs many simulations on `threads` threads (0: all cores) with the interpreter released:
+/// case i is `models[i]` (or the one model) with `settings_json[i]`. The models must need no
+/// callbacks. Returns one `(dict, None)` per case that ran (the dict as from `simulate`) or
+/// `(None, exception)` for a case that failed (its message starts with `case i:`).
+/// `progress`: cancelling it stops every case at its next sample (each then has `cancelled`).
+#[pyfunction]
+#[pyo3(signature = (models, settings_json, threads = 0, progress = None))]
+fn simulate_batch<'py>(
+    py: Python<'py>,
+    models: Vec<PyRef<'py, PyModel>>,
+    settings_json: Vec<String>,
+    threads: usize,
+    progress: Option<&PyProgress>,
+) -> PyResult<Bound<'py, pyo3::types::PyList>> {
+    if models.len() != 1 && models.len() != settings_json.len() {
+        return Err(settings(format!(
+            "simulate_batch: give one model or one per case ({} cases), got {} models",
+            settings_json.len(),
+            models.len()
+        )));
+    }
+    let mut cases = Vec::with_capacity(settings_json.len());
+    for (i, text) in settings_json.iter().enumerate() {
+        let s = parse_settings(text).map_err(|e| settings(format!("case {i}: {}", e.value(py))))?;
+        let m: &mechsys_core::model::Model = &models[if models.len() == 1 { 0 } else { i }].model;
+        cases.push((m, s));
+    }
+    let prog = progress.map(|p| p.inner.clone());
+    let out = py
+        .allow_threads(|| mechsys_core::batch::simulate_batch(&cases, threads, prog.as_deref()))
+        .map_err(PyMechsysError::from)?;
+    let list = pyo3::types::PyList::empty(py);
+    for (i, r) in out.into_iter().enumerate() {
+        match r {
+            Ok(rec) => list.append((recording_dict(py, cases[i].0, rec)?, py.None()))?,
+            Err(e) => list.append((py.None(), PyErr::from(PyMechsysError::from(e)).into_value(py)))?,
+        }
+    }
+    Ok(list)
+}
+
+/// The recorded signals of a run as a dict of numpy arrays, its events and statistics.
+fn recording_dict<'py>(
+    py: Python<'py>,
+    m: &mechsys_core::model::Model,
+    rec: mechsys_core::simulate::Recording,
+) -> PyResult<Bound<'py, PyDict>> {
     let n = rec.n_out;
     let nb = rec.n_bodies;
     let d = PyDict::new(py);
@@ -360,6 +415,7 @@ fn qdot<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyProgress>()?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(qdot, m)?)?;
     Ok(())
 }

@@ -1,8 +1,10 @@
 //! Dormand–Prince 5(4): explicit Runge–Kutta pair with local error control (the 5th-order
 //! solution is propagated, the embedded 4th-order one estimates the error), first-same-as-last,
 //! and the continuous extension of order 4 (Hairer, Nørsett, Wanner, *Solving ODEs I*, II.5–II.6)
-//! for output at any requested time without shortening steps.
+//! for output at any requested time without shortening steps. Unit quaternions in the state are
+//! stepped on the rotation group (RKMK, [`super::lie_group`]).
 
+use super::lie_group::Chart;
 use super::{check_finite, Observer, OdeSystem, Stats};
 use crate::error::{Error, Result};
 
@@ -47,20 +49,56 @@ const D7: f64 = 69997945.0 / 29380423.0;
 
 /// One Dormand–Prince step with its stages and dense-output coefficients, reusable by drivers
 /// that need more than [`integrate`] (the event-driven scheme locates roots on the dense output).
+/// On a state with unit quaternions ([`Step::on_group`]) the stages, the error estimate and the
+/// dense output live in the local coordinates of [`Chart`] (RKMK), the states on the group.
 pub(crate) struct Step {
     n: usize,
-    /// Stages; `k[0]` must hold `f(t, y)` before [`Step::attempt`], `k[6]` holds `f(t + h, y_new)`
-    /// after it (first same as last).
+    chart: Chart,
+    /// Stages (local coordinates); `k[0]` must hold `f(t, y)` before [`Step::attempt`] (see
+    /// [`Step::first_rate`]), `k[6]` holds `f(t + h, y_new)` after it (first same as last);
+    /// `k[7]` holds the same rate in the chart centred at `y_new` (on the group).
     pub k: Vec<Vec<f64>>,
     tmp: Vec<f64>,
     /// The 5th-order solution of the last attempt.
     pub ynew: Vec<f64>,
     r: Vec<Vec<f64>>,
+    /// On the group: the state's rates of the last evaluation, the local increment of the
+    /// stage or step, the step's start (dense output) and the dense output's local point.
+    fy: Vec<f64>,
+    z: Vec<f64>,
+    ybase: Vec<f64>,
+    zd: std::cell::RefCell<Vec<f64>>,
 }
 
 impl Step {
-    pub fn new(n: usize) -> Self {
-        Step { n, k: vec![vec![0.0; n]; 7], tmp: vec![0.0; n], ynew: vec![0.0; n], r: vec![vec![0.0; n]; 5] }
+    /// A step on the state of `n` components laid out by `chart`.
+    pub fn on_group(chart: Chart, n: usize) -> Self {
+        let nl = chart.local_dim();
+        let group = !chart.is_flat();
+        let m = if group { n } else { 0 };
+        Step {
+            n,
+            k: vec![vec![0.0; nl]; 8],
+            tmp: vec![0.0; n],
+            ynew: vec![0.0; n],
+            r: vec![vec![0.0; nl]; 5],
+            fy: vec![0.0; m],
+            z: vec![0.0; if group { nl } else { 0 }],
+            ybase: vec![0.0; m],
+            zd: std::cell::RefCell::new(vec![0.0; if group { nl } else { 0 }]),
+            chart,
+        }
+    }
+
+    /// Evaluates `k[0] = f(t, y)` (in local coordinates on the group).
+    pub fn first_rate<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<()> {
+        if self.chart.is_flat() {
+            sys.rhs(t, y, &mut self.k[0])
+        } else {
+            sys.rhs(t, y, &mut self.fy)?;
+            self.chart.tangent0(y, &self.fy, &mut self.k[0]);
+            Ok(())
+        }
     }
 
     /// Tries the step `[t, t + h]` from `y`; returns the scaled error norm (≤ 1 accepts).
@@ -73,6 +111,9 @@ impl Step {
         rtol: f64,
         atol: f64,
     ) -> Result<f64> {
+        if !self.chart.is_flat() {
+            return self.attempt_on_group(sys, t, y, h, rtol, atol);
+        }
         let n = self.n;
         let (k, tmp) = (&mut self.k, &mut self.tmp);
         macro_rules! stage {
@@ -102,13 +143,61 @@ impl Step {
         Ok((err / n.max(1) as f64).sqrt())
     }
 
+    /// [`Step::attempt`] in the chart centred at `y`: stages at `y ⊕ z_i`, `z_i = h Σ a_ij k_j`.
+    fn attempt_on_group<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        rtol: f64,
+        atol: f64,
+    ) -> Result<f64> {
+        let nl = self.chart.local_dim();
+        let (k, tmp, z, fy, chart) = (&mut self.k, &mut self.tmp, &mut self.z, &mut self.fy, &self.chart);
+        macro_rules! stage {
+            ($dst:expr, $c:expr, $($a:expr => $ki:expr),+) => {{
+                for i in 0..nl {
+                    z[i] = h * (0.0 $(+ $a * k[$ki][i])+);
+                }
+                chart.retract(y, z, tmp);
+                sys.rhs(t + $c * h, tmp, fy)?;
+                chart.tangent(tmp, z, fy, &mut k[$dst]);
+            }};
+        }
+        stage!(1, C2, A21 => 0);
+        stage!(2, C3, A31 => 0, A32 => 1);
+        stage!(3, C4, A41 => 0, A42 => 1, A43 => 2);
+        stage!(4, C5, A51 => 0, A52 => 1, A53 => 2, A54 => 3);
+        stage!(5, 1.0, A61 => 0, A62 => 1, A63 => 2, A64 => 3, A65 => 4);
+        for i in 0..nl {
+            z[i] = h * (A71 * k[0][i] + A73 * k[2][i] + A74 * k[3][i] + A75 * k[4][i] + A76 * k[5][i]);
+        }
+        chart.retract(y, z, &mut self.ynew);
+        sys.rhs(t + h, &self.ynew, fy)?;
+        chart.tangent(&self.ynew, z, fy, &mut k[6]);
+        chart.tangent0(&self.ynew, fy, &mut k[7]);
+        let mut err = 0.0;
+        for i in 0..nl {
+            let e = h * (E1 * k[0][i] + E3 * k[2][i] + E4 * k[3][i] + E5 * k[4][i] + E6 * k[5][i] + E7 * k[6][i]);
+            let sc = atol + rtol * chart.magnitude(i, y, &self.ynew);
+            err += (e / sc).powi(2);
+        }
+        Ok((err / nl.max(1) as f64).sqrt())
+    }
+
     /// Dense-output coefficients of the accepted step `[t, t + h]` from `y` (before [`Step::fsal`]).
     pub fn prepare_dense(&mut self, y: &[f64], h: f64) {
+        let group = !self.chart.is_flat();
+        if group {
+            self.ybase.copy_from_slice(y);
+        }
         let (k, r) = (&self.k, &mut self.r);
-        for i in 0..self.n {
-            let ydiff = self.ynew[i] - y[i];
+        for i in 0..self.chart.local_dim() {
+            // on the group the interpolant runs from z = 0 to the step's increment z
+            let (y0, ydiff) = if group { (0.0, self.z[i]) } else { (y[i], self.ynew[i] - y[i]) };
             let bspl = h * k[0][i] - ydiff;
-            r[0][i] = y[i];
+            r[0][i] = y0;
             r[1][i] = ydiff;
             r[2][i] = bspl;
             r[3][i] = ydiff - h * k[6][i] - bspl;
@@ -119,15 +208,63 @@ impl Step {
     /// The continuous extension at `θ ∈ [0, 1]` of the step prepared by [`Step::prepare_dense`].
     pub fn dense(&self, th: f64, out: &mut [f64]) {
         let (r, th1) = (&self.r, 1.0 - th);
-        for i in 0..self.n {
-            out[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
+        if self.chart.is_flat() {
+            for i in 0..self.n {
+                out[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
+            }
+            return;
         }
+        let mut zd = self.zd.borrow_mut();
+        for (i, v) in zd.iter_mut().enumerate() {
+            *v = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
+        }
+        self.chart.retract(&self.ybase, &zd, out);
     }
 
-    /// Makes the last stage the first of the next step (first same as last).
+    /// Makes the last stage the first of the next step (first same as last; on the group the
+    /// rate in the chart centred at the new state).
     pub fn fsal(&mut self) {
-        self.k.swap(0, 6);
+        let last = if self.chart.is_flat() { 6 } else { 7 };
+        self.k.swap(0, last);
     }
+
+    /// Hairer's starting step ([`starting_step_on`]) in the step's coordinates.
+    pub(crate) fn starting_step<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64], rtol: f64, atol: f64, hmax: f64) -> Result<f64> {
+        let (k0, rest) = self.k.split_at_mut(1);
+        if self.chart.is_flat() {
+            return starting_step(sys, t, y, &k0[0], rtol, atol, hmax, (&mut self.tmp, &mut rest[0]));
+        }
+        let scratch = (&mut self.tmp[..], &mut self.fy[..], &mut self.z[..], &mut rest[0][..]);
+        starting_step_on(sys, &self.chart, t, y, &k0[0], (rtol, atol, hmax), scratch)
+    }
+}
+
+/// [`starting_step`] of a state on the chart `chart` (`k0 = f(t, y)` in its local coordinates);
+/// scratch: a state, its rates, a local increment and local rates.
+pub(crate) fn starting_step_on<S: OdeSystem>(
+    sys: &mut S,
+    chart: &Chart,
+    t: f64,
+    y: &[f64],
+    k0: &[f64],
+    (rtol, atol, hmax): (f64, f64, f64),
+    (tmp, fy, z, k1): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
+) -> Result<f64> {
+    let nl = chart.local_dim();
+    let sc = |i: usize| atol + rtol * chart.magnitude(i, y, y);
+    let norm = |v: &dyn Fn(usize) -> f64| ((0..nl).map(|i| (v(i) / sc(i)).powi(2)).sum::<f64>() / nl.max(1) as f64).sqrt();
+    let (d0, d1) = (norm(&|i| chart.magnitude(i, y, y)), norm(&|i| k0[i]));
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+    let h0 = h0.min(hmax);
+    for i in 0..nl {
+        z[i] = h0 * k0[i];
+    }
+    chart.retract(y, z, tmp);
+    sys.rhs(t + h0, tmp, fy)?;
+    chart.tangent(tmp, z, fy, k1);
+    let d2 = norm(&|i| k1[i] - k0[i]) / h0;
+    let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
+    Ok((100.0 * h0).min(h1).min(hmax))
 }
 
 /// Hairer's starting step from the sizes of y and f (`k0 = f(t, y)`).
@@ -194,13 +331,12 @@ pub fn integrate<S: OdeSystem>(
     let hmax = if max_step > 0.0 { max_step } else { (t_end - t0).abs().max(f64::MIN_POSITIVE) };
     let mut stats = Stats::default();
     let mut y = y0.to_vec();
-    let mut st = Step::new(n);
-    let mut tmp = vec![0.0; n];
+    let mut st = Step::on_group(Chart::new(n, sys.quaternions()), n);
     let mut yout = vec![0.0; n];
     let mut t = t0;
     let mut next = 0usize;
 
-    sys.rhs(t, &y, &mut st.k[0])?;
+    st.first_rate(sys, t, &y)?;
     stats.evaluations += 1;
     while next < t_out.len() && t_out[next] <= t {
         obs(sys, t, &y, true)?;
@@ -213,8 +349,7 @@ pub fn integrate<S: OdeSystem>(
         first_step
     } else {
         stats.evaluations += 1;
-        let (k0, rest) = st.k.split_at_mut(1);
-        starting_step(sys, t, &y, &k0[0], rtol, atol, hmax, (&mut tmp, &mut rest[0]))?
+        st.starting_step(sys, t, &y, rtol, atol, hmax)?
     };
     let mut err_old: f64 = 1e-4;
     let mut reject = false;

@@ -1,7 +1,8 @@
 //! Time integrators behind one interface, one file per scheme.
 //!
-//! An [`OdeSystem`] gives `ẏ = f(t, y)` and a projection back onto the configuration manifold
-//! (unit quaternions); a scheme advances it and calls an observer at each requested output time.
+//! An [`OdeSystem`] gives `ẏ = f(t, y)`, the unit quaternions in y (which the smooth schemes
+//! step on the rotation group, [`lie_group`]) and a projection back onto the constraint
+//! manifold; a scheme advances it and calls an observer at each requested output time.
 //! - [`rk4`]: classical fixed-step Runge–Kutta of order 4;
 //! - [`dopri5`]: Dormand–Prince 5(4) with step-size control and dense output;
 //! - [`radau5`]: the 3-stage Radau IIA method (order 5, L-stable) for stiff systems, at a fixed
@@ -14,6 +15,7 @@
 pub mod dopri5;
 pub mod event_driven;
 pub mod events;
+pub mod lie_group;
 pub mod moreau_jean;
 pub mod radau5;
 pub mod rk4;
@@ -28,7 +30,13 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Evaluates `dy = f(t, y)`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()>;
-    /// Projects y at time t back onto its manifolds after a step (unit quaternions, constraints).
+    /// Offsets in y of the unit quaternions with `Q̇ = ½ Q ⊗ (0, ω_B)` (increasing). The smooth
+    /// schemes step them on the rotation group ([`lie_group`]) so that they stay unit quaternions
+    /// without renormalization; none by default (y is a vector space).
+    fn quaternions(&self) -> &[usize] {
+        &[]
+    }
+    /// Projects y at time t back onto its manifolds after a step (closed-loop constraints).
     fn project(&mut self, _t: f64, _y: &mut [f64]) -> Result<()> {
         Ok(())
     }
@@ -241,3 +249,5 @@ pub(crate) fn check_finite(t: f64, y: &[f64]) -> Result<()> {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_lie;

@@ -351,8 +351,8 @@ impl MoreauJean {
         for (c, r) in self.closed_before.iter_mut().zip(&self.results) {
             *c = r.state != OPEN;
         }
+        // (the exponential map keeps quaternions unit: no renormalization)
         model.integrate(q, u, 0.5 * h, &mut self.q_mid);
-        model.normalize(&mut self.q_mid);
         // ---- smooth part at the midpoint: u_free = u + h M⁻¹ (τ - c(ū)), with the velocity-
         // dependent forces at ū = (u + u_free)/2 (one predictor pass at u): explicit Euler on them
         // would inflate rotating velocity components by (ω h)²/2 per step, e.g. a body-frame
@@ -780,7 +780,6 @@ impl MoreauJean {
         self.dissipated_friction += dw_t;
         // ---- positions at the end of the step, and u in the end's joint frames
         model.integrate(&self.q_mid, u, 0.5 * h, q);
-        model.normalize(q);
         self.reframe(&self.q_mid, q, u);
         // contacts that the velocity-level step let sink into a curved contour: every point of
         // the step's problem that was closed before it (a redundant twin of a closed point

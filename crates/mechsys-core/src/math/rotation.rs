@@ -402,6 +402,23 @@ pub fn quat_integrate_inertial(q: Quat, omega_i: &Vec3, dt: f64) -> Quat {
     quat_mul(rotvec_to_quat(&(omega_i * dt)), q)
 }
 
+/// Rate of the rotation vector `θ` of `A = A₀ exp(θ̃)` for the body-frame angular velocity
+/// `ω_B`: `θ̇ = J_r⁻¹(θ) ω_B` with the inverse right Jacobian of SO(3),
+/// `J_r⁻¹ = E + ½ θ̃ + (1/θ² − (1 + cos θ)/(2 θ sin θ)) θ̃²` (θ = |θ| < 2π). It is the
+/// `dexp⁻¹` that Lie-group Runge–Kutta schemes (Munthe-Kaas) apply to the stage derivatives.
+pub fn rotvec_rate_body(rotvec: &Vec3, omega_b: &Vec3) -> Vec3 {
+    let a2 = rotvec.norm_squared();
+    // the θ̃² coefficient, by its series near θ = 0 where the closed form cancels
+    let k = if a2 < 1e-4 {
+        1.0 / 12.0 + a2 * (1.0 / 720.0 + a2 / 30240.0)
+    } else {
+        let a = a2.sqrt();
+        (1.0 - 0.5 * a * (1.0 + a.cos()) / a.sin()) / a2
+    };
+    let tw = rotvec.cross(omega_b);
+    omega_b + 0.5 * tw + k * rotvec.cross(&tw)
+}
+
 /// Unit quaternion of Euler angles `[ψ, ϑ, φ]`: `q_z(ψ) ⊗ q_x(ϑ) ⊗ q_z(φ)`.
 ///
 /// The sign is continuous in the angles (no hemisphere flip), so the result can be
@@ -1102,6 +1119,21 @@ pub(crate) mod tests {
         // the product is not commutative: i ⊗ j = k, j ⊗ i = −k
         assert_eq!(quat_mul([0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]), [0.0, 0.0, 0.0, 1.0]);
         assert_eq!(quat_mul([0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0]), [0.0, 0.0, 0.0, -1.0]);
+    }
+
+    /// θ̇ = J_r⁻¹(θ) ω: moving θ by θ̇ dt turns A₀ exp(θ̃) by ω dt in its own frame.
+    #[test]
+    fn rotvec_rate_matches_body_rotation() {
+        let w = Vec3::new(0.3, -1.1, 0.7);
+        for th in [Vec3::new(1e-9, 2e-9, -1e-9), Vec3::new(3e-3, -2e-3, 1e-3), Vec3::new(0.4, -1.2, 2.1)] {
+            let rate = rotvec_rate_body(&th, &w);
+            let h = 1e-6;
+            let ap = rotvec_to_matrix(&(th + rate * h));
+            let am = rotvec_to_matrix(&(th - rate * h));
+            let a = rotvec_to_matrix(&th);
+            let wt = a.transpose() * (ap - am) / (2.0 * h);
+            assert!((crate::math::untilde(&wt) - w).norm() < 1e-8, "{th}: {}", crate::math::untilde(&wt));
+        }
     }
 
     #[test]

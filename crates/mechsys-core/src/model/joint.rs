@@ -338,6 +338,8 @@ fn quat_step(q: &[f64], w: &[f64], dt: f64, out: &mut [f64]) {
     out[1] = q[0] * d[1] + q[1] * d[0] + q[2] * d[3] - q[3] * d[2];
     out[2] = q[0] * d[2] - q[1] * d[3] + q[2] * d[0] + q[3] * d[1];
     out[3] = q[0] * d[3] + q[1] * d[2] - q[2] * d[1] + q[3] * d[0];
+    let r = crate::integrator::lie_group::unit_rounding([out[0], out[1], out[2], out[3]]);
+    out.copy_from_slice(&r);
 }
 
 #[cfg(test)]

@@ -189,6 +189,8 @@ pub struct Phase<'a> {
     ws: Workspace,
     z: Vec<f64>,
     ev: EventWork,
+    /// Offsets of the unit quaternions in the state (stepped on the rotation group).
+    quats: Vec<usize>,
 }
 
 /// Scratch of the event handling (impacts, transitions), sized once.
@@ -261,7 +263,8 @@ pub fn integrate<'a>(
     let hmax = if opts.max_step > 0.0 { opts.max_step } else { (t_end - t0).abs().max(f64::MIN_POSITIVE) };
     let mut stats = Stats::default();
     let mut y = y0.to_vec();
-    let mut st = Step::new(n);
+    // the quaternions are stepped on the rotation group (RKMK, crate::integrator::lie_group)
+    let mut st = Step::on_group(crate::integrator::lie_group::Chart::new(n, phase.quaternions()), n);
     let mut yout = vec![0.0; n];
     let mut scratch = vec![0.0; n];
     let mut imp = vec![0.0; 3 * np];
@@ -281,7 +284,7 @@ pub fn integrate<'a>(
     diss.impact += d.impact;
     diss.friction += d.friction;
     diss.external += d.external;
-    phase.rhs(t, &y, &mut st.k[0])?;
+    st.first_rate(phase, t, &y)?;
     phase.event_values(&mut e_start);
     let mut cap = phase.after_step()?;
     while next < t_out.len() && t_out[next] <= t {
@@ -290,10 +293,7 @@ pub fn integrate<'a>(
         diss = Dissipation::default();
         next += 1;
     }
-    let mut h = {
-        let (k0, rest) = st.k.split_at_mut(1);
-        dopri5::starting_step(phase, t, &y, &k0[0], opts.rtol, opts.atol, hmax, (&mut scratch, &mut rest[0]))?
-    };
+    let mut h = st.starting_step(phase, t, &y, opts.rtol, opts.atol, hmax)?;
     let mut err_old: f64 = 1e-4;
     let mut reject = false;
     while next < t_out.len() {
@@ -387,7 +387,7 @@ pub fn integrate<'a>(
             diss.impact += d.impact;
             diss.friction += d.friction;
             diss.external += d.external;
-            phase.rhs(t, &y, &mut st.k[0])?;
+            st.first_rate(phase, t, &y)?;
             stats.evaluations += 1;
             phase.event_values(&mut e_start);
             cap = phase.after_step()?;

@@ -36,6 +36,7 @@ impl<'a> Phase<'a> {
             opts,
             data: Data::new(model),
             dynamics: crate::dynamics::Workspace::new(model),
+            quats: crate::simulate::quaternion_offsets(model),
             d,
             status: vec![OPEN; np],
             dir: vec![[0.0; 2]; np],
@@ -608,9 +609,12 @@ impl OdeSystem for Phase<'_> {
         }
         Ok(())
     }
+    fn quaternions(&self) -> &[usize] {
+        &self.quats
+    }
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        // (no renormalization: the quaternions are stepped on the rotation group)
         let (nq, nu) = (self.model.nq, self.model.nu);
-        self.model.normalize(&mut y[..nq]);
         if self.model.nc > 0 {
             let (q, rest) = y.split_at_mut(nq);
             crate::dynamics::constrained::project(

@@ -2,6 +2,7 @@
 
 use super::coefficients;
 use crate::error::{Error, Result};
+use crate::integrator::lie_group::Chart;
 use crate::integrator::{check_finite, Observer, OdeSystem, Stats};
 use crate::math::linalg::{lu_factor, lu_factor_complex, lu_solve, lu_solve_complex};
 
@@ -137,9 +138,12 @@ impl Tableau {
     }
 }
 
-/// The adaptive scheme's working memory, made once per run.
+/// The adaptive scheme's working memory, made once per run. `n` is the number of local
+/// coordinates of the state's chart (on the rotation group with quaternions in the state):
+/// stages, Jacobian, error and Newton scale live there, states (`tmp`, `ynew`, `yout`) on the group.
 struct Adaptive {
     n: usize,
+    chart: Chart,
     tab: Tableau,
     /// ∂f/∂y (n × n), at the start of the step where it was last evaluated.
     jac: Vec<f64>,
@@ -165,13 +169,20 @@ struct Adaptive {
     ynew: Vec<f64>,
     scal: Vec<f64>,
     yout: Vec<f64>,
+    /// The state's rates (full size) and a local increment, for the chart.
+    fe: Vec<f64>,
+    zl: Vec<f64>,
 }
 
 impl Adaptive {
-    fn new(n: usize) -> Self {
+    fn new(chart: Chart, nfull: usize) -> Self {
         let v = |k: usize| vec![0.0; k];
+        let n = chart.local_dim();
         Adaptive {
             n,
+            chart,
+            fe: v(nfull),
+            zl: v(n),
             tab: Tableau::new(),
             jac: v(n * n),
             e1: v(n * n),
@@ -185,25 +196,33 @@ impl Adaptive {
             f: v(3 * n),
             z_prev: v(3 * n),
             f0: v(n),
-            tmp: v(n),
+            tmp: v(nfull),
             fy: v(n),
             err: v(n),
-            ynew: v(n),
+            ynew: v(nfull),
             scal: v(n),
-            yout: v(n),
+            yout: v(nfull),
         }
     }
 
-    /// ∂f/∂y at (t, y) by forward differences (`f0 = f(t, y)`).
+    /// `f0 = f(t, y)` in local coordinates.
+    fn rate0<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<()> {
+        sys.rhs(t, y, &mut self.fe)?;
+        self.chart.tangent0(y, &self.fe, &mut self.f0);
+        Ok(())
+    }
+
+    /// ∂f/∂z at (t, y), z = 0, by forward differences (`f0 = f(t, y)`).
     fn jacobian<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) -> Result<()> {
         let n = self.n;
-        self.tmp.copy_from_slice(y);
+        self.zl.fill(0.0);
         for j in 0..n {
-            let yj = y[j];
-            let d = 1.5e-8 * yj.abs().max(1e-5);
-            self.tmp[j] = yj + d;
-            sys.rhs(t, &self.tmp, &mut self.fy)?;
-            self.tmp[j] = yj;
+            let d = 1.5e-8 * self.chart.magnitude(j, y, y).max(1e-5);
+            self.zl[j] = d;
+            self.chart.retract(y, &self.zl, &mut self.tmp);
+            sys.rhs(t, &self.tmp, &mut self.fe)?;
+            self.chart.tangent(&self.tmp, &self.zl, &self.fe, &mut self.fy);
+            self.zl[j] = 0.0;
             for i in 0..n {
                 self.jac[i * n + j] = (self.fy[i] - self.f0[i]) / d;
             }
@@ -268,10 +287,10 @@ impl Adaptive {
         let (mut theta, mut norm_old, mut q_old) = (THETA_REUSE, 0.0, 0.0);
         for k in 0..NIT {
             for s in 0..3 {
-                for i in 0..n {
-                    self.tmp[i] = y[i] + self.z[s * n + i];
-                }
-                sys.rhs(t + tab.c[s] * h, &self.tmp, &mut self.f[s * n..(s + 1) * n])?;
+                let zs = &self.z[s * n..(s + 1) * n];
+                self.chart.retract(y, zs, &mut self.tmp);
+                sys.rhs(t + tab.c[s] * h, &self.tmp, &mut self.fe)?;
+                self.chart.tangent(&self.tmp, zs, &self.fe, &mut self.f[s * n..(s + 1) * n]);
             }
             stats.evaluations += 3;
             // eq. 8.16: (Λ/h ⊗ I − I ⊗ J) ΔW = (T⁻¹ ⊗ I) F − (Λ/h ⊗ I) W
@@ -346,7 +365,7 @@ impl Adaptive {
         let norm = |w: &Self| -> f64 {
             let sum: f64 = (0..n)
                 .map(|i| {
-                    let sc = atol + rtol * y[i].abs().max((y[i] + w.z[2 * n + i]).abs());
+                    let sc = atol + rtol * w.chart.magnitude_step(i, y, w.z[2 * n + i]);
                     (w.err[i] / sc).powi(2)
                 })
                 .sum();
@@ -361,10 +380,9 @@ impl Adaptive {
         let mut e = norm(self);
         if refine && e >= 1.0 {
             // the estimate through one more evaluation: bounded as h·λ → ∞ (stiff components)
-            for i in 0..n {
-                self.tmp[i] = y[i] + self.err[i];
-            }
-            sys.rhs(t, &self.tmp, &mut self.fy)?;
+            self.chart.retract(y, &self.err, &mut self.tmp);
+            sys.rhs(t, &self.tmp, &mut self.fe)?;
+            self.chart.tangent(&self.tmp, &self.err, &self.fe, &mut self.fy);
             stats.evaluations += 1;
             for i in 0..n {
                 self.err[i] = self.fy[i] + self.ynew[i];
@@ -399,16 +417,17 @@ pub fn integrate_adaptive<S: OdeSystem>(
     first_step: f64,
     obs: &mut Observer<'_, S>,
 ) -> Result<Stats> {
-    let n = sys.dim();
+    let nfull = sys.dim();
     let t_end = *t_out.last().unwrap_or(&t0);
     let hmax = if max_step > 0.0 { max_step } else { (t_end - t0).abs().max(f64::MIN_POSITIVE) };
     let mut stats = Stats::default();
-    let mut wk = Adaptive::new(n);
+    let mut wk = Adaptive::new(Chart::new(nfull, sys.quaternions()), nfull);
+    let n = wk.n;
     let mut y = y0.to_vec();
     let mut t = t0;
     let mut next = 0usize;
 
-    sys.rhs(t, &y, &mut wk.f0)?;
+    wk.rate0(sys, t, &y)?;
     stats.evaluations += 1;
     while next < t_out.len() && t_out[next] <= t {
         obs(sys, t, &y, true)?;
@@ -421,7 +440,15 @@ pub fn integrate_adaptive<S: OdeSystem>(
         first_step.min(hmax)
     } else {
         stats.evaluations += 1;
-        crate::integrator::dopri5::starting_step(sys, t, &y, &wk.f0, rtol, atol, hmax, (&mut wk.tmp, &mut wk.fy))?
+        crate::integrator::dopri5::starting_step_on(
+            sys,
+            &wk.chart,
+            t,
+            &y,
+            &wk.f0,
+            (rtol, atol, hmax),
+            (&mut wk.tmp, &mut wk.fe, &mut wk.zl, &mut wk.fy),
+        )?
     };
     // Newton's tolerance relative to the error tolerance (HW's fnewt)
     let fnewt = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
@@ -480,7 +507,7 @@ pub fn integrate_adaptive<S: OdeSystem>(
         }
         wk.start(h, h_prev);
         for i in 0..n {
-            wk.scal[i] = atol + rtol * y[i].abs();
+            wk.scal[i] = atol + rtol * wk.chart.magnitude(i, &y, &y);
         }
         sys.switched(); // only the stages of this attempt count, not the difference quotients
         let (iters, theta) = match wk.newton(sys, t, &y, h, fnewt, &mut eta, &mut stats)? {
@@ -530,20 +557,19 @@ pub fn integrate_adaptive<S: OdeSystem>(
 
         // accepted: y₁ = y₀ + Z₃ (stiffly accurate)
         let t_new = t + h;
-        for i in 0..n {
-            wk.ynew[i] = y[i] + wk.z[2 * n + i];
-        }
+        wk.chart.retract(&y, &wk.z[2 * n..], &mut wk.ynew);
         sys.project(t_new, &mut wk.ynew)?;
         check_finite(t_new, &wk.ynew)?;
         {
             // between the step's ends: the collocation polynomial through the stages
-            let (tab, z) = (&wk.tab, &wk.z);
+            let (tab, z, chart, zl) = (&wk.tab, &wk.z, &wk.chart, &mut wk.zl);
             let yy = &y;
             next = crate::integrator::step_outputs(sys, obs, t_out, next, t, h, &wk.ynew, &mut wk.yout, |th, out| {
                 let wt = tab.collocation_weights(th);
                 for i in 0..n {
-                    out[i] = yy[i] + wt[0] * z[i] + wt[1] * z[n + i] + wt[2] * z[2 * n + i];
+                    zl[i] = wt[0] * z[i] + wt[1] * z[n + i] + wt[2] * z[2 * n + i];
                 }
+                chart.retract(yy, zl, out);
             })?;
         }
         sys.accepted(t_new, &mut wk.ynew)?;
@@ -555,7 +581,7 @@ pub fn integrate_adaptive<S: OdeSystem>(
         if next >= t_out.len() || t >= t_end {
             break;
         }
-        sys.rhs(t, &y, &mut wk.f0)?;
+        wk.rate0(sys, t, &y)?;
         stats.evaluations += 1;
         let mut h_new = (h / quot).min(hmax);
         if reject {

@@ -33,12 +33,14 @@ pub use adaptive::integrate_adaptive;
 #[cfg(test)]
 pub(crate) use adaptive::Tableau;
 
+use super::lie_group::Chart;
 use super::{check_finite, IntegratorKind, Observer, OdeSystem, Stats};
 use crate::error::{Error, Result};
 use crate::math::linalg::{lu_factor, lu_solve};
 
 struct Work {
-    n: usize,
+    /// Local coordinates of the state (on the rotation group with quaternions in it).
+    chart: Chart,
     jac: Vec<f64>,
     iter: Vec<f64>,
     piv: Vec<usize>,
@@ -49,6 +51,9 @@ struct Work {
     tmp: Vec<f64>,
     fy: Vec<f64>,
     backup: Vec<f64>,
+    /// The state's rates (n) and a local increment (nl), for the chart.
+    fe: Vec<f64>,
+    zl: Vec<f64>,
 }
 
 pub(crate) fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
@@ -62,7 +67,8 @@ pub(crate) fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
     (a, c)
 }
 
-/// One step of size h from (t, y) into `y` (in place); Err on Newton failure.
+/// One step of size h from (t, y) into `y` (in place); Err on Newton failure. The stages are
+/// `y ⊕ Z_i` in the chart's local coordinates (RKMK on a state with quaternions).
 fn step<S: OdeSystem>(
     sys: &mut S,
     w: &mut Work,
@@ -72,17 +78,20 @@ fn step<S: OdeSystem>(
     tol: f64,
     stats: &mut Stats,
 ) -> Result<bool> {
-    let n = w.n;
+    let n = w.chart.local_dim();
     let (a, c) = coefficients();
-    // Jacobian ∂f/∂y by forward differences
-    sys.rhs(t, y, &mut w.f0)?;
+    // Jacobian ∂f/∂z at z = 0 by forward differences
+    sys.rhs(t, y, &mut w.fe)?;
+    w.chart.tangent0(y, &w.fe, &mut w.f0);
     stats.evaluations += 1;
+    w.zl.fill(0.0);
     for j in 0..n {
-        let yj = y[j];
-        let d = 1.5e-8 * yj.abs().max(1e-5);
-        w.tmp.copy_from_slice(y);
-        w.tmp[j] = yj + d;
-        sys.rhs(t, &w.tmp, &mut w.fy)?;
+        let d = 1.5e-8 * w.chart.magnitude(j, y, y).max(1e-5);
+        w.zl[j] = d;
+        w.chart.retract(y, &w.zl, &mut w.tmp);
+        sys.rhs(t, &w.tmp, &mut w.fe)?;
+        w.chart.tangent(&w.tmp, &w.zl, &w.fe, &mut w.fy);
+        w.zl[j] = 0.0;
         for i in 0..n {
             w.jac[i * n + j] = (w.fy[i] - w.f0[i]) / d;
         }
@@ -108,11 +117,10 @@ fn step<S: OdeSystem>(
     let mut last = f64::INFINITY;
     for _ in 0..12 {
         for s in 0..3 {
-            for i in 0..n {
-                w.tmp[i] = y[i] + w.z[s * n + i];
-            }
-            let (fs, _) = w.f.split_at_mut((s + 1) * n);
-            sys.rhs(t + c[s] * h, &w.tmp, &mut fs[s * n..])?;
+            let zs = &w.z[s * n..(s + 1) * n];
+            w.chart.retract(y, zs, &mut w.tmp);
+            sys.rhs(t + c[s] * h, &w.tmp, &mut w.fe)?;
+            w.chart.tangent(&w.tmp, zs, &w.fe, &mut w.f[s * n..(s + 1) * n]);
         }
         stats.evaluations += 3;
         // residual -G(Z) = -Z + h (A ⊗ I) F
@@ -129,16 +137,16 @@ fn step<S: OdeSystem>(
         let mut nrm = 0.0f64;
         for k in 0..m {
             w.z[k] += w.dz[k];
-            let sc = 1.0 + y[k % n].abs();
+            let sc = 1.0 + w.chart.magnitude(k % n, y, y);
             nrm = nrm.max(w.dz[k].abs() / sc);
         }
         if !nrm.is_finite() || nrm > 2.0 * last && last < 1.0 {
             return Ok(false);
         }
         if nrm <= tol {
-            for i in 0..n {
-                y[i] += w.z[2 * n + i]; // stiffly accurate: y_new = y + Z_3
-            }
+            // stiffly accurate: y_new = y ⊕ Z_3
+            w.tmp.copy_from_slice(y);
+            w.chart.retract(&w.tmp, &w.z[2 * n..], y);
             sys.project(t + h, y)?;
             sys.accepted(t + h, y)?;
             return Ok(true);
@@ -190,9 +198,11 @@ pub fn integrate_fixed<S: OdeSystem>(
     if !(newton_tol.is_finite() && newton_tol > 0.0) {
         return Err(Error::Settings(format!("integrator.newton_tol: must be > 0, got {newton_tol}")));
     }
-    let n = sys.dim();
+    let nfull = sys.dim();
+    let chart = Chart::new(nfull, sys.quaternions());
+    let n = chart.local_dim();
     let mut w = Work {
-        n,
+        chart,
         jac: vec![0.0; n * n],
         iter: vec![0.0; 9 * n * n],
         piv: vec![0; 3 * n],
@@ -200,9 +210,11 @@ pub fn integrate_fixed<S: OdeSystem>(
         dz: vec![0.0; 3 * n],
         f: vec![0.0; 3 * n],
         f0: vec![0.0; n],
-        tmp: vec![0.0; n],
+        tmp: vec![0.0; nfull],
         fy: vec![0.0; n],
-        backup: vec![0.0; n],
+        backup: vec![0.0; nfull],
+        fe: vec![0.0; nfull],
+        zl: vec![0.0; n],
     };
     let mut y = y0.to_vec();
     let mut stats = Stats::default();
