@@ -27,6 +27,8 @@ from .study import Study, StudyError, study
 from .urdf import load_urdf
 from .viewer import view
 from .mjcf import load_mjcf
+from .laws import Material
+from . import hertz
 
 
 def plot(results, signals, out=None, **kwargs):
@@ -65,6 +67,8 @@ __all__ = [
     "Contact",
     "ContactGroup",
     "GapContact",
+    "Material",
+    "hertz",
     "contours",
     "laws",
     "mechanisms",

@@ -218,6 +218,9 @@ pub fn integrate<S: OdeSystem>(
     };
     let mut err_old: f64 = 1e-4;
     let mut reject = false;
+    // steps retaken to end just past a switch: the step the controller wanted before
+    let mut switches = super::switching::Locator::new(sys);
+    let mut located: Option<f64> = None;
 
     loop {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
@@ -255,6 +258,13 @@ pub fn integrate<S: OdeSystem>(
         }
         if err <= 1.0 {
             st.prepare_dense(&y, h);
+            if located.is_none() {
+                if let Some(th) = switches.locate(sys, t, h, &y, &st.ynew, |th, out| st.dense(th, out))? {
+                    located = Some(h);
+                    h *= th;
+                    continue;
+                }
+            }
             let t_new = t + h;
             sys.project(t_new, &mut st.ynew)?;
             check_finite(t_new, &st.ynew)?;
@@ -268,6 +278,9 @@ pub fn integrate<S: OdeSystem>(
                 break;
             }
             h = (h * next_factor(err, err_old, reject)).min(hmax);
+            if let Some(wanted) = located.take() {
+                h = wanted.min(hmax);
+            }
             err_old = err.max(1e-4);
             reject = false;
         } else {

@@ -433,6 +433,8 @@ pub fn integrate_adaptive<S: OdeSystem>(
     let (mut first, mut reject) = (true, false);
     let (mut h_acc, mut err_acc) = (0.0, 0.0); // Gustafsson's memory
     let mut singular = 0u32;
+    let mut switches = crate::integrator::switching::Locator::new(sys);
+    let mut located: Option<f64> = None; // the step wanted before one was cut at a switch
 
     loop {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
@@ -526,13 +528,28 @@ pub fn integrate_adaptive<S: OdeSystem>(
             let gus = (h_acc / h * (err * err / err_acc).powf(0.25) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
             quot = quot.max(gus);
         }
-        (h_acc, err_acc) = (h, err.max(1e-2));
-
         // accepted: y₁ = y₀ + Z₃ (stiffly accurate)
         let t_new = t + h;
         for i in 0..n {
             wk.ynew[i] = y[i] + wk.z[2 * n + i];
         }
+        if located.is_none() {
+            // a switch inside the step (a compliant contact's onset): retaken up to just past it
+            let (tab, z) = (&wk.tab, &wk.z);
+            let yy = &y;
+            let dense = |th: f64, out: &mut [f64]| {
+                let wt = tab.collocation_weights(th);
+                for i in 0..n {
+                    out[i] = yy[i] + wt[0] * z[i] + wt[1] * z[n + i] + wt[2] * z[2 * n + i];
+                }
+            };
+            if let Some(th) = switches.locate(sys, t, h, &y, &wk.ynew, dense)? {
+                located = Some(h);
+                h *= th;
+                continue;
+            }
+        }
+        (h_acc, err_acc) = (h, err.max(1e-2));
         sys.project(t_new, &mut wk.ynew)?;
         check_finite(t_new, &wk.ynew)?;
         {
@@ -570,6 +587,9 @@ pub fn integrate_adaptive<S: OdeSystem>(
             }
         } else {
             need_jac = true;
+        }
+        if let Some(wanted) = located.take() {
+            h_new = wanted.min(hmax);
         }
         h = h_new;
     }

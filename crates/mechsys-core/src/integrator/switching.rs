@@ -1,0 +1,71 @@
+//! Steps that end at switches: a system's switching functions (the gaps of compliant contacts
+//! and their forces before the cut-off, [`crate::forces::compliant::switching`]) change sign
+//! where its right-hand side has a kink; a step across one loses the scheme's order there. After
+//! an accepted step whose end shows a sign change, [`Locator::locate`] finds the first change on
+//! the step's continuous extension by bisection and the scheme retakes the step up to just past
+//! it, so the next step starts on the far side of the kink.
+
+use super::OdeSystem;
+use crate::error::Result;
+
+/// Buffers of the search (sized once per run).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Locator {
+    start: Vec<f64>,
+    probe: Vec<f64>,
+    y: Vec<f64>,
+}
+
+/// Relative width (of the step) to which a switch is located.
+const WIDTH: f64 = 1e-13;
+
+impl Locator {
+    /// Buffers for `sys`.
+    pub(crate) fn new<S: OdeSystem>(sys: &S) -> Self {
+        let m = sys.switches();
+        Locator { start: vec![0.0; m], probe: vec![0.0; m], y: if m > 0 { vec![0.0; sys.dim()] } else { Vec::new() } }
+    }
+
+    /// Whether the system has switching functions.
+    pub(crate) fn active(&self) -> bool {
+        !self.start.is_empty()
+    }
+
+    fn changed(&self) -> bool {
+        self.start.iter().zip(&self.probe).any(|(a, b)| (*a > 0.0) != (*b > 0.0))
+    }
+
+    /// For the step `[t, t + h]` from `y0` to `y1` with continuous extension `dense(θ, out)`:
+    /// the fraction θ ∈ (0, 1) just past the first sign change of a switching function, or None
+    /// when none changes (or the change is at the step's very end).
+    pub(crate) fn locate<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        h: f64,
+        y0: &[f64],
+        y1: &[f64],
+        mut dense: impl FnMut(f64, &mut [f64]),
+    ) -> Result<Option<f64>> {
+        if !self.active() {
+            return Ok(None);
+        }
+        sys.switching(t, y0, &mut self.start)?;
+        sys.switching(t + h, y1, &mut self.probe)?;
+        if !self.changed() {
+            return Ok(None);
+        }
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        while hi - lo > WIDTH {
+            let mid = 0.5 * (lo + hi);
+            dense(mid, &mut self.y);
+            sys.switching(t + mid * h, &self.y, &mut self.probe)?;
+            if self.changed() {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Ok(if hi < 1.0 - 1e-9 { Some(hi) } else { None })
+    }
+}
