@@ -256,7 +256,9 @@ pub fn commit(model: &Model, data: &Data, w: &mut Work, t: f64, states: &mut [f6
         kinematics(c, data, w, t)?;
         for k in 0..c.points() {
             let slot = c.slot + k;
-            let closed = w.kin[k].point.g_n < 0.0;
+            // touching and approaching counts as closed (a step that ends exactly at the onset)
+            let (g, gd) = (w.kin[k].point.g_n, w.kin[k].gd_n);
+            let closed = g < 0.0 || (g == 0.0 && gd < 0.0);
             if closed && w.onset_speed[slot] == 0.0 {
                 w.onset_speed[slot] = (-w.kin[k].gd_n).max(f64::MIN_POSITIVE);
             }

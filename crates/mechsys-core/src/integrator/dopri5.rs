@@ -221,6 +221,7 @@ pub fn integrate<S: OdeSystem>(
     // steps retaken to end just past a switch: the step the controller wanted before
     let mut switches = super::switching::Locator::new(sys);
     let mut located: Option<f64> = None;
+    let mut retaken = f64::NAN; // the step size of an attempt retaken at a switch (not searched again)
 
     loop {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
@@ -258,10 +259,11 @@ pub fn integrate<S: OdeSystem>(
         }
         if err <= 1.0 {
             st.prepare_dense(&y, h);
-            if located.is_none() {
+            if h != retaken {
                 if let Some(th) = switches.locate(sys, t, h, &y, &st.ynew, |th, out| st.dense(th, out))? {
-                    located = Some(h);
+                    located.get_or_insert(h);
                     h *= th;
+                    retaken = h;
                     continue;
                 }
             }

@@ -19,6 +19,9 @@ pub(crate) struct Locator {
 /// Relative width (of the step) to which a switch is located.
 const WIDTH: f64 = 1e-13;
 
+/// How far past the located change (relative to the step) the retaken step ends.
+const MARGIN: f64 = 1e-7;
+
 impl Locator {
     /// Buffers for `sys`.
     pub(crate) fn new<S: OdeSystem>(sys: &S) -> Self {
@@ -32,12 +35,13 @@ impl Locator {
     }
 
     fn changed(&self) -> bool {
-        self.start.iter().zip(&self.probe).any(|(a, b)| (*a > 0.0) != (*b > 0.0))
+        // the sides: ≥ 0 (open, or a force not cut off) and < 0 (closed, cut off)
+        self.start.iter().zip(&self.probe).any(|(a, b)| (*a >= 0.0) != (*b >= 0.0))
     }
 
     /// For the step `[t, t + h]` from `y0` to `y1` with continuous extension `dense(θ, out)`:
     /// the fraction θ ∈ (0, 1) just past the first sign change of a switching function, or None
-    /// when none changes (or the change is at the step's very end).
+    /// when none changes (or the change is within 1e-9 of the step from its start or end).
     pub(crate) fn locate<S: OdeSystem>(
         &mut self,
         sys: &mut S,
@@ -66,6 +70,10 @@ impl Locator {
                 lo = mid;
             }
         }
-        Ok(if hi < 1.0 - 1e-9 { Some(hi) } else { None })
+        // a little past the change, so that the retaken step (whose end differs from the
+        // continuous extension by the local error) ends on the far side; a change at the step's
+        // very start or end leaves a negligible sliver across it
+        let th = hi + MARGIN;
+        Ok(if hi > 1e-9 && th < 1.0 - 1e-9 { Some(th) } else { None })
     }
 }

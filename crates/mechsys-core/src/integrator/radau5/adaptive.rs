@@ -435,6 +435,7 @@ pub fn integrate_adaptive<S: OdeSystem>(
     let mut singular = 0u32;
     let mut switches = crate::integrator::switching::Locator::new(sys);
     let mut located: Option<f64> = None; // the step wanted before one was cut at a switch
+    let mut retaken = f64::NAN; // the step size of an attempt retaken at a switch (not searched again)
 
     loop {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
@@ -533,7 +534,7 @@ pub fn integrate_adaptive<S: OdeSystem>(
         for i in 0..n {
             wk.ynew[i] = y[i] + wk.z[2 * n + i];
         }
-        if located.is_none() {
+        if h != retaken {
             // a switch inside the step (a compliant contact's onset): retaken up to just past it
             let (tab, z) = (&wk.tab, &wk.z);
             let yy = &y;
@@ -544,8 +545,9 @@ pub fn integrate_adaptive<S: OdeSystem>(
                 }
             };
             if let Some(th) = switches.locate(sys, t, h, &y, &wk.ynew, dense)? {
-                located = Some(h);
+                located.get_or_insert(h);
                 h *= th;
+                retaken = h;
                 continue;
             }
         }

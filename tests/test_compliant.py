@@ -1,0 +1,196 @@
+"""Compliant contact (issue 19): Hertz, Johnson, the dissipative Hertz laws, friction of compliant
+contacts and the Hertz post-processing of rigid impacts, against closed forms and independent
+SciPy integrations written here."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk, gamma
+
+import mechsys as ms
+
+STEEL = ms.Material(E=2.1e11, nu=0.3, density=7800.0)
+R = 0.01
+MASS = 7800.0 * 4.0 / 3.0 * math.pi * R**3
+E_STAR = 1.0 / (2.0 * (1 - 0.3**2) / 2.1e11)
+# T v0 / delta_max of an undamped Hertz impact, 2 * int_0^1 dx / sqrt(1 - x^(5/2))
+FACTOR = 0.8 * math.sqrt(math.pi) * gamma(0.4) / gamma(0.9)
+
+
+def peak(t, x):
+    """The maximum of sampled x by the parabola through the largest sample and its neighbours."""
+    k = int(np.argmax(x))
+    y0, y1, y2 = x[k - 1], x[k], x[k + 1]
+    d = y0 - 2 * y1 + y2
+    return y1 - 0.125 * (y2 - y0) ** 2 / d
+
+
+def ball_on_plane(law, v0=1.0, gap=2e-4, gravity=0.0, material=STEEL, friction=None):
+    m = ms.Model("ball", gravity=(0, 0, -gravity))
+    b = m.add_body("ball", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
+    m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=R + gap, u0=-v0))
+    m.add_contact(ms.Contact("c", b.contour(ms.contours.Sphere(radius=R), material=material),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)), material=material), normal=law,
+                             friction=friction))
+    return m
+
+
+def hertz_closed_form(m_eff, v0, k):
+    d = (1.25 * m_eff * v0**2 / k) ** 0.4
+    return d, k * d**1.5, FACTOR * d / v0
+
+
+def contact_times(res, name="c"):
+    close = [e["t"] for e in res.events if e["contact"] == name and e["event"] == "close"]
+    opened = [e["t"] for e in res.events if e["contact"] == name and e["event"] == "open"]
+    return close, opened
+
+
+@pytest.mark.parametrize("integrator", [ms.DOPRI5(rtol=1e-12, atol=1e-16), ms.Radau5(rtol=1e-11, atol=1e-16)])
+def test_hertz_sphere_plane_impact_against_closed_form(integrator):
+    """delta_max = (5 m v0^2 / 4K)^(2/5), F_max = K delta_max^1.5, T = 2.9432 delta_max / v0 with
+    K = (4/3) E* sqrt(R); restitution exactly 1; energy conserved; onset and release events."""
+    res = ms.simulate(ball_on_plane(ms.laws.Hertz()), t_end=4e-4, output_dt=1e-8, integrator=integrator)
+    k = 4.0 / 3.0 * E_STAR * math.sqrt(R)
+    d, f, T = hertz_closed_form(MASS, 1.0, k)
+    assert peak(res["t"], res["contact/c/overlap"]) == pytest.approx(d, rel=1e-6)
+    assert peak(res["t"], res["contact/c/force_n"]) == pytest.approx(f, rel=1e-6)
+    close, opened = contact_times(res)
+    assert len(close) == 1 and len(opened) == 1
+    assert close[0] == pytest.approx(2e-4, rel=1e-9)
+    assert opened[0] - close[0] == pytest.approx(T, rel=1e-6)
+    assert res["joint/z/u"][-1] == pytest.approx(1.0, rel=1e-8)
+    e = res["energy/total"]
+    assert np.ptp(e) < 1e-8 * e[0]
+    # during the contact the energy sits in the overlap: E_el = (2/5) K delta^2.5
+    i = int(np.argmax(res["contact/c/overlap"]))
+    assert res["contact/c/energy_elastic"][i] == pytest.approx(0.4 * k * res["contact/c/overlap"][i] ** 2.5, rel=1e-12)
+    assert abs(res["contact/c/energy_dissipated"][-1]) < 1e-10 * e[0]
+
+
+def test_hertz_sphere_sphere_impact_against_closed_form():
+    """Two free balls (radii 10 and 15 mm, different steels) along x: m = m1 m2/(m1 + m2),
+    1/R = 1/R1 + 1/R2, E* from both materials; momentum conserved, velocities exchanged as for
+    an elastic impact."""
+    r2, soft = 0.015, ms.Material(E=7e10, nu=0.33, density=2700.0)
+    m2 = 2700.0 * 4 / 3 * math.pi * r2**3
+    m = ms.Model("two", gravity=(0, 0, 0))
+    a = m.add_body("a", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
+    b = m.add_body("b", mass=m2, inertia=ms.inertia.sphere(m2, r2))
+    m.add_joint(ms.joints.Prismatic("xa", m.ground, a, axis=(1, 0, 0), q0=0.0, u0=2.0))
+    m.add_joint(ms.joints.Prismatic("xb", m.ground, b, axis=(1, 0, 0), q0=R + r2 + 1e-4, u0=0.5))
+    m.add_contact(ms.Contact("ab", a.contour(ms.contours.Sphere(radius=R), material=STEEL),
+                             b.contour(ms.contours.Sphere(radius=r2), material=soft), normal=ms.laws.Hertz()))
+    res = ms.simulate(m, t_end=3e-4, output_dt=1e-8, integrator=ms.DOPRI5(rtol=1e-12, atol=1e-16))
+    es = 1 / ((1 - 0.09) / 2.1e11 + (1 - 0.33**2) / 7e10)
+    k = 4 / 3 * es * math.sqrt(R * r2 / (R + r2))
+    me, v = MASS * m2 / (MASS + m2), 1.5
+    d, f, T = hertz_closed_form(me, v, k)
+    assert peak(res["t"], res["contact/ab/overlap"]) == pytest.approx(d, rel=1e-6)
+    assert peak(res["t"], res["contact/ab/force_n"]) == pytest.approx(f, rel=1e-6)
+    close, opened = contact_times(res, "ab")
+    assert opened[0] - close[0] == pytest.approx(T, rel=1e-6)
+    ua, ub = res["joint/xa/u"][-1], res["joint/xb/u"][-1]
+    p0 = MASS * 2.0 + m2 * 0.5
+    assert MASS * ua + m2 * ub == pytest.approx(p0, rel=1e-12)
+    # elastic: the relative velocity reverses
+    assert ub - ua == pytest.approx(1.5, rel=1e-8)
+
+
+def scipy_restitution(k, alpha_of_v, v0, m=MASS, kv=None):
+    """Exit speed over v0 of m x'' = -F(x, x') from x = 0, x' = v0 (x the overlap), F = k x^1.5
+    (1 + alpha x') cut at 0 (or Kelvin-Voigt kv = (k, d)), by an independent integration."""
+    alpha = alpha_of_v(v0)
+
+    def f(t, y):
+        x, xd = y
+        if kv is not None:
+            F = max(0.0, kv[0] * x + kv[1] * xd)
+        else:
+            F = max(0.0, k * max(x, 0.0) ** 1.5 * (1 + alpha * xd))
+        return [xd, -F / m]
+
+    def out(t, y):
+        return y[0]
+
+    out.terminal, out.direction = True, -1
+    s = solve_ivp(f, (0, 1.0), [0.0, v0], rtol=1e-12, atol=1e-18, events=out, method="DOP853",
+                  first_step=1e-10)
+    return -s.y_events[0][0][1] / v0
+
+
+@pytest.mark.parametrize("law,alpha", [
+    (ms.laws.HuntCrossley(eps=0.5), lambda v: 1.5 * 0.5 / v),
+    (ms.laws.LankaraniNikravesh(eps=0.5), lambda v: 0.75 * (1 - 0.25) / v),
+    (ms.laws.Flores(eps=0.5), lambda v: 1.6 * 0.5 / 0.5 / v),
+    (ms.laws.HuntCrossley(alpha=0.4), lambda v: 0.4),
+])
+def test_dissipative_laws_restitution_against_scipy(law, alpha):
+    """The restitution each damped Hertz law achieves (not exactly its eps: each mapping rests
+    on its own approximation) against an independent high-accuracy integration; the dissipated
+    energy signal closes the energy balance."""
+    res = ms.simulate(ball_on_plane(law), t_end=4e-4, output_dt=1e-6, integrator=ms.DOPRI5(rtol=1e-12, atol=1e-16))
+    k = 4 / 3 * E_STAR * math.sqrt(R)
+    e_ref = scipy_restitution(k, alpha, 1.0)
+    e = res["joint/z/u"][-1] / 1.0
+    assert e == pytest.approx(e_ref, rel=1e-7)
+    ke0 = 0.5 * MASS
+    assert res["contact/c/energy_dissipated"][-1] == pytest.approx(ke0 * (1 - e * e), rel=1e-7)
+    assert res["energy/dissipated"][-1] == pytest.approx(ke0 * (1 - e * e), rel=1e-7)
+    if getattr(law, "eps", None) is not None:
+        assert abs(e - law.eps) > 1e-3  # the mappings are approximations
+
+
+def test_kelvin_voigt_restitution_and_cutoff_against_scipy():
+    """Kelvin-Voigt with the non-adhesive cut-off: the force reaches zero before the gap opens
+    (a switch located by the scheme); restitution against SciPy."""
+    kk, dd = 1e7, 20.0
+    res = ms.simulate(ball_on_plane(ms.laws.KelvinVoigt(k=kk, d=dd)), t_end=2e-3, output_dt=1e-6,
+                      integrator=ms.DOPRI5(rtol=1e-12, atol=1e-16))
+    e_ref = scipy_restitution(0, lambda v: 0.0, 1.0, kv=(kk, dd))
+    assert res["joint/z/u"][-1] == pytest.approx(e_ref, rel=1e-7)
+    assert np.all(res["contact/c/force_n"] >= 0)
+
+
+def test_ball_drop_keeps_its_apex_over_ten_bounces():
+    """Undamped Hertz: the apex after each of 10 bounces equals the drop height to 1e-8 of it
+    (the flight is a parabola: the apex from three samples around it is exact)."""
+    h = 0.05
+    m = ball_on_plane(ms.laws.Hertz(), v0=0.0, gap=h, gravity=9.81)
+    T0 = 2 * math.sqrt(2 * h / 9.81)
+    res = ms.simulate(m, t_end=10.5 * T0, output_dt=1e-4, integrator=ms.DOPRI5(rtol=1e-13, atol=1e-16))
+    z = res["joint/z/q"] - R
+    t = res["t"]
+    apex = [peak(t[i - 2:i + 3], z[i - 2:i + 3]) for i in range(2, len(z) - 2)
+            if z[i] >= z[i - 1] and z[i] > z[i + 1] and z[i] > 0.5 * h]
+    assert len(apex) >= 10
+    np.testing.assert_allclose(apex[:10], h, rtol=0, atol=1e-8 * h)
+    close, _ = contact_times(res)
+    assert len(close) >= 10
+
+
+def test_bounce_period_tends_to_the_rigid_one_like_e_to_the_minus_two_fifths():
+    """As E grows the period between onsets tends to the rigid 2 sqrt(2h/g); the error (about
+    the contact duration, proportional to K^(-2/5)) falls like E^(-2/5) over three decades."""
+    h = 0.01
+    T0 = 2 * math.sqrt(2 * h / 9.81)
+    errs = []
+    moduli = [2.1e7, 2.1e8, 2.1e9, 2.1e10]
+    for e_mod in moduli:
+        mat = ms.Material(E=e_mod, nu=0.3, density=7800.0)
+        m = ball_on_plane(ms.laws.Hertz(), v0=0.0, gap=h, gravity=9.81, material=mat)
+        res = ms.simulate(m, t_end=2.2 * T0, output_dt=1e-3, integrator=ms.DOPRI5(rtol=1e-11, atol=1e-15))
+        close, _ = contact_times(res)
+        errs.append(close[1] - close[0] - T0)
+    slope = np.polyfit(np.log(moduli), np.log(errs), 1)[0]
+    assert slope == pytest.approx(-0.4, abs=0.01)
+    # the excess is the contact duration of the bounce (gravity during the contact aside)
+    v0 = math.sqrt(2 * 9.81 * h)
+    es = 1 / (2 * (1 - 0.09) / moduli[-1])
+    d, _, T = hertz_closed_form(MASS, v0, 4 / 3 * es * math.sqrt(R))
+    assert errs[-1] == pytest.approx(T, rel=1e-3)
