@@ -194,3 +194,139 @@ def test_bounce_period_tends_to_the_rigid_one_like_e_to_the_minus_two_fifths():
     es = 1 / (2 * (1 - 0.09) / moduli[-1])
     d, _, T = hertz_closed_form(MASS, v0, 4 / 3 * es * math.sqrt(R))
     assert errs[-1] == pytest.approx(T, rel=1e-3)
+
+
+def chain(law, v0=1.0, rigid=False):
+    """Three equal steel balls on the x axis: b and c touching at rest, a arriving at v0."""
+    m = ms.Model("chain", gravity=(0, 0, 0))
+    balls = []
+    for k, (x, u) in enumerate([(-2 * R - 1e-4, v0), (0.0, 0.0), (2 * R, 0.0)]):
+        b = m.add_body(f"b{k}", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
+        m.add_joint(ms.joints.Prismatic(f"x{k}", m.ground, b, axis=(1, 0, 0), q0=x, u0=u))
+        balls.append(b)
+    for k in range(2):
+        kw = {"impact": ms.laws.Newton(eps=1.0)} if rigid else {"normal": law}
+        m.add_contact(ms.Contact(f"c{k}", balls[k].contour(ms.contours.Sphere(radius=R), material=STEEL),
+                                 balls[k + 1].contour(ms.contours.Sphere(radius=R), material=STEEL), **kw))
+    return m
+
+
+def test_three_ball_chain_conserves_and_matches_scipy():
+    """Hertz chain: momentum and energy conserved to 1e-9 and the final velocities of an
+    independent SciPy integration of the three-mass Hertz chain. The rigid model's answers next
+    to it: Newton's law (e = 1) at the simultaneous impact, the touching pair kept together by
+    the complementarity of its closed contact, gives (-1/3, 2/3, 2/3) v0 (event-driven and
+    Moreau-Jean alike, energy conserved); a sequence of pairwise impacts (a on b, then b on c)
+    gives (0, 0, 1) v0. The compliant chain lies in between, near the pairwise answer."""
+    res = ms.simulate(chain(ms.laws.Hertz()), t_end=6e-4, output_dt=1e-6, integrator=ms.DOPRI5(rtol=1e-12, atol=1e-16))
+    u = np.column_stack([res[f"joint/x{k}/u"] for k in range(3)])
+    p = MASS * u.sum(axis=1)
+    assert np.ptp(p) < 1e-9 * MASS
+    e = res["energy/total"]
+    assert np.ptp(e) < 1e-9 * e[0]
+    k = 4 / 3 * E_STAR * math.sqrt(R / 2)
+
+    def f(t, y):
+        x, v = y[:3], y[3:]
+        d01, d12 = max(x[0] - x[1], 0.0), max(x[1] - x[2], 0.0)
+        f01, f12 = k * d01**1.5, k * d12**1.5
+        return [*v, -f01 / MASS, (f01 - f12) / MASS, f12 / MASS]
+
+    # x: each ball's position past its touching place (a starts 0.1 mm short)
+    s = solve_ivp(f, (0, 6e-4), [-1e-4, 0, 0, 1, 0, 0], method="DOP853", rtol=1e-13, atol=1e-18)
+    np.testing.assert_allclose(u[-1], s.y[3:, -1], atol=1e-8)
+    assert 1 - u[-1, 2] > 1e-3 and u[-1, 0] < 0  # a part stays behind: not the rigid answer
+    rigid = ms.simulate(chain(None, rigid=True), t_end=2e-4, output_dt=1e-5, integrator=ms.EventDriven())
+    np.testing.assert_allclose([rigid[f"joint/x{k}/u"][-1] for k in range(3)], [-1 / 3, 2 / 3, 2 / 3], atol=1e-12)
+    pairwise = np.array([1.0, 0.0, 0.0])
+    for i in (0, 1):  # equal masses exchange their velocities
+        pairwise[i], pairwise[i + 1] = pairwise[i + 1], pairwise[i]
+    np.testing.assert_allclose(pairwise, [0, 0, 1])
+    assert np.linalg.norm(u[-1] - pairwise) < np.linalg.norm(u[-1] - [-1 / 3, 2 / 3, 2 / 3])
+
+
+def test_cylinder_line_contact_against_johnson():
+    """A steel cylinder (R = 10 mm, L = 40 mm) resting on a plane under its weight (damped to
+    rest): its overlap solves Johnson's delta = (F/(pi L E*)) (ln(4 pi L E* R / F) - 1)."""
+    L, load = 0.04, 5000.0
+    m = ms.Model("roller", gravity=(0, 0, -9.81))
+    mass = load / 9.81
+    b = m.add_body("roller", mass=mass, inertia=ms.inertia.sphere(mass, R))
+    m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=R))
+    m.add_contact(ms.Contact("line", b.contour(ms.contours.Cylinder(axis=(1, 0, 0), radius=R, length=L), material=STEEL),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)), material=STEEL),
+                             normal=ms.laws.Hertz(alpha=300.0)))
+    res = ms.simulate(m, t_end=0.1, output_dt=1e-3, integrator=ms.Radau5(rtol=1e-10, atol=1e-14))
+    ref = brentq(lambda d: load / (math.pi * L * E_STAR) * (math.log(4 * math.pi * L * E_STAR * R / load) - 1) - d, 1e-9, 1e-3)
+    delta = res["contact/line/overlap"][-1]
+    np.testing.assert_allclose(delta, ref, rtol=1e-6)
+    np.testing.assert_allclose(res["contact/line/force_n"][-1].sum(), load, rtol=1e-6)
+
+
+def scipy_ellipse(A, B, e_star, force):
+    """Hertz's contact ellipse by SciPy: B/A = (E/(1-m) - K)/(K - E), then a, b, delta."""
+    def ratio(m):
+        return (ellipe(m) / (1 - m) - ellipk(m)) / (ellipk(m) - ellipe(m)) - B / A
+
+    m = brentq(ratio, 1e-12, 1 - 1e-14, xtol=1e-16, rtol=1e-15)
+    K, E = ellipk(m), ellipe(m)
+    # a^2 = delta (K - E)/(K m A), P = (2 pi/3) a E* delta / K
+    c = (K - E) / (K * m * A)
+    delta = (force * 3 * K / (2 * math.pi * e_star * math.sqrt(c))) ** (2 / 3)
+    a = math.sqrt(delta * c)
+    return a, a * math.sqrt(1 - m), delta
+
+
+@pytest.mark.parametrize("ratio", [3.0, 40.0])
+def test_ellipse_semi_axes_against_hertz_elliptic_solution(ratio):
+    A = 20.0
+    a, b, delta = scipy_ellipse(A, ratio * A, E_STAR, 100.0)
+    c = ms.hertz.impact  # noqa: F841  (the module is public)
+    from mechsys import _core
+
+    got = _core.hertz_contact(A, ratio * A, E_STAR, 100.0)
+    np.testing.assert_allclose([got["a"], got["b"], got["delta"]], [a, b, delta], rtol=1e-9)
+    assert got["p0"] == pytest.approx(1.5 * 100.0 / (math.pi * a * b), rel=1e-9)
+
+
+def test_ellipsoid_on_plane_static_overlap_from_the_elliptic_solution():
+    """An ellipsoid (semi-axes 20, 10, 5 mm) resting on a plane on its small axis: curvatures
+    c/a^2, c/b^2 at the pole; its overlap under the load is (F/K)^(2/3) with K from SciPy's
+    elliptic solution."""
+    ax = (0.02, 0.01, 0.005)
+    load = 200.0
+    m = ms.Model("egg", gravity=(0, 0, -9.81))
+    mass = load / 9.81
+    b = m.add_body("egg", mass=mass, inertia=ms.inertia.sphere(mass, 0.01))
+    m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=ax[2]))
+    m.add_contact(ms.Contact("pole", b.contour(ms.contours.Ellipsoid(semi_axes=ax), material=STEEL),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)), material=STEEL),
+                             normal=ms.laws.Hertz(alpha=300.0)))
+    res = ms.simulate(m, t_end=0.1, output_dt=1e-3, integrator=ms.Radau5(rtol=1e-10, atol=1e-14))
+    A, B = 0.5 * ax[2] / ax[0] ** 2, 0.5 * ax[2] / ax[1] ** 2
+    _, _, delta = scipy_ellipse(A, B, E_STAR, load)
+    np.testing.assert_allclose(res["contact/pole/overlap"][-1], delta, rtol=1e-6)
+
+
+def test_rigid_newton_impact_post_processed_equals_the_compliant_run():
+    """Section 2.5.4: a rigid e = 1 impact resolved by Hertz afterwards gives the compliant run's
+    delta_max, peak force and duration to 1e-6."""
+    m = ms.Model("ball", gravity=(0, 0, 0))
+    b = m.add_body("ball", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
+    m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=R + 2e-4, u0=-1.0))
+    m.add_contact(ms.Contact("c", b.contour(ms.contours.Sphere(radius=R), material=STEEL),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)), material=STEEL),
+                             impact=ms.laws.Newton(eps=1.0)))
+    rigid = ms.simulate(m, t_end=4e-4, output_dt=1e-5, integrator=ms.EventDriven())
+    rows = ms.hertz.impacts(rigid, m)
+    assert len(rows) == 1
+    comp = ms.simulate(ball_on_plane(ms.laws.Hertz()), t_end=4e-4, output_dt=1e-8, integrator=ms.DOPRI5(rtol=1e-12, atol=1e-16))
+    close, opened = contact_times(comp)
+    r = rows[0]
+    assert r["delta_max"] == pytest.approx(peak(comp["t"], comp["contact/c/overlap"]), rel=1e-6)
+    assert r["force_max"] == pytest.approx(peak(comp["t"], comp["contact/c/force_n"]), rel=1e-6)
+    assert r["duration"] == pytest.approx(opened[0] - close[0], rel=1e-6)
+    # a circle of radius sqrt(R delta) and p0 = 3F/(2 pi a^2)
+    assert r["a"] == pytest.approx(math.sqrt(R * r["delta_max"]), rel=1e-12)
+    assert r["p0"] == pytest.approx(1.5 * r["force_max"] / (math.pi * r["a"] ** 2), rel=1e-12)
+    assert "delta_max" in ms.hertz.table(rows)
