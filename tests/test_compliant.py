@@ -330,3 +330,121 @@ def test_rigid_newton_impact_post_processed_equals_the_compliant_run():
     assert r["a"] == pytest.approx(math.sqrt(R * r["delta_max"]), rel=1e-12)
     assert r["p0"] == pytest.approx(1.5 * r["force_max"] / (math.pi * r["a"] ** 2), rel=1e-12)
     assert "delta_max" in ms.hertz.table(rows)
+
+
+@pytest.mark.parametrize("mat,law,msg", [
+    (ms.Material(E=0.0, nu=0.3, density=7800), ms.laws.Hertz(), "material1.E: Young's modulus must be > 0"),
+    (ms.Material(E=2e11, nu=0.5, density=7800), ms.laws.Hertz(), "material1.nu: Poisson's ratio must lie in (-1, 0.5)"),
+    (ms.Material(E=2e11, nu=-1.0, density=7800), ms.laws.Hertz(), "material1.nu"),
+    (ms.Material(E=2e11, nu=0.3, density=0.0), ms.laws.Hertz(), "material1.density: must be > 0"),
+    (None, ms.laws.Hertz(), "needs the materials of both contours"),
+    (STEEL, ms.laws.HuntCrossley(alpha=-1.0), "alpha: the damping coefficient must be >= 0"),
+    (STEEL, ms.laws.HuntCrossley(), "needs eps (restitution) or alpha"),
+    (STEEL, ms.laws.Flores(eps=1.5), "eps: must be in (0, 1]"),
+    (STEEL, ms.laws.KelvinVoigt(k=-1.0), "normal.k: must be > 0"),
+])
+def test_bad_input_names_the_contact(mat, law, msg):
+    m = ms.Model("bad", gravity=(0, 0, 0))
+    b = m.add_body("ball", mass=1.0, inertia=ms.inertia.sphere(1.0, R))
+    m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=0.02))
+    m.add_contact(ms.Contact("hit", b.contour(ms.contours.Sphere(radius=R), material=mat),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)), material=mat), normal=law))
+    with pytest.raises(ms.ModelError, match="contact.*'hit'") as e:
+        ms.simulate(m, t_end=1e-3, integrator=ms.DOPRI5())
+    assert msg in str(e.value)
+
+
+def test_hertz_on_flat_faces_and_impact_law_are_refused():
+    m = ms.Model("flat", gravity=(0, 0, 0))
+    b = m.add_body("box", mass=1.0, inertia=ms.inertia.box(1.0, (0.1, 0.1, 0.1)))
+    m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=0.06))
+    m.add_contact(ms.Contact("face", b.contour(ms.contours.Box(half_extents=(0.05, 0.05, 0.05)), material=STEEL),
+                             m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)), material=STEEL), normal=ms.laws.Hertz()))
+    with pytest.raises(ms.ModelError, match="'face'.*Hertz law needs curved contours.*KelvinVoigt"):
+        ms.simulate(m, t_end=1e-3, integrator=ms.DOPRI5())
+    m2 = ball_on_plane(ms.laws.Hertz())
+    m2._contacts[0].impact = ms.laws.Newton(eps=0.5)
+    with pytest.raises(ms.ModelError, match="'c'.impact: a compliant contact takes no impact law"):
+        ms.simulate(m2, t_end=1e-3, integrator=ms.DOPRI5())
+
+
+def test_schemes_rigid_and_compliant_side_by_side():
+    """A rigid scheme with only compliant contacts works (Moreau-Jean, the force at the step
+    midpoints); a rigid and a compliant contact mix in one Moreau-Jean run; a smooth scheme with
+    a rigid contact keeps its message; RK4 splits its steps at the onsets."""
+    k = 4 / 3 * E_STAR * math.sqrt(R)
+    _, _, T = hertz_closed_form(MASS, 1.0, k)
+    mj = ms.simulate(ball_on_plane(ms.laws.Hertz()), t_end=4e-4, output_dt=1e-6, integrator=ms.MoreauJean(dt=1e-8))
+    assert mj["joint/z/u"][-1] == pytest.approx(1.0, rel=1e-3)
+    close, opened = contact_times(mj)
+    assert opened[0] - close[0] == pytest.approx(T, rel=2e-3)
+    rk = ms.simulate(ball_on_plane(ms.laws.Hertz()), t_end=4e-4, output_dt=1e-6, integrator=ms.RK4(dt=1e-7))
+    close, opened = contact_times(rk)
+    assert close[0] == pytest.approx(2e-4, rel=1e-9)
+    assert opened[0] - close[0] == pytest.approx(T, rel=1e-6)
+    assert rk["joint/z/u"][-1] == pytest.approx(1.0, rel=1e-8)
+    # mixed: the ball falls on a compliant pad, a second ball on a rigid floor
+    m = ball_on_plane(ms.laws.HuntCrossley(eps=0.8))
+    b2 = m.add_body("rigid_ball", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
+    m.add_joint(ms.joints.Prismatic("z2", m.ground, b2, axis=(0, 0, 1), q0=R + 2e-4, u0=-1.0))
+    m.add_contact(ms.Contact("floor", b2.contour(ms.contours.Sphere(radius=R)), m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
+                             impact=ms.laws.Newton(eps=0.8)))
+    mix = ms.simulate(m, t_end=4e-4, output_dt=1e-6, integrator=ms.MoreauJean(dt=1e-8))
+    assert mix["joint/z2/u"][-1] == pytest.approx(0.8, rel=1e-9)
+    assert 0.75 < mix["joint/z/u"][-1] < 0.9
+    with pytest.raises(ms.SettingsError, match="unilateral contacts \\('floor'\\)"):
+        ms.simulate(m, t_end=1e-3, integrator=ms.DOPRI5())
+
+
+def block(friction, push, normal=100.0):
+    """A 1 kg block sliding along x (its height fixed) on a plane through a Kelvin-Voigt contact
+    pressed to `normal` N, pushed along x by `push` N."""
+    kv = 1e6
+    m = ms.Model("block", gravity=(0, 0, 0))
+    b = m.add_body("block", mass=1.0, inertia=ms.inertia.sphere(1.0, R))
+    m.add_joint(ms.joints.Prismatic("x", m.ground, b, axis=(1, 0, 0)))
+    m.add_contact(ms.Contact("foot", b.contour(ms.contours.Sphere(radius=R, center=(0, 0, -normal / kv))),
+                             m.ground.contour(ms.contours.Plane(point=(0, 0, -R), normal=(0, 0, 1))),
+                             normal=ms.laws.KelvinVoigt(k=kv, v_reg=1e-3), friction=friction))
+    m.add_force(ms.forces.JointForce("push", "x", push))
+    return m
+
+
+def test_regularized_coulomb_creeps_at_the_stated_rate():
+    """Under a push of half mu N the regularized contact creeps at v = v_reg atanh(1/2)."""
+    res = ms.simulate(block(ms.laws.Coulomb(mu=0.4), push=20.0), t_end=0.5, output_dt=1e-2,
+                      integrator=ms.Radau5(rtol=1e-10, atol=1e-14))
+    assert res["joint/x/u"][-1] == pytest.approx(1e-3 * math.atanh(0.5), rel=1e-8)
+    assert res["contact/foot/force_n"][-1] == pytest.approx(100.0, rel=1e-12)
+    assert res["contact/foot/force_t"][-1, 0] * np.sign(res["contact/foot/slip_velocity"][-1, 0]) == pytest.approx(-20.0, rel=1e-8)
+    # beyond mu N it slides
+    slide = ms.simulate(block(ms.laws.Coulomb(mu=0.4), push=50.0), t_end=0.2, output_dt=1e-2, integrator=ms.Radau5(rtol=1e-9, atol=1e-12))
+    assert slide["joint/x/u"][-1] == pytest.approx(0.2 * 10.0, rel=1e-3)
+
+
+def test_lugre_bristles_hold_a_sticking_block_without_drift():
+    """LuGre: under a push below mu0 N the block settles (its bristles carrying the push) and
+    stays: no drift over the second half of 2 s, where the regularized law creeps by
+    v_reg atanh(push/(mu N)) t."""
+    law = ms.laws.LuGre(mu0=0.5, mu=0.4, v_s=1e-3, sigma0=1e4, sigma1=50.0)
+    res = ms.simulate(block(law, push=30.0), t_end=2.0, output_dt=1e-2, integrator=ms.Radau5(rtol=1e-10, atol=1e-14))
+    x = res["joint/x/q"]
+    assert abs(x[-1] - x[len(x) // 2]) < 1e-10
+    assert abs(x[-1]) < 1e-4
+    assert res["contact/foot/force_t"][-1, 0] * np.sign(x[-1]) == pytest.approx(-30.0, rel=1e-8)
+    assert res["contact/foot/energy_dissipated"][-1] > 0
+    creep = ms.simulate(block(ms.laws.Coulomb(mu=0.4), push=30.0), t_end=2.0, output_dt=1e-2,
+                        integrator=ms.Radau5(rtol=1e-10, atol=1e-14))["joint/x/q"]
+    assert creep[-1] - creep[len(creep) // 2] == pytest.approx(1e-3 * math.atanh(0.75) * 1.0, rel=1e-6)
+
+
+def test_user_law_matches_the_built_in_one():
+    """A Python F(delta, delta') equal to Kelvin-Voigt's gives the same run (slow path)."""
+    kv = ms.laws.KelvinVoigt(k=1e7, d=20.0)
+    user = ms.laws.UserLaw(lambda d, dd: 1e7 * d + 20.0 * dd)
+    a = ms.simulate(ball_on_plane(kv), t_end=1e-3, output_dt=1e-5, integrator=ms.DOPRI5(rtol=1e-10, atol=1e-14))
+    b = ms.simulate(ball_on_plane(user), t_end=1e-3, output_dt=1e-5, integrator=ms.DOPRI5(rtol=1e-10, atol=1e-14))
+    np.testing.assert_allclose(b["joint/z/u"], a["joint/z/u"], atol=1e-9)
+    bad = ms.laws.UserLaw(lambda d, dd: float("nan"))
+    with pytest.raises(ms.MechsysError, match="contact 'c'.normal"):
+        ms.simulate(ball_on_plane(bad), t_end=1e-3, integrator=ms.DOPRI5())
