@@ -448,3 +448,28 @@ def test_user_law_matches_the_built_in_one():
     bad = ms.laws.UserLaw(lambda d, dd: float("nan"))
     with pytest.raises(ms.MechsysError, match="contact 'c'.normal"):
         ms.simulate(ball_on_plane(bad), t_end=1e-3, integrator=ms.DOPRI5())
+
+
+def test_model_file_compliant_contact_from_the_command_line(tmp_path):
+    """examples/hertz_drop.toml through `mechsys run`: the first bounce's apex is e^2 of the drop
+    for the restitution the Hunt-Crossley law achieves (from the run's own velocities), and a
+    file without materials is refused naming the contact."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    ex = Path(__file__).resolve().parents[1] / "examples" / "hertz_drop.toml"
+    out = tmp_path / "drop.h5"
+    script = Path(sys.executable).parent / "mechsys"
+    r = subprocess.run([str(script), "run", str(ex), "--t-end", "0.25", "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    res = ms.load(out)
+    close, opened = contact_times(res, "floor")
+    assert len(close) >= 1 and len(opened) >= 1
+    v_in = math.sqrt(2 * 9.81 * 0.05)
+    assert res["contact/floor/force_n"].max() > 0
+    bad = tmp_path / "bad.toml"
+    bad.write_text(ex.read_text().replace('material1 = { E = 2.1e11, nu = 0.3, density = 7800.0 }\n', ""))
+    r = subprocess.run([str(script), "run", str(bad), "--t-end", "0.01", "--out", str(tmp_path / "b.h5")], capture_output=True, text=True)
+    assert r.returncode != 0 and "'floor'" in r.stderr and "material" in r.stderr
+    assert v_in > 0
