@@ -27,7 +27,13 @@ fn complete_elliptic(m: f64) -> PyResult<(f64, f64)> {
 /// E* (Pa) and normal force (N): stiffness K (F = K δ^1.5), approach δ, semi-axes a ≥ b, peak
 /// pressure p0, the ellipse's m = 1 − (b/a)².
 #[pyfunction]
-fn hertz_contact<'py>(py: Python<'py>, a_curv: f64, b_curv: f64, e_star: f64, force: f64) -> PyResult<Bound<'py, PyDict>> {
+fn hertz_contact<'py>(
+    py: Python<'py>,
+    a_curv: f64,
+    b_curv: f64,
+    e_star: f64,
+    force: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let what = "hertz_contact";
     positive(&[("A", a_curv), ("B", b_curv), ("E*", e_star)], what)?;
     if !(force.is_finite() && force >= 0.0) {
@@ -55,7 +61,10 @@ fn johnson_line(delta: f64, radius: f64, length: f64, e_star: f64) -> PyResult<(
     let what = "johnson_line";
     positive(&[("radius", radius), ("length", length), ("E*", e_star)], what)?;
     let x = johnson_x(delta, radius).ok_or_else(|| {
-        settings(format!("{what}: delta {delta} m is beyond the law's range (below 4R/e² = {} m)", 4.0 * radius * (-2f64).exp()))
+        settings(format!(
+            "{what}: delta {delta} m is beyond the law's range (below 4R/e² = {} m)",
+            4.0 * radius * (-2f64).exp()
+        ))
     })?;
     Ok((std::f64::consts::PI * length * e_star * x, johnson_energy(x, radius, length, e_star)))
 }

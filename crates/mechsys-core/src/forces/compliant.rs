@@ -154,7 +154,14 @@ fn normal(
 
 /// Evaluates contact `c` (its recorded values from `o` on): applies its forces to `data.f_ext`,
 /// writes the rates of its extra states and returns the power it dissipates.
-pub fn evaluate(c: &CompliantContact, data: &mut Data, w: &mut Work, o: usize, t: f64, cb: &dyn Callbacks) -> Result<f64> {
+pub fn evaluate(
+    c: &CompliantContact,
+    data: &mut Data,
+    w: &mut Work,
+    o: usize,
+    t: f64,
+    cb: &dyn Callbacks,
+) -> Result<f64> {
     kinematics(c, data, w, t)?;
     let planar = c.pair.tangent_dim() == 1;
     let mut p_diss = 0.0;
@@ -280,7 +287,9 @@ pub fn commit(model: &Model, data: &Data, w: &mut Work, t: f64, states: &mut [f6
 /// The contact and point of compliant point `slot` (for event records).
 pub fn point_of(model: &Model, slot: usize) -> Option<(&str, usize)> {
     model.forces.iter().find_map(|f| match f {
-        ForceElement::Contact(c) if slot >= c.slot && slot < c.slot + c.points() => Some((c.name.as_str(), slot - c.slot)),
+        ForceElement::Contact(c) if slot >= c.slot && slot < c.slot + c.points() => {
+            Some((c.name.as_str(), slot - c.slot))
+        }
         _ => None,
     })
 }

@@ -388,7 +388,9 @@ fn shape(c: &Contour) -> Shape {
         Contour::Plane { .. } | Contour::Line { .. } => Shape::Isotropic(0.0),
         Contour::Ellipsoid { .. } => Shape::Curved,
         Contour::Torus { tube, .. } if *tube > 0.0 => Shape::Curved,
-        Contour::Cylinder { radius, half_length, .. } => Shape::Line { radius: *radius, length: Some(2.0 * half_length) },
+        Contour::Cylinder { radius, half_length, .. } => {
+            Shape::Line { radius: *radius, length: Some(2.0 * half_length) }
+        }
         Contour::Circle { radius, .. } => Shape::Line { radius: *radius, length: None },
         _ => Shape::None,
     }
@@ -397,8 +399,23 @@ fn shape(c: &Contour) -> Shape {
 /// The elastic part of a Hertz-type law on contours `c` (with materials giving `e_star`, or a
 /// given stiffness `k`), and the line `length` where the law asks for one. `what` names the
 /// contact.
-pub fn hertz_elastic(c: &[Contour; 2], e_star: Option<f64>, k: Option<f64>, length: Option<f64>, what: &str) -> Result<Elastic> {
-    let planar = c.iter().any(|x| matches!(x, Contour::Circle { .. } | Contour::Line { .. } | Contour::Point2 { .. } | Contour::Polygon { .. } | Contour::Curve(_)));
+pub fn hertz_elastic(
+    c: &[Contour; 2],
+    e_star: Option<f64>,
+    k: Option<f64>,
+    length: Option<f64>,
+    what: &str,
+) -> Result<Elastic> {
+    let planar = c.iter().any(|x| {
+        matches!(
+            x,
+            Contour::Circle { .. }
+                | Contour::Line { .. }
+                | Contour::Point2 { .. }
+                | Contour::Polygon { .. }
+                | Contour::Curve(_)
+        )
+    });
     let (s1, s2) = (shape(&c[0]), shape(&c[1]));
     let need_e = || {
         e_star.ok_or_else(|| {
