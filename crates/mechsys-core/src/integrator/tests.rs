@@ -405,7 +405,8 @@ fn steps_end_at_switches() {
             Ok(())
         };
         integrate(&kind, &mut Kink, 0.0, &[0.0, 0.0], &[0.0, 1.0], &mut obs).unwrap();
-        // the retaken step ends 1e-7 of a step past the kink: an error of that order squared
-        assert!((end[1] - exact).abs() < 1e-12, "{kind:?}: {} against {exact}", end[1]);
+        // the retaken step ends 1e-7 of a step past the kink: the last stage of that step sees
+        // the sliver, an error of h² 1e-7 at most (a step across the kink errs by about h² / 10)
+        assert!((end[1] - exact).abs() < 1e-9, "{kind:?}: {} against {exact}", end[1]);
     }
 }
