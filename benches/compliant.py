@@ -178,7 +178,7 @@ def main(argv=None) -> int:
         for name, st, rj, ev, tmin, tmed, rest in damp:
             L.append(f"| {name} | {st} | {rj} | {ev} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {rest:.4e} m |")
         L += ["", f"**Pile of {a.pile} spheres**, {a.pile_time:g} s simulated (one run each):", "",
-              "| engine | wall time | largest penetration | energy drift |E+D−E0|/E0 | mean height at the end | notes |",
+              "| engine | wall time | largest penetration | energy drift (E + D − E0)/E0 | mean height at the end | notes |",
               "|---|---:|---:|---:|---:|---|"]
         for name, el, pen, drift, zm, note in pile:
             L.append(f"| {name} | {fmt_time(el)} | {pen:.2e} m | {drift} | {zm:.4f} m | {note} |")
@@ -189,7 +189,11 @@ def main(argv=None) -> int:
               "- The compliant pile carries every pair as an explicit contact (no broad phase for compliant "
               "contacts yet): its cost grows as N²; its penetration is the physical overlap of the soft material "
               "(E = 1e7 Pa), set by the material, not by a solver tolerance. MuJoCo's soft contacts penetrate by "
-              "their solref time constant; mechsys' rigid pile by the Moreau–Jean step's drift."]
+              "their solref time constant; mechsys' rigid pile by the Moreau–Jean step's drift. The compliant pile is
+thousands of times slower than both: every right-hand side evaluates all N(N−1)/2 + 5N pairs (5450 for
+N = 100) and the steps follow the contacts' ≈ 5 ms vibrations (15 000 steps in 0.3 s); a broad phase
+for compliant contacts and an implicit scheme with a sparse Jacobian are what it needs. Its energy
+balance (kinetic + potential + stored − work + dissipated) closes to the integrator's tolerance."]
         write_doc(a.out, "\n".join(L), "<!-- compliant.py:begin -->", "<!-- compliant.py:end -->")
         print(f"updated {a.out}")
     return 0
