@@ -143,7 +143,9 @@ def test_dissipative_laws_restitution_against_scipy(law, alpha):
     assert res["contact/c/energy_dissipated"][-1] == pytest.approx(ke0 * (1 - e * e), rel=1e-7)
     assert res["energy/dissipated"][-1] == pytest.approx(ke0 * (1 - e * e), rel=1e-7)
     if getattr(law, "eps", None) is not None:
-        assert abs(e - law.eps) > 1e-3  # the mappings are approximations
+        # the mappings are approximations: what each achieves at eps = 0.5 (as documented)
+        documented = {"HuntCrossley": 0.663, "LankaraniNikravesh": 0.725, "Flores": 0.470}[type(law).__name__]
+        assert e == pytest.approx(documented, abs=5e-4)
 
 
 def test_kelvin_voigt_restitution_and_cutoff_against_scipy():
