@@ -28,6 +28,8 @@ from .urdf import load_urdf
 from .viewer import view
 from .mjcf import load_mjcf
 from .batch import BatchResults, simulate_batch
+from .laws import Material
+from . import hertz
 
 
 def plot(results, signals, out=None, **kwargs):
@@ -68,6 +70,8 @@ __all__ = [
     "Contact",
     "ContactGroup",
     "GapContact",
+    "Material",
+    "hertz",
     "contours",
     "laws",
     "mechanisms",

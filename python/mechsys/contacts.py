@@ -39,7 +39,6 @@ class Contact:
         for k, side in (("first", self.first), ("second", self.second)):
             if not isinstance(side, OnBody):
                 raise ModelError(f"{what}.{k}: expected a contour on a body (body.contour(ms.contours.X(...))), got {type(side).__name__}")
-        normal = _normal_law(what, self.normal, self.friction, self.impact)
         d = {
             "name": self.name,
             "body1": self.first.body,
@@ -47,9 +46,15 @@ class Contact:
             "body2": self.second.body,
             "contour2": self.second.contour.describe(f"{what}.contour2"),
         }
+        if isinstance(self.normal, laws.COMPLIANT):
+            return _compliant(d, self, what, callbacks)
+        normal = _normal_law(what, self.normal, self.friction, self.impact)
         if normal is not None:
             d["normal"] = normal
         if self.friction is not None:
+            if isinstance(self.friction, laws.LuGre):
+                raise ModelError(f"{what}.friction: the LuGre bristle law acts on compliant contacts (normal=laws.Hertz(), "
+                                 "laws.KelvinVoigt(k), ...); a rigid contact takes Coulomb, Stribeck or FrictionTable")
             if not isinstance(self.friction, (laws.Coulomb, laws.Stribeck, laws.FrictionTable)):
                 raise ModelError(f"{what}.friction: expected a mechsys.laws friction law, got {type(self.friction).__name__}")
             d["friction"] = self.friction.describe(f"{what}.friction")
@@ -64,11 +69,36 @@ class Contact:
         return d
 
 
+def _compliant(d: dict, c: "Contact", what: str, callbacks: list) -> dict:
+    """The description of a compliant contact: its law, materials and friction; its restitution
+    comes from the law, so it takes no impact law."""
+    if c.impact is not None:
+        raise ModelError(f"{what}.impact: a compliant contact takes no impact law (its restitution comes from its normal "
+                         "law: HuntCrossley(eps=...), LankaraniNikravesh, Flores, or KelvinVoigt's damping)")
+    d["normal"] = c.normal.describe(f"{what}.normal", callbacks)
+    for k, side in (("material1", c.first), ("material2", c.second)):
+        mat = getattr(side, "material", None)
+        if mat is not None:
+            if not isinstance(mat, laws.Material):
+                raise ModelError(f"{what}.{k}: expected mechsys.Material(E, nu, density), got {type(mat).__name__}")
+            d[k] = mat.describe(f"{what}.{k}")
+    if c.friction is not None:
+        if not isinstance(c.friction, (laws.Coulomb, laws.Stribeck, laws.FrictionTable, laws.LuGre)):
+            raise ModelError(f"{what}.friction: expected a mechsys.laws friction law, got {type(c.friction).__name__}")
+        d["friction"] = c.friction.describe(f"{what}.friction")
+    if c.points is not None:
+        if isinstance(c.points, bool) or not isinstance(c.points, int) or not 1 <= c.points <= 8:
+            raise ModelError(f"{what}.points: expected a whole number from 1 to 8, got {c.points!r}")
+        d["points"] = int(c.points)
+    return d
+
+
 def _normal_law(what: str, normal, friction, impact) -> dict | None:
     """The description of a contact's normal law (None for Signorini's, the default); a bilateral
     contact takes no friction or impact law."""
     if not isinstance(normal, (laws.Signorini, laws.Bilateral)):
-        raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini() or Bilateral(), got {type(normal).__name__}")
+        raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini(), Bilateral() or a compliant law (KelvinVoigt, Hertz, "
+                         f"HuntCrossley, LankaraniNikravesh, Flores, UserLaw), got {type(normal).__name__}")
     if isinstance(normal, laws.Signorini):
         return None
     for key, law in (("friction", friction), ("impact", impact)):

@@ -829,10 +829,12 @@ def gear_mesh(gear1: Gear, gear2: Gear, center_distance: float) -> GearMesh:
 
 @dataclass
 class OnBody:
-    """A contour attached to a body (what :meth:`mechsys.Body.contour` returns)."""
+    """A contour attached to a body (what :meth:`mechsys.Body.contour` returns), with its
+    material (:class:`mechsys.Material`) for compliant contact laws."""
 
     body: str
     contour: Contour
+    material: Any = None
 
 
 __all__ = [

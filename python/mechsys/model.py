@@ -49,13 +49,17 @@ class Body:
                              f"0..{len(nodes) - 1} or 'n0'..'n{len(nodes) - 1}')")
         return tuple(float(x) for x in nodes[k]["position"])
 
-    def contour(self, contour) -> "Any":
-        """This body carrying a contour (see :mod:`mechsys.contours`), for a :class:`mechsys.Contact`."""
+    def contour(self, contour, material=None) -> "Any":
+        """This body carrying a contour (see :mod:`mechsys.contours`), for a :class:`mechsys.Contact`;
+        ``material``: a :class:`mechsys.Material` for compliant laws (Hertz, Johnson)."""
         from .contours import Contour, OnBody
+        from .laws import Material
 
         if not isinstance(contour, Contour):
             raise ModelError(f"body '{self.name}'.contour: expected a mechsys.contours contour, got {type(contour).__name__}")
-        return OnBody(self.name, contour)
+        if material is not None and not isinstance(material, Material):
+            raise ModelError(f"body '{self.name}'.contour: material: expected mechsys.Material(E, nu, density), got {type(material).__name__}")
+        return OnBody(self.name, contour, material)
 
 
 from .joints import _vec3  # noqa: E402  (one vector check for the whole builder)

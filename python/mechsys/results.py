@@ -266,6 +266,26 @@ class Results:
                     put(f"force/{name}/eccentricity", raw["force_deflection"][:, k], "1")
                     put(f"force/{name}/position_angle", raw["force_deflection"][:, k + 1], "rad")
                     put(f"force/{name}/attitude_angle", raw["force_deflection"][:, k + 2], "rad")
+                elif kind == "compliant_contact":
+                    # per point: F_N, F_T1, F_T2, stored and dissipated energy; delta, delta', slip velocity (t1, t2), alpha
+                    npt, nt = f["points"], f["tangents"]
+                    fv = raw["force_value"][:, k:k + w].reshape(-1, npt, 5)
+                    dv = raw["force_deflection"][:, k:k + w].reshape(-1, npt, 5)
+                    one = npt == 1
+                    pick = (lambda a, i: a[:, 0, i]) if one else (lambda a, i: a[:, :, i])
+                    pre = f"contact/{name}"
+                    put(f"{pre}/overlap", pick(dv, 0), "m")
+                    put(f"{pre}/overlap_rate", pick(dv, 1), "m/s")
+                    put(f"{pre}/force_n", pick(fv, 0), "N")
+                    if nt > 1:
+                        put(f"{pre}/force_t", fv[:, 0, 1:3] if one else fv[:, :, 1:3], "N", ["t1", "t2"] if one else None)
+                        put(f"{pre}/slip_velocity", dv[:, 0, 2:4] if one else dv[:, :, 2:4], "m/s", ["t1", "t2"] if one else None)
+                    else:
+                        put(f"{pre}/force_t", pick(fv, 1), "N")
+                        put(f"{pre}/slip_velocity", pick(dv, 2), "m/s")
+                    put(f"{pre}/damping_alpha", pick(dv, 4), "s/m")
+                    put(f"{pre}/energy_elastic", fv[:, :, 3].sum(axis=1), "J")
+                    put(f"{pre}/energy_dissipated", fv[:, :, 4].sum(axis=1), "J")
                 elif kind == "python_force":
                     labels = [joint_of.get(i, (f"u{i}", ""))[0] for i in range(w)]
                     put(f"force/{name}/force", raw["force_value"][:, sl], "mixed", labels,

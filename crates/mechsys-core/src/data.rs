@@ -123,6 +123,9 @@ pub struct Data {
     pub slider_trial: Vec<f64>,
     /// forces: slider forces λ at the last force evaluation (n_sliders).
     pub slider_force: Vec<f64>,
+    /// Force stage: the elastic energy stored in the compliant contacts (their overlaps and
+    /// bristles) at the last evaluation (J).
+    pub contact_energy: f64,
     /// forces: each element's force at the last evaluation, resisting its deflection (n_force_outputs).
     pub element_force: Vec<f64>,
     /// forces: each element's deflection at the last evaluation (n_force_outputs).
@@ -189,6 +192,7 @@ impl Data {
             slider: vec![0.0; model.n_sliders],
             slider_trial: vec![0.0; model.n_sliders],
             slider_force: vec![0.0; model.n_sliders],
+            contact_energy: 0.0,
             element_force: vec![0.0; model.n_force_outputs],
             element_deflection: vec![0.0; model.n_force_outputs],
             elastic: model.elastic.iter().map(crate::elastic::ElasticWork::new).collect(),

@@ -3,6 +3,7 @@
 //! (`Data::f_ext`, world components about the inertial origin) and generalized forces (`Data::tau_applied`).
 
 pub mod bearing;
+pub mod compliant;
 pub mod damping;
 pub mod jenkins;
 
@@ -65,6 +66,12 @@ pub trait Callbacks {
     fn gap_function(&self, id: usize, t: f64, q: &[f64], u: &[f64], grad: &mut [f64]) -> Result<[f64; 3]> {
         let _ = (t, q, u, grad);
         Err(Error::Callback(format!("gap function callback {id} was not provided")))
+    }
+    /// A compliant contact's user law `F(δ, δ̇)` (callback `id`): the normal force before the
+    /// cut-off at overlap `delta` and overlap rate `rate`. An implementation checks it is finite.
+    fn contact_force(&self, id: usize, delta: f64, rate: f64) -> Result<f64> {
+        let _ = (delta, rate);
+        Err(Error::Callback(format!("contact law callback {id} was not provided")))
     }
 }
 
@@ -237,12 +244,14 @@ pub struct Workspace {
     /// Lemke scratch of each Jenkins chain (press fits), in the order of the model's force
     /// elements ([`jenkins::chains`]).
     pub jenkins: Vec<jenkins::ChainWork>,
+    /// The compliant contacts' scratch, history and extra states ([`compliant::Work`]).
+    pub compliant: compliant::Work,
 }
 
 impl Workspace {
     /// Allocates the force stage's workspace for `model`.
     pub fn new(model: &Model) -> Self {
-        Workspace { jenkins: jenkins::chains(model) }
+        Workspace { jenkins: jenkins::chains(model), compliant: compliant::Work::new(model) }
     }
 }
 
@@ -259,6 +268,7 @@ pub fn evaluate(
 ) -> Result<Powers> {
     data.f_ext.iter_mut().for_each(|f| *f = Force::ZERO);
     data.tau_applied.iter_mut().for_each(|x| *x = 0.0);
+    data.contact_energy = 0.0;
     let mut p_diss = 0.0;
     let mut p_ext = 0.0;
 
@@ -500,6 +510,9 @@ pub fn evaluate(
                     p_ext += v * s * u[j.iu + k];
                     data.element_force[o + k] = v * s;
                 }
+            }
+            ForceElement::Contact(c) => {
+                p_diss += compliant::evaluate(c, data, &mut ws.compliant, o, t, cb)?;
             }
             ForceElement::Callback { name, id } => {
                 let before: f64 = data.tau_applied.iter().zip(u).map(|(a, b)| a * b).sum();

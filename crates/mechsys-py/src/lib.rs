@@ -2,6 +2,7 @@
 //! the GIL is released while a simulation runs.
 
 mod bearing;
+mod compliant;
 mod dynamics;
 mod errors;
 mod geometry;
@@ -18,6 +19,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     model::register(m)?;
     dynamics::register(m)?;
     bearing::register(m)?;
+    compliant::register(m)?;
     geometry::register(m)?;
     kinematics::register(m)?;
     math::register(m)?;

@@ -288,6 +288,7 @@ impl PyModel {
                     F::JournalBearing { .. } => "journal_bearing",
                     F::Jenkins(_) => "jenkins",
                     F::HydrodynamicBearing(_) => "hydrodynamic_bearing",
+                    F::Contact(_) => "compliant_contact",
                 };
                 (f.name().to_string(), t.to_string())
             })
@@ -324,6 +325,8 @@ impl PyModel {
                 F::Callback { .. } => ("python_force", "mixed", ""),
                 // force: F_x, F_y (shell frame), torque; deflection: ε, position angle, attitude angle
                 F::HydrodynamicBearing(_) => ("hydrodynamic_bearing", "N, N, N m", "1, rad, rad"),
+                // per point, force: F_N, F_T1, F_T2, stored and dissipated energy; deflection: δ, δ̇, ġ_T1, ġ_T2, α
+                F::Contact(_) => ("compliant_contact", "N, N, N, J, J", "m, m/s, m/s, m/s, s/m"),
             };
             if width > 0 {
                 let d = PyDict::new(py);
@@ -333,6 +336,10 @@ impl PyModel {
                 d.set_item("width", width)?;
                 d.set_item("force_unit", fu)?;
                 d.set_item("deflection_unit", du)?;
+                if let F::Contact(c) = f {
+                    d.set_item("points", c.points())?;
+                    d.set_item("tangents", c.pair.tangent_dim())?;
+                }
                 out.push(d);
             }
             first += width;

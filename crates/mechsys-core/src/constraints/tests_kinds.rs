@@ -792,6 +792,8 @@ fn model_with_held_contacts() -> Model {
             friction: FrictionDescription::None,
             impact: ImpactDescription::default(),
             points: None,
+            material1: None,
+            material2: None,
         }
     };
     let sphere = |c: [f64; 3], r| ContourDescription::Sphere { center: c, radius: r };

@@ -73,9 +73,12 @@ pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
                 };
             }
             ForceElement::Jenkins(j) => v += jenkins::energy(j, data, q),
+            // the compliant contacts' stored energy, from the last force evaluation
+            ForceElement::Contact(_) => {}
             _ => {}
         }
     }
+    v += data.contact_energy;
     for e in &model.elastic {
         v += crate::elastic::strain_energy(e, &q[e.iq..e.iq + e.ne]);
     }

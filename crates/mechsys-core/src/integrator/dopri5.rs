@@ -353,6 +353,10 @@ pub fn integrate<S: OdeSystem>(
     };
     let mut err_old: f64 = 1e-4;
     let mut reject = false;
+    // steps retaken to end just past a switch: the step the controller wanted before
+    let mut switches = super::switching::Locator::new(sys);
+    let mut located: Option<f64> = None;
+    let mut retaken = f64::NAN; // the step size of an attempt retaken at a switch (not searched again)
 
     loop {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
@@ -390,6 +394,14 @@ pub fn integrate<S: OdeSystem>(
         }
         if err <= 1.0 {
             st.prepare_dense(&y, h);
+            if h != retaken {
+                if let Some(th) = switches.locate(sys, t, h, &y, &st.ynew, |th, out| st.dense(th, out))? {
+                    located.get_or_insert(h);
+                    h *= th;
+                    retaken = h;
+                    continue;
+                }
+            }
             let t_new = t + h;
             sys.project(t_new, &mut st.ynew)?;
             check_finite(t_new, &st.ynew)?;
@@ -403,6 +415,9 @@ pub fn integrate<S: OdeSystem>(
                 break;
             }
             h = (h * next_factor(err, err_old, reject)).min(hmax);
+            if let Some(wanted) = located.take() {
+                h = wanted.min(hmax);
+            }
             err_old = err.max(1e-4);
             reject = false;
         } else {

@@ -19,6 +19,7 @@ pub mod lie_group;
 pub mod moreau_jean;
 pub mod radau5;
 pub mod rk4;
+pub(crate) mod switching;
 
 use serde::{Deserialize, Serialize};
 
@@ -51,6 +52,16 @@ pub trait OdeSystem {
     /// is lost); resets. An adaptive scheme shrinks such a step until it is below its tolerance.
     fn switched(&mut self) -> bool {
         false
+    }
+    /// Number of switching functions: functions of (t, y) whose sign changes mark kinks of the
+    /// right-hand side (a compliant contact's onset); the schemes end their steps there
+    /// ([`switching`]).
+    fn switches(&self) -> usize {
+        0
+    }
+    /// The switching functions at (t, y) into `out` (`switches()` values).
+    fn switching(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) -> Result<()> {
+        Ok(())
     }
 }
 

@@ -6,6 +6,34 @@ use super::lie_group::Chart;
 use super::{check_finite, Observer, OdeSystem, Stats};
 use crate::error::{Error, Result};
 
+/// Most switches one step is split at.
+const MAX_SPLITS: usize = 16;
+
+/// Stages 2–4 of the step `h` from (t, y) with `k1 = f(t, y)`.
+fn stages<S: OdeSystem>(
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    h: f64,
+    k1: &[f64],
+    (k2, k3, k4): (&mut [f64], &mut [f64], &mut [f64]),
+    tmp: &mut [f64],
+) -> Result<()> {
+    let n = y.len();
+    for i in 0..n {
+        tmp[i] = y[i] + 0.5 * h * k1[i];
+    }
+    sys.rhs(t + 0.5 * h, tmp, k2)?;
+    for i in 0..n {
+        tmp[i] = y[i] + 0.5 * h * k2[i];
+    }
+    sys.rhs(t + 0.5 * h, tmp, k3)?;
+    for i in 0..n {
+        tmp[i] = y[i] + h * k3[i];
+    }
+    sys.rhs(t + h, tmp, k4)
+}
+
 /// Integrates with steps of `dt`; observes at each `t_out` (which must be multiples of `dt` from t0).
 pub fn integrate<S: OdeSystem>(
     sys: &mut S,
@@ -24,8 +52,9 @@ pub fn integrate<S: OdeSystem>(
         return integrate_on_group(sys, &chart, t0, y0, dt, t_out, obs);
     }
     let mut y = y0.to_vec();
-    let (mut k1, mut k2, mut k3, mut k4, mut tmp) =
-        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut k1, mut k2, mut k3, mut k4, mut tmp, mut ynew) =
+        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut switches = super::switching::Locator::new(sys);
     let mut stats = Stats::default();
     // output index at each step number
     let mut next = 0usize;
@@ -44,21 +73,49 @@ pub fn integrate<S: OdeSystem>(
             break;
         }
         let h = dt;
-        for i in 0..n {
-            tmp[i] = y[i] + 0.5 * h * k1[i];
-        }
-        sys.rhs(t + 0.5 * h, &tmp, &mut k2)?;
-        for i in 0..n {
-            tmp[i] = y[i] + 0.5 * h * k2[i];
-        }
-        sys.rhs(t + 0.5 * h, &tmp, &mut k3)?;
-        for i in 0..n {
-            tmp[i] = y[i] + h * k3[i];
-        }
-        sys.rhs(t + h, &tmp, &mut k4)?;
-        stats.evaluations += 3;
-        for i in 0..n {
-            y[i] += h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        // a step across a switch (a compliant contact's onset) is split there: substeps up to
+        // just past each switch found on the continuous extension, then the rest of the step
+        let (mut tt, mut rem, mut splits) = (t, h, 0);
+        loop {
+            if splits > 0 {
+                sys.rhs(tt, &y, &mut k1)?;
+                stats.evaluations += 1;
+            }
+            stages(sys, tt, &y, rem, &k1, (&mut k2, &mut k3, &mut k4), &mut tmp)?;
+            stats.evaluations += 3;
+            for i in 0..n {
+                ynew[i] = y[i] + rem / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+            }
+            if splits < MAX_SPLITS {
+                let (a, b, c, d) = (&k1, &k2, &k3, &k4);
+                let yy = &y;
+                let dense = |th: f64, out: &mut [f64]| {
+                    // the continuous extension of order 3 (Hairer, Nørsett, Wanner II.6)
+                    let (t2, t3) = (th * th, th * th * th);
+                    let w1 = th - 1.5 * t2 + 2.0 / 3.0 * t3;
+                    let w23 = t2 - 2.0 / 3.0 * t3;
+                    let w4 = -0.5 * t2 + 2.0 / 3.0 * t3;
+                    for i in 0..n {
+                        out[i] = yy[i] + rem * (w1 * a[i] + w23 * (b[i] + c[i]) + w4 * d[i]);
+                    }
+                };
+                if let Some(th) = switches.locate(sys, tt, rem, &y, &ynew, dense)? {
+                    let h1 = th * rem;
+                    stages(sys, tt, &y, h1, &k1, (&mut k2, &mut k3, &mut k4), &mut tmp)?;
+                    stats.evaluations += 3;
+                    for i in 0..n {
+                        y[i] += h1 / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+                    }
+                    sys.project(tt + h1, &mut y)?;
+                    check_finite(tt + h1, &y)?;
+                    sys.accepted(tt + h1, &mut y)?;
+                    (tt, rem, splits) = (tt + h1, rem - h1, splits + 1);
+                    stats.steps += 1;
+                    continue;
+                }
+            }
+            y.copy_from_slice(&ynew);
+            break;
         }
         sys.project(t + h, &mut y)?;
         check_finite(t + h, &y)?;
@@ -82,8 +139,10 @@ fn integrate_on_group<S: OdeSystem>(
 ) -> Result<Stats> {
     let (n, nl) = (sys.dim(), chart.local_dim());
     let mut y = y0.to_vec();
-    let (mut tmp, mut fy) = (vec![0.0; n], vec![0.0; n]);
-    let (mut k1, mut k2, mut k3, mut k4, mut z) = (vec![0.0; nl], vec![0.0; nl], vec![0.0; nl], vec![0.0; nl], vec![0.0; nl]);
+    let (mut tmp, mut fy, mut ynew) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut k1, mut k2, mut k3, mut k4, mut z, mut zl) =
+        (vec![0.0; nl], vec![0.0; nl], vec![0.0; nl], vec![0.0; nl], vec![0.0; nl], vec![0.0; nl]);
+    let mut switches = super::switching::Locator::new(sys);
     let mut stats = Stats::default();
     let mut next = 0usize;
     let mut step = 0u64;
@@ -102,24 +161,50 @@ fn integrate_on_group<S: OdeSystem>(
             break;
         }
         let h = dt;
-        let mut stage = |c: f64, k_prev: &[f64], k: &mut [f64]| -> Result<()> {
-            for i in 0..nl {
-                z[i] = c * h * k_prev[i];
+        // split at switches as the flat scheme does, the continuous extension in the chart
+        let (mut tt, mut rem, mut splits) = (t, h, 0);
+        loop {
+            if splits > 0 {
+                sys.rhs(tt, &y, &mut fy)?;
+                chart.tangent0(&y, &fy, &mut k1);
+                stats.evaluations += 1;
             }
-            chart.retract(&y, &z, &mut tmp);
-            sys.rhs(t + c * h, &tmp, &mut fy)?;
-            chart.tangent(&tmp, &z, &fy, k);
-            Ok(())
-        };
-        stage(0.5, &k1, &mut k2)?;
-        stage(0.5, &k2, &mut k3)?;
-        stage(1.0, &k3, &mut k4)?;
-        stats.evaluations += 3;
-        for i in 0..nl {
-            z[i] = h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+            group_stages(sys, chart, tt, &y, rem, &k1, (&mut k2, &mut k3, &mut k4), (&mut z, &mut tmp, &mut fy))?;
+            stats.evaluations += 3;
+            for i in 0..nl {
+                z[i] = rem / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+            }
+            chart.retract(&y, &z, &mut ynew);
+            if splits < MAX_SPLITS {
+                let (a, b, c, d, yy, zl) = (&k1, &k2, &k3, &k4, &y, &mut zl);
+                let dense = |th: f64, out: &mut [f64]| {
+                    let (t2, t3) = (th * th, th * th * th);
+                    let (w1, w23, w4) = (th - 1.5 * t2 + 2.0 / 3.0 * t3, t2 - 2.0 / 3.0 * t3, -0.5 * t2 + 2.0 / 3.0 * t3);
+                    for i in 0..nl {
+                        zl[i] = rem * (w1 * a[i] + w23 * (b[i] + c[i]) + w4 * d[i]);
+                    }
+                    chart.retract(yy, zl, out);
+                };
+                if let Some(th) = switches.locate(sys, tt, rem, &y, &ynew, dense)? {
+                    let h1 = th * rem;
+                    group_stages(sys, chart, tt, &y, h1, &k1, (&mut k2, &mut k3, &mut k4), (&mut z, &mut tmp, &mut fy))?;
+                    stats.evaluations += 3;
+                    for i in 0..nl {
+                        z[i] = h1 / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+                    }
+                    chart.retract(&y, &z, &mut tmp);
+                    std::mem::swap(&mut y, &mut tmp);
+                    sys.project(tt + h1, &mut y)?;
+                    check_finite(tt + h1, &y)?;
+                    sys.accepted(tt + h1, &mut y)?;
+                    (tt, rem, splits) = (tt + h1, rem - h1, splits + 1);
+                    stats.steps += 1;
+                    continue;
+                }
+            }
+            std::mem::swap(&mut y, &mut ynew);
+            break;
         }
-        chart.retract(&y, &z, &mut tmp);
-        std::mem::swap(&mut y, &mut tmp);
         sys.project(t + h, &mut y)?;
         check_finite(t + h, &y)?;
         sys.accepted(t + h, &mut y)?;
@@ -127,4 +212,31 @@ fn integrate_on_group<S: OdeSystem>(
         stats.steps += 1;
     }
     Ok(stats)
+}
+
+/// The stages k2..k4 of a step `h` from (t, y) on the group, `k1` given: each at `y ⊕ c h k_prev`,
+/// pulled back into the chart.
+#[allow(clippy::too_many_arguments)]
+fn group_stages<S: OdeSystem>(
+    sys: &mut S,
+    chart: &Chart,
+    t: f64,
+    y: &[f64],
+    h: f64,
+    k1: &[f64],
+    (k2, k3, k4): (&mut [f64], &mut [f64], &mut [f64]),
+    (z, tmp, fy): (&mut [f64], &mut [f64], &mut [f64]),
+) -> Result<()> {
+    let mut stage = |c: f64, k_prev: &[f64], k: &mut [f64]| -> Result<()> {
+        for (zi, kp) in z.iter_mut().zip(k_prev) {
+            *zi = c * h * kp;
+        }
+        chart.retract(y, z, tmp);
+        sys.rhs(t + c * h, tmp, fy)?;
+        chart.tangent(tmp, z, fy, k);
+        Ok(())
+    };
+    stage(0.5, k1, k2)?;
+    stage(0.5, k2, k3)?;
+    stage(1.0, k3, k4)
 }

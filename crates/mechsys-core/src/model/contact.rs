@@ -480,6 +480,133 @@ fn friction_law(friction: &FrictionDescription, what: &str) -> Result<FrictionLa
             }
             FrictionLaw::Table { speed: speed.clone(), mu: mu.clone() }
         }
+        FrictionDescription::LuGre { .. } => {
+            return Err(Error::Model(format!(
+                "{what}.friction: the LuGre bristle law acts on compliant contacts (a normal law such as laws.Hertz or laws.KelvinVoigt); a rigid contact takes Coulomb, Stribeck or a table"
+            )))
+        }
+    })
+}
+
+/// Validates a contact whose normal law is compliant (`index` among the contacts, `slot` its
+/// first point among the compliant contact points): the pair as for a rigid contact, then the
+/// materials, the law and the tangential law. `callbacks` counts a user law's callback.
+pub(super) fn validate_compliant(
+    d: &ContactDescription,
+    index: usize,
+    slot: usize,
+    body: impl Fn(&str, &str) -> Result<usize>,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
+    n_callbacks: &mut usize,
+) -> Result<super::compliant::CompliantContact> {
+    use super::compliant::{self as cc, Dissipation, Elastic, RestitutionMap, Tangential};
+    use super::contact_description::NormalDescription as N;
+    let what = format!("contacts[{index}] '{}'", d.name);
+    let mut rigid = d.clone();
+    rigid.friction = FrictionDescription::None;
+    let c = validate(&rigid, index, 0, &body, rotation)?;
+    let ContactGeometry::Contours { pair, contours } = c.geometry else {
+        return Err(Error::Model(format!("{what}: a compliant contact needs two contours")));
+    };
+    crate::ensure!(
+        pair.surface_velocity().iter().all(|v| v.norm() == 0.0),
+        Model,
+        "{what}: a compliant contact on a moving surface is not supported"
+    );
+    let material = |m: &Option<super::contact_description::MaterialDescription>, k: usize| -> Result<Option<cc::Material>> {
+        m.map(|m| cc::Material::new(m.e, m.nu, m.density, &format!("{what}.material{k}"))).transpose()
+    };
+    let (m1, m2) = (material(&d.material1, 1)?, material(&d.material2, 2)?);
+    let materials = match (m1, m2) {
+        (Some(a), Some(b)) => Some([a, b]),
+        (None, None) => None,
+        _ => {
+            return Err(Error::Model(format!(
+                "{what}: give both contours a material (one has none: E* combines the two sides)"
+            )))
+        }
+    };
+    let e_star = materials.map(|[a, b]| cc::effective_modulus(&a, &b));
+    let positive = |v: f64, key: &str| -> Result<f64> {
+        crate::ensure!(v.is_finite() && v > 0.0, Model, "{what}.normal.{key}: must be > 0, got {v}");
+        Ok(v)
+    };
+    let (elastic, dissipation, v_reg) = match &d.normal {
+        N::KelvinVoigt { k, d: damping, v_reg } => {
+            positive(*k, "k")?;
+            crate::ensure!(damping.is_finite() && *damping >= 0.0, Model, "{what}.normal.d: must be >= 0, got {damping}");
+            (Elastic::KelvinVoigt { k: *k, d: *damping }, Dissipation::None, *v_reg)
+        }
+        N::User { callback, v_reg } => {
+            crate::ensure!(*callback < 1 << 32, Model, "{what}.normal.callback: index {callback} is out of range");
+            *n_callbacks = (*n_callbacks).max(callback + 1);
+            (Elastic::User { callback: *callback }, Dissipation::None, *v_reg)
+        }
+        N::Hertz(h) | N::HuntCrossley(h) | N::LankaraniNikravesh(h) | N::Flores(h) => {
+            let map = match &d.normal {
+                N::HuntCrossley(_) => Some(RestitutionMap::HuntCrossley),
+                N::LankaraniNikravesh(_) => Some(RestitutionMap::LankaraniNikravesh),
+                N::Flores(_) => Some(RestitutionMap::Flores),
+                _ => None,
+            };
+            if let Some(k) = h.stiffness {
+                positive(k, "stiffness")?;
+            }
+            let elastic = cc::hertz_elastic(&contours, e_star, h.stiffness, h.length, &what)?;
+            let dissipation = match (map, h.eps, h.alpha) {
+                (_, Some(_), Some(_)) => {
+                    return Err(Error::Model(format!("{what}.normal: give eps or alpha, not both")))
+                }
+                (_, None, Some(a)) => {
+                    crate::ensure!(a.is_finite() && a >= 0.0, Model, "{what}.normal.alpha: the damping coefficient must be >= 0, got {a}");
+                    if a == 0.0 { Dissipation::None } else { Dissipation::Alpha(a) }
+                }
+                (None, Some(_), None) => {
+                    return Err(Error::Model(format!(
+                        "{what}.normal.eps: the undamped Hertz law has restitution 1; use HuntCrossley, LankaraniNikravesh or Flores for a restitution"
+                    )))
+                }
+                (Some(map), Some(e), None) => {
+                    crate::ensure!(e.is_finite() && e > 0.0 && e <= 1.0, Model, "{what}.normal.eps: must be in (0, 1], got {e}");
+                    if e == 1.0 { Dissipation::None } else { Dissipation::Restitution { map, eps: e } }
+                }
+                (Some(map), None, None) => {
+                    return Err(Error::Model(format!("{what}.normal: the {} law needs eps (restitution) or alpha (s/m)", map.name())))
+                }
+                (None, None, None) => Dissipation::None,
+            };
+            (elastic, dissipation, h.v_reg)
+        }
+        N::Signorini | N::Bilateral { .. } => return Err(Error::Model(format!("{what}.normal: not a compliant law"))),
+    };
+    let tangential = match &d.friction {
+        FrictionDescription::None => Tangential::None,
+        FrictionDescription::LuGre { mu0, mu, v_s, sigma0, sigma1, sigma2 } => {
+            let w = format!("{what}.friction");
+            for (k, v) in [("mu0", mu0), ("mu", mu), ("sigma1", sigma1), ("sigma2", sigma2)] {
+                crate::ensure!(v.is_finite() && *v >= 0.0, Model, "{w}.{k}: must be >= 0, got {v}");
+            }
+            crate::ensure!(v_s.is_finite() && *v_s > 0.0, Model, "{w}.v_s: must be > 0, got {v_s}");
+            crate::ensure!(sigma0.is_finite() && *sigma0 > 0.0, Model, "{w}.sigma0: must be > 0, got {sigma0}");
+            crate::ensure!(*mu0 > 0.0 || *mu > 0.0, Model, "{w}: mu0 and mu are both zero");
+            Tangential::LuGre { mu0: *mu0, mu: *mu, v_s: *v_s, sigma0: *sigma0, sigma1: *sigma1, sigma2: *sigma2 }
+        }
+        f => {
+            let law = friction_law(f, &what)?;
+            let v_reg = v_reg.unwrap_or(1e-4);
+            crate::ensure!(v_reg.is_finite() && v_reg > 0.0, Model, "{what}.normal.v_reg: must be > 0, got {v_reg}");
+            Tangential::Regularized { law, v_reg }
+        }
+    };
+    Ok(cc::CompliantContact {
+        name: d.name.clone(),
+        body1: c.body1,
+        body2: c.body2,
+        pair,
+        contours,
+        law: cc::CompliantLaw { elastic, dissipation, tangential },
+        materials,
+        slot,
     })
 }
 

@@ -41,6 +41,25 @@ pub struct ContactDescription {
     /// most 8): the deepest local minima of the distance, e.g. both flanks of a groove.
     #[serde(default)]
     pub points: Option<usize>,
+    /// Material of contour 1 (compliant laws: E* for Hertz and Johnson).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material1: Option<MaterialDescription>,
+    /// Material of contour 2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material2: Option<MaterialDescription>,
+}
+
+/// An elastic material (see [`super::compliant::Material`]).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDescription {
+    /// Young's modulus (Pa), > 0.
+    #[serde(rename = "E")]
+    pub e: f64,
+    /// Poisson's ratio in (-1, 0.5).
+    pub nu: f64,
+    /// Density (kg/m³), > 0.
+    pub density: f64,
 }
 
 /// A contour: closed-form geometry attached to a body (all data in the body frame, m).
@@ -382,6 +401,54 @@ pub enum NormalDescription {
         #[serde(default)]
         rolling: bool,
     },
+    /// Compliant, Kelvin–Voigt: F = max(0, k δ + d δ̇) with δ = −g_N the overlap.
+    KelvinVoigt {
+        /// Stiffness (N/m), > 0.
+        k: f64,
+        /// Damping (N s/m), ≥ 0.
+        #[serde(default)]
+        d: f64,
+        /// Regularization velocity of the friction law (m/s).
+        #[serde(default)]
+        v_reg: Option<f64>,
+    },
+    /// Compliant, Hertz: F = K δ^{3/2} (point) or Johnson's line law, undamped.
+    Hertz(HertzDescription),
+    /// Compliant, Hertz with Hunt–Crossley damping.
+    HuntCrossley(HertzDescription),
+    /// Compliant, Hertz with Lankarani–Nikravesh damping.
+    LankaraniNikravesh(HertzDescription),
+    /// Compliant, Hertz with Flores' damping.
+    Flores(HertzDescription),
+    /// Compliant, a user law F(δ, δ̇) (a Python callable, by its callback id).
+    User {
+        /// Callback id.
+        callback: usize,
+        /// Regularization velocity of the friction law (m/s).
+        #[serde(default)]
+        v_reg: Option<f64>,
+    },
+}
+
+/// The parameters of a Hertz-type compliant law.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzDescription {
+    /// K (N/m^1.5) given directly instead of from the materials and curvatures.
+    #[serde(default)]
+    pub stiffness: Option<f64>,
+    /// Restitution the damping is tuned for, in (0, 1] (the dissipative laws).
+    #[serde(default)]
+    pub eps: Option<f64>,
+    /// The damping coefficient α (s/m) given directly instead of from `eps`.
+    #[serde(default)]
+    pub alpha: Option<f64>,
+    /// Contact length (m) of a line contact (planar discs; a cylinder's own length otherwise).
+    #[serde(default)]
+    pub length: Option<f64>,
+    /// Regularization velocity of the friction law (m/s).
+    #[serde(default)]
+    pub v_reg: Option<f64>,
 }
 
 /// Tangential contact law.
@@ -417,6 +484,23 @@ pub enum FrictionDescription {
         speed: Vec<f64>,
         /// Coefficients at those speeds, ≥ 0; the first is the static coefficient.
         mu: Vec<f64>,
+    },
+    /// The LuGre bristle law (compliant contacts only; see [`super::compliant`]).
+    LuGre {
+        /// Static coefficient.
+        mu0: f64,
+        /// Sliding coefficient.
+        mu: f64,
+        /// Stribeck velocity (m/s).
+        v_s: f64,
+        /// Bristle stiffness per unit normal force (1/m).
+        sigma0: f64,
+        /// Bristle damping per unit normal force (s/m).
+        #[serde(default)]
+        sigma1: f64,
+        /// Viscous friction per unit normal force (s/m).
+        #[serde(default)]
+        sigma2: f64,
     },
 }
 

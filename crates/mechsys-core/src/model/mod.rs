@@ -10,6 +10,7 @@
 //! stages that evaluate them import the model, never the other way round.
 
 pub mod bearing;
+pub mod compliant;
 pub mod constraint;
 pub mod contact;
 pub mod contact_description;
@@ -335,6 +336,8 @@ pub enum ForceElement {
         /// Callback index.
         id: usize,
     },
+    /// A compliant contact (evaluated by [`crate::forces::compliant`]).
+    Contact(Box<compliant::CompliantContact>),
 }
 
 impl ForceElement {
@@ -351,6 +354,7 @@ impl ForceElement {
             | ForceElement::Callback { name, .. } => name,
             ForceElement::Jenkins(j) => &j.name,
             ForceElement::HydrodynamicBearing(b) => &b.name,
+            ForceElement::Contact(c) => &c.name,
         }
     }
 
@@ -371,6 +375,7 @@ impl ForceElement {
             | ForceElement::Jenkins(_) => 1,
             ForceElement::JointForce { value, .. } => value.len(),
             ForceElement::Callback { .. } => nu,
+            ForceElement::Contact(c) => compliant::OUTPUTS_PER_POINT * c.points(),
         }
     }
 }
@@ -416,6 +421,8 @@ pub struct Model {
     pub n_sliders: usize,
     /// Number of recorded force and deflection values over all force elements.
     pub n_force_outputs: usize,
+    /// Number of candidate points over all compliant contacts (their history and extra states).
+    pub n_compliant_points: usize,
     /// The description it was built from (stored with results).
     pub description: ModelDescription,
     body_index: HashMap<String, usize>,

@@ -1224,6 +1224,7 @@ impl Model {
         let mut contacts = Vec::with_capacity(desc.contacts.len());
         let mut contact_names = HashSet::new();
         let mut n_contact_points = 0;
+        let mut n_compliant_points = 0;
         for (i, d) in desc.contacts.iter().enumerate() {
             crate::ensure!(
                 contact_names.insert(d.name.clone()),
@@ -1231,6 +1232,13 @@ impl Model {
                 "contacts[{i}] '{}': duplicate contact name",
                 d.name
             );
+            if !matches!(d.normal, NormalDescription::Signorini | NormalDescription::Bilateral { .. }) {
+                // compliant: a force element on the contact's geometry, not a unilateral contact
+                let c = super::contact::validate_compliant(d, i, n_compliant_points, body, rotation, &mut n_callbacks)?;
+                n_compliant_points += c.points();
+                forces.push(ForceElement::Contact(Box::new(c)));
+                continue;
+            }
             let c = super::contact::validate(d, i, n_contact_points, body, rotation)?;
             if let NormalDescription::Bilateral { rolling } = d.normal {
                 // held closed: a constraint, not a unilateral contact
@@ -1330,6 +1338,7 @@ impl Model {
             n_callbacks,
             n_sliders,
             n_force_outputs,
+            n_compliant_points,
             description: desc,
             body_index,
             joint_index,

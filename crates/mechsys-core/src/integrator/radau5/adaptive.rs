@@ -460,6 +460,9 @@ pub fn integrate_adaptive<S: OdeSystem>(
     let (mut first, mut reject) = (true, false);
     let (mut h_acc, mut err_acc) = (0.0, 0.0); // Gustafsson's memory
     let mut singular = 0u32;
+    let mut switches = crate::integrator::switching::Locator::new(sys);
+    let mut located: Option<f64> = None; // the step wanted before one was cut at a switch
+    let mut retaken = f64::NAN; // the step size of an attempt retaken at a switch (not searched again)
 
     loop {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
@@ -553,11 +556,29 @@ pub fn integrate_adaptive<S: OdeSystem>(
             let gus = (h_acc / h * (err * err / err_acc).powf(0.25) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
             quot = quot.max(gus);
         }
-        (h_acc, err_acc) = (h, err.max(1e-2));
-
         // accepted: y₁ = y₀ + Z₃ (stiffly accurate)
         let t_new = t + h;
         wk.chart.retract(&y, &wk.z[2 * n..], &mut wk.ynew);
+        if h != retaken {
+            // a switch inside the step (a compliant contact's onset): retaken up to just past it;
+            // the collocation polynomial in the chart's local coordinates, retracted
+            let (tab, z, chart, zl) = (&wk.tab, &wk.z, &wk.chart, &mut wk.zl);
+            let yy = &y;
+            let dense = |th: f64, out: &mut [f64]| {
+                let wt = tab.collocation_weights(th);
+                for i in 0..n {
+                    zl[i] = wt[0] * z[i] + wt[1] * z[n + i] + wt[2] * z[2 * n + i];
+                }
+                chart.retract(yy, zl, out);
+            };
+            if let Some(th) = switches.locate(sys, t, h, &y, &wk.ynew, dense)? {
+                located.get_or_insert(h);
+                h *= th;
+                retaken = h;
+                continue;
+            }
+        }
+        (h_acc, err_acc) = (h, err.max(1e-2));
         sys.project(t_new, &mut wk.ynew)?;
         check_finite(t_new, &wk.ynew)?;
         {
@@ -596,6 +617,9 @@ pub fn integrate_adaptive<S: OdeSystem>(
             }
         } else {
             need_jac = true;
+        }
+        if let Some(wanted) = located.take() {
+            h_new = wanted.min(hmax);
         }
         h = h_new;
     }

@@ -1,0 +1,295 @@
+//! Compliant contacts as force elements (the laws and their formulas: [`crate::model::compliant`]).
+//!
+//! Each evaluation runs the pair's narrow phase and relative kinematics (the same as a rigid
+//! contact's, [`crate::contact::contact_kinematics`]), turns the overlap `δ = −g_N` and its rate
+//! `δ̇ = −ġ_N` into a normal force `F_N ≥ 0` and the sliding velocity into a tangential force, and
+//! applies `F_N n + F_T` to body 1 at its contact point and the opposite to body 2 at its own —
+//! the generalized forces `w_N F_N + W_T F_T` of eq. 2.112's Jacobians.
+//!
+//! History: the dissipative laws tuned by a restitution take the approach speed at the onset of
+//! each contact ([`Work::onset_speed`], committed after accepted steps by [`commit`]); the
+//! dissipated energy and the LuGre bristle deflections are extra states of the smooth schemes
+//! ([`crate::model::compliant::STATES_PER_POINT`] per point), whose values the caller puts into
+//! [`Work::states`] before an evaluation and whose rates it reads from [`Work::rates`].
+//!
+//! Switching functions: per point the gap `g_N` and the force before its cut-off (while closed);
+//! an adaptive scheme ends its steps where either changes sign ([`switching`]), so no step
+//! straddles the kink of the onset, the release or the cut-off.
+
+use crate::contact::ContactKinematics;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::forces::Callbacks;
+use crate::math::Vec3;
+use crate::model::compliant::{
+    johnson_energy, johnson_x, CompliantContact, Dissipation, Elastic, HertzEllipse, Tangential, OUTPUTS_PER_POINT,
+    STATES_PER_POINT,
+};
+use crate::model::{ForceElement, Model};
+use crate::spatial::Force;
+
+/// The compliant contacts' working memory and history, sized once per model.
+#[derive(Debug, Clone, Default)]
+pub struct Work {
+    kin: Vec<ContactKinematics>,
+    /// Extra states (STATES_PER_POINT per point: dissipated energy, bristles z1, z2), set by the
+    /// caller before an evaluation (zero if it carries none).
+    pub states: Vec<f64>,
+    /// Their rates at the last evaluation.
+    pub rates: Vec<f64>,
+    /// Approach speed at the onset of the current contact, per point (0 while open or unset).
+    pub onset_speed: Vec<f64>,
+    /// Whether each point was closed at the last commit.
+    pub closed: Vec<bool>,
+    /// Points that changed (closed or opened) at the last commit, as (point, closed).
+    pub changed: Vec<(usize, bool)>,
+}
+
+impl Work {
+    /// Sized for `model`.
+    pub fn new(model: &Model) -> Work {
+        let n = model.n_compliant_points;
+        let most = model
+            .forces
+            .iter()
+            .filter_map(|f| if let ForceElement::Contact(c) = f { Some(c.points()) } else { None })
+            .max()
+            .unwrap_or(0);
+        Work {
+            kin: vec![ContactKinematics::default(); most],
+            states: vec![0.0; STATES_PER_POINT * n],
+            rates: vec![0.0; STATES_PER_POINT * n],
+            onset_speed: vec![0.0; n],
+            closed: vec![false; n],
+            changed: Vec::with_capacity(n),
+        }
+    }
+}
+
+/// The contact's kinematics into `w.kin[..points]`; errors name the contact.
+fn kinematics(c: &CompliantContact, data: &Data, w: &mut Work, t: f64) -> Result<()> {
+    let b1 = crate::contact::BodyMotion::from_data(data, c.body1);
+    let b2 = crate::contact::BodyMotion::from_data(data, c.body2);
+    crate::contact::contact_kinematics(&c.pair, &b1, &b2, &mut w.kin[..c.points()])
+        .map_err(|e| crate::contact::at_contact(e, &c.name, t))
+}
+
+/// The elastic force and stored energy at overlap `delta > 0` of point `k` (kinematics `kin`).
+fn elastic(c: &CompliantContact, data: &Data, kin: &ContactKinematics, delta: f64, t: f64) -> Result<(f64, f64)> {
+    Ok(match &c.law.elastic {
+        Elastic::KelvinVoigt { k, .. } => (k * delta, 0.5 * k * delta * delta),
+        Elastic::Hertz { k } => (k * delta * delta.sqrt(), 0.4 * k * delta * delta * delta.sqrt()),
+        Elastic::HertzCurved { e_star } => {
+            let (x1, x2) = (&data.x_abs[c.body1], &data.x_abs[c.body2]);
+            let k1 = c.contours[0].curvatures_at(x1, &kin.point.p1);
+            let k2 = c.contours[1].curvatures_at(x2, &kin.point.p2);
+            // one side is isotropic (checked when built): the relative principal curvatures
+            let (s0, s1) = (k1[0] + k2[0], k1[1] + k2[1]);
+            let (a, b) = (0.5 * s0.min(s1), 0.5 * s0.max(s1));
+            if !(a > 0.0 && b.is_finite()) {
+                return Err(Error::Solver(format!(
+                    "contact '{}' at t = {t:.6} s: the relative curvature at the contact point is {a:.4e} 1/m, no Hertz contact (conforming or flat)",
+                    c.name
+                )));
+            }
+            let k = HertzEllipse::new(a, b).stiffness(a, *e_star);
+            (k * delta * delta.sqrt(), 0.4 * k * delta * delta * delta.sqrt())
+        }
+        Elastic::Line { radius, length, e_star } => {
+            let x = johnson_x(delta, *radius).ok_or_else(|| {
+                Error::Solver(format!(
+                    "contact '{}': overlap {delta:.4e} m at t = {t:.6} s is beyond the range of Johnson's line law (below 4R/e² = {:.4e} m)",
+                    c.name,
+                    4.0 * radius * (-2.0f64).exp()
+                ))
+            })?;
+            (std::f64::consts::PI * length * e_star * x, johnson_energy(x, *radius, *length, *e_star))
+        }
+        Elastic::User { .. } => (0.0, 0.0),
+    })
+}
+
+/// The damping coefficient α of point `slot` at approach rate `rate` (the onset speed once committed).
+fn alpha(c: &CompliantContact, w: &Work, slot: usize, rate: f64) -> f64 {
+    match c.law.dissipation {
+        Dissipation::None => 0.0,
+        Dissipation::Alpha(a) => a,
+        Dissipation::Restitution { map, eps } => {
+            let v = if w.onset_speed[slot] > 0.0 { w.onset_speed[slot] } else { rate };
+            if v > 0.0 {
+                map.alpha(eps, v)
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+/// The normal force before the cut-off, the elastic force and the stored energy.
+fn normal(
+    c: &CompliantContact,
+    data: &Data,
+    w: &Work,
+    kin: &ContactKinematics,
+    slot: usize,
+    t: f64,
+    cb: &dyn Callbacks,
+) -> Result<(f64, f64, f64, f64)> {
+    let (delta, rate) = (-kin.point.g_n, -kin.gd_n);
+    if let Elastic::User { callback } = c.law.elastic {
+        let f = cb
+            .contact_force(callback, delta, rate)
+            .map_err(|e| Error::Callback(format!("contact '{}'.normal: {e}", c.name)))?;
+        return Ok((f, 0.0, 0.0, 0.0));
+    }
+    let (f_el, v) = elastic(c, data, kin, delta, t)?;
+    Ok(match c.law.elastic {
+        Elastic::KelvinVoigt { d, .. } => (f_el + d * rate, f_el, v, 0.0),
+        _ => {
+            let a = alpha(c, w, slot, rate);
+            (f_el * (1.0 + a * rate), f_el, v, a)
+        }
+    })
+}
+
+/// Evaluates contact `c` (its recorded values from `o` on): applies its forces to `data.f_ext`,
+/// writes the rates of its extra states and returns the power it dissipates.
+pub fn evaluate(
+    c: &CompliantContact,
+    data: &mut Data,
+    w: &mut Work,
+    o: usize,
+    t: f64,
+    cb: &dyn Callbacks,
+) -> Result<f64> {
+    kinematics(c, data, w, t)?;
+    let planar = c.pair.tangent_dim() == 1;
+    let mut p_diss = 0.0;
+    for k in 0..c.points() {
+        let kin = w.kin[k];
+        let slot = c.slot + k;
+        let s = STATES_PER_POINT * slot;
+        let (delta, rate) = (-kin.point.g_n, -kin.gd_n);
+        let v = [kin.gd_t[0], if planar { 0.0 } else { kin.gd_t[1] }];
+        let (mut f_n, mut f_t, mut energy, mut a) = (0.0, [0.0; 2], 0.0, 0.0);
+        let mut p = 0.0;
+        w.rates[s + 1] = 0.0;
+        w.rates[s + 2] = 0.0;
+        if delta > 0.0 {
+            let (raw, f_el, stored, alpha) = normal(c, data, w, &kin, slot, t, cb)?;
+            f_n = raw.max(0.0);
+            energy = stored;
+            a = alpha;
+            // what the overlap's rate feeds in beyond the stored energy's rate
+            p += (f_n - f_el) * rate;
+            let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+            match &c.law.tangential {
+                Tangential::None => {}
+                Tangential::Regularized { law, v_reg } => {
+                    if speed > 0.0 {
+                        let m = law.mu(speed) * f_n * (speed / v_reg).tanh() / speed;
+                        f_t = [-m * v[0], -m * v[1]];
+                    }
+                }
+                Tangential::LuGre { mu0, mu, v_s, sigma0, sigma1, sigma2 } => {
+                    let g = mu + (mu0 - mu) * (-(speed / v_s).powi(2)).exp();
+                    let z = [w.states[s + 1], w.states[s + 2]];
+                    for i in 0..2 {
+                        let zd = v[i] - sigma0 * speed * z[i] / g;
+                        w.rates[s + 1 + i] = zd;
+                        f_t[i] = -f_n * (sigma0 * z[i] + sigma1 * zd + sigma2 * v[i]);
+                        // the bristles store ½ F_N σ0 z² (at the current F_N)
+                        energy += 0.5 * f_n * sigma0 * z[i] * z[i];
+                        p -= f_n * sigma0 * z[i] * zd;
+                    }
+                }
+            }
+            p -= f_t[0] * v[0] + f_t[1] * v[1];
+            let f = kin.point.n * f_n + kin.point.t1 * f_t[0] + kin.point.t2 * f_t[1];
+            apply(data, c.body1, &kin.point.p1, &f);
+            apply(data, c.body2, &kin.point.p2, &(-f));
+        }
+        w.rates[s] = p;
+        p_diss += p;
+        data.contact_energy += energy;
+        let (fo, d) = (&mut data.element_force, &mut data.element_deflection);
+        let b = o + OUTPUTS_PER_POINT * k;
+        fo[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[f_n, f_t[0], f_t[1], energy, w.states[s]]);
+        d[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[delta, rate, v[0], v[1], a]);
+    }
+    Ok(p_diss)
+}
+
+#[inline]
+fn apply(data: &mut Data, b: usize, p: &Vec3, f: &Vec3) {
+    if b != 0 {
+        data.f_ext[b] += Force::new(p.cross(f), *f);
+    }
+}
+
+/// Number of switching functions of `model`'s compliant contacts (2 per point).
+pub fn switches(model: &Model) -> usize {
+    2 * model.n_compliant_points
+}
+
+/// The switching functions at the state whose kinematics `data` holds (positions and
+/// velocities): per point the gap g_N and, while closed, the normal force before its cut-off
+/// (1 while open, so that only a closed contact's force crossing zero counts).
+pub fn switching(model: &Model, data: &Data, w: &mut Work, t: f64, cb: &dyn Callbacks, out: &mut [f64]) -> Result<()> {
+    for f in &model.forces {
+        let ForceElement::Contact(c) = f else { continue };
+        kinematics(c, data, w, t)?;
+        for k in 0..c.points() {
+            let kin = w.kin[k];
+            let slot = c.slot + k;
+            out[2 * slot] = kin.point.g_n;
+            out[2 * slot + 1] = if kin.point.g_n < 0.0 && !matches!(c.law.elastic, Elastic::User { .. }) {
+                normal(c, data, w, &kin, slot, t, cb)?.0
+            } else {
+                1.0
+            };
+        }
+    }
+    Ok(())
+}
+
+/// After an accepted step (the last evaluation at its end): the onset speeds of the contacts
+/// that closed, the reset of those that opened (their bristles relax), and the points that
+/// changed in [`Work::changed`]. `states` are the extra states (reset in place).
+pub fn commit(model: &Model, data: &Data, w: &mut Work, t: f64, states: &mut [f64]) -> Result<()> {
+    w.changed.clear();
+    for f in &model.forces {
+        let ForceElement::Contact(c) = f else { continue };
+        kinematics(c, data, w, t)?;
+        for k in 0..c.points() {
+            let slot = c.slot + k;
+            // touching and approaching counts as closed (a step that ends exactly at the onset)
+            let (g, gd) = (w.kin[k].point.g_n, w.kin[k].gd_n);
+            let closed = g < 0.0 || (g == 0.0 && gd < 0.0);
+            if closed && w.onset_speed[slot] == 0.0 {
+                w.onset_speed[slot] = (-w.kin[k].gd_n).max(f64::MIN_POSITIVE);
+            }
+            if !closed {
+                w.onset_speed[slot] = 0.0;
+                let s = STATES_PER_POINT * slot;
+                states[s + 1] = 0.0;
+                states[s + 2] = 0.0;
+            }
+            if closed != w.closed[slot] {
+                w.closed[slot] = closed;
+                w.changed.push((slot, closed));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The contact and point of compliant point `slot` (for event records).
+pub fn point_of(model: &Model, slot: usize) -> Option<(&str, usize)> {
+    model.forces.iter().find_map(|f| match f {
+        ForceElement::Contact(c) if slot >= c.slot && slot < c.slot + c.points() => {
+            Some((c.name.as_str(), slot - c.slot))
+        }
+        _ => None,
+    })
+}
