@@ -1,0 +1,205 @@
+//! Independent contact islands: the connected components of the contact graph (two contact
+//! points are linked when their Delassus block `W_ij` is nonzero, i.e. they move a common body
+//! or a common tree). The friction-contact problem is block-diagonal over the islands, so each
+//! island is a problem of its own: solved apart (a small island converges in its own few
+//! sweeps instead of waiting for the slowest), and in parallel on rayon's threads.
+//!
+//! Every island owns its problem, workspace and impulses, refilled in place each step (storage
+//! grows to the largest step seen, then no allocation). An island's solve reads only its own
+//! data, so the impulses are the same bit for bit whether the islands run one after the other
+//! or on any number of threads; the combined report is formed in island order.
+
+use rayon::prelude::*;
+
+use crate::error::Result;
+use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, Report, Workspace};
+
+/// One island's problem and scratch.
+#[derive(Debug, Clone, Default)]
+struct Island {
+    problem: Option<FrictionContact>,
+    ws: Workspace,
+    r: Vec<f64>,
+    diag: Vec<f64>,
+    upper: Vec<(usize, usize)>,
+    upper_val: Vec<f64>,
+    report: Option<Report>,
+}
+
+/// The partition of the step's contacts into islands and the islands' problems.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Islands {
+    /// Union-find parents (per contact), then the island of each contact.
+    of: Vec<usize>,
+    /// Position of each contact inside its island.
+    local: Vec<usize>,
+    /// Contacts of island k: `members[start[k]..start[k + 1]]`, ascending.
+    start: Vec<usize>,
+    members: Vec<usize>,
+    count: usize,
+    pool: Vec<Island>,
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+impl Islands {
+    /// Number of islands of the last partition.
+    pub(super) fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Partitions `n` contacts linked by the pairs `upper` (i < j).
+    pub(super) fn partition(&mut self, n: usize, upper: &[(usize, usize)]) {
+        self.of.clear();
+        self.of.extend(0..n);
+        for &(i, j) in upper {
+            let (a, b) = (find(&mut self.of, i), find(&mut self.of, j));
+            if a != b {
+                // the smaller root wins, so the labels do not depend on the pairs' order
+                let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                self.of[hi] = lo;
+            }
+        }
+        // label islands in the order of their first contact
+        self.local.clear();
+        self.local.resize(n, 0);
+        self.start.clear();
+        self.count = 0;
+        for i in 0..n {
+            let root = find(&mut self.of, i);
+            if root == i {
+                self.local[i] = self.count; // the island's label, for now
+                self.count += 1;
+            }
+        }
+        for i in 0..n {
+            let root = self.of[i];
+            self.of[i] = self.local[root];
+        }
+        // counting sort of the contacts by island
+        self.start.resize(self.count + 2, 0);
+        for i in 0..n {
+            self.start[self.of[i] + 2] += 1;
+        }
+        for k in 0..self.count {
+            self.start[k + 2] += self.start[k + 1];
+        }
+        self.members.clear();
+        self.members.resize(n, 0);
+        for i in 0..n {
+            let k = self.of[i];
+            let s = self.start[k + 1];
+            self.members[s] = i;
+            self.local[i] = s - self.start[k];
+            self.start[k + 1] += 1;
+        }
+        self.start.truncate(self.count + 1);
+        if self.pool.len() < self.count {
+            self.pool.resize_with(self.count, Island::default);
+        }
+    }
+
+    /// Splits `whole` (block-sparse `W`, diagonal blocks `diag`, coupled pairs `upper` with
+    /// values `upper_val`) into the islands' problems, warm-started from `r`.
+    pub(super) fn fill(
+        &mut self,
+        whole: &FrictionContact,
+        diag: &[f64],
+        upper: &[(usize, usize)],
+        upper_val: &[f64],
+        r: &[f64],
+    ) {
+        let d = whole.dim;
+        let dd = d * d;
+        for isl in &mut self.pool[..self.count] {
+            isl.diag.clear();
+            isl.upper.clear();
+            isl.upper_val.clear();
+            isl.r.clear();
+            let p = isl.problem.get_or_insert_with(|| FrictionContact {
+                dim: d,
+                w: Delassus::Blocks(BlockDelassus::default()),
+                q: Vec::new(),
+                mu: Vec::new(),
+            });
+            p.dim = d;
+            p.q.clear();
+            p.mu.clear();
+        }
+        for k in 0..self.count {
+            let isl = &mut self.pool[k];
+            let p = isl.problem.as_mut().expect("filled above");
+            for &i in &self.members[self.start[k]..self.start[k + 1]] {
+                isl.diag.extend_from_slice(&diag[i * dd..(i + 1) * dd]);
+                p.q.extend_from_slice(&whole.q[i * d..(i + 1) * d]);
+                p.mu.push(whole.mu[i]);
+                isl.r.extend_from_slice(&r[i * d..(i + 1) * d]);
+            }
+        }
+        for (e, &(i, j)) in upper.iter().enumerate() {
+            let isl = &mut self.pool[self.of[i]];
+            debug_assert_eq!(self.of[i], self.of[j]);
+            isl.upper.push((self.local[i], self.local[j]));
+            isl.upper_val.extend_from_slice(&upper_val[e * dd..(e + 1) * dd]);
+        }
+        for k in 0..self.count {
+            let n = self.start[k + 1] - self.start[k];
+            let isl = &mut self.pool[k];
+            let p = isl.problem.as_mut().expect("filled above");
+            let Delassus::Blocks(bw) = &mut p.w else { unreachable!("block Delassus") };
+            bw.refill(d, n, &isl.diag, &isl.upper, &isl.upper_val);
+        }
+    }
+
+    /// Refreshes the islands' friction coefficients from the whole problem's (a re-solve after
+    /// a break-away changes some) and their warm starts from `r`.
+    pub(super) fn refresh(&mut self, whole: &FrictionContact, r: &[f64]) {
+        let d = whole.dim;
+        for k in 0..self.count {
+            let isl = &mut self.pool[k];
+            let p = isl.problem.as_mut().expect("filled");
+            for (l, &i) in self.members[self.start[k]..self.start[k + 1]].iter().enumerate() {
+                p.mu[l] = whole.mu[i];
+                isl.r[l * d..(l + 1) * d].copy_from_slice(&r[i * d..(i + 1) * d]);
+            }
+        }
+    }
+
+    /// Solves every island with `method` (in parallel if `parallel`), writes the impulses into
+    /// `r` and returns the islands' largest iteration count, their worst residual (each relative
+    /// to its own free velocity) and whether all converged.
+    pub(super) fn solve(&mut self, method: &Method, parallel: bool, r: &mut [f64]) -> Result<Report> {
+        let run = |isl: &mut Island| -> Result<()> {
+            let p = isl.problem.as_ref().expect("filled");
+            isl.ws.reserve(p, method)?;
+            let warm = isl.r.iter().any(|v| *v != 0.0);
+            isl.report = Some(solver::solve(p, method, &mut isl.r, warm, &mut isl.ws)?);
+            Ok(())
+        };
+        let islands = &mut self.pool[..self.count];
+        if parallel {
+            islands.par_iter_mut().try_for_each(run)?;
+        } else {
+            islands.iter_mut().try_for_each(run)?;
+        }
+        let d = self.pool.first().and_then(|i| i.problem.as_ref()).map_or(3, |p| p.dim);
+        let mut out = Report { iterations: 0, residual: 0.0, converged: true };
+        for k in 0..self.count {
+            let isl = &self.pool[k];
+            for (l, &i) in self.members[self.start[k]..self.start[k + 1]].iter().enumerate() {
+                r[i * d..(i + 1) * d].copy_from_slice(&isl.r[l * d..(l + 1) * d]);
+            }
+            let rep = isl.report.expect("solved");
+            out.iterations = out.iterations.max(rep.iterations);
+            out.residual = out.residual.max(rep.residual);
+            out.converged &= rep.converged;
+        }
+        Ok(out)
+    }
+}
