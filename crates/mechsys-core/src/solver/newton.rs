@@ -25,7 +25,9 @@
 //! error `ε (W + ε)⁻¹ u`: a contraction by `reg / σ` per iteration on each eigenvalue `σ` of the
 //! scaled `W`, while the merit and the stopping test stay those of the exact problem. Along the
 //! null space the step is `ε`-damped, so the impulses of an indeterminate support stay near the
-//! warm start instead of running off.
+//! warm start instead of running off. Three passes of iterative refinement against the exact `J`
+//! (each an `O((d n)²)` solve with the same factors) take the range components on to `(reg/σ)⁴`,
+//! so near the solution the iteration keeps Newton's speed.
 //!
 //! Each iteration solves `J Δ = −Φ` with a dense LU on preallocated storage and backtracks
 //! `r + α Δ` (α = 1, ½, ¼, …) until Armijo's condition `ψ(r + αΔ) ≤ (1 − 2σα) ψ(r)` holds for
@@ -84,6 +86,8 @@ impl NewtonWork {
 
 const ARMIJO: f64 = 1e-4;
 const MAX_BACKTRACKS: usize = 30;
+/// Passes of iterative refinement of the regularized Newton direction.
+const REFINEMENTS: usize = 3;
 
 /// Alart–Curnier function of one contact into `phi`, and optionally `D = ∂P(x)` into `dmat`.
 pub(crate) fn alart_curnier(
@@ -252,6 +256,29 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
                 *x = -f;
             }
             lu_solve(jac, m, piv, dir);
+            // iterative refinement against the exact J: each pass shrinks the regularization's
+            // error by reg/σ, so the iteration converges as Newton's does, not linearly at rate reg
+            for _ in 0..REFINEMENTS {
+                if !dir.iter().all(|v| v.is_finite()) {
+                    break;
+                }
+                matvec(&p.w, d, dir, wdir);
+                for i in 0..n {
+                    let (rho, dm) = (1.0 / diag[i][0], &dblk[i]);
+                    for a in 0..d {
+                        let mut jd = dir[i * d + a];
+                        for c in 0..d {
+                            jd += dm[a * d + c] * (rho * wdir[i * d + c] - dir[i * d + c]);
+                        }
+                        // the right-hand side's residual, −Φ − J Δ
+                        phi_t[i * d + a] = -phi[i * d + a] - jd;
+                    }
+                }
+                lu_solve(jac, m, piv, phi_t);
+                for (x, c) in dir.iter_mut().zip(phi_t.iter()) {
+                    *x += c;
+                }
+            }
             if dir.iter().all(|v| v.is_finite()) {
                 // W Δ once; trial velocities are then u + α W Δ
                 matvec(&p.w, d, dir, wdir);
