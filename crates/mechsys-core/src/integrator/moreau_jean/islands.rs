@@ -92,14 +92,19 @@ impl Islands {
         }
         self.members.clear();
         self.members.resize(n, 0);
+        // start[k + 1] is island k's next free slot while filling, then island k + 1's start
         for i in 0..n {
             let k = self.of[i];
             let s = self.start[k + 1];
             self.members[s] = i;
-            self.local[i] = s - self.start[k];
             self.start[k + 1] += 1;
         }
         self.start.truncate(self.count + 1);
+        for k in 0..self.count {
+            for (l, &i) in self.members[self.start[k]..self.start[k + 1]].iter().enumerate() {
+                self.local[i] = l;
+            }
+        }
         if self.pool.len() < self.count {
             self.pool.resize_with(self.count, Island::default);
         }
