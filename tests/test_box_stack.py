@@ -181,10 +181,10 @@ def test_the_auto_solver_holds_the_stack_at_its_static_weights_every_step(dt):
     assert res["solver/converged"][1:].all()
     assert res["solver/residual"].max() <= 1e-12
     assert (res["solver/contacts"][1:] == 4 * n).all() and (res["solver/islands"][1:] == 1).all()
-    # the first steps start cold and settle; then the warm start and the reused factorization
-    # leave at most a few iterations per step
+    # the first steps start cold and settle; then a warm-started step takes one Gauss-Seidel
+    # sweep, or the auto solver's 10 sweeps and a Newton step with the reused factorization
     it = res["solver/iterations"]
-    assert it.max() <= 40 and np.median(it) <= 1
+    assert it.max() <= 60 and np.median(it) <= 11
     top = res[f"body/box{n - 1}/position"]
     assert np.abs(top - top[0]).max() < 1e-9
     # lambda_n of a sample is the step's impulse over the step: every step's static weights

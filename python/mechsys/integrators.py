@@ -116,7 +116,7 @@ class Auto:
     :class:`MoreauJean`."""
 
     tol: float = 1e-10
-    newton_max_unknowns: int = 360
+    newton_max_unknowns: int = 480
     newton_max_iter: int = 200
     nsgs_max_iter: int = 10_000
 

@@ -164,6 +164,9 @@ impl Default for NewtonOptions {
     }
 }
 
+/// Gauss–Seidel sweeps [`Method::Auto`] takes before it turns to Newton.
+pub const AUTO_SWEEPS: usize = 10;
+
 /// The automatic choice ([`Method::Auto`]): the method by the problem's shape.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -183,7 +186,7 @@ pub struct AutoOptions {
 
 impl Default for AutoOptions {
     fn default() -> Self {
-        Self { tol: 1e-10, newton_max_unknowns: 360, newton_max_iter: 200, nsgs_max_iter: 10_000 }
+        Self { tol: 1e-10, newton_max_unknowns: 480, newton_max_iter: 200, nsgs_max_iter: 10_000 }
     }
 }
 
@@ -208,7 +211,8 @@ pub enum Method {
     Nsgs(NsgsOptions),
     /// Semismooth Newton (friction contact only).
     Newton(NewtonOptions),
-    /// Newton for small friction-contact problems, Gauss–Seidel for large ones, Lemke for LCPs
+    /// Newton for small friction-contact problems (after up to [`AUTO_SWEEPS`] Gauss–Seidel
+    /// sweeps; the report counts both), Gauss–Seidel for large ones, Lemke for LCPs
     /// ([`AutoOptions::pick`]).
     Auto(AutoOptions),
 }
@@ -359,7 +363,22 @@ impl sealed::Sealed for FrictionContact {
     }
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
-            Method::Auto(o) => self.run(&o.pick(self.unknowns()), x, ws),
+            Method::Auto(o) => {
+                let pick = o.pick(self.unknowns());
+                if let Method::Newton(_) = pick {
+                    // a few Gauss–Seidel sweeps first: they finish a warm-started step that
+                    // needs little, and bring a cold start near enough for Newton's few steps
+                    let sweeps = NsgsOptions { tol: o.tol, max_iter: AUTO_SWEEPS, relaxation: 1.0 };
+                    let first = nsgs::solve_fc(self, &sweeps, x, ws)?;
+                    if first.converged {
+                        return Ok(first);
+                    }
+                    let mut rep = self.run(&pick, x, ws)?;
+                    rep.iterations += first.iterations;
+                    return Ok(rep);
+                }
+                self.run(&pick, x, ws)
+            }
             Method::Lemke(o) => friction_lcp::solve(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_fc(self, o, x, ws),
             Method::Newton(o) => newton::solve(self, o, x, ws),

@@ -237,10 +237,11 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
         }
         iterations += 1;
         let psi = evaluate(p, diag, r, u, phi, Some(&mut *dblk));
-        // a factorization of the last solve with the same size and the same projection
-        // derivatives D (a resting contact set: every block stuck the same way) is reused as a
-        // chord direction; the line search decides, and a fresh Jacobian follows if it fails
-        let mut fresh = !(o.reuse && nw.lu_size == m && *dblk == *lu_dblk);
+        // the factorization of the last solve of this size is reused as a chord direction: for
+        // the same projection derivatives D (a resting contact set) it is nearly exact, for a
+        // few changed blocks the refinement against the exact J makes up most of the difference;
+        // the line search decides, and a fresh Jacobian follows if the full step fails
+        let mut fresh = !(o.reuse && nw.lu_size == m);
         let mut accepted = false;
         loop {
             if fresh {
