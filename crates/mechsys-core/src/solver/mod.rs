@@ -131,7 +131,9 @@ pub struct NsgsOptions {
     pub tol: f64,
     /// Cap on sweeps.
     pub max_iter: usize,
-    /// Under-relaxation `ω ∈ (0, 1]`: `r_i ← ω r_i,local + (1 − ω) r_i`.
+    /// Relaxation `ω ∈ (0, 2)`: `r_i ← ω r_i,local + (1 − ω) r_i`; under 1 it damps, over 1 it
+    /// extrapolates (projected onto the cone, and back to 1 for the rest of the solve when a
+    /// sweep changes the impulses more than the one before).
     pub relaxation: f64,
 }
 
@@ -257,9 +259,9 @@ impl Method {
                 ensure!(o.tol > 0.0, Settings, "NSGS: tol must be > 0, got {}", o.tol);
                 ensure!(o.max_iter > 0, Settings, "NSGS: max_iter must be > 0");
                 ensure!(
-                    o.relaxation > 0.0 && o.relaxation <= 1.0,
+                    o.relaxation > 0.0 && o.relaxation < 2.0,
                     Settings,
-                    "NSGS: relaxation must be in (0, 1], got {}",
+                    "NSGS: relaxation must be in (0, 2), got {}",
                     o.relaxation
                 );
             }
