@@ -386,7 +386,7 @@ def _check_integrator(spec: Any, allow_objects: bool) -> Any:
     if allow_objects and isinstance(spec, tuple(_INTEGRATOR_CLASSES.values())):
         solver = getattr(spec, "solver", None)
         if isinstance(spec, MoreauJean) and not isinstance(solver, tuple(_SOLVER_CLASSES.values())):
-            raise ModelError(f"{where}.solver: expected mechsys.NSGS, Newton or Lemke, got {_tname(solver)} {solver!r}")
+            raise ModelError(f"{where}.solver: expected mechsys.NSGS, Newton, Lemke or Auto, got {_tname(solver)} {solver!r}")
         # the fields as given (describe() would convert them and hide, e.g., a string dt); None
         # is "not given" (Radau5's dt or rtol)
         given = {k: v for k, v in _fields(spec, _INTEGRATOR_CLASSES).items() if v is not None}
