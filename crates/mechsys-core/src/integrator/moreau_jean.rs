@@ -637,7 +637,7 @@ impl MoreauJean {
                         self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r);
                     }
                 }
-                None => self.islands.partition(m, &[]),
+                None => self.islands.single(m),
             }
             let split = self.sparse.is_some() && self.islands.count() > 1;
             let report = self.solve_contacts(split, false).map_err(|e| {

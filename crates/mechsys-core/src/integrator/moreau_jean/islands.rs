@@ -54,6 +54,12 @@ impl Islands {
         self.count
     }
 
+    /// One island of `n` contacts (the dense assembly couples every contact through `M̃⁻¹`), or
+    /// none if `n` is 0.
+    pub(super) fn single(&mut self, n: usize) {
+        self.count = usize::from(n > 0);
+    }
+
     /// Partitions `n` contacts linked by the pairs `upper` (i < j).
     pub(super) fn partition(&mut self, n: usize, upper: &[(usize, usize)]) {
         self.of.clear();
@@ -206,5 +212,83 @@ impl Islands {
             out.converged &= rep.converged;
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::fixtures::random_friction_contact;
+    use crate::solver::NsgsOptions;
+
+    #[test]
+    fn partition_labels_islands_by_their_first_contact_and_numbers_their_members() {
+        let mut isl = Islands::default();
+        isl.partition(6, &[(3, 5), (1, 2), (0, 3)]);
+        assert_eq!(isl.count(), 3);
+        assert_eq!(isl.of, [0, 1, 1, 0, 2, 0]);
+        assert_eq!(isl.start, [0, 3, 5, 6]);
+        assert_eq!(isl.members, [0, 3, 5, 1, 2, 4]);
+        assert_eq!(isl.local, [0, 0, 1, 1, 0, 2]);
+        isl.partition(0, &[]);
+        assert_eq!(isl.count(), 0);
+    }
+
+    /// Two random problems of 5 and 4 contacts, interleaved into one block-diagonal problem.
+    fn two_problems() -> (FrictionContact, Vec<f64>, Vec<(usize, usize)>, Vec<f64>) {
+        let (a, b) = (random_friction_contact(3, 5, 0.4, 11).unwrap(), random_friction_contact(3, 4, 0.4, 12).unwrap());
+        // global contact k: even k < 10 from a, the rest from b
+        let owner = |k: usize| if k % 2 == 0 && k < 10 { (0, k / 2) } else { (1, if k < 10 { k / 2 } else { k - 5 }) };
+        let n = 9;
+        let (mut diag, mut upper, mut upper_val, mut q, mut mu) = (vec![], vec![], vec![], vec![], vec![]);
+        let block = |p: &FrictionContact, i: usize, j: usize| -> Vec<f64> {
+            let Delassus::Dense(w) = &p.w else { unreachable!() };
+            let m = 3 * p.contacts();
+            (0..9).map(|e| w[(3 * i + e / 3) * m + 3 * j + e % 3]).collect()
+        };
+        for k in 0..n {
+            let (pk, i) = owner(k);
+            let p = if pk == 0 { &a } else { &b };
+            diag.extend(block(p, i, i));
+            q.extend_from_slice(&p.q[3 * i..3 * i + 3]);
+            mu.push(p.mu[i]);
+            for l in k + 1..n {
+                let (pl, j) = owner(l);
+                if pl == pk {
+                    upper.push((k, l));
+                    upper_val.extend(block(p, i, j));
+                }
+            }
+        }
+        let mut bw = BlockDelassus::default();
+        bw.refill(3, n, &diag, &upper, &upper_val);
+        (FrictionContact::new(3, Delassus::Blocks(bw), q, mu).unwrap(), diag, upper, upper_val)
+    }
+
+    #[test]
+    fn islands_solve_like_the_whole_problem_and_the_same_on_threads() {
+        let (whole, diag, upper, upper_val) = two_problems();
+        let method = Method::Nsgs(NsgsOptions { tol: 1e-13, max_iter: 100_000, relaxation: 1.0 });
+        let mut ws = Workspace::for_problem(&whole, &method).unwrap();
+        let mut r_whole = vec![0.0; 27];
+        assert!(solver::solve(&whole, &method, &mut r_whole, false, &mut ws).unwrap().converged);
+        let mut runs = Vec::new();
+        for parallel in [false, true] {
+            let mut isl = Islands::default();
+            isl.partition(9, &upper);
+            assert_eq!(isl.count(), 2);
+            let mut r = vec![0.0; 27];
+            isl.fill(&whole, &diag, &upper, &upper_val, &r.clone());
+            let rep = isl.solve(&method, parallel, &mut r).unwrap();
+            assert!(rep.converged && rep.residual <= 1e-13, "{rep:?}");
+            let scale = 1.0 + r_whole.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for (x, y) in r.iter().zip(&r_whole) {
+                assert!((x - y).abs() < 1e-9 * scale, "{x} vs {y}");
+            }
+            // the whole problem's residual at the islands' solution
+            assert!(whole.residual(&r).unwrap() < 1e-12);
+            runs.push(r);
+        }
+        assert_eq!(runs[0], runs[1], "serial and threaded islands differ");
     }
 }
