@@ -576,7 +576,7 @@ fn bad_input_is_an_error_naming_the_item() {
     assert!(msg(solve(&good, &Method::nsgs(), &mut [0.0; 3], false, &mut ws).unwrap_err()).contains("3 entries"));
     assert!(msg(solve(&good, &Method::nsgs(), &mut [f64::NAN, 0.0], true, &mut ws).unwrap_err())
         .contains("warm start entry 0"));
-    let bad = Method::Nsgs(NsgsOptions { relaxation: 1.5, ..Default::default() });
+    let bad = Method::Nsgs(NsgsOptions { relaxation: 2.0, ..Default::default() });
     assert!(msg(solve(&good, &bad, &mut r, false, &mut ws).unwrap_err()).contains("relaxation"));
     let bad = Method::Lemke(LemkeOptions { facets: 2, ..Default::default() });
     assert!(msg(solve(&good, &bad, &mut r, false, &mut ws).unwrap_err()).contains("facets"));
