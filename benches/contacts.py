@@ -24,7 +24,9 @@ beforehand, min (median) over repeats.
    for N = 1000) onto them. mechsys: one `ContactGroup` (every pair of spheres, and each sphere
    against the floor and the four walls; pairs from its sweep-and-prune broad phase), Moreau-Jean
    with nonsmooth Gauss-Seidel, two budgets: `NSGS(tol=1e-6, max_iter=100)` and the faster
-   `NSGS(tol=1e-4, max_iter=20)` (sweeps stop at the tolerance or the budget, whichever first;
+   `NSGS(tol=1e-4, max_iter=20)`, and `Auto(tol=1e-4)` (issue 17: islands solved apart, Newton
+   on the small ones, Gauss-Seidel to convergence on the large ones)
+   (sweeps stop at the tolerance or the budget, whichever first;
    the table says in how many steps the budget came first: the impulses of those steps are
    Gauss-Seidel iterates, not solutions, like the fixed iteration counts of the peers).
    MuJoCo: sphere geoms, plane floor and walls, its default settings (Newton solver, pyramidal
@@ -253,21 +255,22 @@ def ms_pile(n):
     return m
 
 
-def run_ms_pile(model, n, dt, t_end, tol, max_iter):
+def run_ms_pile(model, n, dt, t_end, tol, max_iter, auto=False):
     import mechsys as ms
 
     import re
 
+    solver = ms.Auto(tol=tol) if auto else ms.NSGS(tol=tol, max_iter=max_iter)
     with warnings.catch_warnings(record=True) as notes:
         warnings.simplefilter("always")
         t0 = time.perf_counter()
-        res = ms.simulate(model, t_end, ms.MoreauJean(dt, solver=ms.NSGS(tol=tol, max_iter=max_iter)), output_dt=0.05,
-                          progress=False)
+        res = ms.simulate(model, t_end, ms.MoreauJean(dt, solver=solver), output_dt=0.05, progress=False)
         el = time.perf_counter() - t0
     # steps whose contact problem stopped at the sweep budget before the tolerance
     missed = [re.search(r"in (\d+) of (\d+) steps", str(w.message)) for w in notes]
     missed = [m for m in missed if m]
-    MISSED[(id(model), dt, tol, max_iter)] = int(missed[0].group(1)) / int(missed[0].group(2)) if missed else 0.0
+    MISSED[(id(model), dt, tol, "auto" if auto else max_iter)] = (int(missed[0].group(1)) / int(missed[0].group(2))
+                                                                  if missed else 0.0)
     z = res["q"][-1].reshape(n, 7)[:, 2]
     return el, float(res["contact/pile/max_penetration"].max()), float(z.mean()), int(res["contact/pile/closed"][-1]), t_end
 
@@ -349,6 +352,7 @@ def pile_rows(n, t_end, repeat, cap):
     settings = [
         ("mechsys NSGS(tol=1e-6, max_iter=100)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-6, 100)),
         ("mechsys NSGS(tol=1e-4, max_iter=20)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-4, 20)),
+        ("mechsys Auto(tol=1e-4)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-4, 0, auto=True)),
         ("MuJoCo default (Newton)", 1e-3, lambda dt: run_mj_pile(n, dt, t_end, "Newton", cap)),
         ("MuJoCo CG", 1e-3, lambda dt: run_mj_pile(n, dt, t_end, "CG", cap)),
         ("PyBullet", 1e-3, lambda dt: run_pb_pile(n, dt, t_end, cap)),
@@ -376,7 +380,7 @@ def pile_rows(n, t_end, repeat, cap):
         rates = [o[0] / o[4] for o in outs]
         tmin, tmed, (_, pen, zm, ncon, reached) = min(rates), statistics.median(rates), outs[-1]
         if engine.startswith("mechsys"):
-            tol, it = (1e-6, 100) if "1e-6" in engine else (1e-4, 20)
+            tol, it = (1e-6, 100) if "1e-6" in engine else (1e-4, "auto" if "Auto" in engine else 20)
             share = MISSED.get((id(model), dt, tol, it))
             if share is not None:
                 engine = f"{engine}; budget reached before tol in {100 * share:.0f} % of steps"

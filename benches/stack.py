@@ -1,5 +1,5 @@
-"""A stack of 10 boxes at rest (issue 4): mechsys (Moreau-Jean, NSGS) against MuJoCo and PyBullet
-in the same run.
+"""A stack of 10 boxes and a pyramid of 20 at rest (issues 4, 17): mechsys (Moreau-Jean with NSGS
+and with the automatic solver choice) against MuJoCo and PyBullet (stack only) in the same run.
 
 Model, identical in every engine: ten equal boxes (0.2 x 0.2 x 0.1 m, 1 kg, inertia of the solid
 box) stacked face on face on a plane, exactly touching at t = 0 and at rest, gravity 9.81 m/s^2,
@@ -17,8 +17,9 @@ Measured per run:
 - drift of the top box: |r_top(T) - r_top(0)| (includes the initial settling of compliant
   contacts) and |r_top(T) - r_top(T - 1 s)| (creep of the settled stack).
 
-Settings: mechsys `MoreauJean(dt)` with the default `NSGS()` (tol 1e-10, 10^4 sweeps) and a tight
-`NSGS(tol=1e-12, max_iter=10^5)`; box-box contacts are the separating-axis manifold (up to 8 points
+Settings: mechsys `MoreauJean(dt)` with the default `NSGS()` (tol 1e-10, 10^4 sweeps), a tight
+`NSGS(tol=1e-12, max_iter=10^5)` (stack only) and `Auto()` (`solver="auto"`: regularized semismooth
+Newton on problems up to 480 unknowns, tol 1e-10); box-box contacts are the separating-axis manifold (up to 8 points
 per pair, 4 closed for a face-on-face stack). MuJoCo 3.x/4.x defaults (soft contacts, solref 0.02 1,
 pyramidal cone, Newton solver, Euler integrator), box-box collision by its own routine. PyBullet
 defaults (sequential impulses, 50 iterations, split impulse / ERP position correction).
@@ -42,10 +43,33 @@ from benchdoc import fmt_time, machine, ratio, timed, write_doc  # noqa: E402
 
 G, N, MASS, MU = 9.81, 10, 1.0, 0.5
 HALF = (0.1, 0.1, 0.05)
+#: the pyramid's rows, bottom first (20 boxes), and the gap between neighbours in a row (m)
+PYRAMID_ROWS, PYRAMID_GAP = (6, 5, 4, 3, 2), 0.01
 
 
 def z0(k: int) -> float:
     return HALF[2] * (2 * k + 1)
+
+
+def scene(kind: str):
+    """Box centres and the contacts (upper box, lower box or None for the floor) of a scene:
+    ``stack`` (ten boxes face on face) or ``pyramid`` (rows of 6, 5, 4, 3, 2 boxes, each upper box
+    straddling the two below it, half on each)."""
+    if kind == "stack":
+        return [(0.0, 0.0, z0(k)) for k in range(N)], [(0, None)] + [(k, k - 1) for k in range(1, N)]
+    centres, contacts, rows = [], [], []
+    pitch = 2 * HALF[0] + PYRAMID_GAP
+    for r, count in enumerate(PYRAMID_ROWS):
+        row = []
+        for i in range(count):
+            row.append(len(centres))
+            centres.append(((i - (count - 1) / 2) * pitch, 0.0, z0(r)))
+            if r == 0:
+                contacts.append((row[-1], None))
+            else:
+                contacts += [(row[-1], rows[-1][i]), (row[-1], rows[-1][i + 1])]
+        rows.append(row)
+    return centres, contacts
 
 
 
@@ -57,63 +81,71 @@ def drifts(top: np.ndarray, t: np.ndarray, t_end: float) -> tuple[float, float]:
 
 
 # ---- mechsys ------------------------------------------------------------------------------------------
-def ms_model():
+def ms_model(kind="stack"):
     import mechsys as ms
 
-    m = ms.Model("stack10", gravity=(0.0, 0.0, -G))
+    centres, pairs = scene(kind)
+    m = ms.Model(f"{kind}{len(centres)}", gravity=(0.0, 0.0, -G))
     boxes = []
-    for k in range(N):
+    for k, c in enumerate(centres):
         b = m.add_body(f"box{k}", MASS, ms.inertia.box(MASS, tuple(2 * h for h in HALF)))
-        m.add_joint(ms.joints.Free(f"free{k}", m.ground, b, q0=[0, 0, z0(k), 1, 0, 0, 0]))
+        m.add_joint(ms.joints.Free(f"free{k}", m.ground, b, q0=[*c, 1, 0, 0, 0]))
         boxes.append(b)
     shape = ms.contours.Box(half_extents=HALF)
-    m.add_contact(ms.Contact("floor", boxes[0].contour(shape), m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
-                             friction=ms.laws.Coulomb(MU)))
-    for k in range(1, N):
-        m.add_contact(ms.Contact(f"on{k}", boxes[k].contour(shape), boxes[k - 1].contour(shape), friction=ms.laws.Coulomb(MU)))
+    floor = m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)))
+    for up, low in pairs:
+        name = f"floor{up}" if low is None else f"on{up}_{low}"
+        m.add_contact(ms.Contact(name, boxes[up].contour(shape), floor if low is None else boxes[low].contour(shape),
+                                 friction=ms.laws.Coulomb(MU)))
     m.build()
     return m
 
 
-def ms_solver(tight: bool):
+#: mechsys solver settings of the table: label -> solver
+def ms_solvers():
     import mechsys as ms
 
-    return ms.NSGS(tol=1e-12, max_iter=100_000) if tight else ms.NSGS()
+    return {"NSGS default": ms.NSGS(), "NSGS tol 1e-12, 10^5 sweeps": ms.NSGS(tol=1e-12, max_iter=100_000),
+            "auto (tol 1e-10)": ms.Auto()}
 
 
-def run_ms(model, dt, t_end, tight, output_dt=1e-2):
+def run_ms(model, dt, t_end, solver, output_dt=1e-2):
     import mechsys as ms
 
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        res = ms.simulate(model, t_end, ms.MoreauJean(dt, solver=ms_solver(tight)), output_dt=output_dt)
+        res = ms.simulate(model, t_end, ms.MoreauJean(dt, solver=solver), output_dt=output_dt)
     note = next((str(x.message) for x in w if "tolerance" in str(x.message)), "")
     return res, note
 
 
-def ms_measure(model, dt, t_end, tight):
-    res, note = run_ms(model, dt, t_end, tight, output_dt=dt)
-    names = ["floor"] + [f"on{k}" for k in range(1, N)]
-    gmin = min(float(res[f"contact/{c}/g_n"].min()) for c in names)
-    top = res[f"body/box{N - 1}/position"]
-    floor = float(res["contact/floor/lambda_n"][-1].sum()) / (N * MASS * G)
-    unconverged = note.split("tolerance in ")[1].split(" steps")[0] + " steps" if note else "0"
-    return max(0.0, -gmin), drifts(top, res.t, t_end), floor, unconverged
+def ms_measure(model, dt, t_end, solver, kind):
+    res, note = run_ms(model, dt, t_end, solver, output_dt=dt)
+    names = [c for c in res.names() if c.startswith("contact/") and c.endswith("/g_n")]
+    gmin = min(float(res[c].min()) for c in names)
+    top = res[f"body/box{len(scene(kind)[0]) - 1}/position"]
+    floor = sum(float(res[c][-1].sum()) for c in res.names() if c.startswith("contact/floor") and c.endswith("/lambda_n"))
+    floor /= len(scene(kind)[0]) * MASS * G
+    conv = res["solver/converged"][1:]
+    unconverged = f"{int((conv == 0).sum())} of {conv.size} steps"
+    worst = float(res["solver/residual"].max())
+    return max(0.0, -gmin), drifts(top, res.t, t_end), floor, unconverged, worst
 
 
 # ---- MuJoCo -------------------------------------------------------------------------------------------
-def mj_xml(dt):
+def mj_xml(dt, kind="stack"):
+    centres, _ = scene(kind)
     bodies = "".join(
-        f'<body pos="0 0 {z0(k)}"><freejoint/><geom type="box" size="{HALF[0]} {HALF[1]} {HALF[2]}" mass="{MASS}" '
-        f'friction="{MU} 0.005 0.0001"/></body>' for k in range(N))
+        f'<body pos="{c[0]} {c[1]} {c[2]}"><freejoint/><geom type="box" size="{HALF[0]} {HALF[1]} {HALF[2]}" mass="{MASS}" '
+        f'friction="{MU} 0.005 0.0001"/></body>' for c in centres)
     return (f'<mujoco><option timestep="{dt}" gravity="0 0 {-G}"/><worldbody>'
             f'<geom type="plane" size="5 5 0.1" friction="{MU} 0.005 0.0001"/>{bodies}</worldbody></mujoco>')
 
 
-def mj_setup(dt):
+def mj_setup(dt, kind="stack"):
     import mujoco
 
-    m = mujoco.MjModel.from_xml_string(mj_xml(dt))
+    m = mujoco.MjModel.from_xml_string(mj_xml(dt, kind))
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -134,18 +166,19 @@ def mj_measure(setup, dt, t_end):
     import mujoco
 
     m, _, x0, spec = setup
+    top_k = m.nbody - 2
     d = mujoco.MjData(m)
     mujoco.mj_setState(m, d, x0, spec)
     mujoco.mj_forward(m, d)
     n = int(round(t_end / dt))
     top = np.empty((n + 1, 3))
-    top[0] = d.qpos[7 * (N - 1): 7 * (N - 1) + 3]
+    top[0] = d.qpos[7 * top_k: 7 * top_k + 3]
     pen = 0.0
     for k in range(n):
         mujoco.mj_step(m, d)
         if d.ncon:
             pen = max(pen, -float(d.contact.dist[: d.ncon].min()))
-        top[k + 1] = d.qpos[7 * (N - 1): 7 * (N - 1) + 3]
+        top[k + 1] = d.qpos[7 * top_k: 7 * top_k + 3]
     return pen, drifts(top, np.arange(n + 1) * dt, t_end)
 
 
@@ -201,76 +234,78 @@ def main(argv=None) -> int:
     warnings.simplefilter("ignore")
     mach = machine()
     t_start = time.perf_counter()
-    model = ms_model()
-    rows = []  # (dt, engine, tmin, tmed, pen, (drift_all, drift_last), extra)
-    for dt in ([1e-3] if a.quick else [1e-3, 1e-2]):
-        for tight in (False, True):
-            label = "mechsys MoreauJean, NSGS tol 1e-12, 10^5 sweeps" if tight else "mechsys MoreauJean, NSGS default"
-            tmin, tmed, _ = timed(lambda: run_ms(model, dt, T, tight), repeat)
-            pen, dr, floor, unconv = ms_measure(model, dt, T, tight)
-            rows.append((dt, label, tmin, tmed, pen, dr, f"floor carries {floor:.10f} × 10 m g; solver missed its tolerance in {unconv}"))
-            print(f"dt {dt:g} {label:50s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}  {rows[-1][-1]}")
-        try:
-            setup = mj_setup(dt)
-            tmin, tmed, _ = timed(lambda: run_mj(setup, dt, T), repeat)
-            pen, dr = mj_measure(setup, dt, T)
-            rows.append((dt, "MuJoCo (defaults, rollout)", tmin, tmed, pen, dr, ""))
-            print(f"dt {dt:g} {'MuJoCo':50s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}")
-        except Exception as e:  # noqa: BLE001 - a missing peer is reported, not fatal
-            print(f"MuJoCo: {e}")
-        try:
-            tmin, tmed, _ = timed(lambda: run_pb(dt, T), repeat)
-            pen, dr = run_pb(dt, T, measure=True)
-            rows.append((dt, "PyBullet (defaults)", tmin, tmed, pen, dr, ""))
-            print(f"dt {dt:g} {'PyBullet':50s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}")
-        except Exception as e:  # noqa: BLE001
-            print(f"PyBullet: {e}")
+    rows = []  # (scene, dt, engine, tmin, tmed, pen, (drift_all, drift_last), extra)
+    for kind in ("stack", "pyramid"):
+        model = ms_model(kind)
+        nb = len(scene(kind)[0])
+        for dt in ([1e-3] if a.quick else [1e-3, 1e-2]):
+            for label, solver in ms_solvers().items():
+                if kind == "pyramid" and label.startswith("NSGS tol"):
+                    continue  # 10^5 sweeps per step on the pyramid's 136 points: minutes per run
+                tmin, tmed, _ = timed(lambda: run_ms(model, dt, T, solver), repeat)
+                pen, dr, floor, unconv, worst = ms_measure(model, dt, T, solver, kind)
+                extra = (f"worst residual {worst:.1e}, unconverged {unconv}; the floor carries {floor:.10f} × {nb} m g")
+                rows.append((kind, dt, f"mechsys MoreauJean, {label}", tmin, tmed, pen, dr, extra))
+                print(f"{kind} dt {dt:g} {label:32s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}  {extra}")
+            try:
+                setup = mj_setup(dt, kind)
+                tmin, tmed, _ = timed(lambda: run_mj(setup, dt, T), repeat)
+                pen, dr = mj_measure(setup, dt, T)
+                rows.append((kind, dt, "MuJoCo (defaults, rollout)", tmin, tmed, pen, dr, ""))
+                print(f"{kind} dt {dt:g} {'MuJoCo':32s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}")
+            except Exception as e:  # noqa: BLE001 - a missing peer is reported, not fatal
+                print(f"MuJoCo: {e}")
+            if kind == "stack":
+                try:
+                    tmin, tmed, _ = timed(lambda: run_pb(dt, T), repeat)
+                    pen, dr = run_pb(dt, T, measure=True)
+                    rows.append((kind, dt, "PyBullet (defaults)", tmin, tmed, pen, dr, ""))
+                    print(f"{kind} dt {dt:g} {'PyBullet':32s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}")
+                except Exception as e:  # noqa: BLE001
+                    print(f"PyBullet: {e}")
     whole = time.perf_counter() - t_start
     load_end = machine()["load"]
     if a.out:
         try:
             import mechsys
             import mujoco
-            import pybullet  # noqa: F401
 
-            versions = f"mechsys {getattr(mechsys, '__version__', '?')}, MuJoCo {mujoco.__version__}, PyBullet (API {pybullet.getAPIVersion()})"
+            versions = f"mechsys {getattr(mechsys, '__version__', '?')}, MuJoCo {mujoco.__version__}"
         except Exception:  # noqa: BLE001
             versions = "–"
-        L = ["## Stack of 10 boxes at rest (issue 4): mechsys against MuJoCo and PyBullet", ""]
+        L = ["## Stack of 10 boxes and pyramid of 20 at rest (issues 4, 17): mechsys against MuJoCo and PyBullet", ""]
         L.append(f"Generated by `benches/stack.py` (this section only). {time.strftime('%Y-%m-%d %H:%M')} on "
                  f"{mach['nproc']} × {mach['cpu']}; load average {mach['load'][0]:.2f} at the start, "
                  f"{load_end[0]:.2f} at the end (a shared 2-core machine: above ≈ 1 the times are preliminary); "
                  f"whole run {whole:.0f} s. {versions}.")
-        L += ["", f"Ten boxes 0.2 × 0.2 × 0.1 m, 1 kg, face on face on the floor, touching and at rest at t = 0, "
-              f"friction 0.5, {T:g} s simulated. Settings and fairness notes in the script's docstring. Wall time "
-              f"per simulated second: min (median) over {repeat} run(s); “mechsys vs it”: against mechsys with that "
-              "solver setting at the same step.", "",
+        L += ["", f"Boxes 0.2 × 0.2 × 0.1 m, 1 kg, face on face, touching and at rest at t = 0, friction 0.5, {T:g} s "
+              "simulated. *stack*: ten boxes in a column; *pyramid*: rows of 6, 5, 4, 3, 2 boxes 1 cm apart, each upper "
+              "box straddling the two below it (34 box-box or box-floor pairs, 136 closed points). Settings and fairness "
+              f"notes in the script's docstring. Wall time per simulated second: min (median) over {repeat} run(s); "
+              "“mechsys auto vs it”: mechsys with `solver=\"auto\"` against that row at the same step.", "",
               f"Command: `.venv/bin/python benches/stack.py {' '.join(sys.argv[1:] if argv is None else argv)}`", "",
-              "| dt | engine | wall time per simulated second | mechsys (default NSGS) vs it | mechsys (tight NSGS) vs it | largest penetration | top box drift, 0 → T | top box drift over the last 1 s | notes |",
-              "|---:|---|---:|---:|---:|---:|---:|---:|---|"]
-        for dt, engine, tmin, tmed, pen, dr, extra in rows:
-            cells = []
-            for suffix in ("NSGS default", "10^5 sweeps"):
-                ref = next((r[2] for r in rows if r[0] == dt and r[1].endswith(suffix)), None)
-                cells.append(ratio(ref / T, tmin / T) if ref is not None and not engine.startswith("mechsys") else "–")
-            L.append(f"| {dt:g} | {engine} | {fmt_time(tmin / T)} ({fmt_time(tmed / T)}) | {cells[0]} | {cells[1]} | "
+              "| scene | dt | engine | wall time per simulated second | mechsys auto vs it | largest penetration | top box drift, 0 → T | top box drift over the last 1 s | notes |",
+              "|---|---:|---|---:|---:|---:|---:|---:|---|"]
+        for kind, dt, engine, tmin, tmed, pen, dr, extra in rows:
+            ref = next((r[3] for r in rows if r[0] == kind and r[1] == dt and "auto" in r[2]), None)
+            cell = ratio(ref / T, tmin / T) if ref is not None and "auto" not in engine else "–"
+            L.append(f"| {kind} | {dt:g} | {engine} | {fmt_time(tmin / T)} ({fmt_time(tmed / T)}) | {cell} | "
                      f"{pen:.1e} m | {dr[0]:.1e} m | {dr[1]:.1e} m | {extra} |")
         L += ["", "Reading the table:", "",
               "- *Drift 0 → T* includes the settling at the start: compliant contacts (MuJoCo's soft constraints, "
               "PyBullet's position correction) sink in under the load until they carry it; mechsys' contacts are rigid "
               "(Signorini at velocity level), so any drift is solver error. *Drift over the last 1 s* is the creep of "
-              "the settled stack.",
-              "- mechsys' default NSGS (tol 1e-10, at most 10^4 sweeps) misses its tolerance in a few of the first "
-              "steps, started cold: the stack's friction-contact problem (four points per interface, ten bodies in "
-              "series) converges slowly; what it leaves in the velocities stays in the positions (no position "
-              "correction in Moreau-Jean). With tol 1e-12 and up to 10^5 sweeps every step converges and the stack "
-              "holds to rounding, and the warm-started steps are then cheaper, so the whole run is not slower.",
-              "- Where mechsys' time goes (`perf` on the tight run at dt = 1e-3, 2026-11-22): ≈ 70 % of the engine's "
-              "samples in the contact problem (Delassus products and NSGS sweeps over the 44 closed points, 132 rows), "
-              "≈ 15 % in the box-box narrow phase, which then rebuilt the separating-axis manifold for each of a pair's 8 "
-              "candidates (≈ 8 µs per pair and step). Since issue 12 one manifold serves all 8: `contact_kinematics` "
-              "0.80-0.86 µs per pair (4.7-5.2 before), `evaluate` 0.49-0.53 µs (criterion, 100 tilted moving pairs: "
-              "`cargo bench -p mechsys-core --bench contact -- box_box`)."]
+              "the settled stack. The worst residual is `solver/residual` over every step.",
+              "- The stack's and the pyramid's friction-contact problems are singular (four points per interface, "
+              "statically indeterminate), and ten bodies in series make Gauss-Seidel slow from a cold start: NSGS misses "
+              "its tolerance in the first steps. `solver=\"auto\"` takes the semismooth Newton method on these sizes, "
+              "with the Delassus matrix regularized in the direction (ε = 1e-4 W_NN, three refinement passes against "
+              "the exact Jacobian): the cold first step takes tens of iterations, the resting steps 0 or 1, each a "
+              "solve with the factorization of the last step (it is reused while the projection derivatives, i.e. "
+              "the stick/slip/open pattern, do not change).",
+              "- Where the time goes now (`perf`, stack at dt = 1e-3, auto): the step outside the solver "
+              "(narrow phase of 10 box pairs with 8 candidates each, sparse Delassus assembly, mass-matrix factor, "
+              "state classification) dominates; MuJoCo's step is ≈ 16-20 µs on this machine."]
         write_doc(a.out, "\n".join(L), "<!-- stack.py:begin -->", "<!-- stack.py:end -->")
         print(f"updated {a.out}")
     return 0

@@ -167,3 +167,41 @@ def test_a_stack_of_ten_equal_boxes_stays_at_rest():
         assert len(used(res, f"on{k}")) == 4, k
         assert res[f"contact/on{k}/g_n"].min() > -1e-12, k
         np.testing.assert_allclose(res[f"contact/on{k}/lambda_n"][-1].sum(), (n - k) * mass * G, rtol=1e-9)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+def test_the_auto_solver_holds_the_stack_at_its_static_weights_every_step(dt):
+    """The auto solver (regularized Newton on the stack's singular Delassus problem): every step
+    converges with residual <= 1e-12 (signals solver/residual, solver/converged), each interface
+    carries the weight of the boxes above it to 1e-8 N in every step, and the top box stays put to
+    1e-9 m over 2 s at dt = 1e-3 and 1e-2."""
+    n, mass = 10, 1.0
+    m = stack_model(n, mass=mass)
+    res = ms.simulate(m, 2.0, ms.MoreauJean(dt, solver=ms.Auto(tol=1e-12)), output_dt=dt)
+    assert res["solver/converged"][1:].all()
+    assert res["solver/residual"].max() <= 1e-12
+    assert (res["solver/contacts"][1:] == 4 * n).all() and (res["solver/islands"][1:] == 1).all()
+    # the first steps start cold and settle; then a warm-started step takes one Gauss-Seidel
+    # sweep, or the auto solver's 10 sweeps and a Newton step with the reused factorization
+    it = res["solver/iterations"]
+    assert it.max() <= 60 and np.median(it) <= 11
+    top = res[f"body/box{n - 1}/position"]
+    assert np.abs(top - top[0]).max() < 1e-9
+    # lambda_n of a sample is the step's impulse over the step: every step's static weights
+    floor = res["contact/floor/lambda_n"][1:].sum(axis=1)
+    assert np.abs(floor - n * mass * G).max() < 1e-8
+    for k in range(1, n):
+        carried = res[f"contact/on{k}/lambda_n"][1:].sum(axis=1)
+        assert np.abs(carried - (n - k) * mass * G).max() < 1e-8, k
+
+
+def test_an_unconverged_stack_warns_with_the_time_and_the_contacts():
+    """A sweep budget the stack cannot meet: the run warns once, naming the count of
+    unconverged steps, the first one's time and the contacts of its problem; the signals mark
+    those samples."""
+    m = stack_model(4)
+    with pytest.warns(UserWarning, match=r"did not reach its tolerance in \d+ of 50 steps .*first at t = 0\.000500 s, "
+                                         r"contacts \[\"floor\", \"on1\", \"on2\", \"on3\"\]"):
+        res = ms.simulate(m, 0.05, ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-12, max_iter=3)), output_dt=1e-3)
+    assert res["solver/converged"][1] == 0 and res["solver/iterations"][1] == 3
+    assert res["solver/residual"][1] > 1e-12

@@ -1,6 +1,6 @@
 """Integration schemes: smooth dynamics (RK4, DOPRI5, Radau5) and, for models with unilateral
 contacts, Moreau-Jean time-stepping (:class:`MoreauJean`) with a choice of contact solver
-(:class:`NSGS`, :class:`Newton`, :class:`Lemke`) or event-driven integration
+(:class:`NSGS`, :class:`Newton`, :class:`Lemke`, :class:`Auto`) or event-driven integration
 (:class:`EventDriven`).
 
 - :class:`RK4` — classical Runge-Kutta, fixed step: cheap, predictable, 4th order.
@@ -95,13 +95,34 @@ class NSGS:
 
 @dataclass(frozen=True)
 class Newton:
-    """Semismooth Newton on the Alart-Curnier function."""
+    """Semismooth Newton on the Alart-Curnier function with a line search; the direction uses the
+    Delassus matrix regularized by ``regularization`` times each contact's W_NN, so that
+    statically indeterminate supports (a box on four corners, a stack) converge."""
 
     tol: float = 1e-10
     max_iter: int = 200
+    regularization: float = 1e-4
 
     def describe(self) -> dict:
-        return {"type": "newton", "tol": float(self.tol), "max_iter": int(self.max_iter)}
+        return {"type": "newton", "tol": float(self.tol), "max_iter": int(self.max_iter),
+                "regularization": float(self.regularization)}
+
+
+@dataclass(frozen=True)
+class Auto:
+    """The contact solver by problem shape: :class:`Newton` (regularized, its factorization reused
+    while the contact set rests) for problems of at most ``newton_max_unknowns`` unknowns (3 per
+    contact point in space, 2 in the plane), :class:`NSGS` above; ``solver="auto"`` in
+    :class:`MoreauJean`."""
+
+    tol: float = 1e-10
+    newton_max_unknowns: int = 480
+    newton_max_iter: int = 200
+    nsgs_max_iter: int = 10_000
+
+    def describe(self) -> dict:
+        return {"type": "auto", "tol": float(self.tol), "newton_max_unknowns": int(self.newton_max_unknowns),
+                "newton_max_iter": int(self.newton_max_iter), "nsgs_max_iter": int(self.nsgs_max_iter)}
 
 
 @dataclass(frozen=True)
@@ -125,16 +146,27 @@ class MoreauJean:
     ``continue_on_painleve=False`` it raises :class:`mechsys.PainleveError` instead."""
 
     dt: float
-    solver: NSGS | Newton | Lemke = NSGS()
+    #: an object (NSGS, Newton, Lemke, Auto) or a name: "nsgs", "newton", "lemke", "auto"
+    solver: NSGS | Newton | Lemke | Auto | str = NSGS()
     continue_on_painleve: bool = True
     #: project the contacts that stay closed back onto their contours after each step: stops
     #: the O(dt) sinking of a contact rolling or sliding along a curved contour (a ball in a
     #: track); positions move without a force, so the energy balance carries that small work
     project: bool = False
+    #: solve independent contact islands (groups of contacts that share no moving body) on
+    #: several threads; the results are the same bit for bit either way
+    parallel: bool = True
+
+    def __post_init__(self):
+        if isinstance(self.solver, str):
+            from .modelfile import _solver
+
+            object.__setattr__(self, "solver", _solver(self.solver, "MoreauJean.solver"))
 
     def describe(self) -> dict:
         return {"type": "moreau_jean", "dt": float(self.dt), "solver": self.solver.describe(),
-                "continue_on_painleve": bool(self.continue_on_painleve), "project": bool(self.project)}
+                "continue_on_painleve": bool(self.continue_on_painleve), "project": bool(self.project),
+                "parallel": bool(self.parallel)}
 
 
 @dataclass(frozen=True)
@@ -189,4 +221,4 @@ def from_name(name: str, dt: float | None = None, rtol: float | None = None, ato
     raise SettingsError(f"integrator: unknown name '{name}' (expected rk4, dopri5, radau5, moreau_jean or event_driven)")
 
 
-__all__ = ["RK4", "DOPRI5", "Radau5", "MoreauJean", "EventDriven", "NSGS", "Newton", "Lemke"]
+__all__ = ["RK4", "DOPRI5", "Radau5", "MoreauJean", "EventDriven", "NSGS", "Newton", "Lemke", "Auto"]

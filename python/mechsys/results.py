@@ -296,6 +296,14 @@ class Results:
         if engine is not None and "contact_gap" in raw:
             put("energy/dissipated_impact", raw["dissipated_impact"], "J")
             put("energy/dissipated_friction", raw["dissipated_friction"], "J")
+            if "solver" in raw:
+                # the contact solver over the steps since the previous sample
+                sv = raw["solver"]
+                put("solver/residual", sv[:, 0], "1")
+                put("solver/iterations", sv[:, 1], "1")
+                put("solver/converged", sv[:, 2].astype(np.int8), "1")
+                put("solver/contacts", sv[:, 3], "1")
+                put("solver/islands", sv[:, 4], "1")
             for c in engine.contacts():
                 k, n, nt = c["first"], c["points"], c["tangents"]
                 sl = slice(k, k + n) if n > 1 else k
@@ -844,6 +852,7 @@ def signal_universe(engine) -> list[str]:
     names += [f"energy/{x}" for x in ("kinetic", "potential", "total", "dissipated", "external_work", "dissipated_impact",
                                       "dissipated_friction")]
     names += ["momentum/linear", "momentum/angular"]
+    names += [f"solver/{x}" for x in ("residual", "iterations", "converged", "contacts", "islands")]
     for c in engine.constraints():
         names += [f"constraint/{c['name']}/{x}" for x in ("lambda", "violation", "velocity_violation")]
     for name, _ in engine.forces():

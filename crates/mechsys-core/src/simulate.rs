@@ -264,6 +264,11 @@ pub struct Recording {
     pub dissipated_impact: Vec<f64>,
     /// Energy dissipated by friction since t0 (n_out), J.
     pub dissipated_friction: Vec<f64>,
+    /// Moreau–Jean's contact solver over the steps since the previous sample (n_out × 5): the
+    /// worst residual (of [`crate::solver::Report::residual`], 1), the most iterations of a step,
+    /// 1 if every step converged (else 0), the unknowns' contacts of the last step and its
+    /// independent islands.
+    pub solver: Vec<f64>,
     /// Contact groups: candidate points closed (positive normal impulse) in the last step before
     /// each sample (n_out × n_groups).
     pub group_closed: Vec<f64>,
@@ -1180,7 +1185,7 @@ pub fn simulate(
         _ => {}
     }
     let contacts = !model.contacts.is_empty();
-    if let IntegratorKind::MoreauJean { dt, solver, continue_on_painleve, project } = settings.integrator {
+    if let IntegratorKind::MoreauJean { dt, solver, continue_on_painleve, project, parallel } = settings.integrator {
         // Poisson's law (2.203) relates the impulses of an impact's compression and expansion
         // phases; a time step's impulse mixes the impact with the step's smooth forces, so the
         // scheme cannot apply it: refused rather than replaced by Newton's law unseen
@@ -1198,7 +1203,7 @@ pub fn simulate(
                 g.name
             )));
         }
-        return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve, project), rec);
+        return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve, project, parallel), rec);
     }
     crate::ensure!(
         model.contact_groups.is_empty() || matches!(settings.integrator, IntegratorKind::MoreauJean { .. }),
@@ -1380,7 +1385,7 @@ fn time_stepping(
     progress: Option<&Progress>,
     t_out: &[f64],
     y0: Vec<f64>,
-    (dt, solver, continue_on_painleve, project): (f64, crate::solver::Method, bool, bool),
+    (dt, solver, continue_on_painleve, project, parallel): (f64, crate::solver::Method, bool, bool, bool),
     mut rec: Recording,
 ) -> Result<Recording> {
     let budget = Budget::new(settings);
@@ -1390,6 +1395,7 @@ fn time_stepping(
     let every = (settings.output_dt / dt).round() as u64;
     let mut stepper = MoreauJean::new(model, dt, solver)?;
     stepper.project = project;
+    stepper.parallel = parallel;
     stepper.warm_search = settings.warm_search;
     let mut group_stats = vec![crate::integrator::moreau_jean::GroupStats::default(); model.contact_groups.len()];
     let (mut data, mut ws) = (Data::new(model), dynamics::Workspace::new(model));
@@ -1430,6 +1436,9 @@ fn time_stepping(
         crate::forces::compliant::commit(model, &data, w, settings.t0, &mut st)?;
         w.states = st;
     }
+    // the solver's worst residual, most iterations and convergence since the last sample
+    let mut solver_acc = (0.0f64, 0usize, true);
+    rec.solver.reserve(5 * t_out.len());
     for (k, &t_rec) in t_out.iter().enumerate() {
         if k > 0 {
             for _ in 0..every {
@@ -1438,6 +1447,11 @@ fn time_stepping(
                 let (u, energy) = rest.split_at_mut(nu);
                 u_start.copy_from_slice(u);
                 let (work, diss) = stepper.step(model, &mut data, &mut ws, t, q, u, cb)?;
+                if let Some(r) = &stepper.report {
+                    solver_acc.0 = solver_acc.0.max(r.residual);
+                    solver_acc.1 = solver_acc.1.max(r.iterations);
+                    solver_acc.2 &= r.converged;
+                }
                 for (pt, r) in stepper.results.iter().enumerate() {
                     acc_n[pt] += r.impulse_n;
                     acc_t[pt][0] += r.impulse_t[0];
@@ -1535,6 +1549,15 @@ fn time_stepping(
         acc_t.fill([0.0; 2]);
         rec.dissipated_impact.push(stepper.dissipated_impact);
         rec.dissipated_friction.push(stepper.dissipated_friction);
+        let (contacts, islands) = stepper.problem_shape();
+        rec.solver.extend_from_slice(&[
+            solver_acc.0,
+            solver_acc.1 as f64,
+            if solver_acc.2 { 1.0 } else { 0.0 },
+            contacts as f64,
+            islands as f64,
+        ]);
+        solver_acc = (0.0, 0, true);
         // the work of moving surfaces (conveyors) is external work done through the contacts
         if let Some(w) = rec.external_work.last_mut() {
             *w += stepper.surface_work;
@@ -1571,8 +1594,9 @@ fn time_stepping(
         rec.events.sort_by(|a, b| a.t.total_cmp(&b.t));
     }
     if stepper.unconverged.0 > 0 {
+        let (t1, names) = stepper.first_unconverged.clone().unwrap_or_default();
         rec.warnings.push(format!(
-            "the contact solver did not reach its tolerance in {} of {} steps (worst residual {:.1e}); tighten the solver or shorten dt",
+            "the contact solver did not reach its tolerance in {} of {} steps (worst residual {:.1e}; first at t = {t1:.6} s, contacts {names:?}); tighten the solver, raise max_iter or shorten dt",
             stepper.unconverged.0, stats.steps, stepper.unconverged.1
         ));
     }

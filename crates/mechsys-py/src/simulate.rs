@@ -385,6 +385,9 @@ fn recording_dict<'py>(
         put("contact_reserve", rec.contact_reserve, &[n, np])?;
         put("dissipated_impact", rec.dissipated_impact, &[n])?;
         put("dissipated_friction", rec.dissipated_friction, &[n])?;
+        if !rec.solver.is_empty() {
+            put("solver", rec.solver, &[n, 5])?;
+        }
     }
     let ng = m.contact_groups.len();
     if ng > 0 {

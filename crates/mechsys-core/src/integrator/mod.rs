@@ -134,6 +134,10 @@ pub enum IntegratorKind {
         /// balance then carries the projection's (small) work.
         #[serde(default)]
         project: bool,
+        /// Solve independent contact islands on several threads (the impulses are the same
+        /// either way).
+        #[serde(default = "default_true")]
+        parallel: bool,
     },
     /// Event-driven integration of contact models ([`event_driven`]).
     EventDriven(event_driven::Options),

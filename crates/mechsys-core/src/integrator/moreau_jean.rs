@@ -48,6 +48,7 @@ use crate::model::Model;
 use crate::solver::{self, BlockDelassus, ContactState, Delassus, FrictionContact, Method, Workspace};
 use crate::spatial::Motion;
 
+mod islands;
 mod projection;
 mod sparse;
 #[cfg(test)]
@@ -75,6 +76,10 @@ fn margin(last_state: f64, first_step: bool) -> f64 {
         HOLD_MARGIN
     }
 }
+
+/// Islands are solved on several threads from this many active contact points on (below, the
+/// threads' start-up costs more than they save); the impulses are the same either way.
+pub const PARALLEL_MIN_CONTACTS: usize = 64;
 
 /// Contact state code in the recorded signal `contact/<c>/state`.
 pub const OPEN: f64 = 0.0;
@@ -200,6 +205,11 @@ pub struct MoreauJean {
     pub bilateral_impulse: Vec<f64>,
     /// Steps whose contact problem did not reach the solver tolerance, and the worst residual.
     pub unconverged: (usize, f64),
+    /// The first step that ended unconverged: its midpoint time (s) and the contacts of its
+    /// problem (for the run's warning).
+    pub first_unconverged: Option<(f64, Vec<String>)>,
+    /// The solver's report of the last step (`None`: no contact was active).
+    pub report: Option<solver::Report>,
     /// Broad and narrow phase of each contact group.
     pub groups: Vec<GroupPhase>,
     group_stats: Vec<GroupStats>,
@@ -208,6 +218,10 @@ pub struct MoreauJean {
     group_points: Vec<Vec<[f64; 7]>>,
     act: Vec<Active>,
     sparse: Option<SparseRows>,
+    /// The step's independent contact islands.
+    islands: islands::Islands,
+    /// Solve the islands on rayon's threads (the impulses do not depend on it).
+    pub parallel: bool,
     /// Steps taken (for the validity of the groups' warm starts).
     steps: u64,
     /// Whether the contacts that stay closed are projected onto their contours after each step.
@@ -292,6 +306,8 @@ impl MoreauJean {
             surface_work: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
             unconverged: (0, 0.0),
+            first_unconverged: None,
+            report: None,
             groups: model.contact_groups.iter().map(GroupPhase::new).collect(),
             group_stats: vec![GroupStats::default(); model.contact_groups.len()],
             group_points: model
@@ -301,12 +317,20 @@ impl MoreauJean {
                 .collect(),
             act: Vec::with_capacity(np),
             sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
+            islands: islands::Islands::default(),
+            parallel: true,
             steps: 0,
             project: false,
             projection: projection::Projection::new(model),
             in_step: vec![false; np],
             closed_before: vec![false; np],
         })
+    }
+
+    /// The last step's contact problem: active contact points and independent islands (contacts
+    /// that share no moving body solve apart).
+    pub fn problem_shape(&self) -> (usize, usize) {
+        (self.act.len(), self.islands.count())
     }
 
     /// Whether the contact problem is assembled sparsely.
@@ -605,9 +629,18 @@ impl MoreauJean {
                 self.problem.mu.push(mu);
                 self.r.extend_from_slice(&prev[..d]);
             }
-            self.ws.reserve(&self.problem, &self.method)?;
-            let warm = self.r.iter().any(|v| *v != 0.0);
-            let report = solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws).map_err(|e| {
+            // independent islands (sparse assembly only: the dense one couples through M̃⁻¹)
+            match self.sparse.as_ref() {
+                Some(sp) => {
+                    self.islands.partition(m, &sp.upper);
+                    if self.islands.count() > 1 {
+                        self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r);
+                    }
+                }
+                None => self.islands.single(m),
+            }
+            let split = self.sparse.is_some() && self.islands.count() > 1;
+            let report = self.solve_contacts(split, false).map_err(|e| {
                 let names = self.active_names(model);
                 Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
             })?;
@@ -646,17 +679,21 @@ impl MoreauJean {
                     }
                 }
                 if again {
-                    report =
-                        solver::solve(&self.problem, &self.method, &mut self.r, true, &mut self.ws).map_err(|e| {
-                            let names = self.active_names(model);
-                            Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
-                        })?;
+                    report = self.solve_contacts(split, true).map_err(|e| {
+                        let names = self.active_names(model);
+                        Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
+                    })?;
                 }
             }
             if !report.converged {
                 self.unconverged.0 += 1;
                 self.unconverged.1 = self.unconverged.1.max(report.residual);
+                if self.first_unconverged.is_none() {
+                    // once per run: the names for the warning
+                    self.first_unconverged = Some((tm, self.active_names(model)));
+                }
             }
+            self.report = Some(report);
             // u⁺ = u_free + M̃⁻¹ W Λ
             u.copy_from_slice(&self.u_free);
             if let Some(sp) = self.sparse.as_mut() {
@@ -756,6 +793,8 @@ impl MoreauJean {
                 }
             }
         } else {
+            self.report = None;
+            self.islands.partition(0, &[]);
             u.copy_from_slice(&self.u_free);
             for s in self.group_stats.iter_mut() {
                 s.closed = 0;
@@ -792,6 +831,23 @@ impl MoreauJean {
             crate::dynamics::constrained::project(model, data, ws, t + h, q, u, cb)?;
         }
         Ok((p.external * h, p.dissipated * h))
+    }
+
+    /// Solves the step's friction-contact problem into `self.r` (warm-started from it): whole,
+    /// or island by island when `split` (after [`islands::Islands::fill`]); `again` marks the
+    /// re-solve after a break-away changed friction coefficients.
+    fn solve_contacts(&mut self, split: bool, again: bool) -> Result<solver::Report> {
+        if split {
+            if again {
+                self.islands.refresh(&self.problem, &self.r);
+            }
+            // threads pay off only on problems of some size; the result does not depend on it
+            let parallel = self.parallel && self.act.len() >= PARALLEL_MIN_CONTACTS;
+            return self.islands.solve(&self.method, parallel, &mut self.r);
+        }
+        self.ws.reserve(&self.problem, &self.method)?;
+        let warm = again || self.r.iter().any(|v| *v != 0.0);
+        solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws)
     }
 
     /// Steps in which the position projection moved a contact back onto its contour.

@@ -31,7 +31,8 @@
 //! | --- | --- | --- |
 //! | [`Method::Lemke`] | complementary pivoting ([`lemke`]), exact | `d = 2`: exact through the LCP of [`friction_lcp`]; `d = 3`: pyramid with `facets` sides |
 //! | [`Method::Nsgs`] | projected Gauss–Seidel | nonsmooth Gauss–Seidel with exact local solves ([`nsgs`]) |
-//! | [`Method::Newton`] | — | semismooth Newton on the Alart–Curnier function ([`newton`]) |
+//! | [`Method::Newton`] | — | semismooth Newton on the Alart–Curnier function with a regularized Delassus matrix ([`newton`]) |
+//! | [`Method::Auto`] | Lemke | Newton up to [`AutoOptions::newton_max_unknowns`] unknowns, NSGS above |
 //!
 //! Every solve returns a [`Report`]; its residual is recomputed from the returned solution with
 //! the merit described at [`Report::residual`], whatever the method. Failing to reach the
@@ -130,7 +131,9 @@ pub struct NsgsOptions {
     pub tol: f64,
     /// Cap on sweeps.
     pub max_iter: usize,
-    /// Under-relaxation `ω ∈ (0, 1]`: `r_i ← ω r_i,local + (1 − ω) r_i`.
+    /// Relaxation `ω ∈ (0, 2)`: `r_i ← ω r_i,local + (1 − ω) r_i`; under 1 it damps, over 1 it
+    /// extrapolates (projected onto the cone, and back to 1 for the rest of the solve when a
+    /// sweep changes the impulses more than the one before).
     pub relaxation: f64,
 }
 
@@ -148,11 +151,55 @@ pub struct NewtonOptions {
     pub tol: f64,
     /// Cap on Newton iterations (a fallback Gauss–Seidel sweep counts as one).
     pub max_iter: usize,
+    /// Relative regularization `ε_i / W_NN,i` of the Delassus matrix in the Newton direction
+    /// (see [`newton`]); 0 for the plain Jacobian.
+    pub regularization: f64,
+    /// Reuse the last solve's factorization while the projection derivatives are unchanged
+    /// (successive steps of a resting contact set), as a chord direction checked by the line
+    /// search.
+    pub reuse: bool,
 }
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        Self { tol: 1e-10, max_iter: 200 }
+        Self { tol: 1e-10, max_iter: 200, regularization: 1e-4, reuse: true }
+    }
+}
+
+/// Gauss–Seidel sweeps [`Method::Auto`] takes before it turns to Newton.
+pub const AUTO_SWEEPS: usize = 10;
+
+/// The automatic choice ([`Method::Auto`]): the method by the problem's shape.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AutoOptions {
+    /// Stop when the residual of [`Report::residual`] is at most this.
+    pub tol: f64,
+    /// Friction-contact problems with at most this many unknowns (`d n`) go to the regularized
+    /// semismooth Newton method (a dense factorization, `O((d n)³)` but reused while the contact
+    /// set rests: converges on stacks and other statically indeterminate supports in a few
+    /// iterations); larger ones to nonsmooth Gauss–Seidel (`O(d n)` per sweep).
+    pub newton_max_unknowns: usize,
+    /// Cap on Newton iterations.
+    pub newton_max_iter: usize,
+    /// Cap on Gauss–Seidel sweeps.
+    pub nsgs_max_iter: usize,
+}
+
+impl Default for AutoOptions {
+    fn default() -> Self {
+        Self { tol: 1e-10, newton_max_unknowns: 480, newton_max_iter: 200, nsgs_max_iter: 10_000 }
+    }
+}
+
+impl AutoOptions {
+    /// The method it takes for a friction-contact problem of `unknowns` unknowns.
+    pub fn pick(&self, unknowns: usize) -> Method {
+        if unknowns <= self.newton_max_unknowns {
+            Method::Newton(NewtonOptions { tol: self.tol, max_iter: self.newton_max_iter, ..Default::default() })
+        } else {
+            Method::Nsgs(NsgsOptions { tol: self.tol, max_iter: self.nsgs_max_iter, ..Default::default() })
+        }
     }
 }
 
@@ -166,6 +213,10 @@ pub enum Method {
     Nsgs(NsgsOptions),
     /// Semismooth Newton (friction contact only).
     Newton(NewtonOptions),
+    /// Newton for small friction-contact problems (after up to [`AUTO_SWEEPS`] Gauss–Seidel
+    /// sweeps; the report counts both), Gauss–Seidel for large ones, Lemke for LCPs
+    /// ([`AutoOptions::pick`]).
+    Auto(AutoOptions),
 }
 
 impl Method {
@@ -180,6 +231,10 @@ impl Method {
     /// Newton with default options.
     pub fn newton() -> Self {
         Method::Newton(NewtonOptions::default())
+    }
+    /// The automatic choice with default options.
+    pub fn auto() -> Self {
+        Method::Auto(AutoOptions::default())
     }
 
     fn validate(&self) -> Result<()> {
@@ -204,15 +259,29 @@ impl Method {
                 ensure!(o.tol > 0.0, Settings, "NSGS: tol must be > 0, got {}", o.tol);
                 ensure!(o.max_iter > 0, Settings, "NSGS: max_iter must be > 0");
                 ensure!(
-                    o.relaxation > 0.0 && o.relaxation <= 1.0,
+                    o.relaxation > 0.0 && o.relaxation < 2.0,
                     Settings,
-                    "NSGS: relaxation must be in (0, 1], got {}",
+                    "NSGS: relaxation must be in (0, 2), got {}",
                     o.relaxation
+                );
+            }
+            Method::Auto(o) => {
+                ensure!(o.tol > 0.0, Settings, "auto solver: tol must be > 0, got {}", o.tol);
+                ensure!(
+                    o.newton_max_iter > 0 && o.nsgs_max_iter > 0,
+                    Settings,
+                    "auto solver: newton_max_iter and nsgs_max_iter must be > 0"
                 );
             }
             Method::Newton(o) => {
                 ensure!(o.tol > 0.0, Settings, "Newton: tol must be > 0, got {}", o.tol);
                 ensure!(o.max_iter > 0, Settings, "Newton: max_iter must be > 0");
+                ensure!(
+                    o.regularization >= 0.0 && o.regularization < 1.0,
+                    Settings,
+                    "Newton: regularization must be in [0, 1), got {}",
+                    o.regularization
+                );
             }
         }
         Ok(())
@@ -257,10 +326,12 @@ impl sealed::Sealed for Lcp {
             Method::Lemke(_) => Ok(Needs { u: n, lemke: n, ..Needs::default() }),
             Method::Nsgs(_) => Ok(Needs { u: n, ..Needs::default() }),
             Method::Newton(_) => Err(newton_is_not_for_lcps()),
+            Method::Auto(_) => self.needs(&Method::lemke()),
         }
     }
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
+            Method::Auto(_) => lemke::solve_lcp(self, &LemkeOptions::default(), x, ws),
             Method::Lemke(o) => lemke::solve_lcp(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_lcp(self, o, x, ws),
             Method::Newton(_) => Err(newton_is_not_for_lcps()),
@@ -289,10 +360,27 @@ impl sealed::Sealed for FrictionContact {
             }
             Method::Nsgs(_) => Needs { u: m, diag: n, ..Needs::default() },
             Method::Newton(_) => Needs { u: m, diag: n, newton: m, ..Needs::default() },
+            Method::Auto(o) => return self.needs(&o.pick(m)),
         })
     }
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
+            Method::Auto(o) => {
+                let pick = o.pick(self.unknowns());
+                if let Method::Newton(_) = pick {
+                    // a few Gauss–Seidel sweeps first: they finish a warm-started step that
+                    // needs little, and bring a cold start near enough for Newton's few steps
+                    let sweeps = NsgsOptions { tol: o.tol, max_iter: AUTO_SWEEPS, relaxation: 1.0 };
+                    let first = nsgs::solve_fc(self, &sweeps, x, ws)?;
+                    if first.converged {
+                        return Ok(first);
+                    }
+                    let mut rep = self.run(&pick, x, ws)?;
+                    rep.iterations += first.iterations;
+                    return Ok(rep);
+                }
+                self.run(&pick, x, ws)
+            }
             Method::Lemke(o) => friction_lcp::solve(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_fc(self, o, x, ws),
             Method::Newton(o) => newton::solve(self, o, x, ws),

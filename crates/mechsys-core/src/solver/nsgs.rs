@@ -15,6 +15,10 @@
 //!   solved by Newton from the previous sliding direction, or by bracketing all its roots if that
 //!   fails; a root counts if `r_N > 0` and `t · u_T ≥ 0` (the friction force opposes sliding).
 //!
+//! Over-relaxation `ω ∈ (1, 2)` extrapolates each local solution (`r_i ← ω r_i,local + (1 − ω)
+//! r_i`, projected back onto the cone); the solve drops to `ω = 1` at the first sweep that
+//! changes the impulses more than the previous one (the safeguard against overshooting).
+//!
 //! If no case holds to round-off (a singular or strongly non-symmetric block), a projected
 //! fixed-point iteration on the De Saxcé map `r ← proj_K(r − ρ (u + μ|u_T| e_N))` finishes the
 //! local problem. Sweeps stop when the velocity-weighted change `‖W_NN,i Δr_i‖` falls below the
@@ -68,8 +72,16 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
     let qn = 1.0 + norm(&p.q);
     let mut residual = f64::INFINITY;
     let mut check = CheckSchedule::new();
+    // over-relaxation (ω > 1) with a safeguard: when a sweep changes the impulses more than the
+    // one before, the extrapolation overshoots; the solve goes on with plain sweeps (ω = 1)
+    let mut omega = o.relaxation;
+    let mut last_change = f64::INFINITY;
     for it in 1..=o.max_iter {
-        let change = sweep(p, &ws.diag[..n], r, o.relaxation);
+        let change = sweep(p, &ws.diag[..n], r, omega);
+        if omega > 1.0 && change > last_change {
+            omega = 1.0;
+        }
+        last_change = change;
         if check.due(it, change.sqrt() / qn <= o.tol) || it == o.max_iter {
             let u = &mut ws.u[..m];
             p.w.velocity(p.dim, r, &p.q, u);
@@ -128,10 +140,18 @@ pub(crate) fn sweep(p: &FrictionContact, diag: &[[f64; 9]], r: &mut [f64], relax
         }
         let mut new = old;
         local_solve(d, &diag[i], p.mu[i], &b, &mut new);
+        let mut v = [0.0; 3];
         for a in 0..d {
-            let v = relaxation * new[a] + (1.0 - relaxation) * old[a];
-            change += (diag[i][0] * (v - old[a])).powi(2);
-            r[i * d + a] = v;
+            v[a] = relaxation * new[a] + (1.0 - relaxation) * old[a];
+        }
+        if relaxation > 1.0 {
+            // an extrapolated impulse may leave the cone: back onto it
+            let x = v;
+            project_onto_cone(p.mu[i], &x[..d], &mut v[..d]);
+        }
+        for a in 0..d {
+            change += (diag[i][0] * (v[a] - old[a])).powi(2);
+            r[i * d + a] = v[a];
         }
     }
     change
