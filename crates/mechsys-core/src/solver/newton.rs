@@ -57,8 +57,7 @@ pub(crate) struct NewtonWork {
     phi_trial: Vec<f64>,
     /// Per-contact `D` blocks (row-major `d × d`).
     dblk: Vec<[f64; 9]>,
-    /// The `D` blocks and size of the factorization held in `jac` (size 0: none).
-    lu_dblk: Vec<[f64; 9]>,
+    /// The size of the factorization held in `jac` (0: none).
     lu_size: usize,
 }
 
@@ -78,7 +77,6 @@ impl NewtonWork {
                 v.resize(m, 0.0);
             }
             self.dblk.resize(m, [0.0; 9]);
-            self.lu_dblk.resize(m, [0.0; 9]);
             self.lu_size = 0;
         }
     }
@@ -227,7 +225,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
     let (jac, piv) = (&mut nw.jac[..m * m], &mut nw.piv[..m]);
     let (phi, dir, wdir) = (&mut nw.phi[..m], &mut nw.dir[..m], &mut nw.wdir[..m]);
     let (r_t, u_t, phi_t) = (&mut nw.r_trial[..m], &mut nw.u_trial[..m], &mut nw.phi_trial[..m]);
-    let (dblk, lu_dblk) = (&mut nw.dblk[..n], &mut nw.lu_dblk[..n]);
+    let dblk = &mut nw.dblk[..n];
     let mut iterations = 0;
     loop {
         p.w.velocity(d, r, &p.q, u);
@@ -251,7 +249,6 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
                     break;
                 }
                 nw.lu_size = m;
-                lu_dblk.copy_from_slice(dblk);
             }
             for (x, f) in dir.iter_mut().zip(phi.iter()) {
                 *x = -f;
