@@ -203,7 +203,13 @@ pub fn elastic_node(data: &Data, body: usize, p_b: &Vec3) -> Option<(usize, usiz
 /// deflected with it).
 #[inline]
 pub fn point_position(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
-    match elastic_node(data, body, p_b) {
+    point_position_at(data, body, p_b, elastic_node(data, body, p_b))
+}
+
+/// [`point_position`] with the point's elastic node already looked up.
+#[inline]
+fn point_position_at(data: &Data, body: usize, p_b: &Vec3, node: Option<(usize, usize)>) -> Vec3 {
+    match node {
         Some((k, n)) => {
             let w = &data.elastic[k];
             data.x_abs[body].point_to_parent(&(p_b + w.node_field(n, &w.q)))
@@ -216,9 +222,15 @@ pub fn point_position(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
 /// node plus its deflection rate, eq. 2.191).
 #[inline]
 pub fn point_velocity(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
+    point_velocity_at(data, body, p_b, elastic_node(data, body, p_b))
+}
+
+/// [`point_velocity`] with the point's elastic node already looked up.
+#[inline]
+fn point_velocity_at(data: &Data, body: usize, p_b: &Vec3, node: Option<(usize, usize)>) -> Vec3 {
     let v = &data.v[body];
-    let rigid = v.v + v.w.cross(&point_position(data, body, p_b));
-    match elastic_node(data, body, p_b) {
+    let rigid = v.v + v.w.cross(&point_position_at(data, body, p_b, node));
+    match node {
         Some((k, n)) => rigid + data.x_abs[body].a * data.elastic[k].node_field(n, &data.elastic[k].qd),
         None => rigid,
     }
@@ -229,12 +241,18 @@ pub fn point_velocity(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
 /// Requires [`accelerations`] without the gravity offset.
 #[inline]
 pub fn point_acceleration(data: &Data, body: usize, p_b: &Vec3) -> Vec3 {
+    point_acceleration_at(data, body, p_b, elastic_node(data, body, p_b))
+}
+
+/// [`point_acceleration`] with the point's elastic node already looked up.
+#[inline]
+fn point_acceleration_at(data: &Data, body: usize, p_b: &Vec3, node: Option<(usize, usize)>) -> Vec3 {
     let (v, a) = (&data.v[body], &data.a[body]);
-    let p = point_position(data, body, p_b);
+    let p = point_position_at(data, body, p_b, node);
     let vp = v.v + v.w.cross(&p);
     // spatial → classical: a_P = a_O + ω̇ × p + ω × v_P
     let rigid = a.v + a.w.cross(&p) + v.w.cross(&vp);
-    match elastic_node(data, body, p_b) {
+    match node {
         Some((k, n)) => {
             let (w, am) = (&data.elastic[k], &data.x_abs[body].a);
             let rel_v = am * w.node_field(n, &w.qd);
@@ -303,9 +321,11 @@ pub fn frame_motion(data: &Data, body: usize, f: &Pose) -> (BodyMotion, Option<(
     let (th, thd, thdd) = (w.node_rotation(n, &w.q), w.node_rotation(n, &w.qd), w.node_rotation(n, &w.qdd));
     let jl = so3_left_jacobian(&th);
     let (vb, ab) = (&data.v[body], &data.a[body]);
-    let p = point_position(data, body, &f.r);
-    let vp = point_velocity(data, body, &f.r);
-    let ap = point_acceleration(data, body, &f.r);
+    // the node is known: the point functions need not search for it again
+    let node = Some((k, n));
+    let p = point_position_at(data, body, &f.r, node);
+    let vp = point_velocity_at(data, body, &f.r, node);
+    let ap = point_acceleration_at(data, body, &f.r, node);
     let w_rel = xb.a * (jl * thd);
     let om = vb.w + w_rel;
     let al = ab.w + vb.w.cross(&w_rel) + xb.a * (jl * thdd + so3_left_jacobian_rate(&th, &thd));
@@ -314,7 +334,7 @@ pub fn frame_motion(data: &Data, body: usize, f: &Pose) -> (BodyMotion, Option<(
         twist: Motion { w: om, v: vp - om.cross(&p) },
         acc: Motion { w: al, v: ap - al.cross(&p) - om.cross(&vp) },
     };
-    (m, Some((k, n)))
+    (m, node)
 }
 
 /// Adds `sign · S_k·W` for every elastic coordinate k of the node a frame sits at into row `row`
