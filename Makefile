@@ -51,21 +51,7 @@ bench-rust:
 
 bench: $(BUILD)
 	$(PY) -m pip install --quiet pin mujoco exudyn pybullet
-	$(PY) benches/peers.py --out docs/benchmarks.md
-	$(PY) benches/constraints.py --out docs/benchmarks.md
-	$(PY) benches/contacts.py --out docs/benchmarks.md
-	$(PY) benches/stack.py --out docs/benchmarks.md
-	$(PY) benches/event_driven.py --baseline benches/baselines/event_driven_50c2cb9.json --out docs/benchmarks.md
-	$(PY) benches/linear.py --out docs/benchmarks.md
-	$(PY) benches/linear_motion.py --out docs/benchmarks.md
-	$(PY) benches/sensors.py --out docs/benchmarks.md
-	$(PY) benches/stiff.py --out docs/benchmarks.md
-	$(PY) benches/bearing.py --out docs/benchmarks.md
-	$(PY) benches/planar.py --out docs/benchmarks.md
-	$(PY) benches/viewer.py --out docs/benchmarks.md
-	$(PY) benches/elastic.py --out docs/benchmarks.md
-	$(PY) benches/elastic_exudyn.py --out docs/benchmarks.md
-	$(PY) benches/study.py --out docs/benchmarks.md
+	$(PY) benches/run_all.py --out docs/benchmarks.md
 
 clean:
 	rm -rf $(VENV) target results site

@@ -11,12 +11,11 @@ Compared: Radau5 adaptive (rtol 1e-6, atol 1e-10), Radau5 at the largest fixed s
 of the sampling interval) whose error is no larger, DOPRI5 (rtol 1e-6, atol 1e-10); and Radau5
 adaptive with a looser atol, which no longer follows the stiff mode's tiny start-up transient.
 Times: from Python with the model built beforehand, median (min) over repeats, release build.
-Usage: ``.venv/bin/python benches/stiff.py [--out docs/benchmarks.md] [--repeat 5]``.
+Usage: ``.venv/bin/python benches/stiff.py [--out docs/benchmarks.md] [--repeat 5] [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -25,7 +24,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from benchdoc import fmt_time, machine, timed, write_doc  # noqa: E402
+from benchdoc import bench_args, fmt_time, machine, timed, write_doc  # noqa: E402
 from test_radau_adaptive import T_END, exact, stiff_pair  # noqa: E402
 
 import mechsys as ms  # noqa: E402
@@ -35,10 +34,7 @@ RTOL = 1e-6
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path)
-    ap.add_argument("--repeat", type=int, default=5)
-    a = ap.parse_args(argv)
+    a = bench_args(__doc__, argv, repeat=5)
     mach = machine()
     model = stiff_pair()
     model.build()
