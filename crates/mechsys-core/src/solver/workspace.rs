@@ -1,5 +1,6 @@
 //! Scratch storage of the solvers, sized once so that solves do not allocate.
 
+use super::apgd::ApgdWork;
 use super::lemke::LemkeWork;
 use super::newton::NewtonWork;
 use super::{Method, Problem};
@@ -20,6 +21,8 @@ pub struct Needs {
     pub dense: usize,
     /// Unknowns of a Newton solve (0 if none).
     pub newton: usize,
+    /// Unknowns of an APGD solve (0 if none).
+    pub apgd: usize,
 }
 
 impl Needs {
@@ -31,6 +34,7 @@ impl Needs {
             lcp: self.lcp.max(o.lcp),
             dense: self.dense.max(o.dense),
             newton: self.newton.max(o.newton),
+            apgd: self.apgd.max(o.apgd),
         }
     }
 
@@ -55,6 +59,7 @@ pub struct Workspace {
     pub(crate) lcp_z: Vec<f64>,
     pub(crate) dense: Vec<f64>,
     pub(crate) newton: NewtonWork,
+    pub(crate) apgd: ApgdWork,
 }
 
 impl Workspace {
@@ -89,6 +94,7 @@ impl Workspace {
         grow(&mut self.lcp_z, cap.lcp);
         grow(&mut self.dense, cap.dense * cap.dense);
         self.newton.reserve(cap.newton);
+        self.apgd.reserve(cap.apgd);
         self.cap = cap;
         Ok(())
     }
