@@ -260,7 +260,8 @@ def run_ms_pile(model, n, dt, t_end, tol, max_iter, auto=False):
 
     import re
 
-    solver = ms.Auto(tol=tol) if auto else ms.NSGS(tol=tol, max_iter=max_iter)
+    solver = (ms.APGD(tol=tol, max_iter=10_000) if auto == "apgd" else ms.Auto(tol=tol) if auto
+              else ms.NSGS(tol=tol, max_iter=max_iter))
     with warnings.catch_warnings(record=True) as notes:
         warnings.simplefilter("always")
         t0 = time.perf_counter()
@@ -269,7 +270,7 @@ def run_ms_pile(model, n, dt, t_end, tol, max_iter, auto=False):
     # steps whose contact problem stopped at the sweep budget before the tolerance
     missed = [re.search(r"in (\d+) of (\d+) steps", str(w.message)) for w in notes]
     missed = [m for m in missed if m]
-    MISSED[(id(model), dt, tol, "auto" if auto else max_iter)] = (int(missed[0].group(1)) / int(missed[0].group(2))
+    MISSED[(id(model), dt, tol, auto if auto == "apgd" else "auto" if auto else max_iter)] = (int(missed[0].group(1)) / int(missed[0].group(2))
                                                                   if missed else 0.0)
     z = res["q"][-1].reshape(n, 7)[:, 2]
     return el, float(res["contact/pile/max_penetration"].max()), float(z.mean()), int(res["contact/pile/closed"][-1]), t_end
@@ -353,6 +354,10 @@ def pile_rows(n, t_end, repeat, cap):
         ("mechsys NSGS(tol=1e-6, max_iter=100)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-6, 100)),
         ("mechsys NSGS(tol=1e-4, max_iter=20)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-4, 20)),
         ("mechsys Auto(tol=1e-4)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-4, 0, auto=True)),
+        # accelerated projected gradient (issue 17): on the small pile only (one W product per iteration,
+        # thousands of iterations per step on a settling pile)
+        *([("mechsys APGD(tol=1e-4)", 1e-3, lambda dt: run_ms_pile(model, n, dt, t_end, 1e-4, 0, auto="apgd"))]
+          if n <= 100 else []),
         ("MuJoCo default (Newton)", 1e-3, lambda dt: run_mj_pile(n, dt, t_end, "Newton", cap)),
         ("MuJoCo CG", 1e-3, lambda dt: run_mj_pile(n, dt, t_end, "CG", cap)),
         ("PyBullet", 1e-3, lambda dt: run_pb_pile(n, dt, t_end, cap)),
@@ -380,7 +385,7 @@ def pile_rows(n, t_end, repeat, cap):
         rates = [o[0] / o[4] for o in outs]
         tmin, tmed, (_, pen, zm, ncon, reached) = min(rates), statistics.median(rates), outs[-1]
         if engine.startswith("mechsys"):
-            tol, it = (1e-6, 100) if "1e-6" in engine else (1e-4, "auto" if "Auto" in engine else 20)
+            tol, it = (1e-6, 100) if "1e-6" in engine else (1e-4, "auto" if "Auto" in engine else "apgd" if "APGD" in engine else 20)
             share = MISSED.get((id(model), dt, tol, it))
             if share is not None:
                 engine = f"{engine}; budget reached before tol in {100 * share:.0f} % of steps"
