@@ -309,7 +309,7 @@ def main(argv=None) -> int:
               "≈ 6 %), the box-box manifold (once per pair and step: `box_box_all` and its clipping ≈ 4.5 %), tangents "
               "and contact kinematics ≈ 5 %, the tree kinematics and mass-matrix factor ≈ 5 %. The 10 pairs give 40 "
               "active points (4 closed per interface, 120 unknowns). MuJoCo's step is ≈ 16-20 µs on this machine.",
-              "- APGD (`solver="apgd"`) needs hundreds of gradient steps from a cold start and 0 or 1 at rest "
+              "- APGD (`solver=\"apgd\"`) needs hundreds of gradient steps from a cold start and 0 or 1 at rest "
               "(the warm start from the last step's impulses per contact point already meets the tolerance)."]
         write_doc(a.out, "\n".join(L), "<!-- stack.py:begin -->", "<!-- stack.py:end -->")
         print(f"updated {a.out}")
