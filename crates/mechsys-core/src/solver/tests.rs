@@ -436,10 +436,13 @@ fn random_spatial_problems_nsgs_and_newton_agree() {
         for s in states(&p, &r_nsgs) {
             seen[s as usize] = true;
         }
-        // the pyramid (32 facets) is close to the cone
+        // the pyramid (32 facets) is close to the cone: its inscribed facets cut the friction
+        // bound by at most 1 − cos(π/32) ≈ 4.8e-3 relative; over these seeds the impulses differ
+        // by at most 1.7e-3 of the scale, so 4e-3 catches a pyramid a few times coarser
         let (r_lemke, rep) = run_fc(&p, Method::Lemke(LemkeOptions { facets: 32, ..Default::default() })).unwrap();
         assert!(rep.converged);
-        assert!(max_diff(&r_lemke, &r_nsgs) < 0.05 * (1.0 + max_abs(&r_nsgs)), "seed {seed}");
+        let diff = max_diff(&r_lemke, &r_nsgs) / (1.0 + max_abs(&r_nsgs));
+        assert!(diff < 4e-3, "seed {seed}: pyramid against cone {diff:e}");
     }
     assert_eq!(seen, [true; 3], "open, stick and slip all occur");
 }
