@@ -86,3 +86,22 @@ def test_apgd_by_name_table_and_bad_settings():
         _solver({"type": "apgd", "relaxation": 1.2})
     with pytest.raises(Exception, match="APGD: tol must be > 0"):
         ms.simulate(stack(1), 0.01, ms.MoreauJean(1e-3, solver=ms.APGD(tol=-1.0)))
+
+
+def test_apgd_from_the_command_line(tmp_path):
+    """`mechsys run examples/box_stack.py --solver apgd`: the run records the solver and its
+    signals, and the tower's steps converge (the file's own solver is Auto)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "box_stack.py"
+    out = tmp_path / "stack.h5"
+    cmd = [sys.executable, "-m", "mechsys", "run", str(example), "--t-end", "0.05", "--solver", "apgd", "--out", str(out)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, timeout=300,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr
+    res = ms.load(out)
+    assert res.settings["integrator"]["solver"] == {"type": "apgd", "tol": 1e-10, "max_iter": 10_000}
+    assert res["solver/converged"][1:].min() == 1 and res["solver/residual"].max() <= 1e-10
