@@ -304,10 +304,11 @@ def main(argv=None) -> int:
               "solve with the factorization of the last step (it is reused while the projection derivatives, i.e. "
               "the stick/slip/open pattern, do not change).",
               "- Where the time goes now (`perf record` of a 40 s run, stack at dt = 1e-3, auto; shares of all samples, "
-              "the Python start included): the sparse Delassus assembly (`SparseRows::delassus` 15 %, the contact rows "
-              "and their reduction `SparseRows::add_contact` 11 %), the solver (a warm-started sweep and its residual "
-              "≈ 6 %), the box-box manifold (once per pair and step: `box_box_all` and its clipping ≈ 4.5 %), tangents "
-              "and contact kinematics ≈ 5 %, the tree kinematics and mass-matrix factor ≈ 5 %. The 10 pairs give 40 "
+              "the Python start included): the sparse Delassus assembly (`SparseRows::add_contact`, the contact "
+              "rows and their reduction, 10 %; `SparseRows::delassus`, the blocks, 7 % after accumulating them in "
+              "registers, 15 % before), the solver (a warm-started sweep and its residual ≈ 6 %), copies (`memmove` "
+              "5 %), the box-box manifold (once per pair and step: `box_box_all` and its clipping 5 %), tangents and "
+              "contact kinematics 6 %, the tree kinematics and mass-matrix factor ≈ 5 %. The 10 pairs give 40 "
               "active points (4 closed per interface, 120 unknowns). MuJoCo's step is ≈ 16-20 µs on this machine.",
               "- APGD (`solver=\"apgd\"`) needs hundreds of gradient steps from a cold start and 0 or 1 at rest "
               "(the warm start from the last step's impulses per contact point already meets the tolerance)."]
