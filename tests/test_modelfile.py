@@ -293,7 +293,7 @@ def test_python_file_accepts_every_integrator_object(tmp_path, source, integrato
     [
         ("ms.MoreauJean(dt=-1e-3)", r"simulation\.integrator\.dt: must be > 0, got -0\.001"),
         ("ms.MoreauJean(dt='small')", r"simulation\.integrator\.dt: expected a number, got a string 'small'"),
-        ("ms.MoreauJean(1e-3, solver=3)", r"simulation\.integrator\.solver: expected mechsys\.NSGS, Newton, Lemke or Auto"),
+        ("ms.MoreauJean(1e-3, solver=3)", r"simulation\.integrator\.solver: expected mechsys\.NSGS, Newton, APGD, Lemke or Auto"),
         ("ms.MoreauJean(1e-3, solver=ms.NSGS(tol=0.0))", r"simulation\.integrator\.solver\.tol: must be > 0"),
         ("ms.MoreauJean(1e-3, solver=ms.Lemke(facets=2))", r"simulation\.integrator\.solver\.facets: expected an integer >= 3"),
         ("ms.EventDriven(max_events=0)", r"simulation\.integrator\.max_events: expected an integer >= 1, got 0"),
@@ -303,7 +303,7 @@ def test_python_file_accepts_every_integrator_object(tmp_path, source, integrato
         ("3", r"simulation\.integrator: expected mechsys\.RK4, .* got an integer"),
         ("{'type': 'moreau_jean', 'dt': 1e-3, 'solver': {'type': 'nsgs', 'tole': 1}}",
          r"simulation\.integrator\.solver\.tole: unknown key for nsgs; expected one of type, tol, max_iter, relaxation"),
-        ("{'type': 'moreau_jean', 'dt': 1e-3, 'solver': 'gauss'}", r"simulation\.integrator\.solver\.type: expected nsgs, newton, lemke or auto"),
+        ("{'type': 'moreau_jean', 'dt': 1e-3, 'solver': 'gauss'}", r"simulation\.integrator\.solver\.type: expected nsgs, newton, apgd, lemke or auto"),
     ],
 )
 def test_python_file_bad_integrator_names_the_key(tmp_path, value, expected):
@@ -345,7 +345,7 @@ def test_simulation_kwargs_overrides_an_integrator_object():
         simulation_kwargs({"t_end": 1.0}, solver="nsgs")
     with pytest.raises(SettingsError, match=r"--dt: must be > 0, got -1"):
         simulation_kwargs(defaults, dt=-1.0)
-    with pytest.raises(SettingsError, match=r"--solver\.type: expected nsgs, newton, lemke or auto, got 'gauss'"):
+    with pytest.raises(SettingsError, match=r"--solver\.type: expected nsgs, newton, apgd, lemke or auto, got 'gauss'"):
         simulation_kwargs(defaults, solver="gauss")
 
 
@@ -448,5 +448,5 @@ def test_solver_names_and_auto_tables():
     sim = simulation_kwargs({"t_end": 1.0, "integrator": {"type": "moreau_jean", "dt": 1e-3, "parallel": False,
                                                           "solver": {"type": "auto", "tol": 1e-8, "newton_max_unknowns": 90}}})
     assert sim["integrator"] == ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-8, newton_max_unknowns=90), parallel=False)
-    with pytest.raises(SettingsError, match=r"MoreauJean\.solver\.type: expected nsgs, newton, lemke or auto, got 'fast'"):
+    with pytest.raises(SettingsError, match=r"MoreauJean\.solver\.type: expected nsgs, newton, apgd, lemke or auto, got 'fast'"):
         ms.MoreauJean(1e-3, solver="fast")

@@ -18,7 +18,7 @@ from .errors import (
     SolverError,
 )
 from .contacts import Contact, ContactGroup, GapContact
-from .integrators import DOPRI5, RK4, Auto, EventDriven, Lemke, MoreauJean, Newton, NSGS, Radau5
+from .integrators import APGD, DOPRI5, RK4, Auto, EventDriven, Lemke, MoreauJean, Newton, NSGS, Radau5
 from .joints import Frame
 from .model import Body, Model
 from .results import Results, load
@@ -66,6 +66,7 @@ __all__ = [
     "Newton",
     "Lemke",
     "Auto",
+    "APGD",
     "joints",
     "constraints",
     "Contact",

@@ -159,7 +159,7 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
 @click.option("--dt", type=float, help="Step of rk4/radau5/moreau_jean (s); alone it selects rk4; radau5 with --dt takes fixed steps.")
 @click.option("--integrator", type=click.Choice(["rk4", "dopri5", "radau5", "moreau_jean", "event_driven"], case_sensitive=False),
               help="Integration scheme (moreau_jean: time-stepping for models with contacts; event_driven: located contact events).")
-@click.option("--solver", type=click.Choice(["nsgs", "newton", "lemke", "auto"], case_sensitive=False), help="Contact solver of moreau_jean; overrides the model file's.")
+@click.option("--solver", type=click.Choice(["nsgs", "newton", "apgd", "lemke", "auto"], case_sensitive=False), help="Contact solver of moreau_jean; overrides the model file's.")
 @click.option("--rtol", type=float, help="Relative tolerance of dopri5, event_driven and radau5 (radau5 with --rtol: adaptive steps).")
 @click.option("--atol", type=float, help="Absolute tolerance of dopri5, event_driven and adaptive radau5.")
 @click.option("--output-dt", type=float, help="Sampling interval of the results (s).")

@@ -1,6 +1,6 @@
 """Integration schemes: smooth dynamics (RK4, DOPRI5, Radau5) and, for models with unilateral
 contacts, Moreau-Jean time-stepping (:class:`MoreauJean`) with a choice of contact solver
-(:class:`NSGS`, :class:`Newton`, :class:`Lemke`, :class:`Auto`) or event-driven integration
+(:class:`NSGS`, :class:`Newton`, :class:`APGD`, :class:`Lemke`, :class:`Auto`) or event-driven integration
 (:class:`EventDriven`).
 
 - :class:`RK4` — classical Runge-Kutta, fixed step: cheap, predictable, 4th order.
@@ -126,6 +126,20 @@ class Auto:
 
 
 @dataclass(frozen=True)
+class APGD:
+    """Accelerated projected gradient (Nesterov's method with adaptive restart) on the friction
+    cones, with the De Saxce velocity so that its solutions are Coulomb's: one product with the
+    Delassus matrix per iteration and no factorization, for large piles; stops at ``tol`` (the
+    residual of ``solver/residual``) or after ``max_iter`` iterations."""
+
+    tol: float = 1e-10
+    max_iter: int = 10_000
+
+    def describe(self) -> dict:
+        return {"type": "apgd", "tol": float(self.tol), "max_iter": int(self.max_iter)}
+
+
+@dataclass(frozen=True)
 class Lemke:
     """Lemke's pivoting on the LCP form (exact for planar friction; a pyramid of ``facets`` sides in 3-D)."""
 
@@ -146,8 +160,8 @@ class MoreauJean:
     ``continue_on_painleve=False`` it raises :class:`mechsys.PainleveError` instead."""
 
     dt: float
-    #: an object (NSGS, Newton, Lemke, Auto) or a name: "nsgs", "newton", "lemke", "auto"
-    solver: NSGS | Newton | Lemke | Auto | str = NSGS()
+    #: an object (NSGS, Newton, APGD, Lemke, Auto) or a name: "nsgs", "newton", "apgd", "lemke", "auto"
+    solver: NSGS | Newton | APGD | Lemke | Auto | str = NSGS()
     continue_on_painleve: bool = True
     #: project the contacts that stay closed back onto their contours after each step: stops
     #: the O(dt) sinking of a contact rolling or sliding along a curved contour (a ball in a
@@ -221,4 +235,4 @@ def from_name(name: str, dt: float | None = None, rtol: float | None = None, ato
     raise SettingsError(f"integrator: unknown name '{name}' (expected rk4, dopri5, radau5, moreau_jean or event_driven)")
 
 
-__all__ = ["RK4", "DOPRI5", "Radau5", "MoreauJean", "EventDriven", "NSGS", "Newton", "Lemke", "Auto"]
+__all__ = ["RK4", "DOPRI5", "Radau5", "MoreauJean", "EventDriven", "NSGS", "Newton", "Lemke", "Auto", "APGD"]

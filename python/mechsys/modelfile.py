@@ -51,7 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import MechsysError, ModelError, SettingsError
-from .integrators import DOPRI5, NSGS, RK4, Auto, EventDriven, Lemke, MoreauJean, Newton, Radau5
+from .integrators import APGD, DOPRI5, NSGS, RK4, Auto, EventDriven, Lemke, MoreauJean, Newton, Radau5
 from .model import Model
 
 #: Keys of the ``[simulation]`` table.
@@ -68,7 +68,7 @@ INTEGRATOR_KEYS: dict[str, tuple[str, ...]] = {
 }
 
 _INTEGRATOR_CLASSES = {"rk4": RK4, "dopri5": DOPRI5, "radau5": Radau5, "moreau_jean": MoreauJean, "event_driven": EventDriven}
-_SOLVER_CLASSES = {"nsgs": NSGS, "newton": Newton, "lemke": Lemke, "auto": Auto}
+_SOLVER_CLASSES = {"nsgs": NSGS, "newton": Newton, "lemke": Lemke, "auto": Auto, "apgd": APGD}
 #: What an integrator object in a Python model file may be.
 _INTEGRATOR_OBJECTS = "mechsys.RK4, DOPRI5, Radau5, MoreauJean or EventDriven"
 #: Parameters of integrators and solvers: integers (with their least value), booleans, and numbers
@@ -81,6 +81,7 @@ _POSITIVE_KEYS = ("dt", "rtol", "newton_tol", "tol", "pivot_tol", "relaxation")
 SOLVER_KEYS: dict[str, tuple[str, ...]] = {"nsgs": ("tol", "max_iter", "relaxation"),
                                            "newton": ("tol", "max_iter", "regularization"),
                                            "lemke": ("facets", "pivot_tol"),
+                                           "apgd": ("tol", "max_iter"),
                                            "auto": ("tol", "newton_max_unknowns", "newton_max_iter", "nsgs_max_iter")}
 
 
@@ -96,12 +97,12 @@ def _solver(spec: Any, where: str = "integrator.solver", error: type[MechsysErro
     elif isinstance(spec, dict):
         table = dict(spec)
     else:
-        raise error(f"{where}: expected mechsys.NSGS, Newton, Lemke or Auto, a name (nsgs, newton, lemke, auto) or a table with type, "
+        raise error(f"{where}: expected mechsys.NSGS, Newton, APGD, Lemke or Auto, a name (nsgs, newton, apgd, lemke, auto) or a table with type, "
                     f"got {_tname(spec)}")
     kind = table.pop("type", None)
     if not isinstance(kind, str) or kind.lower() not in _SOLVER_CLASSES:
         shown = "missing" if kind is None else repr(kind)
-        raise error(f"{where}.type: expected nsgs, newton, lemke or auto, got {shown}")
+        raise error(f"{where}.type: expected nsgs, newton, apgd, lemke or auto, got {shown}")
     kind = kind.lower()
     args = {key: _parameter(value, key, SOLVER_KEYS[kind], kind, f"{where}.{key}", error) for key, value in table.items()}
     return _SOLVER_CLASSES[kind](**args)
@@ -386,7 +387,7 @@ def _check_integrator(spec: Any, allow_objects: bool) -> Any:
     if allow_objects and isinstance(spec, tuple(_INTEGRATOR_CLASSES.values())):
         solver = getattr(spec, "solver", None)
         if isinstance(spec, MoreauJean) and not isinstance(solver, tuple(_SOLVER_CLASSES.values())):
-            raise ModelError(f"{where}.solver: expected mechsys.NSGS, Newton, Lemke or Auto, got {_tname(solver)} {solver!r}")
+            raise ModelError(f"{where}.solver: expected mechsys.NSGS, Newton, APGD, Lemke or Auto, got {_tname(solver)} {solver!r}")
         # the fields as given (describe() would convert them and hide, e.g., a string dt); None
         # is "not given" (Radau5's dt or rtol)
         given = {k: v for k, v in _fields(spec, _INTEGRATOR_CLASSES).items() if v is not None}

@@ -8,7 +8,7 @@ use mechsys_core::dynamics::Workspace;
 use mechsys_core::forces::NoCallbacks;
 use mechsys_core::integrator::moreau_jean::MoreauJean;
 use mechsys_core::model::{Model, ModelDescription};
-use mechsys_core::solver::{Method, NsgsOptions};
+use mechsys_core::solver::{ApgdOptions, Method, NsgsOptions};
 
 mod common;
 use common::allocations;
@@ -21,11 +21,20 @@ static A: common::Counting = common::Counting;
 /// solves.
 #[test]
 fn group_steps_do_not_allocate_after_warm_up() {
+    pile_steps_do_not_allocate_after_warm_up(Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0 }));
+}
+
+/// The same with the accelerated projected gradient (its scratch sized once in the workspace).
+#[test]
+fn group_steps_with_apgd_do_not_allocate_after_warm_up() {
+    pile_steps_do_not_allocate_after_warm_up(Method::Apgd(ApgdOptions { tol: 1e-8, max_iter: 500 }));
+}
+
+fn pile_steps_do_not_allocate_after_warm_up(method: Method) {
     let model =
         Model::from_description(ModelDescription::from_json(&sphere_pile(27, 0.05, 0.1, 0.17, 0.3, 0.2, 3)).unwrap())
             .unwrap();
     let h = 1e-3;
-    let method = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();
     assert!(st.is_sparse());
     let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));

@@ -220,6 +220,8 @@ pub struct MoreauJean {
     sparse: Option<SparseRows>,
     /// The step's independent contact islands.
     islands: islands::Islands,
+    /// Height of each active point along gravity (m), Gauss–Seidel's visiting order.
+    height: Vec<f64>,
     /// Solve the islands on rayon's threads (the impulses do not depend on it).
     pub parallel: bool,
     /// Steps taken (for the validity of the groups' warm starts).
@@ -318,6 +320,7 @@ impl MoreauJean {
             act: Vec::with_capacity(np),
             sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
             islands: islands::Islands::default(),
+            height: Vec::new(),
             parallel: true,
             steps: 0,
             project: false,
@@ -629,12 +632,21 @@ impl MoreauJean {
                 self.problem.mu.push(mu);
                 self.r.extend_from_slice(&prev[..d]);
             }
+            // sweeps from the bottom up along gravity: each contact then sees the newest support
+            // below it, and a warm-started pile settles in fewer sweeps than in pair order
+            self.height.clear();
+            let g = model.gravity;
+            if g.norm() > 0.0 {
+                let down = g / g.norm();
+                self.height.extend(self.act.iter().map(|a| -down.dot(&(0.5 * (a.point.p1 + a.point.p2)))));
+            }
+            self.ws.set_order(&self.height);
             // independent islands (sparse assembly only: the dense one couples through M̃⁻¹)
             match self.sparse.as_ref() {
                 Some(sp) => {
                     self.islands.partition(m, &sp.upper);
                     if self.islands.count() > 1 {
-                        self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r);
+                        self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r, &self.height);
                     }
                 }
                 None => self.islands.single(m),

@@ -32,6 +32,7 @@
 //! | [`Method::Lemke`] | complementary pivoting ([`lemke`]), exact | `d = 2`: exact through the LCP of [`friction_lcp`]; `d = 3`: pyramid with `facets` sides |
 //! | [`Method::Nsgs`] | projected Gauss–Seidel | nonsmooth Gauss–Seidel with exact local solves ([`nsgs`]) |
 //! | [`Method::Newton`] | — | semismooth Newton on the Alart–Curnier function with a regularized Delassus matrix ([`newton`]) |
+//! | [`Method::Apgd`] | — | accelerated projected gradient with adaptive restart on the De Saxcé velocity ([`apgd`]) |
 //! | [`Method::Auto`] | Lemke | Newton up to [`AutoOptions::newton_max_unknowns`] unknowns, NSGS above |
 //!
 //! Every solve returns a [`Report`]; its residual is recomputed from the returned solution with
@@ -65,6 +66,7 @@
 //! for the modified velocity; Acary & Brogliato, *Numerical Methods for Nonsmooth Dynamical Systems*
 //! (2008), for the merit function.
 
+pub mod apgd;
 pub mod fixtures;
 pub mod friction_lcp;
 pub mod lemke;
@@ -166,6 +168,22 @@ impl Default for NewtonOptions {
     }
 }
 
+/// Accelerated projected gradient ([`apgd`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ApgdOptions {
+    /// Stop when the residual of [`Report::residual`] is at most this.
+    pub tol: f64,
+    /// Cap on iterations (each one product with `W`, more while the step size is searched).
+    pub max_iter: usize,
+}
+
+impl Default for ApgdOptions {
+    fn default() -> Self {
+        Self { tol: 1e-10, max_iter: 10_000 }
+    }
+}
+
 /// Gauss–Seidel sweeps [`Method::Auto`] takes before it turns to Newton.
 pub const AUTO_SWEEPS: usize = 10;
 
@@ -213,6 +231,8 @@ pub enum Method {
     Nsgs(NsgsOptions),
     /// Semismooth Newton (friction contact only).
     Newton(NewtonOptions),
+    /// Accelerated projected gradient (friction contact only).
+    Apgd(ApgdOptions),
     /// Newton for small friction-contact problems (after up to [`AUTO_SWEEPS`] Gauss–Seidel
     /// sweeps; the report counts both), Gauss–Seidel for large ones, Lemke for LCPs
     /// ([`AutoOptions::pick`]).
@@ -231,6 +251,10 @@ impl Method {
     /// Newton with default options.
     pub fn newton() -> Self {
         Method::Newton(NewtonOptions::default())
+    }
+    /// APGD with default options.
+    pub fn apgd() -> Self {
+        Method::Apgd(ApgdOptions::default())
     }
     /// The automatic choice with default options.
     pub fn auto() -> Self {
@@ -272,6 +296,10 @@ impl Method {
                     Settings,
                     "auto solver: newton_max_iter and nsgs_max_iter must be > 0"
                 );
+            }
+            Method::Apgd(o) => {
+                ensure!(o.tol > 0.0, Settings, "APGD: tol must be > 0, got {}", o.tol);
+                ensure!(o.max_iter > 0, Settings, "APGD: max_iter must be > 0");
             }
             Method::Newton(o) => {
                 ensure!(o.tol > 0.0, Settings, "Newton: tol must be > 0, got {}", o.tol);
@@ -325,7 +353,7 @@ impl sealed::Sealed for Lcp {
         match method {
             Method::Lemke(_) => Ok(Needs { u: n, lemke: n, ..Needs::default() }),
             Method::Nsgs(_) => Ok(Needs { u: n, ..Needs::default() }),
-            Method::Newton(_) => Err(newton_is_not_for_lcps()),
+            Method::Newton(_) | Method::Apgd(_) => Err(not_for_lcps(method)),
             Method::Auto(_) => self.needs(&Method::lemke()),
         }
     }
@@ -334,7 +362,7 @@ impl sealed::Sealed for Lcp {
             Method::Auto(_) => lemke::solve_lcp(self, &LemkeOptions::default(), x, ws),
             Method::Lemke(o) => lemke::solve_lcp(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_lcp(self, o, x, ws),
-            Method::Newton(_) => Err(newton_is_not_for_lcps()),
+            Method::Newton(_) | Method::Apgd(_) => Err(not_for_lcps(method)),
         }
     }
 }
@@ -356,10 +384,11 @@ impl sealed::Sealed for FrictionContact {
             Method::Lemke(o) => {
                 let nl = (friction_lcp::directions(self.dim, o) + 2) * n;
                 let dense = if matches!(self.w, Delassus::Blocks(_)) { m } else { 0 };
-                Needs { u: m, diag: n, lemke: nl, lcp: nl, dense, newton: 0 }
+                Needs { u: m, diag: n, lemke: nl, lcp: nl, dense, newton: 0, apgd: 0 }
             }
             Method::Nsgs(_) => Needs { u: m, diag: n, ..Needs::default() },
             Method::Newton(_) => Needs { u: m, diag: n, newton: m, ..Needs::default() },
+            Method::Apgd(_) => Needs { u: m, diag: n, apgd: m, ..Needs::default() },
             Method::Auto(o) => return self.needs(&o.pick(m)),
         })
     }
@@ -384,12 +413,14 @@ impl sealed::Sealed for FrictionContact {
             Method::Lemke(o) => friction_lcp::solve(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_fc(self, o, x, ws),
             Method::Newton(o) => newton::solve(self, o, x, ws),
+            Method::Apgd(o) => apgd::solve(self, o, x, ws),
         }
     }
 }
 
-fn newton_is_not_for_lcps() -> crate::Error {
-    crate::Error::Settings("solver: Newton solves friction-contact problems; solve an LCP with Lemke or Nsgs".into())
+fn not_for_lcps(method: &Method) -> crate::Error {
+    let name = if matches!(method, Method::Apgd(_)) { "APGD" } else { "Newton" };
+    crate::Error::Settings(format!("solver: {name} solves friction-contact problems; solve an LCP with Lemke or Nsgs"))
 }
 
 /// Solves `problem` with `method` into `x`.

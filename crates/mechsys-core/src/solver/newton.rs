@@ -220,6 +220,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
     let diag = &mut ws.diag[..n];
     cache_diagonal(p, diag);
     let diag = &ws.diag[..n];
+    let order = &ws.order;
     let u = &mut ws.u[..m];
     let nw = &mut ws.newton;
     let (jac, piv) = (&mut nw.jac[..m * m], &mut nw.piv[..m]);
@@ -305,7 +306,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             fresh = true;
         }
         if !accepted {
-            sweep(p, diag, r, 1.0);
+            sweep(p, diag, order, r, 1.0);
         }
     }
 }

@@ -77,7 +77,7 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
     let mut omega = o.relaxation;
     let mut last_change = f64::INFINITY;
     for it in 1..=o.max_iter {
-        let change = sweep(p, &ws.diag[..n], r, omega);
+        let change = sweep(p, &ws.diag[..n], &ws.order, r, omega);
         if omega > 1.0 && change > last_change {
             omega = 1.0;
         }
@@ -126,11 +126,16 @@ pub(crate) fn cache_diagonal(p: &FrictionContact, diag: &mut [[f64; 9]]) {
     }
 }
 
-/// One Gauss–Seidel sweep over the contacts; returns `Σ_i ‖W_NN,i Δr_i‖²`.
-pub(crate) fn sweep(p: &FrictionContact, diag: &[[f64; 9]], r: &mut [f64], relaxation: f64) -> f64 {
+/// One Gauss–Seidel sweep over the contacts, in `order` if it holds a permutation of them
+/// ([`Workspace::set_order`]), else by index; returns `Σ_i ‖W_NN,i Δr_i‖²`.
+pub(crate) fn sweep(p: &FrictionContact, diag: &[[f64; 9]], order: &[usize], r: &mut [f64], relaxation: f64) -> f64 {
     let d = p.dim;
     let mut change = 0.0;
-    for i in 0..p.contacts() {
+    let nc = p.contacts();
+    // the caller's visiting order (a permutation of the contacts), else the natural one
+    let ordered = order.len() == nc;
+    for ii in 0..nc {
+        let i = if ordered { order[ii] } else { ii };
         let mut b = [0.0; 3];
         p.w.add_row_product(d, i, r, true, &mut b);
         let mut old = [0.0; 3];

@@ -1,5 +1,6 @@
 //! Scratch storage of the solvers, sized once so that solves do not allocate.
 
+use super::apgd::ApgdWork;
 use super::lemke::LemkeWork;
 use super::newton::NewtonWork;
 use super::{Method, Problem};
@@ -20,6 +21,8 @@ pub struct Needs {
     pub dense: usize,
     /// Unknowns of a Newton solve (0 if none).
     pub newton: usize,
+    /// Unknowns of an APGD solve (0 if none).
+    pub apgd: usize,
 }
 
 impl Needs {
@@ -31,6 +34,7 @@ impl Needs {
             lcp: self.lcp.max(o.lcp),
             dense: self.dense.max(o.dense),
             newton: self.newton.max(o.newton),
+            apgd: self.apgd.max(o.apgd),
         }
     }
 
@@ -55,6 +59,9 @@ pub struct Workspace {
     pub(crate) lcp_z: Vec<f64>,
     pub(crate) dense: Vec<f64>,
     pub(crate) newton: NewtonWork,
+    pub(crate) apgd: ApgdWork,
+    /// Gauss–Seidel's visiting order of the contacts (empty: by index), see [`Workspace::set_order`].
+    pub(crate) order: Vec<usize>,
 }
 
 impl Workspace {
@@ -89,8 +96,23 @@ impl Workspace {
         grow(&mut self.lcp_z, cap.lcp);
         grow(&mut self.dense, cap.dense * cap.dense);
         self.newton.reserve(cap.newton);
+        self.apgd.reserve(cap.apgd);
         self.cap = cap;
         Ok(())
+    }
+
+    /// Makes Gauss–Seidel sweeps (NSGS, and Newton's fallback sweeps) visit the contacts by
+    /// ascending `key` (ties by index) in the following solves of problems with `key.len()`
+    /// contacts; an empty `key` restores the index order. A problem of another size is swept by
+    /// index. Allocates only when the number of contacts grows beyond anything seen.
+    ///
+    /// The time-stepping scheme orders by height along gravity, so that a sweep carries the
+    /// weights of a pile down through it in one pass instead of one contact per sweep.
+    pub fn set_order(&mut self, key: &[f64]) {
+        self.order.clear();
+        self.order.extend(0..key.len());
+        // an unstable sort with the index as tie-break: deterministic and allocation-free
+        self.order.sort_unstable_by(|&a, &b| key[a].total_cmp(&key[b]).then(a.cmp(&b)));
     }
 
     pub(crate) fn check(&self, need: &Needs) -> Result<()> {

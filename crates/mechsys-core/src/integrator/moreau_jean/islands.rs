@@ -23,6 +23,8 @@ struct Island {
     diag: Vec<f64>,
     upper: Vec<(usize, usize)>,
     upper_val: Vec<f64>,
+    /// Sweep-order keys of its contacts (empty: by index).
+    key: Vec<f64>,
     report: Option<Report>,
 }
 
@@ -117,7 +119,8 @@ impl Islands {
     }
 
     /// Splits `whole` (block-sparse `W`, diagonal blocks `diag`, coupled pairs `upper` with
-    /// values `upper_val`) into the islands' problems, warm-started from `r`.
+    /// values `upper_val`) into the islands' problems, warm-started from `r`; `key` (one per
+    /// contact, or empty) orders each island's Gauss–Seidel sweeps.
     pub(super) fn fill(
         &mut self,
         whole: &FrictionContact,
@@ -125,6 +128,7 @@ impl Islands {
         upper: &[(usize, usize)],
         upper_val: &[f64],
         r: &[f64],
+        key: &[f64],
     ) {
         let d = whole.dim;
         let dd = d * d;
@@ -133,6 +137,7 @@ impl Islands {
             isl.upper.clear();
             isl.upper_val.clear();
             isl.r.clear();
+            isl.key.clear();
             let p = isl.problem.get_or_insert_with(|| FrictionContact {
                 dim: d,
                 w: Delassus::Blocks(BlockDelassus::default()),
@@ -151,6 +156,9 @@ impl Islands {
                 p.q.extend_from_slice(&whole.q[i * d..(i + 1) * d]);
                 p.mu.push(whole.mu[i]);
                 isl.r.extend_from_slice(&r[i * d..(i + 1) * d]);
+                if let Some(k) = key.get(i) {
+                    isl.key.push(*k);
+                }
             }
         }
         for (e, &(i, j)) in upper.iter().enumerate() {
@@ -189,6 +197,7 @@ impl Islands {
         let run = |isl: &mut Island| -> Result<()> {
             let p = isl.problem.as_ref().expect("filled");
             isl.ws.reserve(p, method)?;
+            isl.ws.set_order(&isl.key);
             let warm = isl.r.iter().any(|v| *v != 0.0);
             isl.report = Some(solver::solve(p, method, &mut isl.r, warm, &mut isl.ws)?);
             Ok(())
@@ -278,7 +287,7 @@ mod tests {
             isl.partition(9, &upper);
             assert_eq!(isl.count(), 2);
             let mut r = vec![0.0; 27];
-            isl.fill(&whole, &diag, &upper, &upper_val, &r.clone());
+            isl.fill(&whole, &diag, &upper, &upper_val, &r.clone(), &[]);
             let rep = isl.solve(&method, parallel, &mut r).unwrap();
             assert!(rep.converged && rep.residual <= 1e-13, "{rep:?}");
             let scale = 1.0 + r_whole.iter().fold(0.0f64, |a, v| a.max(v.abs()));

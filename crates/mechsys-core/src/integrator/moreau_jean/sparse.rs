@@ -293,15 +293,18 @@ impl SparseRows {
         }
         // y = D^{-1/2} L⁻ᵀ w on the pattern, leaves first
         self.y.extend_from_slice(&self.w[w0..w0 + len * d]);
-        let f = &self.factor;
+        let (f, y, pos, pat) = (&self.factor, &mut self.y, &self.pos, &self.pat_idx);
         for e in (0..len).rev() {
-            let k = self.pat_idx[start + e];
+            let k = pat[start + e];
             let ye = w0 + e * d;
+            // entry e's rows in registers while its ancestors are updated (they are other entries)
+            let mut v = [0.0; 3];
+            v[..d].copy_from_slice(&y[ye..ye + d]);
             for p in f.anc_ptr[k]..f.anc_ptr[k + 1] {
                 let l = f.off[p];
-                let ya = w0 + self.pos[f.anc_idx[p]] * d;
-                for r in 0..d {
-                    self.y[ya + r] -= l * self.y[ye + r];
+                let ya = w0 + pos[f.anc_idx[p]] * d;
+                for (t, vr) in y[ya..ya + d].iter_mut().zip(&v) {
+                    *t -= l * vr;
                 }
             }
         }
@@ -325,11 +328,24 @@ impl SparseRows {
         for a in 0..n {
             let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
             let blk = &mut self.diag[a * dd..(a + 1) * dd];
-            for x in s..e {
-                let y = &self.y[x * d..(x + 1) * d];
-                for r in 0..d {
-                    for c in 0..d {
-                        blk[r * d + c] += y[r] * y[c];
+            if d == 3 {
+                // accumulated in registers (the same sums in the same order as the general loop)
+                let mut acc = [0.0; 9];
+                for y in self.y[s * 3..e * 3].chunks_exact(3) {
+                    for r in 0..3 {
+                        acc[3 * r] += y[r] * y[0];
+                        acc[3 * r + 1] += y[r] * y[1];
+                        acc[3 * r + 2] += y[r] * y[2];
+                    }
+                }
+                blk.copy_from_slice(&acc);
+            } else {
+                for x in s..e {
+                    let y = &self.y[x * d..(x + 1) * d];
+                    for r in 0..d {
+                        for c in 0..d {
+                            blk[r * d + c] += y[r] * y[c];
+                        }
                     }
                 }
             }
@@ -398,14 +414,17 @@ impl SparseRows {
                             let blk = &mut self.upper_val[off..off + dd];
                             let (ya, yb) = (&self.y[ep * d..(ep + len) * d], &self.y[eq * d..(eq + len) * d]);
                             if d == 3 {
+                                // in registers, stored once per run (same order of the sums)
                                 let blk: &mut [f64; 9] = blk.try_into().unwrap();
+                                let mut acc = *blk;
                                 for (a, b) in ya.chunks_exact(3).zip(yb.chunks_exact(3)) {
                                     for r in 0..3 {
-                                        blk[3 * r] += a[r] * b[0];
-                                        blk[3 * r + 1] += a[r] * b[1];
-                                        blk[3 * r + 2] += a[r] * b[2];
+                                        acc[3 * r] += a[r] * b[0];
+                                        acc[3 * r + 1] += a[r] * b[1];
+                                        acc[3 * r + 2] += a[r] * b[2];
                                     }
                                 }
+                                *blk = acc;
                             } else {
                                 for (a, b) in ya.chunks_exact(d).zip(yb.chunks_exact(d)) {
                                     for r in 0..d {
