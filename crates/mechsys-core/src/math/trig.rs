@@ -49,7 +49,10 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() <= 1e5) {
         return x.sin_cos();
     }
-    let n = (x * INV_PIO2).round();
+    // the nearest whole number of quarter turns (ties to even) by the 1.5·2⁵² shift, exact for
+    // |x·2/π| < 2⁵¹: `f64::round` is a call into the C library on the baseline x86-64 target
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let n = (x * INV_PIO2 + SHIFT) - SHIFT;
     let r = ((x - n * PIO2_1) - n * PIO2_2) - n * (PIO2_3 + PIO2_3T);
     let (s, c) = (kernel_sin(r), kernel_cos(r));
     match (n as i64) & 3 {
