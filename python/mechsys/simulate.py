@@ -176,12 +176,9 @@ def simulate(
         # callbacks need the interpreter; running in this thread keeps tracebacks simple
         run()
     else:
-        # not a daemon: the interpreter never ends while the engine still runs in it (a daemon
-        # thread stopped at exit inside the engine aborts the process)
-        worker = threading.Thread(target=run, name="mechsys-simulate")
-        worker.start()
+        worker = _engine_thread(run)
         interrupted = _wait(done, prog, n_expected, progress)
-        worker.join()
+        worker()
         if interrupted and (error or "cancelled" not in raw):
             # stopped otherwise (an error, or it ended on its own just then): the interrupt wins
             raise KeyboardInterrupt
@@ -212,6 +209,46 @@ def simulate(
         interrupt.results = res
         raise interrupt
     return res
+
+
+_pool: tuple | None = None  # (pid, executor, lock): the kept engine thread of this process
+
+
+def _engine_thread(run):
+    """Starts ``run`` on an engine thread; returns the call that waits for it to end.
+
+    One thread is kept between runs: starting a thread for each costs a few tenths of a
+    millisecond, much of it the new thread's allocator faulting in the pages of the result arrays
+    afresh. A run while that thread is busy (runs from several Python threads) gets a thread of
+    its own. Neither is a daemon: the interpreter never ends while the engine still runs in it (a
+    daemon thread stopped at exit inside the engine aborts the process); the executor's thread is
+    joined at exit. The executor is made anew in a forked child, which does not inherit threads.
+    """
+    global _pool
+    import os
+
+    if _pool is None or _pool[0] != os.getpid():
+        from concurrent.futures import ThreadPoolExecutor
+
+        _pool = (os.getpid(), ThreadPoolExecutor(max_workers=1, thread_name_prefix="mechsys-simulate"), threading.Lock())
+    _, pool, lock = _pool
+    if lock.acquire(blocking=False):
+
+        def job():
+            try:
+                run()
+            finally:
+                lock.release()
+
+        try:
+            future = pool.submit(job)
+        except RuntimeError:  # the executor was shut down (interpreter exit): a thread of its own
+            lock.release()
+        else:
+            return future.result
+    worker = threading.Thread(target=run, name="mechsys-simulate")
+    worker.start()
+    return worker.join
 
 
 def _stabilization(value) -> dict:

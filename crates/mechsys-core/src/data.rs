@@ -29,6 +29,9 @@ pub struct Data {
     pub x_abs: Vec<Pose>,
     /// kinematics: placement of the child joint frame of the joint moving body i, in I (nbody).
     pub x_joint: Vec<Pose>,
+    /// kinematics: `(sin q, cos q)` of the revolute joint moving body i about a coordinate axis,
+    /// computed for all such joints before the placements (nbody; others unused).
+    pub sin_cos: Vec<(f64, f64)>,
     /// kinematics: motion subspace of the joint moving body i, world twists (nbody × 6, nu used).
     pub s: Vec<[Motion; 6]>,
     /// kinematics: twist of body i, world components about the origin (nbody).
@@ -147,6 +150,7 @@ impl Data {
         Data {
             x_abs: vec![Pose::IDENTITY; nb],
             x_joint: vec![Pose::IDENTITY; nb],
+            sin_cos: vec![(0.0, 1.0); nb],
             s: vec![[Motion::ZERO; 6]; nb],
             v: vec![Motion::ZERO; nb],
             c: vec![Motion::ZERO; nb],

@@ -1844,12 +1844,26 @@ fn record(model: &Model, data: &Data, saddle: &Saddle, t: f64, y: &[f64], rec: &
             }
         }
         rec.body_orientation.extend_from_slice(&qb);
-        let origin = crate::math::Vec3::zeros();
-        rec.body_velocity.extend_from_slice(point_velocity(data, i, &origin).as_slice());
-        rec.body_angular_velocity.extend_from_slice(data.v[i].w.as_slice());
-        if acc {
-            rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
-            rec.body_angular_acceleration.extend_from_slice(data.a[i].w.as_slice());
+        let (v, a) = (&data.v[i], &data.a[i]);
+        if data.body_elastic.get(i).copied().flatten().is_none() {
+            // a rigid body's origin (the common case, without the elastic node search):
+            // v_O = v + ω × r, a_O = a + ω̇ × r + ω × v_O (world convention, eq. 2.41)
+            let vo = v.v + v.w.cross(&x.r);
+            rec.body_velocity.extend_from_slice(vo.as_slice());
+            rec.body_angular_velocity.extend_from_slice(v.w.as_slice());
+            if acc {
+                let ao = a.v + a.w.cross(&x.r) + v.w.cross(&vo);
+                rec.body_acceleration.extend_from_slice(ao.as_slice());
+                rec.body_angular_acceleration.extend_from_slice(a.w.as_slice());
+            }
+        } else {
+            let origin = crate::math::Vec3::zeros();
+            rec.body_velocity.extend_from_slice(point_velocity(data, i, &origin).as_slice());
+            rec.body_angular_velocity.extend_from_slice(v.w.as_slice());
+            if acc {
+                rec.body_acceleration.extend_from_slice(point_acceleration(data, i, &origin).as_slice());
+                rec.body_angular_acceleration.extend_from_slice(a.w.as_slice());
+            }
         }
         rec.body_mass.push(data.inertia[i].m);
     }

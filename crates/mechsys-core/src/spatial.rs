@@ -341,7 +341,8 @@ impl Motion {
     /// Pairing with a force given as a plain array `[n; f]`.
     #[inline]
     pub fn dot6(&self, f: &V6) -> f64 {
-        self.w.x * f[0] + self.w.y * f[1] + self.w.z * f[2] + self.v.x * f[3] + self.v.y * f[4] + self.v.z * f[5]
+        // a balanced sum (see [`M6::mul`])
+        (self.w.x * f[0] + self.w.y * f[1]) + (self.w.z * f[2] + self.v.x * f[3]) + (self.v.y * f[4] + self.v.z * f[5])
     }
 }
 
@@ -378,17 +379,19 @@ impl M6 {
             (false, false) => self.c[TRI[r - 3][c - 3]],
         }
     }
-    /// Product with a plain 6-vector.
+    /// Product with a plain 6-vector. Each row is summed as a balanced tree (three additions deep
+    /// instead of five in a row): the ABA's inward pass is a serial chain through these products,
+    /// and its latency, not the operation count, bounds a chain.
     #[inline(always)]
     pub fn mul(&self, x: &V6) -> V6 {
         let (a, b, c) = (&self.a, &self.b, &self.c);
         [
-            a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + b[0][0] * x[3] + b[0][1] * x[4] + b[0][2] * x[5],
-            a[1] * x[0] + a[3] * x[1] + a[4] * x[2] + b[1][0] * x[3] + b[1][1] * x[4] + b[1][2] * x[5],
-            a[2] * x[0] + a[4] * x[1] + a[5] * x[2] + b[2][0] * x[3] + b[2][1] * x[4] + b[2][2] * x[5],
-            b[0][0] * x[0] + b[1][0] * x[1] + b[2][0] * x[2] + c[0] * x[3] + c[1] * x[4] + c[2] * x[5],
-            b[0][1] * x[0] + b[1][1] * x[1] + b[2][1] * x[2] + c[1] * x[3] + c[3] * x[4] + c[4] * x[5],
-            b[0][2] * x[0] + b[1][2] * x[1] + b[2][2] * x[2] + c[2] * x[3] + c[4] * x[4] + c[5] * x[5],
+            (a[0] * x[0] + a[1] * x[1]) + (a[2] * x[2] + b[0][0] * x[3]) + (b[0][1] * x[4] + b[0][2] * x[5]),
+            (a[1] * x[0] + a[3] * x[1]) + (a[4] * x[2] + b[1][0] * x[3]) + (b[1][1] * x[4] + b[1][2] * x[5]),
+            (a[2] * x[0] + a[4] * x[1]) + (a[5] * x[2] + b[2][0] * x[3]) + (b[2][1] * x[4] + b[2][2] * x[5]),
+            (b[0][0] * x[0] + b[1][0] * x[1]) + (b[2][0] * x[2] + c[0] * x[3]) + (c[1] * x[4] + c[2] * x[5]),
+            (b[0][1] * x[0] + b[1][1] * x[1]) + (b[2][1] * x[2] + c[1] * x[3]) + (c[3] * x[4] + c[4] * x[5]),
+            (b[0][2] * x[0] + b[1][2] * x[1]) + (b[2][2] * x[2] + c[2] * x[3]) + (c[4] * x[4] + c[5] * x[5]),
         ]
     }
     /// Product with a motion vector; the result is a force vector.

@@ -40,7 +40,8 @@ fn invert_spd(d: &mut [[f64; 6]; 6], n: usize) -> bool {
 
 #[inline]
 fn dot6(a: &V6, b: &V6) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
+    // a balanced sum: D = Sᵀ U lies on the inward pass's serial chain (see `M6::mul`)
+    (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]) + (a[4] * b[4] + a[5] * b[5])
 }
 
 /// ABA on prepared data (kinematics, inertias, `f_ext`, `tau_applied`); `tau` is an optional extra

@@ -31,15 +31,33 @@ fn position_step(j: &crate::model::Joint, data: &mut Data, i: usize, q: &[f64]) 
     // mostly pure offsets: skip the rotation products then)
     let xp = &data.x_abs[j.parent];
     let x_pj = if j.frames_plain.0 { xp.translate(&j.parent_frame.r) } else { xp.compose(&j.parent_frame) };
+    let mut axis = Vec3::zeros();
     let x_cj = match j.coordinate_axis {
         Some(k) => {
             // rotation about coordinate axis k: only the two other columns turn (eq. 2.12-2.18)
-            let (s, c) = crate::math::trig::sin_cos(qj[0]);
-            let (i1, i2) = ((k + 1) % 3, (k + 2) % 3);
-            let mut a = x_pj.a;
-            let (c1, c2) = (x_pj.a.column(i1).into_owned(), x_pj.a.column(i2).into_owned());
-            a.set_column(i1, &(c1 * c + c2 * s));
-            a.set_column(i2, &(c2 * c - c1 * s));
+            // (the columns are picked with constant indices per axis: writing them at a runtime
+            // index into a matrix on the stack made the loads after it wait on store forwarding)
+            let (s, c) = data.sin_cos[i];
+            let a = &x_pj.a;
+            let col = |i: usize| Vec3::new(a[(0, i)], a[(1, i)], a[(2, i)]);
+            let turn = |c1: Vec3, c2: Vec3| (c1 * c + c2 * s, c2 * c - c1 * s);
+            let a = match k {
+                0 => {
+                    let (n1, n2) = turn(col(1), col(2));
+                    axis = col(0);
+                    Mat3::from_columns(&[axis, n1, n2])
+                }
+                1 => {
+                    let (n1, n2) = turn(col(2), col(0));
+                    axis = col(1);
+                    Mat3::from_columns(&[n2, axis, n1])
+                }
+                _ => {
+                    let (n1, n2) = turn(col(0), col(1));
+                    axis = col(2);
+                    Mat3::from_columns(&[n1, n2, axis])
+                }
+            };
             Pose::new(a, x_pj.r)
         }
         None => x_pj.compose(&j.kind.placement(qj)),
@@ -50,10 +68,9 @@ fn position_step(j: &crate::model::Joint, data: &mut Data, i: usize, q: &[f64]) 
         _ => x_cj.compose(&j.child_frame_inv),
     };
     data.x_joint[i] = x_cj;
-    if let Some(k) = j.coordinate_axis {
-        // the axis in I is a column of A; the twist about it through r is (ω, r × ω)
-        let w = x_cj.a.column(k).into_owned();
-        data.s[i][0] = Motion::new(w, x_cj.r.cross(&w));
+    if j.coordinate_axis.is_some() {
+        // the axis in I is a column of A (kept above); the twist about it through r is (ω, r × ω)
+        data.s[i][0] = Motion::new(axis, x_cj.r.cross(&axis));
         return;
     }
     let mut s = [Motion::ZERO; 6];
@@ -125,10 +142,23 @@ fn deform_elastic(model: &Model, data: &mut Data) {
     }
 }
 
+/// `(sin q, cos q)` of every revolute joint about a coordinate axis, ahead of the placements:
+/// the angles do not depend on each other, so these polynomial chains overlap in the pipeline
+/// instead of each one stalling the serial parent-to-child recursion.
+#[inline(always)]
+fn joint_sin_cos(model: &Model, data: &mut Data, q: &[f64]) {
+    for (j, sc) in model.joints.iter().zip(data.sin_cos[1..].iter_mut()) {
+        if j.coordinate_axis.is_some() {
+            *sc = crate::math::trig::sin_cos(q[j.iq]);
+        }
+    }
+}
+
 /// Position stage: placements `x_abs`, `x_joint` and motion subspaces `s` (world) of all bodies.
 ///
 /// eq. 2.46: A_IBi = A_IBi-1 · A_Bi-1Bi; eq. 2.51: r_IBi = r_IBi-1 + A_IBi-1 r_Bi-1Bi.
 pub fn positions(model: &Model, data: &mut Data, q: &[f64]) {
+    joint_sin_cos(model, data, q);
     for (ji, j) in model.joints.iter().enumerate() {
         position_step(j, data, ji + 1, q);
     }
@@ -156,6 +186,7 @@ pub fn inertias(model: &Model, data: &mut Data, t: f64) {
 /// Positions, velocities and inertias in one sweep over the tree (the stages of one evaluation
 /// before the forces; fused so each body's placement is used while it is still in registers).
 pub fn forward_pass(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64]) {
+    joint_sin_cos(model, data, q);
     for (ji, j) in model.joints.iter().enumerate() {
         let i = ji + 1;
         position_step(j, data, i, q);

@@ -49,15 +49,19 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() <= 1e5) {
         return x.sin_cos();
     }
-    let n = (x * INV_PIO2).round();
+    // the nearest whole number of quarter turns (ties to even) by the 1.5·2⁵² shift, exact for
+    // |x·2/π| < 2⁵¹: `f64::round` is a call into the C library on the baseline x86-64 target
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let n = (x * INV_PIO2 + SHIFT) - SHIFT;
     let r = ((x - n * PIO2_1) - n * PIO2_2) - n * (PIO2_3 + PIO2_3T);
     let (s, c) = (kernel_sin(r), kernel_cos(r));
-    match (n as i64) & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    // quadrants 0..3 give (s, c), (c, -s), (-s, -c), (-c, s): a swap on odd quadrants and signs
+    // from the two low bits, as selects and exact multiplications by ±1 instead of a branch
+    let k = n as i64;
+    let (a, b) = if k & 1 == 0 { (s, c) } else { (c, s) };
+    let sign_sin = if k & 2 == 0 { 1.0 } else { -1.0 };
+    let sign_cos = if (k ^ (k >> 1)) & 1 == 0 { 1.0 } else { -1.0 };
+    (a * sign_sin, b * sign_cos)
 }
 
 #[cfg(test)]
