@@ -286,6 +286,17 @@ class Results:
                     put(f"{pre}/damping_alpha", pick(dv, 4), "s/m")
                     put(f"{pre}/energy_elastic", fv[:, :, 3].sum(axis=1), "J")
                     put(f"{pre}/energy_dissipated", fv[:, :, 4].sum(axis=1), "J")
+                elif kind == "compliant_group":
+                    # force: sum of F_N, stored and dissipated energy, touching pairs; deflection: max delta, max delta', pairs kept
+                    fv, dv = raw["force_value"][:, k:k + 4], raw["force_deflection"][:, k:k + 4]
+                    pre = f"contact/{name}"
+                    put(f"{pre}/force_n", fv[:, 0], "N")
+                    put(f"{pre}/energy_elastic", fv[:, 1], "J")
+                    put(f"{pre}/energy_dissipated", fv[:, 2], "J")
+                    put(f"{pre}/touching", fv[:, 3], "1")
+                    put(f"{pre}/max_overlap", dv[:, 0], "m")
+                    put(f"{pre}/max_overlap_rate", dv[:, 1], "m/s")
+                    put(f"{pre}/pairs", dv[:, 2], "1")
                 elif kind == "python_force":
                     labels = [joint_of.get(i, (f"u{i}", ""))[0] for i in range(w)]
                     put(f"force/{name}/force", raw["force_value"][:, sl], "mixed", labels,

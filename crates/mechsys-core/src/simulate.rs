@@ -1212,7 +1212,7 @@ pub fn simulate(
         model.contact_groups.first().map_or("", |g| g.name.as_str())
     );
     if let IntegratorKind::EventDriven(opts) = settings.integrator {
-        if let Some(f) = model.forces.iter().find(|f| matches!(f, ForceElement::Contact(_))) {
+        if let Some(f) = model.forces.iter().find(|f| matches!(f, ForceElement::Contact(_) | ForceElement::ContactGroup(_))) {
             return Err(Error::Settings(format!(
                 "contact '{}' is compliant: the event-driven scheme does not carry compliant contacts yet; mix them with rigid contacts under MoreauJean, or run compliant contacts under DOPRI5, Radau5 or RK4",
                 f.name()

@@ -236,6 +236,110 @@ impl CompliantContact {
     }
 }
 
+/// A compliant law's elastic part before the pair of contours is known (a contact group's
+/// pairs differ in kind and material).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ElasticSpec {
+    /// Independent of the contours (Kelvin–Voigt, a user law).
+    Given(Elastic),
+    /// A Hertz-type law: K (or Johnson's line law) from the pair's curvatures and E*, or given.
+    Hertz {
+        /// K given directly (N/m^{3/2}).
+        stiffness: Option<f64>,
+        /// Contact length of a planar line contact (m).
+        length: Option<f64>,
+    },
+}
+
+impl ElasticSpec {
+    /// The elastic law on contours `c` with effective modulus `e_star` (if both have materials).
+    pub fn resolve(&self, c: &[Contour; 2], e_star: Option<f64>, what: &str) -> Result<Elastic> {
+        match self {
+            ElasticSpec::Given(e) => Ok(e.clone()),
+            ElasticSpec::Hertz { stiffness, length } => hertz_elastic(c, e_star, *stiffness, *length, what),
+        }
+    }
+}
+
+/// A compliant contact group: the pairs of a contact group's contours (found by its broad phase,
+/// [`crate::contact::group::GroupPhase`], at every evaluation) each carry a compliant law,
+/// resolved per pair from the pair's contours and materials when it first comes close
+/// ([`CompliantGroup::law`]). Its forces are evaluated by [`crate::forces::compliant_group`].
+#[derive(Debug, Clone)]
+pub struct CompliantGroup {
+    /// The contours (name, members, `against`; its rigid laws are unused).
+    pub geometry: super::contact::ContactGroup,
+    /// Material of each contour: the members, then the `against` contours.
+    pub materials: Vec<Option<Material>>,
+    /// The elastic law before the pair is known.
+    pub elastic: ElasticSpec,
+    /// Damping factor.
+    pub dissipation: Dissipation,
+    /// Tangential law (regularized only: bristle states per pair are not kept in groups).
+    pub tangential: Tangential,
+    /// Its slot among the compliant contact points (its dissipated energy is that slot's state).
+    pub slot: usize,
+    /// Its index among the model's compliant groups (its working memory).
+    pub index: usize,
+}
+
+impl PartialEq for CompliantGroup {
+    /// Same contours, materials, law and slots.
+    fn eq(&self, o: &Self) -> bool {
+        self.geometry.name == o.geometry.name
+            && self.geometry.members == o.geometry.members
+            && self.geometry.against == o.geometry.against
+            && self.materials == o.materials
+            && self.elastic == o.elastic
+            && self.dissipation == o.dissipation
+            && self.tangential == o.tangential
+            && self.slot == o.slot
+            && self.index == o.index
+    }
+}
+
+impl CompliantGroup {
+    /// The contour with index `k` (members first, then `against`).
+    pub fn contour(&self, k: usize) -> &super::contact::GroupContour {
+        let m = self.geometry.members.len();
+        if k < m {
+            &self.geometry.members[k]
+        } else {
+            &self.geometry.against[k - m]
+        }
+    }
+
+    /// The compliant law of the pair of contours `i`, `j`.
+    pub fn law(&self, i: usize, j: usize) -> Result<CompliantLaw> {
+        let e_star = match (self.materials[i], self.materials[j]) {
+            (Some(a), Some(b)) => Some(effective_modulus(&a, &b)),
+            _ => None,
+        };
+        let what = format!("contact group '{}': {}–{}", self.geometry.name, self.label(i), self.label(j));
+        let c = [self.contour(i).contour.clone(), self.contour(j).contour.clone()];
+        Ok(CompliantLaw {
+            elastic: self.elastic.resolve(&c, e_star, &what)?,
+            dissipation: self.dissipation,
+            tangential: self.tangential.clone(),
+        })
+    }
+
+    /// `members[k]` or `against[k − members]`.
+    pub fn label(&self, k: usize) -> String {
+        let m = self.geometry.members.len();
+        if k < m {
+            format!("members[{k}]")
+        } else {
+            format!("against[{}]", k - m)
+        }
+    }
+}
+
+/// Values a compliant group records (force columns: total normal force, stored energy,
+/// dissipated energy, touching pairs; deflection columns: largest overlap, largest approach
+/// rate, pairs kept by the broad phase, 0).
+pub const GROUP_OUTPUTS: usize = 4;
+
 /// Values each compliant contact point records (force columns: F_N, F_T1, F_T2, stored energy,
 /// dissipated energy; deflection columns: δ, δ̇, ġ_T1, ġ_T2, α in use).
 pub const OUTPUTS_PER_POINT: usize = 5;
