@@ -149,7 +149,7 @@ class ContactGroup:
     With a compliant ``normal`` law (``laws.Hertz()``, ``laws.HuntCrossley(eps=0.3)``,
     ``laws.KelvinVoigt(k, d)``, ...) and a ``material`` (or materials on the contours), every
     pair the broad phase finds carries that law as a force, in every scheme (DOPRI5, Radau5, RK4,
-    MoreauJean); friction is regularized (``v_reg`` of the normal law), LuGre is refused; onsets
+    MoreauJean, EventDriven); friction is regularized (``v_reg`` of the normal law), LuGre is refused; onsets
     are stepped over under error control rather than located. Signals: ``contact/<name>/touching``
     (pairs in contact), ``max_overlap`` (m), ``max_overlap_rate`` (m/s), ``force_n`` (N, sum of
     the normal forces), ``energy_elastic`` and ``energy_dissipated`` (J), ``pairs`` (kept by the
