@@ -127,12 +127,7 @@ fn elastic(p: &PairLaw, data: &Data, kin: &ContactKinematics, delta: f64, t: f64
         Elastic::KelvinVoigt { k, .. } => (k * delta, 0.5 * k * delta * delta),
         Elastic::Hertz { k } => (k * delta * delta.sqrt(), 0.4 * k * delta * delta * delta.sqrt()),
         Elastic::HertzCurved { e_star } => {
-            let (x1, x2) = (&data.x_abs[p.body1], &data.x_abs[p.body2]);
-            let k1 = p.contours[0].curvatures_at(x1, &kin.point.p1);
-            let k2 = p.contours[1].curvatures_at(x2, &kin.point.p2);
-            // one side is isotropic (checked when built): the relative principal curvatures
-            let (s0, s1) = (k1[0] + k2[0], k1[1] + k2[1]);
-            let (a, b) = (0.5 * s0.min(s1), 0.5 * s0.max(s1));
+            let (a, b) = relative_curvatures(p, data, kin).unwrap_or((f64::NAN, f64::NAN));
             if !(a > 0.0 && b.is_finite()) {
                 return Err(Error::Solver(format!(
                     "contact '{}' at t = {t:.6} s: the relative curvature at the contact point is {a:.4e} 1/m, no Hertz contact (conforming or flat)",
@@ -154,6 +149,19 @@ fn elastic(p: &PairLaw, data: &Data, kin: &ContactKinematics, delta: f64, t: f64
         }
         Elastic::User { .. } => (0.0, 0.0),
     })
+}
+
+/// Hertz's relative curvatures `A ≤ B` at the contact point: half the eigenvalues of the sum of
+/// the two surfaces' curvature tensors in the contact's tangent plane (`t1`, `t2`), so that two
+/// doubly curved bodies whose principal directions cross at any angle are covered (Johnson,
+/// Contact Mechanics, 4.2). None where a contour has no curvature there.
+fn relative_curvatures(p: &PairLaw, data: &Data, kin: &ContactKinematics) -> Option<(f64, f64)> {
+    let (t1, t2) = (&kin.point.t1, &kin.point.t2);
+    let c1 = p.contours[0].curvature_tensor_at(&data.x_abs[p.body1], &kin.point.p1, t1, t2)?;
+    let c2 = p.contours[1].curvature_tensor_at(&data.x_abs[p.body2], &kin.point.p2, t1, t2)?;
+    let (s11, s12, s22) = (c1[0] + c2[0], c1[1] + c2[1], c1[2] + c2[2]);
+    let (m, d) = (0.5 * (s11 + s22), (0.25 * (s11 - s22).powi(2) + s12 * s12).sqrt());
+    Some((0.5 * (m - d), 0.5 * (m + d)))
 }
 
 /// The damping coefficient α at approach rate `rate`, with the approach speed `onset` of the

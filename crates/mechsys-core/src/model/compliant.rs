@@ -133,7 +133,8 @@ pub enum Elastic {
         k: f64,
     },
     /// `K δ^{3/2}` with K from the curvatures at the contact point at every evaluation (an
-    /// ellipsoid or a torus against a sphere, plane or bowl).
+    /// ellipsoid, a torus or a capsule against a sphere, plane or bowl, or two of them: the
+    /// relative curvature tensor's eigenvalues give A and B).
     HertzCurved {
         /// E*.
         e_star: f64,
@@ -477,7 +478,8 @@ pub fn johnson_energy(x: f64, radius: f64, length: f64, e_star: f64) -> f64 {
 }
 
 /// What kind of contour a Hertz law sees: a constant curvature in every direction (κ, a sphere,
-/// bowl or plane), two principal curvatures that vary (an ellipsoid, a torus), a cylinder's
+/// bowl or plane), two principal curvatures that vary (an ellipsoid, a torus, a capsule: a
+/// cylinder's side with spherical ends), a cylinder's
 /// side or a planar disc (line contact), or nothing to work with (flat faces, edges, vertices).
 enum Shape {
     Isotropic(f64),
@@ -491,7 +493,7 @@ fn shape(c: &Contour) -> Shape {
         Contour::Sphere { radius, .. } => Shape::Isotropic(1.0 / radius),
         Contour::Bowl { radius, .. } => Shape::Isotropic(-1.0 / radius),
         Contour::Plane { .. } | Contour::Line { .. } => Shape::Isotropic(0.0),
-        Contour::Ellipsoid { .. } => Shape::Curved,
+        Contour::Ellipsoid { .. } | Contour::Capsule { .. } => Shape::Curved,
         Contour::Torus { tube, .. } if *tube > 0.0 => Shape::Curved,
         Contour::Cylinder { radius, half_length, .. } => {
             Shape::Line { radius: *radius, length: Some(2.0 * half_length) }
@@ -550,15 +552,14 @@ pub fn hertz_elastic(
             }
             Ok(Elastic::Hertz { k: match k { Some(k) => k, None => 4.0 / 3.0 * need_e()? * (1.0 / kappa).sqrt() } })
         }
-        (Shape::Curved, Shape::Isotropic(_)) | (Shape::Isotropic(_), Shape::Curved) => match k {
-            Some(k) => Ok(Elastic::Hertz { k }),
-            None => Ok(Elastic::HertzCurved { e_star: need_e()? }),
-        },
-        (Shape::Curved, Shape::Curved) => Err(Error::Model(format!(
-            "{what}: a Hertz law between two contours curved differently in two directions ({} and {}) needs the angle between their principal axes, which is not available; give one of them a sphere or a plane",
-            c[0].kind(),
-            c[1].kind()
-        ))),
+        // doubly curved on one or both sides: K from the relative curvature tensor at the contact
+        // point at every evaluation (principal directions crossing at any angle)
+        (Shape::Curved, Shape::Isotropic(_)) | (Shape::Isotropic(_), Shape::Curved) | (Shape::Curved, Shape::Curved) => {
+            match k {
+                Some(k) => Ok(Elastic::Hertz { k }),
+                None => Ok(Elastic::HertzCurved { e_star: need_e()? }),
+            }
+        }
         (Shape::Line { radius, length: l }, other) | (other, Shape::Line { radius, length: l }) => {
             let r = match other {
                 Shape::Isotropic(k) if flat(other) && *k == 0.0 => *radius,
