@@ -145,6 +145,10 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
             break
     if "energy/total" in results:
         names.append("energy/total")
+    # the first compliant contact's (or compliant group's) normal force
+    force = next((n for n in results.names() if n.startswith("contact/") and n.endswith("/force_n")), None)
+    if force is not None:
+        names.append(force)
     # a selective recording (--sensors) may hold neither: its first signals then
     return names or [n for n in results.names() if n != "t"][:2]
 

@@ -267,10 +267,11 @@ class Results:
                     put(f"force/{name}/position_angle", raw["force_deflection"][:, k + 1], "rad")
                     put(f"force/{name}/attitude_angle", raw["force_deflection"][:, k + 2], "rad")
                 elif kind == "compliant_contact":
-                    # per point: F_N, F_T1, F_T2, stored and dissipated energy; delta, delta', slip velocity (t1, t2), alpha
+                    # per point: F_N, F_T1, F_T2, stored and dissipated energy, point, friction force (world);
+                    # delta, delta', slip velocity (t1, t2), alpha, normal (world), unused
                     npt, nt = f["points"], f["tangents"]
-                    fv = raw["force_value"][:, k:k + w].reshape(-1, npt, 5)
-                    dv = raw["force_deflection"][:, k:k + w].reshape(-1, npt, 5)
+                    fv = raw["force_value"][:, k:k + w].reshape(-1, npt, 11)
+                    dv = raw["force_deflection"][:, k:k + w].reshape(-1, npt, 11)
                     one = npt == 1
                     pick = (lambda a, i: a[:, 0, i]) if one else (lambda a, i: a[:, :, i])
                     pre = f"contact/{name}"
@@ -286,6 +287,11 @@ class Results:
                     put(f"{pre}/damping_alpha", pick(dv, 4), "s/m")
                     put(f"{pre}/energy_elastic", fv[:, :, 3].sum(axis=1), "J")
                     put(f"{pre}/energy_dissipated", fv[:, :, 4].sum(axis=1), "J")
+                    # where it acts (the viewer's dot and arrows), world axes: the point on the first
+                    # contour, the normal (towards the first contour) and the friction force on it
+                    put(f"{pre}/point", fv[:, 0, 5:8] if one else fv[:, :, 5:8], "m", xyz if one else None)
+                    put(f"{pre}/normal", dv[:, 0, 5:8] if one else dv[:, :, 5:8], "1", xyz if one else None)
+                    put(f"{pre}/friction_force", fv[:, 0, 8:11] if one else fv[:, :, 8:11], "N", xyz if one else None)
                 elif kind == "compliant_group":
                     # force: sum of F_N, stored and dissipated energy, touching pairs; deflection: max delta, max delta', pairs kept
                     fv, dv = raw["force_value"][:, k:k + 4], raw["force_deflection"][:, k:k + 4]

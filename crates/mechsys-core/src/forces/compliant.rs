@@ -293,8 +293,24 @@ pub fn evaluate(
         data.contact_energy += pf.energy;
         let (fo, d) = (&mut data.element_force, &mut data.element_deflection);
         let b = o + OUTPUTS_PER_POINT * k;
-        fo[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[pf.f_n, pf.f_t[0], pf.f_t[1], pf.energy, w.states[s]]);
-        d[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[delta, rate, v[0], v[1], pf.alpha]);
+        // where it acts, for the viewer: the point on contour 1, the normal, the friction force
+        let (pt, n) = (&kin.point.p1, &kin.point.n);
+        let ft = kin.point.t1 * pf.f_t[0] + kin.point.t2 * pf.f_t[1];
+        fo[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[
+            pf.f_n,
+            pf.f_t[0],
+            pf.f_t[1],
+            pf.energy,
+            w.states[s],
+            pt.x,
+            pt.y,
+            pt.z,
+            ft.x,
+            ft.y,
+            ft.z,
+        ]);
+        d[b..b + OUTPUTS_PER_POINT]
+            .copy_from_slice(&[delta, rate, v[0], v[1], pf.alpha, n.x, n.y, n.z, 0.0, 0.0, 0.0]);
     }
     Ok(p_diss)
 }

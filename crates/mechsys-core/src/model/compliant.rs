@@ -342,8 +342,9 @@ impl CompliantGroup {
 pub const GROUP_OUTPUTS: usize = 4;
 
 /// Values each compliant contact point records (force columns: F_N, F_T1, F_T2, stored energy,
-/// dissipated energy; deflection columns: δ, δ̇, ġ_T1, ġ_T2, α in use).
-pub const OUTPUTS_PER_POINT: usize = 5;
+/// dissipated energy, the contact point on contour 1 (world, m), the friction force (world, N);
+/// deflection columns: δ, δ̇, ġ_T1, ġ_T2, α in use, the normal (world), three zeros).
+pub const OUTPUTS_PER_POINT: usize = 11;
 
 /// Extra ODE states per compliant contact point: dissipated energy, bristle deflections z1, z2.
 pub const STATES_PER_POINT: usize = 3;
