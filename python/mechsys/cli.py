@@ -249,8 +249,16 @@ def run(
                          follow_symlinks)
     out_path, plot_out, csv_out = outs["--out"], outs["--plot"], outs["--csv"]
     start = time.perf_counter()
+    import warnings
+
     try:
-        res = simulate(model, **kwargs)
+        # the run's warnings as `warning:` lines, not Python's with the source line (review
+        # newcomer.md, finding 16)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = simulate(model, **kwargs)
+        for w in caught:
+            click.echo(f"warning: {w.message}", err=True)
     except KeyboardInterrupt as e:
         partial = getattr(e, "results", None)
         if partial is None or not len(partial.t):
