@@ -84,3 +84,32 @@ def test_view_and_plot_from_the_command_line(rolling, tmp_path):
                         "-o", str(tmp_path / "ball.png")], capture_output=True, text=True, env={"MPLBACKEND": "Agg", **__import__("os").environ})
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "ball.png").stat().st_size > 1000
+
+
+def test_viewer_draws_a_compliant_groups_touching_points(tmp_path):
+    """examples/compliant_pile.toml: the group records its first touching points (two per member at
+    most) with the force on their first contour; the viewer draws them as a rigid group's."""
+    from mechsys.modelfile import load_model
+
+    model, sim = load_model(Path(__file__).resolve().parents[1] / "examples" / "compliant_pile.toml")
+    res = ms.simulate(model, t_end=0.5, output_dt=1e-2, integrator=ms.DOPRI5(rtol=1e-7, atol=1e-10), progress=False)
+    n_pts = res["contact/pile/touching_points"]
+    pts, forces, states = res["contact/pile/points"], res["contact/pile/point_forces"], res["contact/pile/point_states"]
+    assert pts.shape[1] == 12 and n_pts.max() >= 6
+    np.testing.assert_array_equal(states.sum(axis=1), np.minimum(n_pts, 12))
+    # the drawn points lie within the box and carry forces (zero only where a separating contact's
+    # damped force is cut off); undrawn slots are zero
+    drawn = states > 0
+    norms = np.linalg.norm(forces[drawn], axis=1)
+    assert np.all(norms >= 0) and np.mean(norms > 0) > 0.9
+    assert np.all(np.abs(forces[~drawn]) == 0)
+    assert np.all(np.abs(pts[drawn][:, :2]) <= 0.12 + 1e-3) and np.all(pts[drawn][:, 2] >= -1e-3)  # (the overlap)
+    # a point on the floor (z near 0) is pushed up
+    on_floor = drawn & (pts[:, :, 2] < 1e-3)
+    assert on_floor.any() and np.all(forces[on_floor][:, 2] >= 0)
+    data = viewer.page_data(res)
+    group = [c for c in data["contacts"] if c["contact"] == "pile"]
+    assert len(group) == 12
+    idx = np.searchsorted(res.t, arr(data["t"]))
+    st = np.stack([arr(c["state"]) for c in group], axis=1)
+    np.testing.assert_array_equal(st > 0, drawn[idx])

@@ -153,7 +153,8 @@ class ContactGroup:
     are stepped over under error control rather than located. Signals: ``contact/<name>/touching``
     (pairs in contact), ``max_overlap`` (m), ``max_overlap_rate`` (m/s), ``force_n`` (N, sum of
     the normal forces), ``energy_elastic`` and ``energy_dissipated`` (J), ``pairs`` (kept by the
-    broad phase).
+    broad phase), ``touching_points``, and the first touching points (two per member at most) as
+    ``points``, ``point_forces`` and ``point_states``, drawn by the viewer.
     """
 
     name: str

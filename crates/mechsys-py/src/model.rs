@@ -333,8 +333,9 @@ impl PyModel {
                     "N, N, N, J, J, m, m, m, N, N, N",
                     "m, m/s, m/s, m/s, s/m, 1, 1, 1, 1, 1, 1",
                 ),
-                // force: ΣF_N, stored and dissipated energy, touching pairs; deflection: max δ, max δ̇, broad-phase pairs
-                F::ContactGroup(_) => ("compliant_group", "N, J, J, 1", "m, m/s, 1, 1"),
+                // force: ΣF_N, stored and dissipated energy, touching pairs, then per drawn point its
+                // position and force; deflection: max δ, max δ̇, broad-phase pairs, touching points
+                F::ContactGroup(_) => ("compliant_group", "N, J, J, 1, (m, N) per point", "m, m/s, 1, 1"),
             };
             if width > 0 {
                 let d = PyDict::new(py);

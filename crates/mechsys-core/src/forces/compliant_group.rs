@@ -19,8 +19,9 @@
 //!
 //! Recorded per group ([`crate::model::compliant::GROUP_OUTPUTS`]): the sum of the normal
 //! forces, the stored energy, the dissipated energy (one extra ODE state, the group's slot),
-//! the number of touching pairs; the largest overlap and approach rate, and the number of pairs
-//! the broad phase kept.
+//! the number of touching pairs; the largest overlap and approach rate, the number of pairs
+//! the broad phase kept and of touching points; then the first touching points (two per member
+//! at most) with the force on their first contour, for the viewer.
 
 use super::compliant::{apply_point, point_force, PairLaw, Work};
 use super::Callbacks;
@@ -84,6 +85,11 @@ pub fn evaluate(g: &CompliantGroup, data: &mut Data, w: &mut Work, o: usize, t: 
     gw.update(g, data)?;
     let (mut f_sum, mut energy, mut power, mut touching) = (0.0, 0.0, 0.0, 0usize);
     let (mut max_d, mut max_rate) = (0.0f64, 0.0f64);
+    // the first touching points, for drawing: position and force on the first contour
+    let (drawn, mut points) = (g.drawn(), 0usize);
+    let width = g.outputs();
+    data.element_force[o + GROUP_OUTPUTS..o + width].fill(0.0);
+    data.element_deflection[o + GROUP_OUTPUTS..o + width].fill(0.0);
     for &sl in &gw.phase.live {
         let slot = &gw.phase.slots[sl];
         let (i, j) = (slot.key.0 as usize, slot.key.1 as usize);
@@ -103,6 +109,12 @@ pub fn evaluate(g: &CompliantGroup, data: &mut Data, w: &mut Work, o: usize, t: 
             }
             let pf = point_force(&pl, data, kin, gw.onset[gw.first[sl] + k], [0.0; 2], planar, t, cb)?;
             apply_point(data, slot.body1, slot.body2, kin, &pf);
+            if points < drawn {
+                let f = kin.point.n * pf.f_n + kin.point.t1 * pf.f_t[0] + kin.point.t2 * pf.f_t[1];
+                let (p1, b) = (&kin.point.p1, o + GROUP_OUTPUTS + 6 * points);
+                data.element_force[b..b + 6].copy_from_slice(&[p1.x, p1.y, p1.z, f.x, f.y, f.z]);
+            }
+            points += 1;
             touched = true;
             f_sum += pf.f_n;
             energy += pf.energy;
@@ -120,7 +132,7 @@ pub fn evaluate(g: &CompliantGroup, data: &mut Data, w: &mut Work, o: usize, t: 
     let fo = &mut data.element_force[o..o + GROUP_OUTPUTS];
     fo.copy_from_slice(&[f_sum, energy, states[s], touching as f64]);
     let d = &mut data.element_deflection[o..o + GROUP_OUTPUTS];
-    d.copy_from_slice(&[max_d, max_rate, gw.phase.live.len() as f64, 0.0]);
+    d.copy_from_slice(&[max_d, max_rate, gw.phase.live.len() as f64, points as f64]);
     Ok(power)
 }
 

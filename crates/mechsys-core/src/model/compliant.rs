@@ -325,6 +325,18 @@ impl CompliantGroup {
         })
     }
 
+    /// Contact points recorded per sample for drawing (two per member, at most 256): the first
+    /// touching points in pair order.
+    pub fn drawn(&self) -> usize {
+        (2 * self.geometry.members.len()).min(256)
+    }
+
+    /// Values recorded per sample: [`GROUP_OUTPUTS`] totals, then per drawn point its position
+    /// (m) and the force on the first contour (N), world axes.
+    pub fn outputs(&self) -> usize {
+        GROUP_OUTPUTS + 6 * self.drawn()
+    }
+
     /// `members[k]` or `against[k − members]`.
     pub fn label(&self, k: usize) -> String {
         let m = self.geometry.members.len();
@@ -336,9 +348,10 @@ impl CompliantGroup {
     }
 }
 
-/// Values a compliant group records (force columns: total normal force, stored energy,
+/// Totals a compliant group records (force columns: total normal force, stored energy,
 /// dissipated energy, touching pairs; deflection columns: largest overlap, largest approach
-/// rate, pairs kept by the broad phase, 0).
+/// rate, pairs kept by the broad phase, touching points), before its drawn points
+/// ([`CompliantGroup::outputs`]).
 pub const GROUP_OUTPUTS: usize = 4;
 
 /// Values each compliant contact point records (force columns: F_N, F_T1, F_T2, stored energy,

@@ -379,7 +379,7 @@ impl ForceElement {
             ForceElement::JointForce { value, .. } => value.len(),
             ForceElement::Callback { .. } => nu,
             ForceElement::Contact(c) => compliant::OUTPUTS_PER_POINT * c.points(),
-            ForceElement::ContactGroup(_) => compliant::GROUP_OUTPUTS,
+            ForceElement::ContactGroup(g) => g.outputs(),
         }
     }
 }
