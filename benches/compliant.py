@@ -219,7 +219,9 @@ def main(argv=None) -> int:
               "located. Its penetration is the physical overlap of the soft material (E = 1e7 Pa), set by the "
               "material, not by a solver tolerance; MuJoCo's soft contacts penetrate by their solref time "
               "constant; mechsys' rigid pile by the Moreau–Jean step's drift. The steps follow the contacts' "
-              "≈ 5 ms vibrations (DOPRI5 is explicit), which is what keeps it behind the time-stepping engines. "
+              "≈ 5 ms vibrations (DOPRI5 is explicit), which is what keeps it behind the time-stepping engines; "
+              "per evaluation (≈ 95 µs for N = 100) `perf` puts the tree dynamics (ABA, forward kinematics) at "
+              "about 45 % and the group's broad and narrow phases at about 12 %. "
               "Its energy balance (kinetic + potential + stored − work + dissipated) closes to the integrator's "
               "tolerance."]
         write_doc(a.out, "\n".join(L), "<!-- compliant.py:begin -->", "<!-- compliant.py:end -->")

@@ -28,6 +28,13 @@
 //!
 //! An accumulation of impacts (a ball coming to rest) passes in finitely many events: an approach
 //! slower than `velocity_tol` closes the contact without impact.
+//!
+//! Compliant contacts ([`crate::forces::compliant`]) are smooth forces of the phases (so the
+//! transition and impact problems see them like any applied force); their onsets, releases and
+//! force cut-offs are kinks, not events: a step across one is retaken up to just past it (located
+//! by [`crate::integrator::switching`] on the step's continuous extension) and the phase goes on
+//! without a transition. Their dissipated energy and bristle states follow the contact forces'
+//! integrals in the state.
 
 mod impact;
 mod matrices;
