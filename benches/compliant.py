@@ -11,8 +11,9 @@ contact, and a pile of compliant spheres against MuJoCo's soft contacts and mech
    DOPRI5's are held at its stability limit.
 3. Pile of N compliant spheres (r = 5 cm, 0.1 kg, E = 1e7 Pa, nu = 0.3, Hunt-Crossley eps = 0.3,
    friction 0.5 regularized at 1e-3 m/s) in a box, the lattice of benches/contacts.py, 0.3 s
-   simulated (the layers fall in and land; ``--pile-time``): every pair an explicit contact (N(N-1)/2 plus 5 N against floor and walls: there is
-   no broad phase for compliant contacts yet), DOPRI5 at rtol 1e-6; against MuJoCo (soft contacts,
+   simulated (the layers fall in and land; ``--pile-time``): one compliant contact group (broad phase at
+   every evaluation), DOPRI5 at rtol 1e-6, and at N = ``--explicit`` (20) the same pile both as a group
+   and as explicit pairs (N(N-1)/2 plus 5 N contacts, onsets located); against MuJoCo (soft contacts,
    defaults, dt 1e-3) and mechsys' rigid pile (one contact group, Moreau-Jean dt 1e-3, NSGS tol 1e-6).
    Columns: wall time, largest penetration (compliant: the largest overlap sampled every 5 ms;
    rigid: the group's max_penetration; MuJoCo: -min dist after every step), and the energy drift
@@ -90,7 +91,9 @@ def damped_rows(repeat):
     return rows
 
 
-def compliant_pile(n):
+def compliant_pile(n, group=True):
+    """The pile with compliant contacts: one compliant contact group (broad phase), or (group=False)
+    every pair an explicit contact."""
     half, pos = pile_layout(n)
     mat = ms.Material(E=1e7, nu=0.3, density=PILE_M / (4 / 3 * math.pi * PILE_R**3))
     m = ms.Model(f"compliant-pile-{n}", gravity=(0, 0, -G))
@@ -101,6 +104,12 @@ def compliant_pile(n):
         bodies.append(b)
     law = ms.laws.HuntCrossley(eps=0.3, v_reg=1e-3)
     fr = ms.laws.Coulomb(PILE_MU)
+    if group:
+        m.add_contact(ms.ContactGroup("pile", members=[b.contour(ms.contours.Sphere(radius=PILE_R)) for b in bodies],
+                                      against=[m.ground.contour(ms.contours.Plane(point=p, normal=nrm)) for p, nrm in _walls(half)],
+                                      normal=law, friction=fr, material=mat))
+        m.build()
+        return m
     for i in range(n):
         for j in range(i + 1, n):
             m.add_contact(ms.Contact(f"p{i}_{j}", bodies[i].contour(ms.contours.Sphere(radius=PILE_R), material=mat),
@@ -112,26 +121,41 @@ def compliant_pile(n):
     return m
 
 
-def pile_rows(n, t_end):
-    rows = []
-    model = compliant_pile(n)
+def compliant_row(n, t_end, group):
+    model = compliant_pile(n, group)
     t0 = time.perf_counter()
     res = ms.simulate(model, t_end=t_end, output_dt=5e-3, integrator=ms.DOPRI5(rtol=1e-6, atol=1e-9), progress=False)
     el = time.perf_counter() - t0
-    pen = max(float(np.max(res[k])) for k in res.names() if k.endswith("/overlap"))
+    if group:
+        pen = float(np.max(res["contact/pile/max_overlap"]))
+        what = f"mechsys compliant group (Hunt-Crossley, DOPRI5 rtol 1e-6), N = {n}"
+        note = f"{int(res['contact/pile/touching'][-1])} pairs touching at the end"
+    else:
+        pen = max(float(np.max(res[k])) for k in res.names() if k.endswith("/overlap"))
+        what = f"mechsys compliant, explicit pairs (DOPRI5 rtol 1e-6), N = {n}, {len(model._contacts)} contacts"
+        note = "onsets located"
     e = res["energy/total"] + res["energy/dissipated"]
     drift = abs(e[-1] - e[0]) / abs(e[0])
     z = res["q"][-1].reshape(n, 7)[:, 2]
-    rows.append((f"mechsys compliant (Hunt-Crossley, DOPRI5 rtol 1e-6), {len(model._contacts)} contacts", el, pen,
-                 f"{drift:.1e}", float(z.mean()), f"{res.stats['steps']} steps, {res.stats['rejected']} rejected"))
-    print(f"pile {rows[-1]}")
+    row = (what, el, pen, f"{drift:.1e}", float(z.mean()), f"{res.stats['steps']} steps, {res.stats['rejected']} rejected, {note}")
+    print(f"pile {row}")
+    return row
+
+
+def pile_rows(n, t_end, explicit):
+    rows = [compliant_row(n, t_end, True)]
+    if explicit:
+        # the same pile with every pair an explicit contact (N^2 cost), at a size that runs quickly,
+        # next to the group at that size
+        rows.append(compliant_row(explicit, t_end, True))
+        rows.append(compliant_row(explicit, t_end, False))
     rigid = ms_pile(n)
     el, pen, zm, closed, _ = run_ms_pile(rigid, n, 1e-3, t_end, 1e-6, 100)
-    rows.append(("mechsys rigid (contact group, Moreau-Jean dt 1e-3, NSGS 1e-6)", el, pen, "–", zm, f"{closed} points closed at the end"))
+    rows.append((f"mechsys rigid (contact group, Moreau-Jean dt 1e-3, NSGS 1e-6), N = {n}", el, pen, "–", zm, f"{closed} points closed at the end"))
     print(f"pile {rows[-1]}")
     try:
         el, pen, zm, ncon, _ = run_mj_pile(n, 1e-3, t_end, "Newton")
-        rows.append(("MuJoCo (soft contacts, defaults, dt 1e-3)", el, pen, "–", zm, f"{ncon} contacts at the end"))
+        rows.append((f"MuJoCo (soft contacts, defaults, dt 1e-3), N = {n}", el, pen, "–", zm, f"{ncon} contacts at the end"))
         print(f"pile {rows[-1]}")
     except Exception as ex:  # noqa: BLE001 - a missing peer is reported, not fatal
         print(f"MuJoCo: {ex}")
@@ -145,6 +169,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--pile", type=int, default=100)
     ap.add_argument("--pile-time", type=float, default=0.3)
+    ap.add_argument("--explicit", type=int, default=20, help="also run a pile of this size as explicit pairs (0: no)")
     a = ap.parse_args(argv)
     repeat = 1 if a.quick else a.repeat
     warnings.simplefilter("ignore")
@@ -152,7 +177,7 @@ def main(argv=None) -> int:
     t_start = time.perf_counter()
     imp = impact_rows(repeat)
     damp = damped_rows(repeat)
-    pile = pile_rows(a.pile, a.pile_time)
+    pile = pile_rows(a.pile, a.pile_time, a.explicit)
     whole = time.perf_counter() - t_start
     if a.out:
         try:
@@ -177,7 +202,7 @@ def main(argv=None) -> int:
               "| integrator | steps | rejected | evaluations | wall time | overlap at rest |", "|---|---:|---:|---:|---:|---:|"]
         for name, st, rj, ev, tmin, tmed, rest in damp:
             L.append(f"| {name} | {st} | {rj} | {ev} | {fmt_time(tmin)} ({fmt_time(tmed)}) | {rest:.4e} m |")
-        L += ["", f"**Pile of {a.pile} spheres**, {a.pile_time:g} s simulated (one run each):", "",
+        L += ["", f"**Pile of {a.pile} spheres** (and of {a.explicit} for the explicit pairs), {a.pile_time:g} s simulated (one run each):", "",
               "| engine | wall time | largest penetration | energy drift (E + D − E0)/E0 | mean height at the end | notes |",
               "|---|---:|---:|---:|---:|---|"]
         for name, el, pen, drift, zm, note in pile:
@@ -186,14 +211,19 @@ def main(argv=None) -> int:
               "- The impact's δ_max is within the tolerance's reach of the closed form because no step straddles "
               "the onset or the release (located switches); the damped case is stiff, and Radau5 needs a small "
               "fraction of DOPRI5's steps.",
-              "- The compliant pile carries every pair as an explicit contact (no broad phase for compliant "
-              "contacts yet): its cost grows as N²; its penetration is the physical overlap of the soft material "
-              "(E = 1e7 Pa), set by the material, not by a solver tolerance. MuJoCo's soft contacts penetrate by "
-              "their solref time constant; mechsys' rigid pile by the Moreau–Jean step's drift. The compliant pile is
-thousands of times slower than both: every right-hand side evaluates all N(N−1)/2 + 5N pairs (5450 for
-N = 100) and the steps follow the contacts' ≈ 5 ms vibrations (15 000 steps in 0.3 s); a broad phase
-for compliant contacts and an implicit scheme with a sparse Jacobian are what it needs. Its energy
-balance (kinetic + potential + stored − work + dissipated) closes to the integrator's tolerance."]
+              "- The compliant pile is one compliant contact group: at every right-hand side the broad phase "
+              "(sweep and prune over the contours' boxes) keeps the pairs whose boxes overlap, and only those get "
+              "the narrow phase and the Hertz–Hunt–Crossley force, so an evaluation costs O(N) instead of the "
+              "N(N−1)/2 + 5N explicit pairs (5450 for N = 100, 1080 s before groups took compliant laws). Onsets "
+              "in a group are stepped over under error control (Hertz forces are continuous at δ = 0), not "
+              "located. Its penetration is the physical overlap of the soft material (E = 1e7 Pa), set by the "
+              "material, not by a solver tolerance; MuJoCo's soft contacts penetrate by their solref time "
+              "constant; mechsys' rigid pile by the Moreau–Jean step's drift. The steps follow the contacts' "
+              "≈ 5 ms vibrations (DOPRI5 is explicit), which is what keeps it behind the time-stepping engines; "
+              "per evaluation (≈ 95 µs for N = 100) `perf` puts the tree dynamics (ABA, forward kinematics) at "
+              "about 45 % and the group's broad and narrow phases at about 12 %. "
+              "Its energy balance (kinetic + potential + stored − work + dissipated) closes to the integrator's "
+              "tolerance."]
         write_doc(a.out, "\n".join(L), "<!-- compliant.py:begin -->", "<!-- compliant.py:end -->")
         print(f"updated {a.out}")
     return 0

@@ -371,3 +371,18 @@ def test_usage_error_exit_code(runner):
     result = runner.invoke(cli, ["run"])
     assert result.exit_code == 2
     assert "Missing argument 'MODEL'" in result.output
+
+
+def test_run_prints_warnings_as_warning_lines_and_plots_without_offset(tmp_path):
+    """A run's warnings reach the terminal as `warning: ...` lines, without Python's source line
+    (review newcomer.md, 16); plotted axes carry absolute tick labels, not an offset (13)."""
+    ex = Path(__file__).resolve().parents[1] / "examples" / "slider_crank.py"
+    script = Path(sys.executable).parent / "mechsys"
+    r = subprocess.run([str(script), "run", str(ex), "--t-end", "0.01", "--out", str(tmp_path / "sc.h5")],
+                       capture_output=True, text=True, env={**os.environ, "MPLBACKEND": "Agg"})
+    assert r.returncode == 0, r.stderr
+    assert "warning: model 'slider-crank': 1 redundant constraint equation(s)" in r.stderr
+    assert "UserWarning" not in r.stderr and "cli.py" not in r.stderr
+    res = ms.load(tmp_path / "sc.h5")
+    fig = ms.plot(res, ["energy/total"], out=tmp_path / "e.png")
+    assert all(not ax.yaxis.get_major_formatter().get_useOffset() for ax in fig.axes)

@@ -145,6 +145,10 @@ def _default_signals(results: Any, joints: list[dict]) -> list[str]:
             break
     if "energy/total" in results:
         names.append("energy/total")
+    # the first compliant contact's (or compliant group's) normal force
+    force = next((n for n in results.names() if n.startswith("contact/") and n.endswith("/force_n")), None)
+    if force is not None:
+        names.append(force)
     # a selective recording (--sensors) may hold neither: its first signals then
     return names or [n for n in results.names() if n != "t"][:2]
 
@@ -245,8 +249,16 @@ def run(
                          follow_symlinks)
     out_path, plot_out, csv_out = outs["--out"], outs["--plot"], outs["--csv"]
     start = time.perf_counter()
+    import warnings
+
     try:
-        res = simulate(model, **kwargs)
+        # the run's warnings as `warning:` lines, not Python's with the source line (review
+        # newcomer.md, finding 16)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = simulate(model, **kwargs)
+        for w in caught:
+            click.echo(f"warning: {w.message}", err=True)
     except KeyboardInterrupt as e:
         partial = getattr(e, "results", None)
         if partial is None or not len(partial.t):

@@ -145,6 +145,16 @@ class ContactGroup:
     previous sample) and ``force_against`` (N, the same over the interval: with a container at
     rest, the weight of its contents); the energy they take goes into
     ``energy/dissipated_impact`` and ``energy/dissipated_friction``.
+
+    With a compliant ``normal`` law (``laws.Hertz()``, ``laws.HuntCrossley(eps=0.3)``,
+    ``laws.KelvinVoigt(k, d)``, ...) and a ``material`` (or materials on the contours), every
+    pair the broad phase finds carries that law as a force, in every scheme (DOPRI5, Radau5, RK4,
+    MoreauJean, EventDriven); friction is regularized (``v_reg`` of the normal law), LuGre is refused; onsets
+    are stepped over under error control rather than located. Signals: ``contact/<name>/touching``
+    (pairs in contact), ``max_overlap`` (m), ``max_overlap_rate`` (m/s), ``force_n`` (N, sum of
+    the normal forces), ``energy_elastic`` and ``energy_dissipated`` (J), ``pairs`` (kept by the
+    broad phase), ``touching_points``, and the first touching points (two per member at most) as
+    ``points``, ``point_forces`` and ``point_states``, drawn by the viewer.
     """
 
     name: str
@@ -152,9 +162,21 @@ class ContactGroup:
     against: list = field(default_factory=list)
     friction: Any = None
     impact: Any = None
+    #: ``None`` (Signorini's law: a rigid group, MoreauJean) or a compliant law
+    #: (``laws.Hertz()``, ``laws.HuntCrossley(eps=...)``, ``laws.KelvinVoigt(k, d)``, ...): a
+    #: compliant group runs in every scheme, see "Compliant contact groups" in docs/usage.md
+    normal: Any = None
+    #: the material of every contour that has none of its own (compliant groups)
+    material: Any = None
 
     def describe(self, callbacks: list) -> dict:
         what = f"contact group '{self.name}'"
+        compliant = isinstance(self.normal, laws.COMPLIANT)
+        if self.normal is not None and not compliant and not isinstance(self.normal, laws.Signorini):
+            raise ModelError(f"{what}.normal: expected None, mechsys.laws.Signorini() or a compliant law (KelvinVoigt, Hertz, "
+                             f"HuntCrossley, LankaraniNikravesh, Flores, UserLaw), got {type(self.normal).__name__}")
+        if self.material is not None and not compliant:
+            raise ModelError(f"{what}.material: materials belong to compliant groups (normal=laws.Hertz(), ...); a rigid group takes none")
         if not isinstance(self.name, str) or not self.name.strip():
             raise ModelError(f"contact group: name must be a non-empty string, got {self.name!r}")
         out = {"name": self.name}
@@ -166,10 +188,29 @@ class ContactGroup:
             for k, side in enumerate(items):
                 if not isinstance(side, OnBody):
                     raise ModelError(f"{what}.{key}[{k}]: expected a contour on a body (body.contour(ms.contours.X(...))), got {type(side).__name__}")
-                lst.append({"body": side.body, "contour": side.contour.describe(f"{what}.{key}[{k}].contour")})
+                item = {"body": side.body, "contour": side.contour.describe(f"{what}.{key}[{k}].contour")}
+                mat = getattr(side, "material", None)
+                if mat is not None and compliant:
+                    if not isinstance(mat, laws.Material):
+                        raise ModelError(f"{what}.{key}[{k}].material: expected mechsys.Material(E, nu, density), got {type(mat).__name__}")
+                    item["material"] = mat.describe(f"{what}.{key}[{k}].material")
+                lst.append(item)
             out[key] = lst
         if not out["members"]:
             raise ModelError(f"{what}.members: a group needs at least one member")
+        if compliant:
+            if self.impact is not None:
+                raise ModelError(f"{what}.impact: a compliant group takes no impact law (its restitution comes from its normal "
+                                 "law: HuntCrossley(eps=...), LankaraniNikravesh, Flores, or KelvinVoigt's damping)")
+            if isinstance(self.friction, laws.LuGre):
+                raise ModelError(f"{what}.friction: the LuGre bristle law needs a bristle state per contact point, which a group's "
+                                 "pairs do not carry; give the group Coulomb, Stribeck or FrictionTable (regularized) or declare "
+                                 "the contacts that need bristles explicitly")
+            out["normal"] = self.normal.describe(f"{what}.normal", callbacks)
+            if self.material is not None:
+                if not isinstance(self.material, laws.Material):
+                    raise ModelError(f"{what}.material: expected mechsys.Material(E, nu, density), got {type(self.material).__name__}")
+                out["material"] = self.material.describe(f"{what}.material")
         out.update(_law_fields(what, self.friction, self.impact))
         return out
 

@@ -39,29 +39,38 @@ def effective_modulus(material1, material2) -> float:
     return 1.0 / ((1 - material1.nu ** 2) / material1.E + (1 - material2.nu ** 2) / material2.E)
 
 
-def _curvatures(c1, c2, what: str) -> tuple[float, float]:
-    """The relative principal curvatures A <= B from each contour's (kappa_1, kappa_2), principal
-    directions taken as aligned (exact when one side is a sphere or a plane)."""
+def _curvatures(c1, c2, what: str, angle: float = 0.0) -> tuple[float, float]:
+    """The relative principal curvatures A <= B from each contour's (kappa_1, kappa_2), the
+    directions of the two kappa_1 crossing at ``angle`` (rad; 0: aligned, exact whatever the angle
+    when one side is a sphere or a plane): A + B = (sum of the four)/2 and
+    B - A = (1/2) sqrt(g1^2 + g2^2 + 2 g1 g2 cos 2 angle) with g_i = kappa_i1 - kappa_i2."""
     k1, k2 = np.asarray(c1, dtype=float), np.asarray(c2, dtype=float)
     if k1.shape != (2,) or k2.shape != (2,) or not (np.all(np.isfinite(k1)) and np.all(np.isfinite(k2))):
         raise ModelError(f"{what}: Hertz's contact needs finite principal curvatures on both contours (a vertex, edge or "
                          f"point has none), got {k1.tolist()} and {k2.tolist()}")
-    s = np.sort(0.5 * (k1 + k2))
+    if not (isinstance(angle, (int, float, np.floating)) and math.isfinite(angle)):
+        raise ModelError(f"{what}: angle must be a finite number (rad), got {angle!r}")
+    g1, g2 = k1[0] - k1[1], k2[0] - k2[1]
+    half_sum = 0.25 * (k1.sum() + k2.sum())
+    half_dif = 0.25 * math.sqrt(max(0.0, g1 * g1 + g2 * g2 + 2 * g1 * g2 * math.cos(2 * angle)))
+    s = np.array([half_sum - half_dif, half_sum + half_dif])
     if not s[0] > 0:
         raise ModelError(f"{what}: no Hertz contact: the relative curvature is {s[0]:.4g} 1/m (flat or conforming faces)")
     return float(s[0]), float(s[1])
 
 
-def impact(mass: float, speed: float, e_star: float, curvature1=(0.0, 0.0), curvature2=(0.0, 0.0)) -> dict:
+def impact(mass: float, speed: float, e_star: float, curvature1=(0.0, 0.0), curvature2=(0.0, 0.0),
+           angle: float = 0.0) -> dict:
     """The Hertz resolution of one impact: effective ``mass`` (kg), approach ``speed`` (m/s, > 0),
     ``e_star`` (Pa) and each contour's principal curvatures at the contact (1/m; a sphere of radius
-    R is (1/R, 1/R), a plane (0, 0)). Returns ``delta_max`` (m), ``force_max`` (N), ``duration``
+    R is (1/R, 1/R), a plane (0, 0), a cylinder (1/R, 0)); ``angle`` (rad) between the directions of
+    the two first curvatures (crossed cylinders at 90°: ``angle=pi/2``). Returns ``delta_max`` (m), ``force_max`` (N), ``duration``
     (s), ``a``, ``b`` (m, contact semi-axes at the peak), ``p0`` (Pa), ``stiffness`` (K, N/m^1.5),
     with ``mass`` and ``speed``."""
     for k, v in (("mass", mass), ("speed", speed), ("e_star", e_star)):
         if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
             raise ModelError(f"hertz.impact: {k} must be > 0, got {v!r}")
-    a_curv, b_curv = _curvatures(curvature1, curvature2, "hertz.impact")
+    a_curv, b_curv = _curvatures(curvature1, curvature2, "hertz.impact", angle)
     k = _core.hertz_contact(a_curv, b_curv, float(e_star), 1.0)["stiffness"]
     delta = (1.25 * mass * speed ** 2 / k) ** 0.4
     force = k * delta ** 1.5

@@ -128,6 +128,12 @@ def plot(
         short = n.rsplit("/", 1)[-1]
         ax.set_ylabel(f"{short} [{unit}]" if unit else short)
         ax.grid(True, alpha=0.3)
+        # absolute tick labels: a conserved energy would otherwise read as an offset axis of noise
+        # (review newcomer.md, finding 13)
+        try:
+            ax.ticklabel_format(axis="y", useOffset=False)
+        except AttributeError:  # a formatter without offsets
+            pass
     axes[-1].set_xlabel("t [s]")
     if len(t):
         axes[-1].set_xlim(t[0], t[-1] if t[-1] > t[0] else t[0] + 1.0)

@@ -267,10 +267,11 @@ class Results:
                     put(f"force/{name}/position_angle", raw["force_deflection"][:, k + 1], "rad")
                     put(f"force/{name}/attitude_angle", raw["force_deflection"][:, k + 2], "rad")
                 elif kind == "compliant_contact":
-                    # per point: F_N, F_T1, F_T2, stored and dissipated energy; delta, delta', slip velocity (t1, t2), alpha
+                    # per point: F_N, F_T1, F_T2, stored and dissipated energy, point, friction force (world);
+                    # delta, delta', slip velocity (t1, t2), alpha, normal (world), unused
                     npt, nt = f["points"], f["tangents"]
-                    fv = raw["force_value"][:, k:k + w].reshape(-1, npt, 5)
-                    dv = raw["force_deflection"][:, k:k + w].reshape(-1, npt, 5)
+                    fv = raw["force_value"][:, k:k + w].reshape(-1, npt, 11)
+                    dv = raw["force_deflection"][:, k:k + w].reshape(-1, npt, 11)
                     one = npt == 1
                     pick = (lambda a, i: a[:, 0, i]) if one else (lambda a, i: a[:, :, i])
                     pre = f"contact/{name}"
@@ -286,6 +287,33 @@ class Results:
                     put(f"{pre}/damping_alpha", pick(dv, 4), "s/m")
                     put(f"{pre}/energy_elastic", fv[:, :, 3].sum(axis=1), "J")
                     put(f"{pre}/energy_dissipated", fv[:, :, 4].sum(axis=1), "J")
+                    # where it acts (the viewer's dot and arrows), world axes: the point on the first
+                    # contour, the normal (towards the first contour) and the friction force on it
+                    put(f"{pre}/point", fv[:, 0, 5:8] if one else fv[:, :, 5:8], "m", xyz if one else None)
+                    put(f"{pre}/normal", dv[:, 0, 5:8] if one else dv[:, :, 5:8], "1", xyz if one else None)
+                    put(f"{pre}/friction_force", fv[:, 0, 8:11] if one else fv[:, :, 8:11], "N", xyz if one else None)
+                elif kind == "compliant_group":
+                    # force: sum of F_N, stored and dissipated energy, touching pairs, drawn points; deflection: max delta,
+                    # max delta', pairs kept, touching points
+                    fv, dv = raw["force_value"][:, k:k + 4], raw["force_deflection"][:, k:k + 4]
+                    pre = f"contact/{name}"
+                    put(f"{pre}/touching_points", dv[:, 3], "1")
+                    put(f"{pre}/force_n", fv[:, 0], "N")
+                    put(f"{pre}/energy_elastic", fv[:, 1], "J")
+                    put(f"{pre}/energy_dissipated", fv[:, 2], "J")
+                    put(f"{pre}/touching", fv[:, 3], "1")
+                    put(f"{pre}/max_overlap", dv[:, 0], "m")
+                    put(f"{pre}/max_overlap_rate", dv[:, 1], "m/s")
+                    put(f"{pre}/pairs", dv[:, 2], "1")
+                    # the first touching points (two per member at most), as a rigid group's, for
+                    # the viewer: position, force on the first contour, 1 where a point is drawn
+                    nd = (w - 4) // 6
+                    if nd > 0:
+                        pts = raw["force_value"][:, k + 4:k + w].reshape(-1, nd, 6)
+                        used = np.arange(nd)[None, :] < np.minimum(dv[:, 3], nd)[:, None]
+                        put(f"{pre}/points", pts[:, :, :3], "m")
+                        put(f"{pre}/point_forces", pts[:, :, 3:], "N")
+                        put(f"{pre}/point_states", used.astype(float), "1")
                 elif kind == "python_force":
                     labels = [joint_of.get(i, (f"u{i}", ""))[0] for i in range(w)]
                     put(f"force/{name}/force", raw["force_value"][:, sl], "mixed", labels,

@@ -4,6 +4,7 @@
 
 pub mod bearing;
 pub mod compliant;
+pub mod compliant_group;
 pub mod damping;
 pub mod jenkins;
 
@@ -513,6 +514,9 @@ pub fn evaluate(
             }
             ForceElement::Contact(c) => {
                 p_diss += compliant::evaluate(c, data, &mut ws.compliant, o, t, cb)?;
+            }
+            ForceElement::ContactGroup(g) => {
+                p_diss += compliant_group::evaluate(g, data, &mut ws.compliant, o, t, cb)?;
             }
             ForceElement::Callback { name, id } => {
                 let before: f64 = data.tau_applied.iter().zip(u).map(|(a, b)| a * b).sum();

@@ -1212,12 +1212,6 @@ pub fn simulate(
         model.contact_groups.first().map_or("", |g| g.name.as_str())
     );
     if let IntegratorKind::EventDriven(opts) = settings.integrator {
-        if let Some(f) = model.forces.iter().find(|f| matches!(f, ForceElement::Contact(_))) {
-            return Err(Error::Settings(format!(
-                "contact '{}' is compliant: the event-driven scheme does not carry compliant contacts yet; mix them with rigid contacts under MoreauJean, or run compliant contacts under DOPRI5, Radau5 or RK4",
-                f.name()
-            )));
-        }
         return event_driven(model, settings, cb, progress, &t_out, y0, opts, rec);
     }
     crate::ensure!(
@@ -1626,6 +1620,9 @@ fn event_driven(
     phase.warm_search = settings.warm_search;
     let mut y = vec![0.0; phase.state_len()];
     y[..nq + nu + 2].copy_from_slice(&y0);
+    // compliant contacts closed at the start: their onset speeds, no event
+    phase.commit_compliant(settings.t0, &mut y)?;
+    phase.compliant_changes.clear();
     let e = nq + nu;
     // integrals of the forces at the previous sample, and the energy taken by impacts so far
     let mut prev = vec![0.0; 3 * np];
@@ -1682,6 +1679,16 @@ fn event_driven(
     }
     rec.warnings.extend(warnings);
     rec.events = EventRecord::from_log(model, &phase.log);
+    if !phase.compliant_changes.is_empty() {
+        // the compliant points' closings and openings among the rigid events, in time order
+        let mut w = crate::forces::compliant::Work::default();
+        for &(t, slot, closed) in &phase.compliant_changes {
+            w.changed.clear();
+            w.changed.push((slot, closed));
+            compliant_events(model, &w, t, &mut rec.events);
+        }
+        rec.events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    }
     Ok(rec)
 }
 

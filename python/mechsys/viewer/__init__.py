@@ -12,7 +12,7 @@ What the page shows:
   body with neither is drawn as rods from its centre of mass to its joints and attachment points;
 * joint frames and markers as axis triads (toggle "frames"), the path of chosen points as
   trails, a camera that orbits, pans, zooms and follows a body;
-* contacts: a dot at the contact point, the normal force and the friction force as arrows scaled
+* contacts (rigid and compliant): a dot at the contact point, the normal force and the friction force as arrows scaled
   by magnitude, coloured by state (open grey, stick blue, slip orange), impacts flashed at their
   events; a contact group's closed points with their whole contact force as one arrow;
 * plots of signals with a cursor following the timeline; a click on a plot moves the timeline.
@@ -246,6 +246,8 @@ def _default_signals(res) -> list[str]:
     for c in contacts[:2]:
         if f"contact/{c}/lambda_n" in res:
             names.append(f"contact/{c}/lambda_n")
+        elif f"contact/{c}/force_n" in res:
+            names.append(f"contact/{c}/force_n")
     if "energy/total" in res and not names:
         names.append("energy/total")
     if "q" in res and np.asarray(res["q"]).reshape(len(res.t), -1).shape[1] <= 6:
@@ -541,10 +543,19 @@ def _contacts(res, model: dict, idx: np.ndarray, scene: float) -> list[dict]:
             continue
         p = np.asarray(res[f"contact/{name}/point"])[idx]
         n = np.asarray(res[f"contact/{name}/normal"])[idx]
-        ln = np.asarray(res[f"contact/{name}/lambda_n"])[idx]
         ft = np.asarray(res[f"contact/{name}/friction_force"])[idx] if f"contact/{name}/friction_force" in res \
             else np.zeros(p.shape)
-        st = np.asarray(res[f"contact/{name}/state"])[idx]
+        if f"contact/{name}/lambda_n" in res:
+            ln = np.asarray(res[f"contact/{name}/lambda_n"])[idx]
+            st = np.asarray(res[f"contact/{name}/state"])[idx]
+        else:
+            # a compliant contact: its force where it overlaps; drawn as slipping where it slides
+            # (faster than 1 µm/s), as sticking otherwise, hidden while open
+            ln = np.asarray(res[f"contact/{name}/force_n"])[idx]
+            over = np.asarray(res[f"contact/{name}/overlap"])[idx] > 0
+            slip = np.asarray(res[f"contact/{name}/slip_velocity"])[idx]
+            speed = np.abs(slip) if slip.ndim == over.ndim else np.linalg.norm(slip, axis=-1)
+            st = np.where(over, np.where(speed > 1e-6, 2, 1), 0)
         if p.ndim == 2:
             p, n, ft, ln, st = p[:, None], n[:, None], ft[:, None], ln[:, None], st[:, None]
         for k in range(p.shape[1]):

@@ -519,6 +519,98 @@ impl Contour {
 
 /// A planar vector as a 3-vector of the body's x-y plane.
 impl Contour {
+    /// The curvature tensor (second fundamental form, 1/m; convex > 0) of the contour's surface at
+    /// the world point `p` on it, the body at `pose`, in the world tangent directions `t1`, `t2`
+    /// (orthonormal, tangent to the surface at `p`): `[c11, c12, c22]` with `c_ij = t_iᵀ C t_j`.
+    /// Two bodies touching at `p` with a common tangent plane have the relative curvature tensor
+    /// `C₁ + C₂`, whose eigenvalues are twice Hertz's A and B whatever the angle between their
+    /// principal directions. None where the curvature is undefined (edges, vertices, rims) or not
+    /// available (meshes, parametric contours).
+    ///
+    /// # Example
+    /// ```
+    /// use mechsys_core::contact::Contour;
+    /// use mechsys_core::math::Vec3;
+    /// use mechsys_core::spatial::Pose;
+    /// // a capsule along x: curved 1/R across its axis, straight along it
+    /// let rod = Contour::Capsule { a: Vec3::new(-1.0, 0.0, 0.0), b: Vec3::new(1.0, 0.0, 0.0), radius: 0.5 };
+    /// let c = rod.curvature_tensor_at(&Pose::IDENTITY, &Vec3::new(0.0, 0.0, 0.5), &Vec3::x(), &Vec3::y()).unwrap();
+    /// assert!((c[0] - 0.0).abs() < 1e-15 && (c[2] - 2.0).abs() < 1e-15 && c[1].abs() < 1e-15);
+    /// ```
+    pub fn curvature_tensor_at(&self, pose: &Pose, p: &Vec3, t1: &Vec3, t2: &Vec3) -> Option<[f64; 3]> {
+        let l = pose.a.transpose() * (p - pose.r);
+        // tangent directions in body components
+        let (u1, u2) = (pose.a.transpose() * t1, pose.a.transpose() * t2);
+        let iso = |k: f64| Some([k, 0.0, k]);
+        // principal curvature `ka` across a direction `d` (body frame, unit) along which the
+        // curvature is `kb`, on a surface with unit normal `n`: C = ka (I − n nᵀ − d dᵀ) + kb d dᵀ
+        let with_axis = |ka: f64, kb: f64, d: &Vec3, n: &Vec3| {
+            let f = |x: &Vec3, y: &Vec3| {
+                ka * (x.dot(y) - x.dot(n) * y.dot(n) - x.dot(d) * y.dot(d)) + kb * x.dot(d) * y.dot(d)
+            };
+            Some([f(&u1, &u1), f(&u1, &u2), f(&u2, &u2)])
+        };
+        match self {
+            Contour::Sphere { radius, .. } => iso(1.0 / radius),
+            Contour::Bowl { radius, .. } => iso(-1.0 / radius),
+            Contour::Plane { .. } => iso(0.0),
+            Contour::Ellipsoid { center, rotation, semi_axes } => {
+                // the shape operator from the gradient and Hessian of F = ½ yᵀ D⁻² y
+                let y = rotation.transpose() * (l - center);
+                let dinv = Vec3::from_fn(|k, _| 1.0 / (semi_axes[k] * semi_axes[k]));
+                let gn = y.component_mul(&dinv).norm();
+                let (v1, v2) = (rotation.transpose() * u1, rotation.transpose() * u2);
+                let h = |a: &Vec3, b: &Vec3| a.component_mul(&dinv).dot(b) / gn;
+                Some([h(&v1, &v1), h(&v1, &v2), h(&v2, &v2)])
+            }
+            Contour::Torus { center, axis, radius, tube } if *tube > 0.0 => {
+                // 1/ρ about the tube, cos φ / (R + ρ cos φ) along the rim (the circumferential
+                // direction u × e_r)
+                let u = axis.normalize();
+                let y = l - center;
+                let z = y.dot(&u);
+                let radial = y - u * z;
+                let rho = radial.norm();
+                if rho <= 0.0 {
+                    return None;
+                }
+                let e_r = radial / rho;
+                let ring = e_r * *radius;
+                let n = (y - ring).normalize();
+                let cphi = ((rho - radius) / tube).clamp(-1.0, 1.0);
+                with_axis(1.0 / tube, cphi / (radius + tube * cphi), &u.cross(&e_r), &n)
+            }
+            Contour::Capsule { a, b, radius } => {
+                let d = b - a;
+                let s = (l - a).dot(&d) / d.norm_squared();
+                if s > 0.0 && s < 1.0 {
+                    let axis = d.normalize();
+                    let foot = a + d * s;
+                    let n = (l - foot).normalize();
+                    with_axis(1.0 / radius, 0.0, &axis, &n)
+                } else {
+                    iso(1.0 / radius)
+                }
+            }
+            Contour::Cylinder { center, axis, radius, half_length } => {
+                let u = axis.normalize();
+                let y = l - center;
+                let z = y.dot(&u);
+                let radial = y - u * z;
+                let rho = radial.norm();
+                let tol = 1e-9 * radius.max(*half_length);
+                let side = (rho - radius).abs() <= tol;
+                let cap = (z.abs() - half_length).abs() <= tol;
+                match (side, cap) {
+                    (true, false) => with_axis(1.0 / radius, 0.0, &u, &(radial / rho)),
+                    (false, true) => iso(0.0),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
     /// Principal curvatures (1/m; convex > 0, hollow < 0; `∞` at a point, a vertex or an edge,
     /// where no curvature is defined) of the contour's surface at the world point `p` on it, the
     /// body at `pose`. Planar contours are extruded along z, so their second curvature is 0.

@@ -74,7 +74,7 @@ pub fn potential_energy(model: &Model, data: &Data, q: &[f64]) -> f64 {
             }
             ForceElement::Jenkins(j) => v += jenkins::energy(j, data, q),
             // the compliant contacts' stored energy, from the last force evaluation
-            ForceElement::Contact(_) => {}
+            ForceElement::Contact(_) | ForceElement::ContactGroup(_) => {}
             _ => {}
         }
     }

@@ -16,13 +16,13 @@
 //! an adaptive scheme ends its steps where either changes sign ([`switching`]), so no step
 //! straddles the kink of the onset, the release or the cut-off.
 
-use crate::contact::ContactKinematics;
+use crate::contact::{ContactKinematics, Contour};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::math::Vec3;
 use crate::model::compliant::{
-    johnson_energy, johnson_x, CompliantContact, Dissipation, Elastic, HertzEllipse, Tangential, OUTPUTS_PER_POINT,
+    johnson_energy, johnson_x, CompliantContact, CompliantLaw, Dissipation, Elastic, HertzEllipse, Tangential, OUTPUTS_PER_POINT,
     STATES_PER_POINT,
 };
 use crate::model::{ForceElement, Model};
@@ -43,6 +43,8 @@ pub struct Work {
     pub closed: Vec<bool>,
     /// Points that changed (closed or opened) at the last commit, as (point, closed).
     pub changed: Vec<(usize, bool)>,
+    /// The compliant groups' broad phases, pair laws and histories, in model order.
+    pub groups: Vec<super::compliant_group::GroupWork>,
 }
 
 impl Work {
@@ -62,6 +64,14 @@ impl Work {
             onset_speed: vec![0.0; n],
             closed: vec![false; n],
             changed: Vec::with_capacity(n),
+            groups: model
+                .forces
+                .iter()
+                .filter_map(|f| match f {
+                    ForceElement::ContactGroup(g) => Some(super::compliant_group::GroupWork::new(g)),
+                    _ => None,
+                })
+                .collect(),
         }
     }
 }
@@ -74,22 +84,54 @@ fn kinematics(c: &CompliantContact, data: &Data, w: &mut Work, t: f64) -> Result
         .map_err(|e| crate::contact::at_contact(e, &c.name, t))
 }
 
-/// The elastic force and stored energy at overlap `delta > 0` of point `k` (kinematics `kin`).
-fn elastic(c: &CompliantContact, data: &Data, kin: &ContactKinematics, delta: f64, t: f64) -> Result<(f64, f64)> {
-    Ok(match &c.law.elastic {
+/// One compliant pair as its laws see it: an explicit contact, or a pair of a compliant group.
+pub(crate) struct PairLaw<'a> {
+    /// The law.
+    pub law: &'a CompliantLaw,
+    /// The two contours (body-frame data), for curvatures.
+    pub contours: [&'a Contour; 2],
+    /// Body of contour 1.
+    pub body1: usize,
+    /// Body of contour 2.
+    pub body2: usize,
+    /// The contact's (or group's) name, for errors.
+    pub name: &'a str,
+}
+
+impl<'a> PairLaw<'a> {
+    fn of(c: &'a CompliantContact) -> Self {
+        PairLaw { law: &c.law, contours: [&c.contours[0], &c.contours[1]], body1: c.body1, body2: c.body2, name: &c.name }
+    }
+}
+
+/// What one closed point applies and records.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PointForce {
+    /// Normal force (≥ 0).
+    pub f_n: f64,
+    /// Tangential force along t1, t2.
+    pub f_t: [f64; 2],
+    /// Stored energy (elastic, and the bristles').
+    pub energy: f64,
+    /// Damping coefficient in use.
+    pub alpha: f64,
+    /// Power dissipated.
+    pub power: f64,
+    /// Bristle rates (LuGre).
+    pub zd: [f64; 2],
+}
+
+/// The elastic force and stored energy at overlap `delta > 0` (kinematics `kin`).
+fn elastic(p: &PairLaw, data: &Data, kin: &ContactKinematics, delta: f64, t: f64) -> Result<(f64, f64)> {
+    Ok(match &p.law.elastic {
         Elastic::KelvinVoigt { k, .. } => (k * delta, 0.5 * k * delta * delta),
         Elastic::Hertz { k } => (k * delta * delta.sqrt(), 0.4 * k * delta * delta * delta.sqrt()),
         Elastic::HertzCurved { e_star } => {
-            let (x1, x2) = (&data.x_abs[c.body1], &data.x_abs[c.body2]);
-            let k1 = c.contours[0].curvatures_at(x1, &kin.point.p1);
-            let k2 = c.contours[1].curvatures_at(x2, &kin.point.p2);
-            // one side is isotropic (checked when built): the relative principal curvatures
-            let (s0, s1) = (k1[0] + k2[0], k1[1] + k2[1]);
-            let (a, b) = (0.5 * s0.min(s1), 0.5 * s0.max(s1));
+            let (a, b) = relative_curvatures(p, data, kin).unwrap_or((f64::NAN, f64::NAN));
             if !(a > 0.0 && b.is_finite()) {
                 return Err(Error::Solver(format!(
                     "contact '{}' at t = {t:.6} s: the relative curvature at the contact point is {a:.4e} 1/m, no Hertz contact (conforming or flat)",
-                    c.name
+                    p.name
                 )));
             }
             let k = HertzEllipse::new(a, b).stiffness(a, *e_star);
@@ -99,7 +141,7 @@ fn elastic(c: &CompliantContact, data: &Data, kin: &ContactKinematics, delta: f6
             let x = johnson_x(delta, *radius).ok_or_else(|| {
                 Error::Solver(format!(
                     "contact '{}': overlap {delta:.4e} m at t = {t:.6} s is beyond the range of Johnson's line law (below 4R/e² = {:.4e} m)",
-                    c.name,
+                    p.name,
                     4.0 * radius * (-2.0f64).exp()
                 ))
             })?;
@@ -109,13 +151,27 @@ fn elastic(c: &CompliantContact, data: &Data, kin: &ContactKinematics, delta: f6
     })
 }
 
-/// The damping coefficient α of point `slot` at approach rate `rate` (the onset speed once committed).
-fn alpha(c: &CompliantContact, w: &Work, slot: usize, rate: f64) -> f64 {
-    match c.law.dissipation {
+/// Hertz's relative curvatures `A ≤ B` at the contact point: half the eigenvalues of the sum of
+/// the two surfaces' curvature tensors in the contact's tangent plane (`t1`, `t2`), so that two
+/// doubly curved bodies whose principal directions cross at any angle are covered (Johnson,
+/// Contact Mechanics, 4.2). None where a contour has no curvature there.
+fn relative_curvatures(p: &PairLaw, data: &Data, kin: &ContactKinematics) -> Option<(f64, f64)> {
+    let (t1, t2) = (&kin.point.t1, &kin.point.t2);
+    let c1 = p.contours[0].curvature_tensor_at(&data.x_abs[p.body1], &kin.point.p1, t1, t2)?;
+    let c2 = p.contours[1].curvature_tensor_at(&data.x_abs[p.body2], &kin.point.p2, t1, t2)?;
+    let (s11, s12, s22) = (c1[0] + c2[0], c1[1] + c2[1], c1[2] + c2[2]);
+    let (m, d) = (0.5 * (s11 + s22), (0.25 * (s11 - s22).powi(2) + s12 * s12).sqrt());
+    Some((0.5 * (m - d), 0.5 * (m + d)))
+}
+
+/// The damping coefficient α at approach rate `rate`, with the approach speed `onset` of the
+/// current contact once committed (0 before).
+fn alpha(law: &CompliantLaw, onset: f64, rate: f64) -> f64 {
+    match law.dissipation {
         Dissipation::None => 0.0,
         Dissipation::Alpha(a) => a,
         Dissipation::Restitution { map, eps } => {
-            let v = if w.onset_speed[slot] > 0.0 { w.onset_speed[slot] } else { rate };
+            let v = if onset > 0.0 { onset } else { rate };
             if v > 0.0 {
                 map.alpha(eps, v)
             } else {
@@ -125,31 +181,83 @@ fn alpha(c: &CompliantContact, w: &Work, slot: usize, rate: f64) -> f64 {
     }
 }
 
-/// The normal force before the cut-off, the elastic force and the stored energy.
+/// The normal force before the cut-off, the elastic force, the stored energy and α.
 fn normal(
-    c: &CompliantContact,
+    p: &PairLaw,
     data: &Data,
-    w: &Work,
     kin: &ContactKinematics,
-    slot: usize,
+    onset: f64,
     t: f64,
     cb: &dyn Callbacks,
 ) -> Result<(f64, f64, f64, f64)> {
     let (delta, rate) = (-kin.point.g_n, -kin.gd_n);
-    if let Elastic::User { callback } = c.law.elastic {
+    if let Elastic::User { callback } = p.law.elastic {
         let f = cb
             .contact_force(callback, delta, rate)
-            .map_err(|e| Error::Callback(format!("contact '{}'.normal: {e}", c.name)))?;
+            .map_err(|e| Error::Callback(format!("contact '{}'.normal: {e}", p.name)))?;
         return Ok((f, 0.0, 0.0, 0.0));
     }
-    let (f_el, v) = elastic(c, data, kin, delta, t)?;
-    Ok(match c.law.elastic {
+    let (f_el, v) = elastic(p, data, kin, delta, t)?;
+    Ok(match p.law.elastic {
         Elastic::KelvinVoigt { d, .. } => (f_el + d * rate, f_el, v, 0.0),
         _ => {
-            let a = alpha(c, w, slot, rate);
+            let a = alpha(p.law, onset, rate);
             (f_el * (1.0 + a * rate), f_el, v, a)
         }
     })
+}
+
+/// The forces of a closed point (overlap > 0) with kinematics `kin`, bristle deflections `z`;
+/// `planar` pairs slide along t1 only.
+pub(crate) fn point_force(
+    p: &PairLaw,
+    data: &Data,
+    kin: &ContactKinematics,
+    onset: f64,
+    z: [f64; 2],
+    planar: bool,
+    t: f64,
+    cb: &dyn Callbacks,
+) -> Result<PointForce> {
+    let rate = -kin.gd_n;
+    let v = [kin.gd_t[0], if planar { 0.0 } else { kin.gd_t[1] }];
+    let (raw, f_el, stored, a) = normal(p, data, kin, onset, t, cb)?;
+    let mut out = PointForce { f_n: raw.max(0.0), energy: stored, alpha: a, ..PointForce::default() };
+    let f_n = out.f_n;
+    // what the overlap's rate feeds in beyond the stored energy's rate
+    out.power = (f_n - f_el) * rate;
+    let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+    match &p.law.tangential {
+        Tangential::None => {}
+        Tangential::Regularized { law, v_reg } => {
+            if speed > 0.0 {
+                let m = law.mu(speed) * f_n * (speed / v_reg).tanh() / speed;
+                out.f_t = [-m * v[0], -m * v[1]];
+            }
+        }
+        Tangential::LuGre { mu0, mu, v_s, sigma0, sigma1, sigma2 } => {
+            let g = mu + (mu0 - mu) * (-(speed / v_s).powi(2)).exp();
+            for i in 0..2 {
+                let zd = v[i] - sigma0 * speed * z[i] / g;
+                out.zd[i] = zd;
+                out.f_t[i] = -f_n * (sigma0 * z[i] + sigma1 * zd + sigma2 * v[i]);
+                // the bristles store ½ F_N σ0 z² (at the current F_N)
+                out.energy += 0.5 * f_n * sigma0 * z[i] * z[i];
+                out.power -= f_n * sigma0 * z[i] * zd;
+            }
+        }
+    }
+    out.power -= out.f_t[0] * v[0] + out.f_t[1] * v[1];
+    Ok(out)
+}
+
+/// Applies the point's force `F_N n + F_T` to body 1 at its contact point and the opposite to
+/// body 2 at its own.
+#[inline]
+pub(crate) fn apply_point(data: &mut Data, body1: usize, body2: usize, kin: &ContactKinematics, pf: &PointForce) {
+    let f = kin.point.n * pf.f_n + kin.point.t1 * pf.f_t[0] + kin.point.t2 * pf.f_t[1];
+    apply(data, body1, &kin.point.p1, &f);
+    apply(data, body2, &kin.point.p2, &(-f));
 }
 
 /// Evaluates contact `c` (its recorded values from `o` on): applies its forces to `data.f_ext`,
@@ -164,6 +272,7 @@ pub fn evaluate(
 ) -> Result<f64> {
     kinematics(c, data, w, t)?;
     let planar = c.pair.tangent_dim() == 1;
+    let pl = PairLaw::of(c);
     let mut p_diss = 0.0;
     for k in 0..c.points() {
         let kin = w.kin[k];
@@ -171,57 +280,43 @@ pub fn evaluate(
         let s = STATES_PER_POINT * slot;
         let (delta, rate) = (-kin.point.g_n, -kin.gd_n);
         let v = [kin.gd_t[0], if planar { 0.0 } else { kin.gd_t[1] }];
-        let (mut f_n, mut f_t, mut energy, mut a) = (0.0, [0.0; 2], 0.0, 0.0);
-        let mut p = 0.0;
-        w.rates[s + 1] = 0.0;
-        w.rates[s + 2] = 0.0;
+        let mut pf = PointForce::default();
         if delta > 0.0 {
-            let (raw, f_el, stored, alpha) = normal(c, data, w, &kin, slot, t, cb)?;
-            f_n = raw.max(0.0);
-            energy = stored;
-            a = alpha;
-            // what the overlap's rate feeds in beyond the stored energy's rate
-            p += (f_n - f_el) * rate;
-            let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
-            match &c.law.tangential {
-                Tangential::None => {}
-                Tangential::Regularized { law, v_reg } => {
-                    if speed > 0.0 {
-                        let m = law.mu(speed) * f_n * (speed / v_reg).tanh() / speed;
-                        f_t = [-m * v[0], -m * v[1]];
-                    }
-                }
-                Tangential::LuGre { mu0, mu, v_s, sigma0, sigma1, sigma2 } => {
-                    let g = mu + (mu0 - mu) * (-(speed / v_s).powi(2)).exp();
-                    let z = [w.states[s + 1], w.states[s + 2]];
-                    for i in 0..2 {
-                        let zd = v[i] - sigma0 * speed * z[i] / g;
-                        w.rates[s + 1 + i] = zd;
-                        f_t[i] = -f_n * (sigma0 * z[i] + sigma1 * zd + sigma2 * v[i]);
-                        // the bristles store ½ F_N σ0 z² (at the current F_N)
-                        energy += 0.5 * f_n * sigma0 * z[i] * z[i];
-                        p -= f_n * sigma0 * z[i] * zd;
-                    }
-                }
-            }
-            p -= f_t[0] * v[0] + f_t[1] * v[1];
-            let f = kin.point.n * f_n + kin.point.t1 * f_t[0] + kin.point.t2 * f_t[1];
-            apply(data, c.body1, &kin.point.p1, &f);
-            apply(data, c.body2, &kin.point.p2, &(-f));
+            let z = [w.states[s + 1], w.states[s + 2]];
+            pf = point_force(&pl, data, &kin, w.onset_speed[slot], z, planar, t, cb)?;
+            apply_point(data, c.body1, c.body2, &kin, &pf);
         }
-        w.rates[s] = p;
-        p_diss += p;
-        data.contact_energy += energy;
+        w.rates[s] = pf.power;
+        w.rates[s + 1] = pf.zd[0];
+        w.rates[s + 2] = pf.zd[1];
+        p_diss += pf.power;
+        data.contact_energy += pf.energy;
         let (fo, d) = (&mut data.element_force, &mut data.element_deflection);
         let b = o + OUTPUTS_PER_POINT * k;
-        fo[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[f_n, f_t[0], f_t[1], energy, w.states[s]]);
-        d[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[delta, rate, v[0], v[1], a]);
+        // where it acts, for the viewer: the point on contour 1, the normal, the friction force
+        let (pt, n) = (&kin.point.p1, &kin.point.n);
+        let ft = kin.point.t1 * pf.f_t[0] + kin.point.t2 * pf.f_t[1];
+        fo[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[
+            pf.f_n,
+            pf.f_t[0],
+            pf.f_t[1],
+            pf.energy,
+            w.states[s],
+            pt.x,
+            pt.y,
+            pt.z,
+            ft.x,
+            ft.y,
+            ft.z,
+        ]);
+        d[b..b + OUTPUTS_PER_POINT]
+            .copy_from_slice(&[delta, rate, v[0], v[1], pf.alpha, n.x, n.y, n.z, 0.0, 0.0, 0.0]);
     }
     Ok(p_diss)
 }
 
 #[inline]
-fn apply(data: &mut Data, b: usize, p: &Vec3, f: &Vec3) {
+pub(crate) fn apply(data: &mut Data, b: usize, p: &Vec3, f: &Vec3) {
     if b != 0 {
         data.f_ext[b] += Force::new(p.cross(f), *f);
     }
@@ -237,14 +332,24 @@ pub fn switches(model: &Model) -> usize {
 /// (1 while open, so that only a closed contact's force crossing zero counts).
 pub fn switching(model: &Model, data: &Data, w: &mut Work, t: f64, cb: &dyn Callbacks, out: &mut [f64]) -> Result<()> {
     for f in &model.forces {
-        let ForceElement::Contact(c) = f else { continue };
+        let c = match f {
+            ForceElement::Contact(c) => c,
+            ForceElement::ContactGroup(g) => {
+                // a group's onsets are stepped over under error control (module doc of
+                // compliant_group): constant switching functions
+                out[2 * g.slot] = 1.0;
+                out[2 * g.slot + 1] = 1.0;
+                continue;
+            }
+            _ => continue,
+        };
         kinematics(c, data, w, t)?;
         for k in 0..c.points() {
             let kin = w.kin[k];
             let slot = c.slot + k;
             out[2 * slot] = kin.point.g_n;
             out[2 * slot + 1] = if kin.point.g_n < 0.0 && !matches!(c.law.elastic, Elastic::User { .. }) {
-                normal(c, data, w, &kin, slot, t, cb)?.0
+                normal(&PairLaw::of(c), data, &kin, w.onset_speed[slot], t, cb)?.0
             } else {
                 1.0
             };
@@ -259,7 +364,14 @@ pub fn switching(model: &Model, data: &Data, w: &mut Work, t: f64, cb: &dyn Call
 pub fn commit(model: &Model, data: &Data, w: &mut Work, t: f64, states: &mut [f64]) -> Result<()> {
     w.changed.clear();
     for f in &model.forces {
-        let ForceElement::Contact(c) = f else { continue };
+        let c = match f {
+            ForceElement::Contact(c) => c,
+            ForceElement::ContactGroup(g) => {
+                super::compliant_group::commit(g, data, &mut w.groups[g.index], t)?;
+                continue;
+            }
+            _ => continue,
+        };
         kinematics(c, data, w, t)?;
         for k in 0..c.points() {
             let slot = c.slot + k;

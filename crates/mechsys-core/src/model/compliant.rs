@@ -133,7 +133,8 @@ pub enum Elastic {
         k: f64,
     },
     /// `K δ^{3/2}` with K from the curvatures at the contact point at every evaluation (an
-    /// ellipsoid or a torus against a sphere, plane or bowl).
+    /// ellipsoid, a torus or a capsule against a sphere, plane or bowl, or two of them: the
+    /// relative curvature tensor's eigenvalues give A and B).
     HertzCurved {
         /// E*.
         e_star: f64,
@@ -236,9 +237,127 @@ impl CompliantContact {
     }
 }
 
+/// A compliant law's elastic part before the pair of contours is known (a contact group's
+/// pairs differ in kind and material).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ElasticSpec {
+    /// Independent of the contours (Kelvin–Voigt, a user law).
+    Given(Elastic),
+    /// A Hertz-type law: K (or Johnson's line law) from the pair's curvatures and E*, or given.
+    Hertz {
+        /// K given directly (N/m^{3/2}).
+        stiffness: Option<f64>,
+        /// Contact length of a planar line contact (m).
+        length: Option<f64>,
+    },
+}
+
+impl ElasticSpec {
+    /// The elastic law on contours `c` with effective modulus `e_star` (if both have materials).
+    pub fn resolve(&self, c: &[Contour; 2], e_star: Option<f64>, what: &str) -> Result<Elastic> {
+        match self {
+            ElasticSpec::Given(e) => Ok(e.clone()),
+            ElasticSpec::Hertz { stiffness, length } => hertz_elastic(c, e_star, *stiffness, *length, what),
+        }
+    }
+}
+
+/// A compliant contact group: the pairs of a contact group's contours (found by its broad phase,
+/// [`crate::contact::group::GroupPhase`], at every evaluation) each carry a compliant law,
+/// resolved per pair from the pair's contours and materials when it first comes close
+/// ([`CompliantGroup::law`]). Its forces are evaluated by [`crate::forces::compliant_group`].
+#[derive(Debug, Clone)]
+pub struct CompliantGroup {
+    /// The contours (name, members, `against`; its rigid laws are unused).
+    pub geometry: super::contact::ContactGroup,
+    /// Material of each contour: the members, then the `against` contours.
+    pub materials: Vec<Option<Material>>,
+    /// The elastic law before the pair is known.
+    pub elastic: ElasticSpec,
+    /// Damping factor.
+    pub dissipation: Dissipation,
+    /// Tangential law (regularized only: bristle states per pair are not kept in groups).
+    pub tangential: Tangential,
+    /// Its slot among the compliant contact points (its dissipated energy is that slot's state).
+    pub slot: usize,
+    /// Its index among the model's compliant groups (its working memory).
+    pub index: usize,
+}
+
+impl PartialEq for CompliantGroup {
+    /// Same contours, materials, law and slots.
+    fn eq(&self, o: &Self) -> bool {
+        self.geometry.name == o.geometry.name
+            && self.geometry.members == o.geometry.members
+            && self.geometry.against == o.geometry.against
+            && self.materials == o.materials
+            && self.elastic == o.elastic
+            && self.dissipation == o.dissipation
+            && self.tangential == o.tangential
+            && self.slot == o.slot
+            && self.index == o.index
+    }
+}
+
+impl CompliantGroup {
+    /// The contour with index `k` (members first, then `against`).
+    pub fn contour(&self, k: usize) -> &super::contact::GroupContour {
+        let m = self.geometry.members.len();
+        if k < m {
+            &self.geometry.members[k]
+        } else {
+            &self.geometry.against[k - m]
+        }
+    }
+
+    /// The compliant law of the pair of contours `i`, `j`.
+    pub fn law(&self, i: usize, j: usize) -> Result<CompliantLaw> {
+        let e_star = match (self.materials[i], self.materials[j]) {
+            (Some(a), Some(b)) => Some(effective_modulus(&a, &b)),
+            _ => None,
+        };
+        let what = format!("contact group '{}': {}–{}", self.geometry.name, self.label(i), self.label(j));
+        let c = [self.contour(i).contour.clone(), self.contour(j).contour.clone()];
+        Ok(CompliantLaw {
+            elastic: self.elastic.resolve(&c, e_star, &what)?,
+            dissipation: self.dissipation,
+            tangential: self.tangential.clone(),
+        })
+    }
+
+    /// Contact points recorded per sample for drawing (two per member, at most 256): the first
+    /// touching points in pair order.
+    pub fn drawn(&self) -> usize {
+        (2 * self.geometry.members.len()).min(256)
+    }
+
+    /// Values recorded per sample: [`GROUP_OUTPUTS`] totals, then per drawn point its position
+    /// (m) and the force on the first contour (N), world axes.
+    pub fn outputs(&self) -> usize {
+        GROUP_OUTPUTS + 6 * self.drawn()
+    }
+
+    /// `members[k]` or `against[k − members]`.
+    pub fn label(&self, k: usize) -> String {
+        let m = self.geometry.members.len();
+        if k < m {
+            format!("members[{k}]")
+        } else {
+            format!("against[{}]", k - m)
+        }
+    }
+}
+
+/// Totals a compliant group records (force columns: total normal force, stored energy,
+/// dissipated energy, touching pairs; deflection columns: largest overlap, largest approach
+/// rate, pairs kept by the broad phase, touching points), before its drawn points
+/// ([`CompliantGroup::outputs`]).
+pub const GROUP_OUTPUTS: usize = 4;
+
 /// Values each compliant contact point records (force columns: F_N, F_T1, F_T2, stored energy,
-/// dissipated energy; deflection columns: δ, δ̇, ġ_T1, ġ_T2, α in use).
-pub const OUTPUTS_PER_POINT: usize = 5;
+/// dissipated energy, the contact point on contour 1 (world, m), the friction force (world, N);
+/// deflection columns: δ, δ̇, ġ_T1, ġ_T2, α in use, the normal (world), three zeros).
+pub const OUTPUTS_PER_POINT: usize = 11;
 
 /// Extra ODE states per compliant contact point: dissipated energy, bristle deflections z1, z2.
 pub const STATES_PER_POINT: usize = 3;
@@ -373,7 +492,8 @@ pub fn johnson_energy(x: f64, radius: f64, length: f64, e_star: f64) -> f64 {
 }
 
 /// What kind of contour a Hertz law sees: a constant curvature in every direction (κ, a sphere,
-/// bowl or plane), two principal curvatures that vary (an ellipsoid, a torus), a cylinder's
+/// bowl or plane), two principal curvatures that vary (an ellipsoid, a torus, a capsule: a
+/// cylinder's side with spherical ends), a cylinder's
 /// side or a planar disc (line contact), or nothing to work with (flat faces, edges, vertices).
 enum Shape {
     Isotropic(f64),
@@ -387,7 +507,7 @@ fn shape(c: &Contour) -> Shape {
         Contour::Sphere { radius, .. } => Shape::Isotropic(1.0 / radius),
         Contour::Bowl { radius, .. } => Shape::Isotropic(-1.0 / radius),
         Contour::Plane { .. } | Contour::Line { .. } => Shape::Isotropic(0.0),
-        Contour::Ellipsoid { .. } => Shape::Curved,
+        Contour::Ellipsoid { .. } | Contour::Capsule { .. } => Shape::Curved,
         Contour::Torus { tube, .. } if *tube > 0.0 => Shape::Curved,
         Contour::Cylinder { radius, half_length, .. } => {
             Shape::Line { radius: *radius, length: Some(2.0 * half_length) }
@@ -446,15 +566,14 @@ pub fn hertz_elastic(
             }
             Ok(Elastic::Hertz { k: match k { Some(k) => k, None => 4.0 / 3.0 * need_e()? * (1.0 / kappa).sqrt() } })
         }
-        (Shape::Curved, Shape::Isotropic(_)) | (Shape::Isotropic(_), Shape::Curved) => match k {
-            Some(k) => Ok(Elastic::Hertz { k }),
-            None => Ok(Elastic::HertzCurved { e_star: need_e()? }),
-        },
-        (Shape::Curved, Shape::Curved) => Err(Error::Model(format!(
-            "{what}: a Hertz law between two contours curved differently in two directions ({} and {}) needs the angle between their principal axes, which is not available; give one of them a sphere or a plane",
-            c[0].kind(),
-            c[1].kind()
-        ))),
+        // doubly curved on one or both sides: K from the relative curvature tensor at the contact
+        // point at every evaluation (principal directions crossing at any angle)
+        (Shape::Curved, Shape::Isotropic(_)) | (Shape::Isotropic(_), Shape::Curved) | (Shape::Curved, Shape::Curved) => {
+            match k {
+                Some(k) => Ok(Elastic::Hertz { k }),
+                None => Ok(Elastic::HertzCurved { e_star: need_e()? }),
+            }
+        }
         (Shape::Line { radius, length: l }, other) | (other, Shape::Line { radius, length: l }) => {
             let r = match other {
                 Shape::Isotropic(k) if flat(other) && *k == 0.0 => *radius,

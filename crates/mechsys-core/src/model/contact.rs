@@ -488,6 +488,90 @@ fn friction_law(friction: &FrictionDescription, what: &str) -> Result<FrictionLa
     })
 }
 
+/// The parts of a compliant law that do not depend on the pair of contours: the elastic law
+/// (resolved per pair by [`super::compliant::ElasticSpec::resolve`]), the damping and the
+/// tangential law. `what` names the contact or group in errors.
+pub(super) fn compliant_law(
+    normal: &super::contact_description::NormalDescription,
+    friction: &FrictionDescription,
+    what: &str,
+    n_callbacks: &mut usize,
+) -> Result<(super::compliant::ElasticSpec, super::compliant::Dissipation, super::compliant::Tangential)> {
+    use super::compliant::{Dissipation, Elastic, ElasticSpec, RestitutionMap, Tangential};
+    use super::contact_description::NormalDescription as N;
+    let positive = |v: f64, key: &str| -> Result<f64> {
+        crate::ensure!(v.is_finite() && v > 0.0, Model, "{what}.normal.{key}: must be > 0, got {v}");
+        Ok(v)
+    };
+    let (elastic, dissipation, v_reg) = match normal {
+        N::KelvinVoigt { k, d: damping, v_reg } => {
+            positive(*k, "k")?;
+            crate::ensure!(damping.is_finite() && *damping >= 0.0, Model, "{what}.normal.d: must be >= 0, got {damping}");
+            (ElasticSpec::Given(Elastic::KelvinVoigt { k: *k, d: *damping }), Dissipation::None, *v_reg)
+        }
+        N::User { callback, v_reg } => {
+            crate::ensure!(*callback < 1 << 32, Model, "{what}.normal.callback: index {callback} is out of range");
+            *n_callbacks = (*n_callbacks).max(callback + 1);
+            (ElasticSpec::Given(Elastic::User { callback: *callback }), Dissipation::None, *v_reg)
+        }
+        N::Hertz(h) | N::HuntCrossley(h) | N::LankaraniNikravesh(h) | N::Flores(h) => {
+            let map = match normal {
+                N::HuntCrossley(_) => Some(RestitutionMap::HuntCrossley),
+                N::LankaraniNikravesh(_) => Some(RestitutionMap::LankaraniNikravesh),
+                N::Flores(_) => Some(RestitutionMap::Flores),
+                _ => None,
+            };
+            if let Some(k) = h.stiffness {
+                positive(k, "stiffness")?;
+            }
+            let dissipation = match (map, h.eps, h.alpha) {
+                (_, Some(_), Some(_)) => {
+                    return Err(Error::Model(format!("{what}.normal: give eps or alpha, not both")))
+                }
+                (_, None, Some(a)) => {
+                    crate::ensure!(a.is_finite() && a >= 0.0, Model, "{what}.normal.alpha: the damping coefficient must be >= 0, got {a}");
+                    if a == 0.0 { Dissipation::None } else { Dissipation::Alpha(a) }
+                }
+                (None, Some(_), None) => {
+                    return Err(Error::Model(format!(
+                        "{what}.normal.eps: the undamped Hertz law has restitution 1; use HuntCrossley, LankaraniNikravesh or Flores for a restitution"
+                    )))
+                }
+                (Some(map), Some(e), None) => {
+                    crate::ensure!(e.is_finite() && e > 0.0 && e <= 1.0, Model, "{what}.normal.eps: must be in (0, 1], got {e}");
+                    if e == 1.0 { Dissipation::None } else { Dissipation::Restitution { map, eps: e } }
+                }
+                (Some(map), None, None) => {
+                    return Err(Error::Model(format!("{what}.normal: the {} law needs eps (restitution) or alpha (s/m)", map.name())))
+                }
+                (None, None, None) => Dissipation::None,
+            };
+            (ElasticSpec::Hertz { stiffness: h.stiffness, length: h.length }, dissipation, h.v_reg)
+        }
+        N::Signorini | N::Bilateral { .. } => return Err(Error::Model(format!("{what}.normal: not a compliant law"))),
+    };
+    let tangential = match friction {
+        FrictionDescription::None => Tangential::None,
+        FrictionDescription::LuGre { mu0, mu, v_s, sigma0, sigma1, sigma2 } => {
+            let w = format!("{what}.friction");
+            for (k, v) in [("mu0", mu0), ("mu", mu), ("sigma1", sigma1), ("sigma2", sigma2)] {
+                crate::ensure!(v.is_finite() && *v >= 0.0, Model, "{w}.{k}: must be >= 0, got {v}");
+            }
+            crate::ensure!(v_s.is_finite() && *v_s > 0.0, Model, "{w}.v_s: must be > 0, got {v_s}");
+            crate::ensure!(sigma0.is_finite() && *sigma0 > 0.0, Model, "{w}.sigma0: must be > 0, got {sigma0}");
+            crate::ensure!(*mu0 > 0.0 || *mu > 0.0, Model, "{w}: mu0 and mu are both zero");
+            Tangential::LuGre { mu0: *mu0, mu: *mu, v_s: *v_s, sigma0: *sigma0, sigma1: *sigma1, sigma2: *sigma2 }
+        }
+        f => {
+            let law = friction_law(f, what)?;
+            let v_reg = v_reg.unwrap_or(1e-4);
+            crate::ensure!(v_reg.is_finite() && v_reg > 0.0, Model, "{what}.normal.v_reg: must be > 0, got {v_reg}");
+            Tangential::Regularized { law, v_reg }
+        }
+    };
+    Ok((elastic, dissipation, tangential))
+}
+
 /// Validates a contact whose normal law is compliant (`index` among the contacts, `slot` its
 /// first point among the compliant contact points): the pair as for a rigid contact, then the
 /// materials, the law and the tangential law. `callbacks` counts a user law's callback.
@@ -499,8 +583,7 @@ pub(super) fn validate_compliant(
     rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
     n_callbacks: &mut usize,
 ) -> Result<super::compliant::CompliantContact> {
-    use super::compliant::{self as cc, Dissipation, Elastic, RestitutionMap, Tangential};
-    use super::contact_description::NormalDescription as N;
+    use super::compliant as cc;
     let what = format!("contacts[{index}] '{}'", d.name);
     let mut rigid = d.clone();
     rigid.friction = FrictionDescription::None;
@@ -527,77 +610,8 @@ pub(super) fn validate_compliant(
         }
     };
     let e_star = materials.map(|[a, b]| cc::effective_modulus(&a, &b));
-    let positive = |v: f64, key: &str| -> Result<f64> {
-        crate::ensure!(v.is_finite() && v > 0.0, Model, "{what}.normal.{key}: must be > 0, got {v}");
-        Ok(v)
-    };
-    let (elastic, dissipation, v_reg) = match &d.normal {
-        N::KelvinVoigt { k, d: damping, v_reg } => {
-            positive(*k, "k")?;
-            crate::ensure!(damping.is_finite() && *damping >= 0.0, Model, "{what}.normal.d: must be >= 0, got {damping}");
-            (Elastic::KelvinVoigt { k: *k, d: *damping }, Dissipation::None, *v_reg)
-        }
-        N::User { callback, v_reg } => {
-            crate::ensure!(*callback < 1 << 32, Model, "{what}.normal.callback: index {callback} is out of range");
-            *n_callbacks = (*n_callbacks).max(callback + 1);
-            (Elastic::User { callback: *callback }, Dissipation::None, *v_reg)
-        }
-        N::Hertz(h) | N::HuntCrossley(h) | N::LankaraniNikravesh(h) | N::Flores(h) => {
-            let map = match &d.normal {
-                N::HuntCrossley(_) => Some(RestitutionMap::HuntCrossley),
-                N::LankaraniNikravesh(_) => Some(RestitutionMap::LankaraniNikravesh),
-                N::Flores(_) => Some(RestitutionMap::Flores),
-                _ => None,
-            };
-            if let Some(k) = h.stiffness {
-                positive(k, "stiffness")?;
-            }
-            let elastic = cc::hertz_elastic(&contours, e_star, h.stiffness, h.length, &what)?;
-            let dissipation = match (map, h.eps, h.alpha) {
-                (_, Some(_), Some(_)) => {
-                    return Err(Error::Model(format!("{what}.normal: give eps or alpha, not both")))
-                }
-                (_, None, Some(a)) => {
-                    crate::ensure!(a.is_finite() && a >= 0.0, Model, "{what}.normal.alpha: the damping coefficient must be >= 0, got {a}");
-                    if a == 0.0 { Dissipation::None } else { Dissipation::Alpha(a) }
-                }
-                (None, Some(_), None) => {
-                    return Err(Error::Model(format!(
-                        "{what}.normal.eps: the undamped Hertz law has restitution 1; use HuntCrossley, LankaraniNikravesh or Flores for a restitution"
-                    )))
-                }
-                (Some(map), Some(e), None) => {
-                    crate::ensure!(e.is_finite() && e > 0.0 && e <= 1.0, Model, "{what}.normal.eps: must be in (0, 1], got {e}");
-                    if e == 1.0 { Dissipation::None } else { Dissipation::Restitution { map, eps: e } }
-                }
-                (Some(map), None, None) => {
-                    return Err(Error::Model(format!("{what}.normal: the {} law needs eps (restitution) or alpha (s/m)", map.name())))
-                }
-                (None, None, None) => Dissipation::None,
-            };
-            (elastic, dissipation, h.v_reg)
-        }
-        N::Signorini | N::Bilateral { .. } => return Err(Error::Model(format!("{what}.normal: not a compliant law"))),
-    };
-    let tangential = match &d.friction {
-        FrictionDescription::None => Tangential::None,
-        FrictionDescription::LuGre { mu0, mu, v_s, sigma0, sigma1, sigma2 } => {
-            let w = format!("{what}.friction");
-            for (k, v) in [("mu0", mu0), ("mu", mu), ("sigma1", sigma1), ("sigma2", sigma2)] {
-                crate::ensure!(v.is_finite() && *v >= 0.0, Model, "{w}.{k}: must be >= 0, got {v}");
-            }
-            crate::ensure!(v_s.is_finite() && *v_s > 0.0, Model, "{w}.v_s: must be > 0, got {v_s}");
-            crate::ensure!(sigma0.is_finite() && *sigma0 > 0.0, Model, "{w}.sigma0: must be > 0, got {sigma0}");
-            crate::ensure!(*mu0 > 0.0 || *mu > 0.0, Model, "{w}: mu0 and mu are both zero");
-            Tangential::LuGre { mu0: *mu0, mu: *mu, v_s: *v_s, sigma0: *sigma0, sigma1: *sigma1, sigma2: *sigma2 }
-        }
-        f => {
-            let law = friction_law(f, &what)?;
-            let v_reg = v_reg.unwrap_or(1e-4);
-            crate::ensure!(v_reg.is_finite() && v_reg > 0.0, Model, "{what}.normal.v_reg: must be > 0, got {v_reg}");
-            Tangential::Regularized { law, v_reg }
-        }
-    };
+    let (spec, dissipation, tangential) = compliant_law(&d.normal, &d.friction, &what, n_callbacks)?;
+    let elastic = spec.resolve(&contours, e_star, &what)?;
     Ok(cc::CompliantContact {
         name: d.name.clone(),
         body1: c.body1,
@@ -876,4 +890,79 @@ pub(super) fn validate_group(
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
     Ok(ContactGroup { name: d.name.clone(), members, against, friction, impact, planar: any_planar })
+}
+
+/// Validates a contact group whose normal law is compliant (`slot` its place among the compliant
+/// points, `index` among the compliant groups): the contours as for a rigid group, the
+/// materials, and the law of every kind of pair the group can form (so that no pair met during
+/// the run fails). The bristle law (LuGre) is refused: a group's pairs come and go, and their
+/// bristle states would have to follow them through the integrator's extra states.
+pub(super) fn validate_compliant_group(
+    d: &ContactGroupDescription,
+    index: usize,
+    slot: usize,
+    group_index: usize,
+    body: impl Fn(&str, &str) -> Result<usize>,
+    rotation: impl Fn(&Option<super::description::RotationDescription>, &str) -> Result<crate::math::Mat3> + Copy,
+    n_callbacks: &mut usize,
+) -> Result<super::compliant::CompliantGroup> {
+    use super::compliant as cc;
+    let what = format!("contact_groups[{index}] '{}'", d.name);
+    crate::ensure!(
+        matches!(d.impact, ImpactDescription::Newton { eps } if eps == 0.0),
+        Model,
+        "{what}.impact: a compliant group takes no impact law (its restitution comes from its normal law: HuntCrossley(eps=...), LankaraniNikravesh, Flores, or KelvinVoigt's damping)"
+    );
+    if matches!(d.friction, FrictionDescription::LuGre { .. }) {
+        return Err(Error::Model(format!(
+            "{what}.friction: the LuGre bristle law needs a bristle state per contact point, which a group's pairs (found anew at every evaluation) do not carry; give the group a regularized law (Coulomb, Stribeck, table) or declare the contacts that need bristles explicitly"
+        )));
+    }
+    let mut rigid = d.clone();
+    rigid.friction = FrictionDescription::None;
+    rigid.normal = super::contact_description::NormalDescription::Signorini;
+    let geometry = validate_group(&rigid, index, body, rotation)?;
+    let (elastic, dissipation, tangential) = compliant_law(&d.normal, &d.friction, &what, n_callbacks)?;
+    let mut materials = Vec::with_capacity(d.members.len() + d.against.len());
+    for (key, list) in [("members", &d.members), ("against", &d.against)] {
+        for (k, m) in list.iter().enumerate() {
+            let desc = m.material.or(d.material);
+            let w = if m.material.is_some() { format!("{what}.{key}[{k}].material") } else { format!("{what}.material") };
+            materials.push(desc.map(|x| cc::Material::new(x.e, x.nu, x.density, &w)).transpose()?);
+        }
+    }
+    let group = cc::CompliantGroup { geometry, materials, elastic, dissipation, tangential, slot, index: group_index };
+    if let cc::ElasticSpec::Hertz { stiffness: None, .. } = group.elastic {
+        if let Some(k) = group.materials.iter().position(|m| m.is_none()) {
+            return Err(Error::Model(format!(
+                "{what}.{}: a Hertz-type law needs the material of every contour (the group's material = ms.Material(E, nu, density), or body.contour(..., material=...)) or a given stiffness",
+                group.label(k)
+            )));
+        }
+    }
+    // one pair per kind of contour pair (and per material, where they differ)
+    let n = group.materials.len();
+    let members = d.members.len();
+    let mut reps: Vec<usize> = Vec::new();
+    for k in 0..n {
+        let c = group.contour(k);
+        let same = |r: &usize| {
+            let o = group.contour(*r);
+            (*r < members) == (k < members) && o.contour.kind() == c.contour.kind() && group.materials[*r] == group.materials[k]
+        };
+        // a kind seen twice among the members keeps its second member too (member–member pairs)
+        let seen = reps.iter().filter(|r| same(r)).count();
+        if seen == 0 || (k < members && seen == 1) {
+            reps.push(k);
+        }
+    }
+    for (x, &i) in reps.iter().enumerate() {
+        if i >= members {
+            continue;
+        }
+        for &j in &reps[x + 1..] {
+            group.law(i, j)?;
+        }
+    }
+    Ok(group)
 }

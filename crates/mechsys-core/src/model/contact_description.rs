@@ -430,6 +430,13 @@ pub enum NormalDescription {
     },
 }
 
+impl NormalDescription {
+    /// Whether this is Signorini's law (the default, left out when written).
+    pub fn is_signorini(&self) -> bool {
+        matches!(self, NormalDescription::Signorini)
+    }
+}
+
 /// The parameters of a Hertz-type compliant law.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -555,6 +562,14 @@ pub struct ContactGroupDescription {
     /// Impact law (a fully plastic Newton impact, ε = 0, if absent).
     #[serde(default)]
     pub impact: ImpactDescription,
+    /// Normal law of every pair: Signorini's (rigid, Moreau–Jean) if absent, or a compliant law
+    /// (Kelvin–Voigt, Hertz and its dissipative forms, a user law): the group's pairs are then
+    /// force elements found by the broad phase at every evaluation, in the smooth schemes too.
+    #[serde(default, skip_serializing_if = "NormalDescription::is_signorini")]
+    pub normal: NormalDescription,
+    /// Material of every contour that gives none of its own (compliant groups).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<MaterialDescription>,
 }
 
 /// A contour on a body, as a member of a contact group.
@@ -565,4 +580,7 @@ pub struct GroupContourDescription {
     pub body: String,
     /// The contour, body-frame data.
     pub contour: ContourDescription,
+    /// Its material (compliant groups; the group's `material` if absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<MaterialDescription>,
 }

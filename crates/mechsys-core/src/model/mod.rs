@@ -338,6 +338,8 @@ pub enum ForceElement {
     },
     /// A compliant contact (evaluated by [`crate::forces::compliant`]).
     Contact(Box<compliant::CompliantContact>),
+    /// A compliant contact group (evaluated by [`crate::forces::compliant_group`]).
+    ContactGroup(Box<compliant::CompliantGroup>),
 }
 
 impl ForceElement {
@@ -355,6 +357,7 @@ impl ForceElement {
             ForceElement::Jenkins(j) => &j.name,
             ForceElement::HydrodynamicBearing(b) => &b.name,
             ForceElement::Contact(c) => &c.name,
+            ForceElement::ContactGroup(g) => &g.geometry.name,
         }
     }
 
@@ -376,6 +379,7 @@ impl ForceElement {
             ForceElement::JointForce { value, .. } => value.len(),
             ForceElement::Callback { .. } => nu,
             ForceElement::Contact(c) => compliant::OUTPUTS_PER_POINT * c.points(),
+            ForceElement::ContactGroup(g) => g.outputs(),
         }
     }
 }
@@ -421,7 +425,8 @@ pub struct Model {
     pub n_sliders: usize,
     /// Number of recorded force and deflection values over all force elements.
     pub n_force_outputs: usize,
-    /// Number of candidate points over all compliant contacts (their history and extra states).
+    /// Number of candidate points over all compliant contacts (their history and extra states),
+    /// plus one per compliant group (its dissipated energy state).
     pub n_compliant_points: usize,
     /// The description it was built from (stored with results).
     pub description: ModelDescription,

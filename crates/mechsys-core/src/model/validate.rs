@@ -1300,6 +1300,7 @@ impl Model {
         }
 
         let mut contact_groups = Vec::with_capacity(desc.contact_groups.len());
+        let mut n_compliant_groups = 0;
         for (i, d) in desc.contact_groups.iter().enumerate() {
             crate::ensure!(
                 contact_names.insert(d.name.clone()),
@@ -1307,6 +1308,22 @@ impl Model {
                 "contact_groups[{i}] '{}': duplicate name (contacts and contact groups share one namespace)",
                 d.name
             );
+            if !d.normal.is_signorini() {
+                // compliant: a force element whose pairs the broad phase finds at every evaluation
+                let g = super::contact::validate_compliant_group(
+                    d,
+                    i,
+                    n_compliant_points,
+                    n_compliant_groups,
+                    body,
+                    rotation,
+                    &mut n_callbacks,
+                )?;
+                n_compliant_points += 1;
+                n_compliant_groups += 1;
+                forces.push(ForceElement::ContactGroup(Box::new(g)));
+                continue;
+            }
             contact_groups.push(super::contact::validate_group(d, i, body, rotation)?);
         }
 

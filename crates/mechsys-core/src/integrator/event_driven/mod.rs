@@ -28,6 +28,13 @@
 //!
 //! An accumulation of impacts (a ball coming to rest) passes in finitely many events: an approach
 //! slower than `velocity_tol` closes the contact without impact.
+//!
+//! Compliant contacts ([`crate::forces::compliant`]) are smooth forces of the phases (so the
+//! transition and impact problems see them like any applied force); their onsets, releases and
+//! force cut-offs are kinks, not events: a step across one is retaken up to just past it (located
+//! by [`crate::integrator::switching`] on the step's continuous extension) and the phase goes on
+//! without a transition. Their dissipated energy and bristle states follow the contact forces'
+//! integrals in the state.
 
 mod impact;
 mod matrices;
@@ -184,6 +191,8 @@ pub struct Phase<'a> {
     pub evaluations: usize,
     /// Every contact event, in time order.
     pub log: EventLog,
+    /// Compliant contact points that closed or opened, as (t, point slot, closed).
+    pub compliant_changes: Vec<(f64, usize, bool)>,
     lcp: Lcp,
     fc: FrictionContact,
     ws: Workspace,
@@ -278,6 +287,8 @@ pub fn integrate<'a>(
     let mut next = 0usize;
     let mut events = 0usize;
     let (mut last_event, mut same_instant) = (f64::NEG_INFINITY, 0usize);
+    // the compliant contacts' switches (none without compliant contacts)
+    let mut locator = crate::integrator::switching::Locator::new(phase);
 
     phase.project(t, &mut y)?;
     let d = timed_transition(phase, t, &mut y, (&mut imp, warnings), &triggered, &mut stats)?;
@@ -343,7 +354,21 @@ pub fn integrate<'a>(
         for i in 0..3 * np {
             triggered[i] = roots[i] <= theta + resolution;
         }
-        let t_new = if theta.is_finite() { t + theta * h } else { t + h };
+        // a compliant contact's onset, release or cut-off before the first rigid event: the step
+        // ends just past it (a kink of the smooth phase's forces, no transition)
+        let mut switch = None;
+        if locator.active() {
+            let ynew = &st.ynew;
+            let found = locator.locate(phase, t, h, &y, ynew, |th, out| st.dense(th, out))?;
+            if let Some(th) = found.filter(|th| *th < theta) {
+                switch = Some(th);
+            }
+        }
+        let t_new = match switch {
+            Some(th) => t + th * h,
+            None if theta.is_finite() => t + theta * h,
+            None => t + h,
+        };
         // outputs inside the step (up to and including an event's time)
         while next < t_out.len() && t_out[next] <= t_new + 1e-12 * t_new.abs().max(1.0) {
             let to = t_out[next].min(t_new);
@@ -356,6 +381,27 @@ pub fn integrate<'a>(
             next += 1;
         }
         stats.steps += 1;
+        if let Some(th) = switch {
+            // the step again, ending just past the switch; the phase goes on without a transition
+            st.attempt(phase, t, &y, th * h, opts.rtol, opts.atol)?;
+            y.copy_from_slice(&st.ynew);
+            t = t_new;
+            phase.project(t, &mut y)?;
+            crate::integrator::check_finite(t, &y)?;
+            phase.accepted(t, &mut y)?;
+            st.first_rate(phase, t, &y)?;
+            stats.evaluations += 1;
+            phase.event_values(&mut e_start);
+            cap = phase.after_step()?;
+            while next < t_out.len() && t_out[next] <= t {
+                sample(phase, t_out[next], &y, &imp, diss)?;
+                imp.fill(0.0);
+                diss = Dissipation::default();
+                next += 1;
+            }
+            reject = false;
+            continue;
+        }
         if theta.is_finite() {
             // the step again, ending at the event, then the event itself
             let hs = theta * h;

@@ -63,6 +63,7 @@ impl<'a> Phase<'a> {
             tmp: vec![0.0; nu],
             evaluations: 0,
             log: EventLog::default(),
+            compliant_changes: Vec::new(),
             lcp: Lcp { m: Vec::with_capacity((np * (k + 2)).pow(2)), q: Vec::with_capacity(np * (k + 2)) },
             fc: FrictionContact {
                 dim: d,
@@ -99,9 +100,32 @@ impl<'a> Phase<'a> {
         })
     }
 
-    /// Length of the integrated state.
+    /// Length of the integrated state: q, u, the three energy integrals, the contact forces'
+    /// time integrals, then the compliant contacts' extra states.
     pub fn state_len(&self) -> usize {
+        self.compliant_offset() + crate::model::compliant::STATES_PER_POINT * self.model.n_compliant_points
+    }
+
+    /// Where the compliant contacts' extra states (dissipated energy, bristles) start in the state.
+    pub fn compliant_offset(&self) -> usize {
         self.model.nq + self.model.nu + 3 + 3 * self.model.n_contact_points
+    }
+
+    /// The compliant contacts at the state `y` of time `t`: the approach speeds of those closed
+    /// (their histories), without an event. Called once before the first step.
+    pub fn commit_compliant(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
+        if self.model.n_compliant_points == 0 {
+            return Ok(());
+        }
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        let (head, aux) = y.split_at_mut(self.compliant_offset());
+        crate::kinematics::forward_pass(self.model, &mut self.data, t, &head[..nq], &head[nq..nq + nu]);
+        let w = &mut self.dynamics.forces.compliant;
+        crate::forces::compliant::commit(self.model, &self.data, w, t, aux)?;
+        for &(slot, closed) in &w.changed {
+            self.compliant_changes.push((t, slot, closed));
+        }
+        Ok(())
     }
 
     /// The motion without contact forces: kinematics, smooth forces, the mass matrix factored,
@@ -579,6 +603,10 @@ impl OdeSystem for Phase<'_> {
         let (nq, nu, np) = (self.model.nq, self.model.nu, self.model.n_contact_points);
         let (q, rest) = y.split_at(nq);
         let u = &rest[..nu];
+        let aux = self.compliant_offset();
+        if self.model.n_compliant_points > 0 {
+            self.dynamics.forces.compliant.states.copy_from_slice(&y[aux..]);
+        }
         let p = self.evaluate(t, q, u)?;
         self.model.qdot(q, u, &mut dy[..nq]);
         dy[nq..nq + nu].copy_from_slice(&self.data.udot);
@@ -599,7 +627,20 @@ impl OdeSystem for Phase<'_> {
             dy[e + 3 + np + 2 * pt] = self.lam_t[pt][0];
             dy[e + 3 + np + 2 * pt + 1] = self.lam_t[pt][1];
         }
+        if self.model.n_compliant_points > 0 {
+            dy[aux..].copy_from_slice(&self.dynamics.forces.compliant.rates);
+        }
         Ok(())
+    }
+    fn switches(&self) -> usize {
+        crate::forces::compliant::switches(self.model)
+    }
+    fn switching(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<()> {
+        // the compliant contacts' gaps and forces before the cut-off (located like the smooth
+        // schemes do, [`crate::integrator::switching`]); the rigid points have event_values
+        let (nq, nu) = (self.model.nq, self.model.nu);
+        crate::kinematics::forward_pass(self.model, &mut self.data, t, &y[..nq], &y[nq..nq + nu]);
+        crate::forces::compliant::switching(self.model, &self.data, &mut self.dynamics.forces.compliant, t, self.cb, out)
     }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
@@ -607,7 +648,7 @@ impl OdeSystem for Phase<'_> {
             let chains = &mut self.dynamics.forces.jenkins;
             y[nq + nu] += crate::forces::jenkins::commit(self.model, &mut self.data, chains, &y[..nq], t)?;
         }
-        Ok(())
+        self.commit_compliant(t, y)
     }
     fn quaternions(&self) -> &[usize] {
         &self.quats

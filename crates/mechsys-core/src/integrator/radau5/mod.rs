@@ -8,7 +8,11 @@
 //!
 //! **Fixed step** (`dt`): the stage equations are solved by simplified Newton on the 3n × 3n
 //! iteration matrix I − h A ⊗ J with a finite-difference Jacobian at the step start; if Newton
-//! does not converge the step is split in halves (up to 2⁸ pieces).
+//! does not converge the step is split in halves (up to 2⁸ pieces). A step across a switch (a
+//! compliant contact's onset, release or force cut-off, [`crate::integrator::switching`]) is
+//! split there as well: the switch is located on the collocation polynomial, the step retaken up
+//! to just past it, then the rest of the step (up to 16 splits per step), so no step straddles
+//! the kink and the outputs stay on the `dt` grid.
 //!
 //! **Adaptive** (`rtol`, `atol`; Hairer & Wanner, *Solving ODEs II*, section IV.8):
 //! - the iteration matrix is brought to block-diagonal form by the eigen-decomposition
@@ -54,7 +58,14 @@ struct Work {
     /// The state's rates (n) and a local increment (nl), for the chart.
     fe: Vec<f64>,
     zl: Vec<f64>,
+    /// The collocation polynomial's local increment at a point of the step (nl), for the search.
+    zp: Vec<f64>,
+    /// The switch search.
+    switches: crate::integrator::switching::Locator,
 }
+
+/// Most splits of one fixed step at switches.
+const MAX_SPLITS: u32 = 16;
 
 pub(crate) fn coefficients() -> ([[f64; 3]; 3], [f64; 3]) {
     let s6 = 6f64.sqrt();
@@ -144,11 +155,10 @@ fn step<S: OdeSystem>(
             return Ok(false);
         }
         if nrm <= tol {
-            // stiffly accurate: y_new = y ⊕ Z_3
+            // stiffly accurate: y_new = y ⊕ Z_3 (accepted by the caller, after the switch search)
             w.tmp.copy_from_slice(y);
             w.chart.retract(&w.tmp, &w.z[2 * n..], y);
             sys.project(t + h, y)?;
-            sys.accepted(t + h, y)?;
             return Ok(true);
         }
         last = nrm;
@@ -156,6 +166,24 @@ fn step<S: OdeSystem>(
     Ok(false)
 }
 
+/// Lagrange weights at `th` of the collocation polynomial through (0, 0) and (c_i, Z_i).
+fn collocation_weights(c: &[f64; 3], th: f64) -> [f64; 3] {
+    let mut l = [0.0; 3];
+    for i in 0..3 {
+        let mut v = th / c[i];
+        for j in 0..3 {
+            if j != i {
+                v *= (th - c[j]) / (c[i] - c[j]);
+            }
+        }
+        l[i] = v;
+    }
+    l
+}
+
+/// One step of `h` from (t, y), split at Newton failures (`depth`) and, while `splits` allow,
+/// at the first switch found on the collocation polynomial.
+#[allow(clippy::too_many_arguments)]
 fn advance<S: OdeSystem>(
     sys: &mut S,
     w: &mut Work,
@@ -164,10 +192,32 @@ fn advance<S: OdeSystem>(
     h: f64,
     tol: f64,
     depth: u32,
+    splits: u32,
     stats: &mut Stats,
 ) -> Result<()> {
     w.backup.copy_from_slice(y);
     if step(sys, w, t, y, h, tol, stats)? {
+        if splits < MAX_SPLITS && w.switches.active() {
+            let n = w.chart.local_dim();
+            let (_, c) = coefficients();
+            let Work { chart, z, zp, backup, switches, .. } = &mut *w;
+            let (z, chart, y0) = (&*z, &*chart, &*backup);
+            let dense = |th: f64, out: &mut [f64]| {
+                let l = collocation_weights(&c, th);
+                for i in 0..n {
+                    zp[i] = l[0] * z[i] + l[1] * z[n + i] + l[2] * z[2 * n + i];
+                }
+                chart.retract(y0, zp, out);
+            };
+            if let Some(th) = switches.locate(sys, t, h, y0, y, dense)? {
+                // retaken up to just past the switch (no search there: the switch sits at its
+                // end), then the rest of the step
+                y.copy_from_slice(&w.backup);
+                advance(sys, w, t, y, th * h, tol, depth, MAX_SPLITS, stats)?;
+                return advance(sys, w, t + th * h, y, (1.0 - th) * h, tol, depth, splits + 1, stats);
+            }
+        }
+        sys.accepted(t + h, y)?;
         stats.steps += 1;
         return Ok(());
     }
@@ -178,8 +228,8 @@ fn advance<S: OdeSystem>(
             "radau5: Newton iteration did not converge at t = {t:.6} s even with step {h:.3e} s"
         )));
     }
-    advance(sys, w, t, y, 0.5 * h, tol, depth + 1, stats)?;
-    advance(sys, w, t + 0.5 * h, y, 0.5 * h, tol, depth + 1, stats)
+    advance(sys, w, t, y, 0.5 * h, tol, depth + 1, splits, stats)?;
+    advance(sys, w, t + 0.5 * h, y, 0.5 * h, tol, depth + 1, splits, stats)
 }
 
 /// Fixed-step integration with observations at `t_out` (multiples of `dt` from t0).
@@ -215,6 +265,8 @@ pub fn integrate_fixed<S: OdeSystem>(
         backup: vec![0.0; nfull],
         fe: vec![0.0; nfull],
         zl: vec![0.0; n],
+        zp: vec![0.0; n],
+        switches: crate::integrator::switching::Locator::new(sys),
     };
     let mut y = y0.to_vec();
     let mut stats = Stats::default();
@@ -231,7 +283,7 @@ pub fn integrate_fixed<S: OdeSystem>(
         if step_no >= n_steps || next >= t_out.len() {
             break;
         }
-        advance(sys, &mut w, t, &mut y, dt, newton_tol, 0, &mut stats)?;
+        advance(sys, &mut w, t, &mut y, dt, newton_tol, 0, 0, &mut stats)?;
         check_finite(t + dt, &y)?;
         step_no += 1;
     }
