@@ -10,23 +10,9 @@ import pytest
 
 import mechsys as ms
 from mechsys.errors import SettingsError
+from test_box_stack import stack_model
 
 G = 9.81
-
-
-def stack(n, half=(0.1, 0.1, 0.05), mass=1.0, mu=0.5):
-    m = ms.Model("stack", gravity=(0.0, 0.0, -G))
-    boxes = []
-    for k in range(n):
-        b = m.add_body(f"box{k}", mass, ms.inertia.box(mass, tuple(2 * h for h in half)))
-        m.add_joint(ms.joints.Free(f"free{k}", m.ground, b, q0=[0, 0, half[2] * (2 * k + 1), 1, 0, 0, 0]))
-        boxes.append(b)
-    shape = ms.contours.Box(half_extents=half)
-    m.add_contact(ms.Contact("floor", boxes[0].contour(shape), m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
-                             friction=ms.laws.Coulomb(mu)))
-    for k in range(1, n):
-        m.add_contact(ms.Contact(f"on{k}", boxes[k].contour(shape), boxes[k - 1].contour(shape), friction=ms.laws.Coulomb(mu)))
-    return m
 
 
 def test_apgd_stack_carries_the_weights_and_rests_without_iterations():
@@ -36,7 +22,7 @@ def test_apgd_stack_carries_the_weights_and_rests_without_iterations():
     (kept per contact point) solve the next step's problem: at most one iteration in 95 % of the
     steps (round-off moves the resting boxes by 1e-13 m, so now and then a step takes a few)."""
     n = 4
-    res = ms.simulate(stack(n), 0.5, ms.MoreauJean(1e-3, solver=ms.APGD(tol=1e-12, max_iter=100_000)), output_dt=1e-3)
+    res = ms.simulate(stack_model(n), 0.5, ms.MoreauJean(1e-3, solver=ms.APGD(tol=1e-12, max_iter=100_000)), output_dt=1e-3)
     assert res["solver/converged"][1:].min() == 1
     assert res["solver/residual"].max() <= 1e-12
     for k in range(n):
@@ -85,7 +71,7 @@ def test_apgd_by_name_table_and_bad_settings():
     with pytest.raises(SettingsError, match=r"integrator\.solver\.relaxation: unknown key for apgd"):
         _solver({"type": "apgd", "relaxation": 1.2})
     with pytest.raises(Exception, match="APGD: tol must be > 0"):
-        ms.simulate(stack(1), 0.01, ms.MoreauJean(1e-3, solver=ms.APGD(tol=-1.0)))
+        ms.simulate(stack_model(1), 0.01, ms.MoreauJean(1e-3, solver=ms.APGD(tol=-1.0)))
 
 
 def test_apgd_from_the_command_line(tmp_path):

@@ -307,6 +307,23 @@ pub fn integrate<'a>(
     let mut h = st.starting_step(phase, t, &y, opts.rtol, opts.atol, hmax)?;
     let mut err_old: f64 = 1e-4;
     let mut reject = false;
+    // after a step retaken to end at a switch or an event: the first rate and event values at the
+    // new start, the phase's step cap, and the samples up to t (which see the state after it)
+    macro_rules! restart {
+        () => {
+            st.first_rate(phase, t, &y)?;
+            stats.evaluations += 1;
+            phase.event_values(&mut e_start);
+            cap = phase.after_step()?;
+            while next < t_out.len() && t_out[next] <= t {
+                sample(phase, t_out[next], &y, &imp, diss)?;
+                imp.fill(0.0);
+                diss = Dissipation::default();
+                next += 1;
+            }
+            reject = false;
+        };
+    }
     while next < t_out.len() {
         if t_end - t <= 1e-13 * t.abs().max(1.0) {
             while next < t_out.len() {
@@ -389,17 +406,7 @@ pub fn integrate<'a>(
             phase.project(t, &mut y)?;
             crate::integrator::check_finite(t, &y)?;
             phase.accepted(t, &mut y)?;
-            st.first_rate(phase, t, &y)?;
-            stats.evaluations += 1;
-            phase.event_values(&mut e_start);
-            cap = phase.after_step()?;
-            while next < t_out.len() && t_out[next] <= t {
-                sample(phase, t_out[next], &y, &imp, diss)?;
-                imp.fill(0.0);
-                diss = Dissipation::default();
-                next += 1;
-            }
-            reject = false;
+            restart!();
             continue;
         }
         if theta.is_finite() {
@@ -433,18 +440,8 @@ pub fn integrate<'a>(
             diss.impact += d.impact;
             diss.friction += d.friction;
             diss.external += d.external;
-            st.first_rate(phase, t, &y)?;
-            stats.evaluations += 1;
-            phase.event_values(&mut e_start);
-            cap = phase.after_step()?;
             // samples at exactly the event time see the state after it
-            while next < t_out.len() && t_out[next] <= t {
-                sample(phase, t_out[next], &y, &imp, diss)?;
-                imp.fill(0.0);
-                diss = Dissipation::default();
-                next += 1;
-            }
-            reject = false;
+            restart!();
             continue;
         }
         phase.project(t_new, &mut st.ynew)?;
