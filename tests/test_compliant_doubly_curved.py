@@ -21,16 +21,17 @@ E_STAR = 1.0 / (2.0 * (1 - 0.3**2) / 2.1e11)
 MASS, V0, GAP = 0.05, 1.0, 2e-4
 
 
-def crossed(angle: float, r1: float, r2: float) -> ms.Model:
+def crossed(angle: float, r1: float, r2: float, rigid: bool = False) -> ms.Model:
     """A capsule of radius r2 whose axis makes `angle` with that of a fixed capsule of radius r1
-    (along x), falling onto it at V0 (no gravity)."""
+    (along x), falling onto it at V0 (no gravity); Hertz's law, or with ``rigid`` Signorini's
+    with a Newton impact e = 1."""
     m = ms.Model("crossed", gravity=(0, 0, 0))
     b = m.add_body("rod", MASS, ms.inertia.sphere(MASS, r2))
     m.add_joint(ms.joints.Prismatic("z", m.ground, b, axis=(0, 0, 1), q0=r1 + r2 + GAP, u0=-V0))
     d = np.array([math.cos(angle), math.sin(angle), 0.0]) * 0.1
     m.add_contact(ms.Contact("cross", b.contour(ms.contours.Capsule(a=tuple(-d), b=tuple(d), radius=r2), material=STEEL),
                              m.ground.contour(ms.contours.Capsule(a=(-0.1, 0, 0), b=(0.1, 0, 0), radius=r1), material=STEEL),
-                             normal=ms.laws.Hertz()))
+                             **({"impact": ms.laws.Newton(eps=1.0)} if rigid else {"normal": ms.laws.Hertz()})))
     return m
 
 
@@ -104,3 +105,23 @@ def test_hertz_impact_post_processing_takes_the_crossing_angle():
         ms.hertz.impact(MASS, V0, E_STAR, (1 / r1, 0.0), (1 / r2, 0.0))
     with pytest.raises(ms.ModelError, match="angle"):
         ms.hertz.impact(MASS, V0, E_STAR, (1 / r1, 0.0), (1 / r2, 0.0), angle=float("nan"))
+
+
+def test_rigid_impact_of_crossed_rods_post_processed_at_their_angle():
+    """ms.hertz.impacts on a rigid e = 1 run of rods crossed at 60 degrees takes the angle from the
+    contact geometry (the summed curvature tensor, dynamics.contact_geometry's
+    relative_curvature) and gives the compliant run's delta_max."""
+    r1, r2, angle = 0.01, 0.02, math.radians(60)
+    m = crossed(angle, r1, r2, rigid=True)
+    rigid = ms.simulate(m, t_end=GAP / V0 + 1e-4, output_dt=1e-5, integrator=ms.EventDriven(), progress=False)
+    rows = ms.hertz.impacts(rigid, m)
+    assert len(rows) == 1
+    d, _ = delta_max(crossed(angle, r1, r2))
+    assert rows[0]["delta_max"] == pytest.approx(d, rel=1e-6)
+    # the angle matters: the same rods crossed at right angles approach by a different amount
+    right = ms.hertz.impact(MASS, V0, E_STAR, (1 / r1, 0.0), (1 / r2, 0.0), angle=math.pi / 2)
+    assert abs(right["delta_max"] / d - 1) > 1e-2
+    geo = ms.dynamics.contact_geometry(m, [r1 + r2])
+    s = 1 / r1 + 1 / r2
+    dif = math.sqrt(1 / r1**2 + 1 / r2**2 + 2 * math.cos(2 * angle) / (r1 * r2))
+    np.testing.assert_allclose(geo["relative_curvature"][0], [0.5 * (s - dif), 0.5 * (s + dif)], rtol=1e-12)

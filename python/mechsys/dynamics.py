@@ -84,7 +84,9 @@ def contact_geometry(model: Model, q) -> dict:
     unit ``normal`` from contour 2 towards contour 1 and the tangents ``tangent1``, ``tangent2``,
     and each contour's principal curvatures at its witness point, ``curvature1``, ``curvature2``
     (points x 2, 1/m: convex > 0, hollow < 0; planar contours [kappa, 0]; inf at a point, vertex
-    or edge), with ``contact`` naming the contact of each point. Unused candidates of a pair
+    or edge), ``relative_curvature`` (points x 2, 1/m: the principal values of the two curvature
+    tensors summed in the tangent plane, Hertz's 2A <= 2B whatever angle the contours' principal
+    directions make; inf where either has none), with ``contact`` naming the contact of each point. Unused candidates of a pair
     asked for several points have a gap larger than any real one."""
     core, _ = model.engine()
     return _core.contact_geometry(core, _arr(q))

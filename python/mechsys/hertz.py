@@ -120,7 +120,11 @@ def impacts(res, model, materials: dict | None = None) -> list[dict]:
         geo = dynamics.contact_geometry(model, q)
         j = [k for k, c in enumerate(geo["contact"]) if c == name][pt]
         m1, m2 = _materials(model, name, materials)
-        row = impact(1.0 / w_nn, speed, effective_modulus(m1, m2), geo["curvature1"][j], geo["curvature2"][j])
+        # the summed curvature tensor's principal values: exact for principal directions at any
+        # angle (crossed rods), where the two contours' own principal values are not enough
+        krel = tuple(float(k) for k in geo["relative_curvature"][j])
+        c1, c2 = (krel, (0.0, 0.0)) if all(math.isfinite(k) for k in krel) else (geo["curvature1"][j], geo["curvature2"][j])
+        row = impact(1.0 / w_nn, speed, effective_modulus(m1, m2), c1, c2)
         rows.append({"t": ev["t"], "contact": name, "point": pt, **row})
     return rows
 

@@ -481,6 +481,7 @@ fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>
     let (mut names, mut gap) = (Vec::new(), Vec::new());
     let (mut p1, mut p2, mut n, mut t1, mut t2, mut k1, mut k2) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut krel = Vec::new();
     for con in &m.contacts {
         // gap contacts have no contours (their gap and rows: contact_matrices)
         let (Some(pair), Some(contours)) = (con.pair(), con.contours()) else { continue };
@@ -497,6 +498,18 @@ fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>
             t2.extend_from_slice(c.t2.as_slice());
             k1.extend_from_slice(&contours[0].curvatures_at(&x1, &c.p1));
             k2.extend_from_slice(&contours[1].curvatures_at(&x2, &c.p2));
+            // the principal values of the two surfaces' curvature tensors summed in the common
+            // tangent plane: what a Hertz contact feels whatever angle the principal directions
+            // make (∞ where a contour has no curvature)
+            let tensor = |k: usize, x: &mechsys_core::spatial::Pose, p| contours[k].curvature_tensor_at(x, p, &c.t1, &c.t2);
+            match (tensor(0, &x1, &c.p1), tensor(1, &x2, &c.p2)) {
+                (Some(a), Some(b)) => {
+                    let (s11, s12, s22) = (a[0] + b[0], a[1] + b[1], a[2] + b[2]);
+                    let (m, d) = (0.5 * (s11 + s22), (0.25 * (s11 - s22).powi(2) + s12 * s12).sqrt());
+                    krel.extend_from_slice(&[m - d, m + d]);
+                }
+                _ => krel.extend_from_slice(&[f64::INFINITY; 2]),
+            }
         }
     }
     let np = gap.len();
@@ -513,5 +526,6 @@ fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>
     d.set_item("tangent2", shaped(t2, &[np, 3])?)?;
     d.set_item("curvature1", shaped(k1, &[np, 2])?)?;
     d.set_item("curvature2", shaped(k2, &[np, 2])?)?;
+    d.set_item("relative_curvature", shaped(krel, &[np, 2])?)?;
     Ok(d)
 }
