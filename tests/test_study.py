@@ -377,10 +377,11 @@ def test_ctrl_c_stops_a_process_study_without_waiting_for_its_cases(tmp_path):
         time.sleep(4.0)  # the workers started and busy (64 cases of about 0.25 s each)
         start = time.perf_counter()
         p.send_signal(signal.SIGINT)
-        _, err = p.communicate(timeout=60)
+        out, err = p.communicate(timeout=60)
     finally:
         p.kill()
-    assert p.returncode == 130 and "interrupted" in err
+    # on failure, say how the study ended (it has been seen to end with 0 under heavy load)
+    assert p.returncode == 130 and "interrupted" in err, (p.returncode, out[-1500:], err[-1500:])
     assert time.perf_counter() - start < 10  # not the remaining cases
     assert not (tmp_path / "s.h5").exists()
 
