@@ -59,6 +59,81 @@ pub fn lu_solve(a: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
     }
 }
 
+/// [`lu_factor`] for a matrix whose rows end early (a banded or profile matrix, such as the
+/// Jacobian of a contact problem ordered along a stack): `ext[r] = (lo, hi)` receives, for row `r`
+/// of the factors, the first column of L's nonzeros and one past the last of U's, and the
+/// elimination and [`lu_solve_profile`] skip the exact zeros outside them. Same factors, bit for
+/// bit, as [`lu_factor`]: only products with entries that are exactly zero are left out.
+pub fn lu_factor_profile(a: &mut [f64], n: usize, piv: &mut [usize], ext: &mut [(usize, usize)]) -> Result<()> {
+    // one past the last nonzero of each row; an update by row k extends row r to row k's end
+    for (r, e) in ext[..n].iter_mut().enumerate() {
+        let row = &a[r * n..(r + 1) * n];
+        e.1 = row.iter().rposition(|v| *v != 0.0).map_or(0, |c| c + 1);
+    }
+    for k in 0..n {
+        let mut p = k;
+        let mut best = a[k * n + k].abs();
+        for r in k + 1..n {
+            let v = a[r * n + k].abs();
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        piv[k] = p;
+        if best == 0.0 || !best.is_finite() {
+            return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
+        }
+        if p != k {
+            for c in 0..n {
+                a.swap(k * n + c, p * n + c);
+            }
+            ext.swap(k, p);
+        }
+        let d = a[k * n + k];
+        let end = ext[k].1.max(k + 1);
+        for r in k + 1..n {
+            let l = a[r * n + k] / d;
+            a[r * n + k] = l;
+            if l != 0.0 {
+                let (top, bottom) = a.split_at_mut(r * n);
+                let urow = &top[k * n + k + 1..k * n + end];
+                for (x, u) in bottom[k + 1..end].iter_mut().zip(urow) {
+                    *x -= l * u;
+                }
+                ext[r].1 = ext[r].1.max(end);
+            }
+        }
+    }
+    for (r, e) in ext[..n].iter_mut().enumerate() {
+        e.0 = a[r * n..r * n + r].iter().position(|v| *v != 0.0).unwrap_or(r);
+    }
+    Ok(())
+}
+
+/// Solves `A x = b` in place with the factors and row extents of [`lu_factor_profile`].
+pub fn lu_solve_profile(a: &[f64], n: usize, piv: &[usize], ext: &[(usize, usize)], b: &mut [f64]) {
+    for k in 0..n {
+        b.swap(k, piv[k]);
+    }
+    for r in 0..n {
+        let lo = ext[r].0;
+        let mut s = b[r];
+        for (x, y) in a[r * n + lo..r * n + r].iter().zip(&b[lo..r]) {
+            s -= x * y;
+        }
+        b[r] = s;
+    }
+    for r in (0..n).rev() {
+        let hi = ext[r].1.max(r + 1);
+        let mut s = b[r];
+        for (x, y) in a[r * n + r + 1..r * n + hi].iter().zip(&b[r + 1..hi]) {
+            s -= x * y;
+        }
+        b[r] = s / a[r * n + r];
+    }
+}
+
 /// Factors the complex row-major `n × n` matrix `re + i·im` in place, its real and imaginary
 /// parts in two arrays laid out as for [`lu_factor`]; pivots (largest modulus) into `piv`.
 pub fn lu_factor_complex(re: &mut [f64], im: &mut [f64], n: usize, piv: &mut [usize]) -> Result<()> {
@@ -268,6 +343,51 @@ mod tests {
         }
         let mut s = [1.0, 2.0, 2.0, 4.0];
         assert!(lu_factor(&mut s, 2, &mut [0; 2]).is_err());
+    }
+
+    #[test]
+    fn profile_lu_equals_the_dense_lu_bit_for_bit() {
+        // banded with pivoting (small diagonal entries), a block-tridiagonal pattern with empty
+        // rows ends, and a full matrix: the same factors and solutions as the dense routines
+        let n = 24;
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for (kl, ku) in [(2usize, 3usize), (5, 1), (0, 0), (n, n)] {
+            let mut a0 = vec![0.0; n * n];
+            for r in 0..n {
+                for c in r.saturating_sub(kl)..(r + ku + 1).min(n) {
+                    a0[r * n + c] = rnd();
+                }
+                a0[r * n + r] *= 0.01;
+            }
+            let b0: Vec<f64> = (0..n).map(|_| rnd()).collect();
+            let (mut a1, mut a2) = (a0.clone(), a0.clone());
+            let (mut p1, mut p2, mut ext) = (vec![0; n], vec![0; n], vec![(0, 0); n]);
+            lu_factor(&mut a1, n, &mut p1).unwrap();
+            lu_factor_profile(&mut a2, n, &mut p2, &mut ext).unwrap();
+            assert_eq!(p1, p2, "pivots, band ({kl}, {ku})");
+            assert!(a1.iter().zip(&a2).all(|(x, y)| x == y), "factors, band ({kl}, {ku})");
+            let (mut x1, mut x2) = (b0.clone(), b0.clone());
+            lu_solve(&a1, n, &p1, &mut x1);
+            lu_solve_profile(&a2, n, &p2, &ext, &mut x2);
+            assert_eq!(x1, x2, "solution, band ({kl}, {ku})");
+            // and it solves the system
+            for r in 0..n {
+                let ax: f64 = (0..n).map(|c| a0[r * n + c] * x2[c]).sum();
+                assert!((ax - b0[r]).abs() < 1e-9, "residual row {r}, band ({kl}, {ku})");
+            }
+            if kl < n {
+                // U keeps the band grown by the row exchanges (kl + ku), so the solves skip work
+                for (r, &(_, hi)) in ext.iter().enumerate() {
+                    assert!(hi <= (r + kl + ku + 1).min(n), "row {r}: U ends at {hi}");
+                }
+            }
+        }
+        let mut s = [1.0, 2.0, 2.0, 4.0];
+        assert!(lu_factor_profile(&mut s, 2, &mut [0; 2], &mut [(0, 0); 2]).is_err());
     }
 
     #[test]

@@ -29,7 +29,7 @@
 //! (each an `O((d n)²)` solve with the same factors) take the range components on to `(reg/σ)⁴`,
 //! so near the solution the iteration keeps Newton's speed.
 //!
-//! Each iteration solves `J Δ = −Φ` with a dense LU on preallocated storage and backtracks
+//! Each iteration solves `J Δ = −Φ` with an LU on preallocated storage (dense, skipping the zeros beyond each row's profile: contacts along a stack give a banded J) and backtracks
 //! `r + α Δ` (α = 1, ½, ¼, …) until Armijo's condition `ψ(r + αΔ) ≤ (1 − 2σα) ψ(r)` holds for
 //! the merit `ψ = ½|Φ|²` (σ = 10⁻⁴; `−2ψ` is the directional derivative along a Newton step).
 //! When the LU fails or no step is accepted, one nonsmooth Gauss–Seidel sweep is taken instead:
@@ -42,13 +42,15 @@ use super::nsgs::{cache_diagonal, sweep};
 use super::problem::{fc_residual, Delassus, FrictionContact};
 use super::{NewtonOptions, Report, Workspace};
 use crate::error::Result;
-use crate::math::linalg::{lu_factor, lu_solve};
+use crate::math::linalg::{lu_factor_profile, lu_solve_profile};
 
 /// Newton scratch for `m = d n` unknowns.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct NewtonWork {
     jac: Vec<f64>,
     piv: Vec<usize>,
+    /// Row extents of the factors (a contact problem ordered along a stack is banded).
+    ext: Vec<(usize, usize)>,
     phi: Vec<f64>,
     dir: Vec<f64>,
     wdir: Vec<f64>,
@@ -66,6 +68,7 @@ impl NewtonWork {
         if self.phi.len() < m {
             self.jac.resize(m * m, 0.0);
             self.piv.resize(m, 0);
+            self.ext.resize(m, (0, 0));
             for v in [
                 &mut self.phi,
                 &mut self.dir,
@@ -223,7 +226,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
     let order = &ws.order;
     let u = &mut ws.u[..m];
     let nw = &mut ws.newton;
-    let (jac, piv) = (&mut nw.jac[..m * m], &mut nw.piv[..m]);
+    let (jac, piv, ext) = (&mut nw.jac[..m * m], &mut nw.piv[..m], &mut nw.ext[..m]);
     let (phi, dir, wdir) = (&mut nw.phi[..m], &mut nw.dir[..m], &mut nw.wdir[..m]);
     let (r_t, u_t, phi_t) = (&mut nw.r_trial[..m], &mut nw.u_trial[..m], &mut nw.phi_trial[..m]);
     let dblk = &mut nw.dblk[..n];
@@ -246,7 +249,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             if fresh {
                 assemble(p, diag, dblk, o.regularization, jac);
                 nw.lu_size = 0;
-                if lu_factor(jac, m, piv).is_err() {
+                if lu_factor_profile(jac, m, piv, ext).is_err() {
                     break;
                 }
                 nw.lu_size = m;
@@ -254,7 +257,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             for (x, f) in dir.iter_mut().zip(phi.iter()) {
                 *x = -f;
             }
-            lu_solve(jac, m, piv, dir);
+            lu_solve_profile(jac, m, piv, ext, dir);
             // iterative refinement against the exact J: each pass shrinks the regularization's
             // error by reg/σ, so the iteration converges as Newton's does, not linearly at rate reg
             for _ in 0..REFINEMENTS {
@@ -273,7 +276,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
                         phi_t[i * d + a] = -phi[i * d + a] - jd;
                     }
                 }
-                lu_solve(jac, m, piv, phi_t);
+                lu_solve_profile(jac, m, piv, ext, phi_t);
                 for (x, c) in dir.iter_mut().zip(phi_t.iter()) {
                     *x += c;
                 }
