@@ -402,16 +402,14 @@ impl MoreauJean {
             if pass == 0 {
                 let Data { inertia, s, ic, elastic, .. } = &mut *data;
                 let saddle = &mut ws.saddle;
-                let mut tree = self.sparse.as_mut().map(|sp| &mut sp.factor);
                 crate::dynamics::crba::composite_inertias(model, inertia, s, ic, elastic, |r, col, v| {
                     saddle.put_mass(r, col, v);
-                    if let Some(f) = tree.as_mut() {
-                        f.put(r, col, v);
-                    }
                 });
-                let ok = ws.saddle.factor_mass() && self.sparse.as_mut().is_none_or(|sp| sp.factor.factor());
-                if !ok {
+                if !ws.saddle.factor_mass() {
                     return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s{}", crate::elastic::runaway(model, data))));
+                }
+                if let Some(sp) = self.sparse.as_mut() {
+                    sp.factor.copy_from(&ws.saddle);
                 }
             }
             for v in c.iter_mut() {
@@ -505,10 +503,12 @@ impl MoreauJean {
                 bw.refill(d, m, &sp.diag, &sp.upper, &sp.upper_val);
                 let (mut g, mut g0) = ([0.0; 3], [0.0; 3]);
                 for ai in 0..m {
-                    sp.local_velocity(ai, &self.u_free, &mut g);
-                    sp.local_velocity(ai, &self.u_prev, &mut g0);
-                    self.problem.q[ai * d..(ai + 1) * d].copy_from_slice(&g[..d]);
-                    self.gd_before[ai * d..(ai + 1) * d].copy_from_slice(&g0[..d]);
+                    sp.local_velocity2(ai, &self.u_free, &self.u_prev, &mut g, &mut g0);
+                    // (element-wise: a slice copy of d values is a library call)
+                    for r in 0..d {
+                        self.problem.q[ai * d + r] = g[r];
+                        self.gd_before[ai * d + r] = g0[r];
+                    }
                 }
             } else {
                 self.assemble_rows(model, data);
@@ -630,7 +630,7 @@ impl MoreauJean {
                     !matches!(friction, FrictionLaw::None) && !sliding_in && friction.mu(f64::MIN_POSITIVE) < mu;
                 self.static_mu.push(sliding_less);
                 self.problem.mu.push(mu);
-                self.r.extend_from_slice(&prev[..d]);
+                self.r.extend(prev.iter().take(d));
             }
             // sweeps from the bottom up along gravity: each contact then sees the newest support
             // below it, and a warm-started pile settles in fewer sweeps than in pair order
@@ -735,7 +735,9 @@ impl MoreauJean {
                     ContactState::Slip => SLIP,
                 };
                 let mut imp = [0.0; 3];
-                imp[..d].copy_from_slice(&self.r[ai * d..(ai + 1) * d]);
+                for (r, v) in imp.iter_mut().enumerate().take(d) {
+                    *v = self.r[ai * d + r];
+                }
                 match self.act[ai].source {
                     Source::Point(pt) => {
                         self.results[pt] = PointResult {

@@ -217,6 +217,15 @@ impl BlockDelassusBuilder {
     }
 }
 
+/// Resizes `v` to `n` entries, filling with `x` only where it grows.
+fn set_len<T: Copy>(v: &mut Vec<T>, n: usize, x: T) {
+    if v.len() > n {
+        v.truncate(n);
+    } else {
+        v.resize(n, x);
+    }
+}
+
 impl Default for BlockDelassus {
     fn default() -> Self {
         BlockDelassus { dim: 3, n: 0, diag: Vec::new(), row_start: vec![0], col: Vec::new(), val: Vec::new() }
@@ -248,10 +257,9 @@ impl BlockDelassus {
             self.row_start[i + 2] += self.row_start[i + 1];
         }
         let m = 2 * upper.len();
-        self.col.clear();
-        self.col.resize(m, 0);
-        self.val.clear();
-        self.val.resize(m * dd, 0.0);
+        // every slot is written below: sized without zeroing what is already there
+        set_len(&mut self.col, m, 0);
+        set_len(&mut self.val, m * dd, 0.0);
         // row_start[i + 1] is the next free slot of row i while filling; afterwards the start of row i + 1
         for (k, &(i, j)) in upper.iter().enumerate() {
             let b = &upper_val[k * dd..(k + 1) * dd];
@@ -262,9 +270,14 @@ impl BlockDelassus {
             let s = self.row_start[j + 1];
             self.row_start[j + 1] += 1;
             self.col[s] = i;
-            for a in 0..dim {
-                for c in 0..dim {
-                    self.val[s * dd + a * dim + c] = b[c * dim + a];
+            if dim == 3 {
+                let t = &mut self.val[s * 9..s * 9 + 9];
+                t.copy_from_slice(&[b[0], b[3], b[6], b[1], b[4], b[7], b[2], b[5], b[8]]);
+            } else {
+                for a in 0..dim {
+                    for c in 0..dim {
+                        self.val[s * dd + a * dim + c] = b[c * dim + a];
+                    }
                 }
             }
         }

@@ -86,6 +86,10 @@ impl Islands {
                 self.count += 1;
             }
         }
+        if self.count <= 1 {
+            // one island (or none): the problem is solved whole, the members are not needed
+            return;
+        }
         for i in 0..n {
             let root = self.of[i];
             self.of[i] = self.local[root];

@@ -20,73 +20,39 @@ use crate::math::Vec3;
 use crate::model::Model;
 use crate::spatial::Motion;
 
-/// `M = Lᵀ D L` on the velocity tree (the same recursion as the constrained solve's factor,
-/// kept here so that the contact rows can be reduced on their own patterns).
+/// `M = Lᵀ D L` on the velocity tree: a copy of the dynamics stage's factor
+/// ([`crate::dynamics::sparse::Saddle`], the same ancestor layout), with `D^{-1/2}`, so that the
+/// contact rows can be reduced on their own patterns.
 #[derive(Debug, Clone)]
 pub(super) struct TreeFactor {
     nu: usize,
-    depth: Vec<usize>,
     /// Ancestors of velocity k, nearest first: `anc_idx[anc_ptr[k]..anc_ptr[k + 1]]`.
     anc_ptr: Vec<usize>,
     anc_idx: Vec<usize>,
-    /// `M(k, ancestor)`, then `L` after [`TreeFactor::factor`].
+    /// `L(k, ancestor)`.
     off: Vec<f64>,
-    /// Diagonal of M, then D.
+    /// D.
     diag: Vec<f64>,
-    /// `D^{-1/2}` after factoring.
+    /// `D^{-1/2}`.
     inv_sqrt_d: Vec<f64>,
 }
 
 impl TreeFactor {
     fn new(model: &Model) -> Self {
         let nu = model.nu;
-        let (_, depth, anc_ptr, anc_idx) = crate::dynamics::sparse::velocity_ancestors(model);
-        TreeFactor {
-            nu,
-            depth,
-            off: vec![0.0; anc_idx.len()],
-            anc_ptr,
-            anc_idx,
-            diag: vec![0.0; nu],
-            inv_sqrt_d: vec![0.0; nu],
-        }
+        let (_, _, anc_ptr, anc_idx) = crate::dynamics::sparse::velocity_ancestors(model);
+        TreeFactor { nu, off: vec![0.0; anc_idx.len()], anc_ptr, anc_idx, diag: vec![0.0; nu], inv_sqrt_d: vec![0.0; nu] }
     }
 
-    /// Sets `M(r, c)` (either triangle; r and c on one root path).
-    #[inline]
-    pub(super) fn put(&mut self, r: usize, c: usize, v: f64) {
-        if r == c {
-            self.diag[r] = v;
-        } else {
-            let (hi, lo) = if r > c { (r, c) } else { (c, r) };
-            self.off[self.anc_ptr[hi] + self.depth[hi] - 1 - self.depth[lo]] = v;
+    /// Takes the factor of M just computed by [`crate::dynamics::sparse::Saddle::factor_mass`]
+    /// (factoring M a second time here gave the same numbers).
+    pub(super) fn copy_from(&mut self, saddle: &crate::dynamics::sparse::Saddle) {
+        let (off, diag) = saddle.mass_factor();
+        self.off.copy_from_slice(off);
+        self.diag.copy_from_slice(diag);
+        for (s, d) in self.inv_sqrt_d.iter_mut().zip(&self.diag) {
+            *s = 1.0 / d.sqrt();
         }
-    }
-
-    /// Factors in place, leaves first: `M = Lᵀ D L`; false if a pivot is not positive.
-    pub(super) fn factor(&mut self) -> bool {
-        let scale = self.diag.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
-        for k in (0..self.nu).rev() {
-            let d = self.diag[k];
-            if !(d > 1e-14 * scale) {
-                return false;
-            }
-            let (s, e) = (self.anc_ptr[k], self.anc_ptr[k + 1]);
-            for p in 0..e - s {
-                let i = self.anc_idx[s + p];
-                let mk = self.off[s + p];
-                let a = mk / d;
-                self.diag[i] -= a * mk;
-                // M(i, j) -= a M(k, j) for the ancestors j of i (they follow i on k's path)
-                let si = self.anc_ptr[i];
-                for q in p + 1..e - s {
-                    self.off[si + q - p - 1] -= a * self.off[s + q];
-                }
-                self.off[s + p] = a;
-            }
-            self.inv_sqrt_d[k] = 1.0 / d.sqrt();
-        }
-        true
     }
 
     /// `x ← M⁻¹ x`.
@@ -116,6 +82,13 @@ pub(super) struct SparseRows {
     dim: usize,
     /// Root velocity of body b's path (usize::MAX for the ground and bodies without velocities).
     root: Vec<usize>,
+    /// Per body: the first velocity of its joint if its root path is one free joint on the ground
+    /// and it has no elastic coordinates (its rows take [`SparseRows::add_free_contact`]), else
+    /// usize::MAX.
+    free: Vec<usize>,
+    /// Per body: the ground or a free body in the sense of `free`, both without elastic
+    /// coordinates.
+    fast: Vec<bool>,
     /// Pattern of contact a: `pat_idx[pat_ptr[a]..pat_ptr[a + 1]]`, ascending.
     pat_ptr: Vec<usize>,
     pat_idx: Vec<usize>,
@@ -152,6 +125,8 @@ impl SparseRows {
         let factor = TreeFactor::new(model);
         let nb = model.nbodies();
         let mut root = vec![usize::MAX; nb];
+        let mut free = vec![usize::MAX; nb];
+        let mut fast = vec![false; nb];
         let (mut body_runs_ptr, mut body_runs) = (vec![0; nb + 1], Vec::new());
         let mut buf = Vec::new();
         for b in 0..nb {
@@ -180,11 +155,20 @@ impl SparseRows {
             }
             buf.sort_unstable();
             root[b] = buf.first().copied().unwrap_or(usize::MAX);
+            if b != 0 && model.bodies[b].elastic.is_none() {
+                let j = &model.joints[b - 1];
+                if j.parent == 0 && matches!(j.kind, crate::model::JointKind::Free) {
+                    free[b] = j.iu;
+                }
+            }
+            fast[b] = model.bodies[b].elastic.is_none() && (b == 0 || free[b] != usize::MAX);
         }
         SparseRows {
             factor,
             dim,
             root,
+            free,
+            fast,
             pat_ptr: vec![0],
             pat_idx: Vec::new(),
             run_ptr: vec![0],
@@ -234,6 +218,13 @@ impl SparseRows {
         p2: &Vec3,
         dirs: &[Vec3; 3],
     ) {
+        if b1 != b2 && self.fast[b1] && self.fast[b2] {
+            match self.dim {
+                3 => self.add_free_contact::<3>(s_all, b1, p1, b2, p2, dirs),
+                _ => self.add_free_contact::<2>(s_all, b1, p1, b2, p2, dirs),
+            }
+            return;
+        }
         let d = self.dim;
         let start = self.pat_idx.len();
         // pattern: the union of the two ascending paths, joint by joint (two runs are the same
@@ -314,6 +305,79 @@ impl SparseRows {
                 self.y[w0 + e * d + r] *= s;
             }
         }
+    }
+
+    /// [`SparseRows::add_contact`] for two distinct bodies that are each the ground or a free
+    /// body on the ground: the pattern is one block of six velocities per free body, and within
+    /// it `L` is a dense unit triangle (velocity `iu + j` has the ancestors `iu + j - 1, ..., iu`),
+    /// so the rows are built and reduced block by block without the pattern's indirection. The
+    /// same sums in the same order as the general path: the results are identical.
+    fn add_free_contact<const D: usize>(
+        &mut self,
+        s_all: &[[Motion; 6]],
+        b1: usize,
+        p1: &Vec3,
+        b2: usize,
+        p2: &Vec3,
+        dirs: &[Vec3; 3],
+    ) {
+        let start = self.pat_idx.len();
+        // the free sides in ascending velocity order (the pattern's)
+        let mut sides = [(0usize, p1, 1.0f64, usize::MAX); 2];
+        let mut ns = 0;
+        for (b, p, sign) in [(b1, p1, 1.0), (b2, p2, -1.0)] {
+            if b != 0 {
+                sides[ns] = (b, p, sign, self.free[b]);
+                ns += 1;
+            }
+        }
+        if ns == 2 && sides[1].3 < sides[0].3 {
+            sides.swap(0, 1);
+        }
+        for side in &sides[..ns] {
+            let iu = side.3;
+            self.runs.push((iu, 6, self.pat_idx.len()));
+            self.pat_idx.extend(iu..iu + 6);
+        }
+        self.run_ptr.push(self.runs.len());
+        self.pat_ptr.push(self.pat_idx.len());
+        self.roots.push([self.root[b1], self.root[b2]]);
+        let w0 = self.w.len();
+        let f = &self.factor;
+        for &(b, p, sign, iu) in &sides[..ns] {
+            // eq. 2.112 ff.: the six columns of J_P, projected on the directions
+            let mut w = [[0.0; D]; 6];
+            for (k, wk) in w.iter_mut().enumerate() {
+                let s = &s_all[b][k];
+                let v = (s.v + s.w.cross(p)) * sign;
+                for r in 0..D {
+                    // (0 + x as in the general path's accumulation: the same signed zeros)
+                    wk[r] = 0.0 + dirs[r].dot(&v);
+                }
+            }
+            // y = D^{-1/2} L⁻ᵀ w, leaves first; L(iu + j, iu + j - 1 - p) at off[base + j(j-1)/2 + p]
+            let base = f.anc_ptr[iu];
+            let mut y = w;
+            for j in (1..6).rev() {
+                let v = y[j];
+                let lj = base + j * (j - 1) / 2;
+                for p in 0..j {
+                    let l = f.off[lj + p];
+                    for r in 0..D {
+                        y[j - 1 - p][r] -= l * v[r];
+                    }
+                }
+            }
+            for (k, yk) in y.iter_mut().enumerate() {
+                let s = f.inv_sqrt_d[iu + k];
+                for v in yk.iter_mut() {
+                    *v *= s;
+                }
+            }
+            self.w.extend(w.iter().flatten());
+            self.y.extend(y.iter().flatten());
+        }
+        debug_assert_eq!(self.w.len(), w0 + (self.pat_idx.len() - start) * D);
     }
 
     /// The Delassus blocks of the contacts added: `diag` (n d², row-major) and the coupled pairs
@@ -454,6 +518,23 @@ impl SparseRows {
                 out[r] += self.w[x * d + r] * uk;
             }
         }
+    }
+
+    /// [`SparseRows::local_velocity`] at two velocity vectors in one pass over the rows.
+    pub(super) fn local_velocity2(&self, a: usize, u: &[f64], v: &[f64], out_u: &mut [f64; 3], out_v: &mut [f64; 3]) {
+        let d = self.dim;
+        let (mut gu, mut gv) = ([0.0; 3], [0.0; 3]);
+        for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
+            let k = self.pat_idx[x];
+            let (uk, vk) = (u[k], v[k]);
+            let w = &self.w[x * d..x * d + d];
+            for r in 0..d {
+                gu[r] += w[r] * uk;
+                gv[r] += w[r] * vk;
+            }
+        }
+        *out_u = gu;
+        *out_v = gv;
     }
 
     /// `u += M⁻¹ Σ_a w_a Λ_a` for the impulses `lambda` (d per contact).
