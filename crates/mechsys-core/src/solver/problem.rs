@@ -266,14 +266,18 @@ impl BlockDelassus {
             let s = self.row_start[i + 1];
             self.row_start[i + 1] += 1;
             self.col[s] = j;
-            self.val[s * dd..(s + 1) * dd].copy_from_slice(b);
-            let s = self.row_start[j + 1];
+            let t = self.row_start[j + 1];
             self.row_start[j + 1] += 1;
-            self.col[s] = i;
-            if dim == 3 {
-                let t = &mut self.val[s * 9..s * 9 + 9];
-                t.copy_from_slice(&[b[0], b[3], b[6], b[1], b[4], b[7], b[2], b[5], b[8]]);
+            self.col[t] = i;
+            if let Ok(b) = <&[f64; 9]>::try_from(b) {
+                // fixed-size copies (a slice copy of d² values is a library call)
+                let v: &mut [f64; 9] = (&mut self.val[s * 9..s * 9 + 9]).try_into().unwrap();
+                *v = *b;
+                let v: &mut [f64; 9] = (&mut self.val[t * 9..t * 9 + 9]).try_into().unwrap();
+                *v = [b[0], b[3], b[6], b[1], b[4], b[7], b[2], b[5], b[8]];
             } else {
+                self.val[s * dd..(s + 1) * dd].copy_from_slice(b);
+                let s = t;
                 for a in 0..dim {
                     for c in 0..dim {
                         self.val[s * dd + a * dim + c] = b[c * dim + a];

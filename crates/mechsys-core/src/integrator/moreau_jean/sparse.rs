@@ -452,20 +452,23 @@ impl SparseRows {
             let (s, e) = (self.bucket_ptr[r], self.bucket_ptr[r + 1]);
             for x in s..e {
                 let i = self.bucket[x];
+                let ri = self.roots[i];
                 for z in x + 1..e {
                     let j = self.bucket[z];
+                    let rj = self.roots[j];
                     // the pair is formed at the smallest root the two contacts share
-                    let shared = self.roots[i]
-                        .iter()
-                        .filter(|&&ri| ri != usize::MAX && self.roots[j].contains(&ri))
-                        .min()
-                        .copied();
-                    if shared != Some(r) {
+                    let mut shared = usize::MAX;
+                    for a in ri {
+                        if a != usize::MAX && (a == rj[0] || a == rj[1]) && a < shared {
+                            shared = a;
+                        }
+                    }
+                    if shared != r {
                         continue;
                     }
-                    let off = self.upper_val.len();
-                    self.upper_val.resize(off + dd, 0.0);
-                    // Σ over the shared velocities: the runs both patterns have (ascending)
+                    // Σ over the shared velocities: the runs both patterns have (ascending), the
+                    // block in registers (every sum from 0 in the same order)
+                    let mut acc = [0.0; 9];
                     let (mut p, pe) = (self.run_ptr[i], self.run_ptr[i + 1]);
                     let (mut q, qe) = (self.run_ptr[j], self.run_ptr[j + 1]);
                     while p < pe && q < qe {
@@ -475,25 +478,18 @@ impl SparseRows {
                         } else if kq < kp {
                             q += 1;
                         } else {
-                            let blk = &mut self.upper_val[off..off + dd];
                             let (ya, yb) = (&self.y[ep * d..(ep + len) * d], &self.y[eq * d..(eq + len) * d]);
                             if d == 3 {
-                                // in registers, stored once per run (same order of the sums)
-                                let blk: &mut [f64; 9] = blk.try_into().unwrap();
-                                let mut acc = *blk;
-                                for (a, b) in ya.chunks_exact(3).zip(yb.chunks_exact(3)) {
-                                    for r in 0..3 {
-                                        acc[3 * r] += a[r] * b[0];
-                                        acc[3 * r + 1] += a[r] * b[1];
-                                        acc[3 * r + 2] += a[r] * b[2];
-                                    }
+                                match (<&[f64; 18]>::try_from(ya), <&[f64; 18]>::try_from(yb)) {
+                                    // a free joint's six velocities: fixed-size, unrolled
+                                    (Ok(ya), Ok(yb)) => add_products3(&mut acc, ya, yb),
+                                    _ => add_products3(&mut acc, ya, yb),
                                 }
-                                *blk = acc;
                             } else {
                                 for (a, b) in ya.chunks_exact(d).zip(yb.chunks_exact(d)) {
                                     for r in 0..d {
                                         for c in 0..d {
-                                            blk[r * d + c] += a[r] * b[c];
+                                            acc[r * d + c] += a[r] * b[c];
                                         }
                                     }
                                 }
@@ -502,6 +498,7 @@ impl SparseRows {
                             q += 1;
                         }
                     }
+                    self.upper_val.extend_from_slice(&acc[..dd]);
                     self.upper.push((i, j));
                 }
             }
@@ -510,25 +507,38 @@ impl SparseRows {
 
     /// `out[r] = w_{a,r}ᵀ u`, r < dim, for contact `a`.
     pub(super) fn local_velocity(&self, a: usize, u: &[f64], out: &mut [f64; 3]) {
-        let d = self.dim;
-        *out = [0.0; 3];
-        for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
-            let uk = u[self.pat_idx[x]];
-            for r in 0..d {
-                out[r] += self.w[x * d + r] * uk;
+        match self.dim {
+            3 => self.local_velocity_d::<3>(a, u, out),
+            _ => self.local_velocity_d::<2>(a, u, out),
+        }
+    }
+
+    fn local_velocity_d<const D: usize>(&self, a: usize, u: &[f64], out: &mut [f64; 3]) {
+        let mut g = [0.0; 3];
+        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+        for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
+            let uk = u[*k];
+            for r in 0..D {
+                g[r] += w[r] * uk;
             }
         }
+        *out = g;
     }
 
     /// [`SparseRows::local_velocity`] at two velocity vectors in one pass over the rows.
     pub(super) fn local_velocity2(&self, a: usize, u: &[f64], v: &[f64], out_u: &mut [f64; 3], out_v: &mut [f64; 3]) {
-        let d = self.dim;
+        match self.dim {
+            3 => self.local_velocity2_d::<3>(a, u, v, out_u, out_v),
+            _ => self.local_velocity2_d::<2>(a, u, v, out_u, out_v),
+        }
+    }
+
+    fn local_velocity2_d<const D: usize>(&self, a: usize, u: &[f64], v: &[f64], out_u: &mut [f64; 3], out_v: &mut [f64; 3]) {
         let (mut gu, mut gv) = ([0.0; 3], [0.0; 3]);
-        for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
-            let k = self.pat_idx[x];
-            let (uk, vk) = (u[k], v[k]);
-            let w = &self.w[x * d..x * d + d];
-            for r in 0..d {
+        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+        for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
+            let (uk, vk) = (u[*k], v[*k]);
+            for r in 0..D {
                 gu[r] += w[r] * uk;
                 gv[r] += w[r] * vk;
             }
@@ -539,24 +549,46 @@ impl SparseRows {
 
     /// `u += M⁻¹ Σ_a w_a Λ_a` for the impulses `lambda` (d per contact).
     pub(super) fn apply(&mut self, lambda: &[f64], u: &mut [f64]) {
-        let d = self.dim;
         self.f.fill(0.0);
-        for a in 0..self.len() {
-            let l = &lambda[a * d..(a + 1) * d];
-            if l.iter().all(|v| *v == 0.0) {
-                continue;
-            }
-            for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
-                let mut s = 0.0;
-                for r in 0..d {
-                    s += self.w[x * d + r] * l[r];
-                }
-                self.f[self.pat_idx[x]] += s;
-            }
+        match self.dim {
+            3 => self.scatter::<3>(lambda),
+            _ => self.scatter::<2>(lambda),
         }
         self.factor.solve(&mut self.f);
         for (ui, fi) in u.iter_mut().zip(&self.f) {
             *ui += fi;
+        }
+    }
+}
+
+impl SparseRows {
+    /// `f += Σ_a w_a Λ_a` on the patterns.
+    fn scatter<const D: usize>(&mut self, lambda: &[f64]) {
+        for a in 0..self.len() {
+            let l: &[f64; D] = lambda[a * D..(a + 1) * D].try_into().unwrap();
+            if l.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+            for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
+                let mut s = 0.0;
+                for r in 0..D {
+                    s += w[r] * l[r];
+                }
+                self.f[*k] += s;
+            }
+        }
+    }
+}
+
+/// `acc += Σ_k a_k b_kᵀ` over the 3-vectors of `a` and `b` (row-major 3 × 3 `acc`).
+#[inline(always)]
+fn add_products3(acc: &mut [f64; 9], a: &[f64], b: &[f64]) {
+    for (a, b) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
+        for r in 0..3 {
+            acc[3 * r] += a[r] * b[0];
+            acc[3 * r + 1] += a[r] * b[1];
+            acc[3 * r + 2] += a[r] * b[2];
         }
     }
 }
