@@ -385,39 +385,33 @@ impl SparseRows {
     /// move, e.g. out of the plane of a planar mechanism) gets the normal's diagonal value so that
     /// its impulse comes out zero.
     pub(super) fn delassus(&mut self) {
-        let (d, n) = (self.dim, self.len());
-        let dd = d * d;
+        // fixed-size blocks: no loop over the dimension nor library calls for d² copies
+        match self.dim {
+            3 => self.delassus_d::<3>(),
+            _ => self.delassus_d::<2>(),
+        }
+    }
+
+    fn delassus_d<const D: usize>(&mut self) {
+        let n = self.len();
         self.diag.clear();
-        self.diag.resize(n * dd, 0.0);
         for a in 0..n {
             let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
-            let blk = &mut self.diag[a * dd..(a + 1) * dd];
-            if d == 3 {
-                // accumulated in registers (the same sums in the same order as the general loop)
-                let mut acc = [0.0; 9];
-                for y in self.y[s * 3..e * 3].chunks_exact(3) {
-                    for r in 0..3 {
-                        acc[3 * r] += y[r] * y[0];
-                        acc[3 * r + 1] += y[r] * y[1];
-                        acc[3 * r + 2] += y[r] * y[2];
-                    }
-                }
-                blk.copy_from_slice(&acc);
-            } else {
-                for x in s..e {
-                    let y = &self.y[x * d..(x + 1) * d];
-                    for r in 0..d {
-                        for c in 0..d {
-                            blk[r * d + c] += y[r] * y[c];
-                        }
+            // accumulated in registers, every sum from 0 in pattern order
+            let mut acc = [[0.0; D]; D];
+            for y in self.y[s * D..e * D].chunks_exact(D) {
+                for r in 0..D {
+                    for c in 0..D {
+                        acc[r][c] += y[r] * y[c];
                     }
                 }
             }
-            for r in 1..d {
-                if (s..e).all(|x| self.w[x * d + r] == 0.0) {
-                    blk[r * d + r] = blk[0].max(f64::MIN_POSITIVE);
+            for r in 1..D {
+                if self.w[s * D..e * D].chunks_exact(D).all(|w| w[r] == 0.0) {
+                    acc[r][r] = acc[0][0].max(f64::MIN_POSITIVE);
                 }
             }
+            self.diag.extend(acc.iter().flatten());
         }
         // buckets of contacts by root velocity
         let nu = self.pos.len();
@@ -468,7 +462,7 @@ impl SparseRows {
                     }
                     // Σ over the shared velocities: the runs both patterns have (ascending), the
                     // block in registers (every sum from 0 in the same order)
-                    let mut acc = [0.0; 9];
+                    let mut acc = [[0.0; D]; D];
                     let (mut p, pe) = (self.run_ptr[i], self.run_ptr[i + 1]);
                     let (mut q, qe) = (self.run_ptr[j], self.run_ptr[j + 1]);
                     while p < pe && q < qe {
@@ -478,27 +472,18 @@ impl SparseRows {
                         } else if kq < kp {
                             q += 1;
                         } else {
-                            let (ya, yb) = (&self.y[ep * d..(ep + len) * d], &self.y[eq * d..(eq + len) * d]);
-                            if d == 3 {
-                                match (<&[f64; 18]>::try_from(ya), <&[f64; 18]>::try_from(yb)) {
-                                    // a free joint's six velocities: fixed-size, unrolled
-                                    (Ok(ya), Ok(yb)) => add_products3(&mut acc, ya, yb),
-                                    _ => add_products3(&mut acc, ya, yb),
-                                }
+                            let (ya, yb) = (&self.y[ep * D..(ep + len) * D], &self.y[eq * D..(eq + len) * D]);
+                            if len == 6 {
+                                // a free joint's six velocities: fixed-size, unrolled
+                                add_products::<D>(&mut acc, &ya[..6 * D], &yb[..6 * D]);
                             } else {
-                                for (a, b) in ya.chunks_exact(d).zip(yb.chunks_exact(d)) {
-                                    for r in 0..d {
-                                        for c in 0..d {
-                                            acc[r * d + c] += a[r] * b[c];
-                                        }
-                                    }
-                                }
+                                add_products::<D>(&mut acc, ya, yb);
                             }
                             p += 1;
                             q += 1;
                         }
                     }
-                    self.upper_val.extend_from_slice(&acc[..dd]);
+                    self.upper_val.extend(acc.iter().flatten());
                     self.upper.push((i, j));
                 }
             }
@@ -581,14 +566,14 @@ impl SparseRows {
     }
 }
 
-/// `acc += Σ_k a_k b_kᵀ` over the 3-vectors of `a` and `b` (row-major 3 × 3 `acc`).
+/// `acc += Σ_k a_k b_kᵀ` over the D-vectors of `a` and `b`.
 #[inline(always)]
-fn add_products3(acc: &mut [f64; 9], a: &[f64], b: &[f64]) {
-    for (a, b) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
-        for r in 0..3 {
-            acc[3 * r] += a[r] * b[0];
-            acc[3 * r + 1] += a[r] * b[1];
-            acc[3 * r + 2] += a[r] * b[2];
+fn add_products<const D: usize>(acc: &mut [[f64; D]; D], a: &[f64], b: &[f64]) {
+    for (a, b) in a.chunks_exact(D).zip(b.chunks_exact(D)) {
+        for r in 0..D {
+            for c in 0..D {
+                acc[r][c] += a[r] * b[c];
+            }
         }
     }
 }
