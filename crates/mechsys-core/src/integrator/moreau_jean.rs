@@ -630,7 +630,12 @@ impl MoreauJean {
                     !matches!(friction, FrictionLaw::None) && !sliding_in && friction.mu(f64::MIN_POSITIVE) < mu;
                 self.static_mu.push(sliding_less);
                 self.problem.mu.push(mu);
-                self.r.extend(prev.iter().take(d));
+                if d == 3 {
+                    // (a fixed-size copy: a slice of d values is a library call)
+                    self.r.extend_from_slice(&prev);
+                } else {
+                    self.r.extend_from_slice(&prev[..d]);
+                }
             }
             // sweeps from the bottom up along gravity: each contact then sees the newest support
             // below it, and a warm-started pile settles in fewer sweeps than in pair order
@@ -728,7 +733,7 @@ impl MoreauJean {
             let q_scale = 1.0 + self.problem.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             for ai in 0..m {
                 let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
-                let state = self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)?;
+                let state = self.problem.contact_state_unchecked(ai, &self.r, tol, r_scale, q_scale);
                 let code = match state {
                     ContactState::Open => OPEN,
                     ContactState::Stick => STICK,

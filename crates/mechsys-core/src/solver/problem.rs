@@ -605,13 +605,21 @@ impl FrictionContact {
         q_scale: f64,
     ) -> Result<ContactState> {
         let (ri, u) = self.local(i, r)?;
-        Ok(if ri[0] <= tol * r_scale {
-            ContactState::Open
-        } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {
-            ContactState::Slip
-        } else {
-            ContactState::Stick
-        })
+        Ok(classify(&ri, &u, tol, r_scale, q_scale))
+    }
+
+    /// [`FrictionContact::contact_state_scaled`] without the checks of `i` and `r` (a stepper's
+    /// loop over the contacts of the problem it has just solved).
+    pub(crate) fn contact_state_unchecked(&self, i: usize, r: &[f64], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
+        let d = self.dim;
+        let mut u = [0.0; 3];
+        self.w.add_row_product(d, i, r, false, &mut u);
+        let mut ri = [0.0; 3];
+        for a in 0..d {
+            u[a] += self.q[i * d + a];
+            ri[a] = r[i * d + a];
+        }
+        classify(&ri, &u, tol, r_scale, q_scale)
     }
 
     /// Open, stick or slip for contact `i` of the solution `r`.
@@ -630,6 +638,18 @@ impl FrictionContact {
         } else {
             ContactState::Stick
         })
+    }
+}
+
+/// Open if `r_N ≤ tol r_scale`, else slip if `|u_T| > tol q_scale`, else stick.
+#[inline]
+fn classify(ri: &[f64; 3], u: &[f64; 3], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
+    if ri[0] <= tol * r_scale {
+        ContactState::Open
+    } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {
+        ContactState::Slip
+    } else {
+        ContactState::Stick
     }
 }
 

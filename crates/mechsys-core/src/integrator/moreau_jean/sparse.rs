@@ -374,8 +374,8 @@ impl SparseRows {
                     *v *= s;
                 }
             }
-            self.w.extend(w.iter().flatten());
-            self.y.extend(y.iter().flatten());
+            self.w.extend_from_slice(w.as_flattened());
+            self.y.extend_from_slice(y.as_flattened());
         }
         debug_assert_eq!(self.w.len(), w0 + (self.pat_idx.len() - start) * D);
     }
@@ -411,7 +411,7 @@ impl SparseRows {
                     acc[r][r] = acc[0][0].max(f64::MIN_POSITIVE);
                 }
             }
-            self.diag.extend(acc.iter().flatten());
+            self.diag.extend_from_slice(acc.as_flattened());
         }
         // buckets of contacts by root velocity
         let nu = self.pos.len();
@@ -483,7 +483,7 @@ impl SparseRows {
                             q += 1;
                         }
                     }
-                    self.upper_val.extend(acc.iter().flatten());
+                    self.upper_val.extend_from_slice(acc.as_flattened());
                     self.upper.push((i, j));
                 }
             }
