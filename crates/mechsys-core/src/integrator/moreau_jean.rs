@@ -131,6 +131,8 @@ enum Source {
 struct Active {
     b1: usize,
     b2: usize,
+    /// The explicit contact of a [`Source::Point`] (index into `model.contacts`; 0 for a group's).
+    contact: usize,
     point: ContactPoint,
     source: Source,
 }
@@ -452,7 +454,7 @@ impl MoreauJean {
         // ---- contacts at the midpoint: the explicit pairs, then the groups' pairs
         let (d, np) = (self.dim, model.n_contact_points);
         self.act.clear();
-        for con in &model.contacts {
+        for (ci, con) in model.contacts.iter().enumerate() {
             let k = &mut self.kin[con.first..con.first + con.points()];
             let s = self.warm_search.then(|| &mut self.search[con.first..con.first + con.points()]);
             // a gap function reads the step's start velocities (its w̃ does not depend on them)
@@ -461,7 +463,7 @@ impl MoreauJean {
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
                 if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
-                    self.act.push(Active { b1: con.body1, b2: con.body2, point: kk.point, source: Source::Point(pt) });
+                    self.act.push(Active { b1: con.body1, b2: con.body2, contact: ci, point: kk.point, source: Source::Point(pt) });
                 }
             }
         }
@@ -476,7 +478,7 @@ impl MoreauJean {
                     pen = pen.max(-kk.point.g_n);
                     if kk.point.g_n <= margin(if fresh { sl.last[k].1 } else { OPEN }, self.steps == 0) {
                         let source = Source::Group { group: gi, slot, k };
-                        self.act.push(Active { b1: sl.body1, b2: sl.body2, point: kk.point, source });
+                        self.act.push(Active { b1: sl.body1, b2: sl.body2, contact: 0, point: kk.point, source });
                     }
                 }
             }
@@ -574,7 +576,7 @@ impl MoreauJean {
             for (ai, a) in self.act.iter().enumerate() {
                 let (friction, impact, gd_t, prev, prev_state) = match a.source {
                     Source::Point(pt) => {
-                        let con = model.contact_of_point(pt);
+                        let con = &model.contacts[a.contact];
                         let r = &self.results[pt];
                         let prev = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
                         (&con.friction, &con.impact, self.kin[pt].gd_t, prev, r.state)
@@ -649,7 +651,7 @@ impl MoreauJean {
             // independent islands (sparse assembly only: the dense one couples through M̃⁻¹)
             match self.sparse.as_ref() {
                 Some(sp) => {
-                    self.islands.partition(m, &sp.upper);
+                    self.islands.partition(m, &sp.links);
                     if self.islands.count() > 1 {
                         self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r, &self.height);
                     }
@@ -688,7 +690,7 @@ impl MoreauJean {
                         || self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip
                     {
                         let law = match self.act[ai].source {
-                            Source::Point(pt) => &model.contact_of_point(pt).friction,
+                            Source::Point(_) => &model.contacts[self.act[ai].contact].friction,
                             Source::Group { group, .. } => &model.contact_groups[group].friction,
                         };
                         self.problem.mu[ai] = law.mu(speed.max(f64::MIN_POSITIVE));

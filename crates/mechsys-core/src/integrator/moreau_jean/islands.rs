@@ -62,7 +62,8 @@ impl Islands {
         self.count = usize::from(n > 0);
     }
 
-    /// Partitions `n` contacts linked by the pairs `upper` (i < j).
+    /// Partitions `n` contacts linked by the pairs `upper` (the coupled pairs, or any set of
+    /// links with the same connected components).
     pub(super) fn partition(&mut self, n: usize, upper: &[(usize, usize)]) {
         self.of.clear();
         self.of.extend(0..n);

@@ -115,6 +115,9 @@ pub(super) struct SparseRows {
     /// Off-diagonal pairs (i < j) and their row-major blocks.
     pub(super) upper: Vec<(usize, usize)>,
     pub(super) upper_val: Vec<f64>,
+    /// Each contact that shares a root with an earlier one, linked to the first contact of that
+    /// root: the same connected components as `upper` with fewer links (for the islands).
+    pub(super) links: Vec<(usize, usize)>,
     /// Scratch (nu).
     f: Vec<f64>,
 }
@@ -184,6 +187,7 @@ impl SparseRows {
             diag: Vec::new(),
             upper: Vec::new(),
             upper_val: Vec::new(),
+            links: Vec::new(),
             f: vec![0.0; model.nu],
         }
     }
@@ -440,6 +444,13 @@ impl SparseRows {
             }
         }
         // bucket_ptr[r]..bucket_ptr[r + 1] now lists root r's contacts, ascending
+        self.links.clear();
+        for r in 0..nu {
+            let (s, e) = (self.bucket_ptr[r], self.bucket_ptr[r + 1]);
+            for x in s + 1..e {
+                self.links.push((self.bucket[s], self.bucket[x]));
+            }
+        }
         self.upper.clear();
         self.upper_val.clear();
         for r in 0..nu {
