@@ -227,8 +227,24 @@ impl SparseRows {
                 3 => self.add_free_contact::<3>(s_all, b1, p1, b2, p2, dirs),
                 _ => self.add_free_contact::<2>(s_all, b1, p1, b2, p2, dirs),
             }
-            return;
+        } else {
+            self.add_general_contact(model, s_all, el, b1, p1, b2, p2, dirs);
         }
+    }
+
+    /// [`SparseRows::add_contact`] on any two bodies (root paths of any joints, elastic points).
+    #[allow(clippy::too_many_arguments)]
+    fn add_general_contact(
+        &mut self,
+        model: &Model,
+        s_all: &[[Motion; 6]],
+        el: crate::kinematics::ElasticView<'_>,
+        b1: usize,
+        p1: &Vec3,
+        b2: usize,
+        p2: &Vec3,
+        dirs: &[Vec3; 3],
+    ) {
         let d = self.dim;
         let start = self.pat_idx.len();
         // pattern: the union of the two ascending paths, joint by joint (two runs are the same
@@ -585,6 +601,83 @@ fn add_products<const D: usize>(acc: &mut [[f64; D]; D], a: &[f64], b: &[f64]) {
             for c in 0..D {
                 acc[r][c] += a[r] * b[c];
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::Data;
+    use crate::dynamics::sparse::Saddle;
+    use crate::model::ModelDescription;
+
+    /// Two free bodies (off-centre mass) and an arm on a revolute joint.
+    fn model() -> Model {
+        let json = r#"{
+            "name": "free", "gravity": [0, 0, -9.81],
+            "bodies": [
+                {"name": "a", "mass": 1.3, "inertia": [0.01, 0.02, 0.03], "com": [0.05, -0.02, 0.01]},
+                {"name": "b", "mass": 0.7, "inertia": [0.004, 0.005, 0.006]},
+                {"name": "arm", "mass": 0.5, "inertia": [0.001, 0.02, 0.02], "com": [0.2, 0, 0]}
+            ],
+            "joints": [
+                {"name": "fa", "type": "free", "parent": "ground", "child": "a",
+                 "q0": [0.1, 0.2, 0.3, 0.9, 0.1, -0.3, 0.2], "u0": [0.3, -0.2, 0.1, 1.0, -2.0, 0.5]},
+                {"name": "fb", "type": "free", "parent": "ground", "child": "b",
+                 "q0": [-0.2, 0.1, 0.5, 0.7, -0.4, 0.1, 0.5], "u0": [0.1, 0.2, -0.3, 0.4, 0.2, -1.0]},
+                {"name": "j", "type": "revolute", "parent": "ground", "child": "arm", "axis": [0, 1, 0]}
+            ]
+        }"#;
+        Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap()
+    }
+
+    /// The free-body rows and their reduction are the general path's bit for bit (any sign or
+    /// index slip in the fixed-size code shows), and so are the Delassus blocks built from them.
+    #[test]
+    fn free_body_rows_are_the_general_rows_bit_for_bit() {
+        let model = model();
+        let mut data = Data::new(&model);
+        let mut q = model.q0();
+        model.normalize(&mut q);
+        crate::kinematics::forward_pass(&model, &mut data, 0.0, &q, &model.u0());
+        let mut saddle = Saddle::new(&model);
+        {
+            let Data { inertia, s, ic, elastic, .. } = &mut data;
+            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| saddle.put_mass(r, c, v));
+        }
+        assert!(saddle.factor_mass());
+        let n = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let t1 = n.cross(&Vec3::x()).normalize();
+        let dirs = [n, t1, n.cross(&t1)];
+        // (b1, b2): body and ground either way round, two free bodies in both orders
+        let pairs = [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0)];
+        for dim in [3, 2] {
+            let (mut fast, mut general) = (SparseRows::new(&model, dim), SparseRows::new(&model, dim));
+            fast.factor.copy_from(&saddle);
+            general.factor.copy_from(&saddle);
+            for (k, &(b1, b2)) in pairs.iter().enumerate() {
+                let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
+                let p2 = p1 - 1e-3 * n;
+                let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+                fast.add_contact(&model, &data.s, el, b1, &p1, b2, &p2, &dirs);
+                general.add_general_contact(&model, &data.s, el, b1, &p1, b2, &p2, &dirs);
+            }
+            assert_eq!(fast.pat_ptr, general.pat_ptr);
+            assert_eq!(fast.pat_idx, general.pat_idx);
+            assert_eq!(fast.run_ptr, general.run_ptr);
+            assert_eq!(fast.runs, general.runs);
+            assert_eq!(fast.roots, general.roots);
+            assert!(fast.w.iter().any(|v| *v != 0.0) && fast.y.iter().any(|v| *v != 0.0));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&fast.w), bits(&general.w), "rows (dim {dim})");
+            assert_eq!(bits(&fast.y), bits(&general.y), "reduced rows (dim {dim})");
+            fast.delassus();
+            general.delassus();
+            assert_eq!(fast.upper, general.upper);
+            assert!(fast.upper.len() >= 4, "pairs {:?}", fast.upper);
+            assert_eq!(bits(&fast.diag), bits(&general.diag));
+            assert_eq!(bits(&fast.upper_val), bits(&general.upper_val));
         }
     }
 }
