@@ -255,6 +255,12 @@ impl Saddle {
         true
     }
 
+    /// The factor of M after [`Saddle::factor_mass`]: `L` below the diagonal (per velocity, its
+    /// ancestors nearest first, as [`velocity_ancestors`] lists them) and `D`.
+    pub(crate) fn mass_factor(&self) -> (&[f64], &[f64]) {
+        (&self.m_off, &self.m_diag)
+    }
+
     /// `x ← Lᵀ⁻¹ x` (leaves to root).
     fn solve_lt(&self, x: &mut [f64]) {
         for k in (0..self.nu).rev() {

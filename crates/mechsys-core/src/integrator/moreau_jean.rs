@@ -131,6 +131,8 @@ enum Source {
 struct Active {
     b1: usize,
     b2: usize,
+    /// The explicit contact of a [`Source::Point`] (index into `model.contacts`; 0 for a group's).
+    contact: usize,
     point: ContactPoint,
     source: Source,
 }
@@ -402,16 +404,14 @@ impl MoreauJean {
             if pass == 0 {
                 let Data { inertia, s, ic, elastic, .. } = &mut *data;
                 let saddle = &mut ws.saddle;
-                let mut tree = self.sparse.as_mut().map(|sp| &mut sp.factor);
                 crate::dynamics::crba::composite_inertias(model, inertia, s, ic, elastic, |r, col, v| {
                     saddle.put_mass(r, col, v);
-                    if let Some(f) = tree.as_mut() {
-                        f.put(r, col, v);
-                    }
                 });
-                let ok = ws.saddle.factor_mass() && self.sparse.as_mut().is_none_or(|sp| sp.factor.factor());
-                if !ok {
+                if !ws.saddle.factor_mass() {
                     return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s{}", crate::elastic::runaway(model, data))));
+                }
+                if let Some(sp) = self.sparse.as_mut() {
+                    sp.factor.copy_from(&ws.saddle);
                 }
             }
             for v in c.iter_mut() {
@@ -454,7 +454,7 @@ impl MoreauJean {
         // ---- contacts at the midpoint: the explicit pairs, then the groups' pairs
         let (d, np) = (self.dim, model.n_contact_points);
         self.act.clear();
-        for con in &model.contacts {
+        for (ci, con) in model.contacts.iter().enumerate() {
             let k = &mut self.kin[con.first..con.first + con.points()];
             let s = self.warm_search.then(|| &mut self.search[con.first..con.first + con.points()]);
             // a gap function reads the step's start velocities (its w̃ does not depend on them)
@@ -463,7 +463,7 @@ impl MoreauJean {
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
                 if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
-                    self.act.push(Active { b1: con.body1, b2: con.body2, point: kk.point, source: Source::Point(pt) });
+                    self.act.push(Active { b1: con.body1, b2: con.body2, contact: ci, point: kk.point, source: Source::Point(pt) });
                 }
             }
         }
@@ -478,7 +478,7 @@ impl MoreauJean {
                     pen = pen.max(-kk.point.g_n);
                     if kk.point.g_n <= margin(if fresh { sl.last[k].1 } else { OPEN }, self.steps == 0) {
                         let source = Source::Group { group: gi, slot, k };
-                        self.act.push(Active { b1: sl.body1, b2: sl.body2, point: kk.point, source });
+                        self.act.push(Active { b1: sl.body1, b2: sl.body2, contact: 0, point: kk.point, source });
                     }
                 }
             }
@@ -505,10 +505,12 @@ impl MoreauJean {
                 bw.refill(d, m, &sp.diag, &sp.upper, &sp.upper_val);
                 let (mut g, mut g0) = ([0.0; 3], [0.0; 3]);
                 for ai in 0..m {
-                    sp.local_velocity(ai, &self.u_free, &mut g);
-                    sp.local_velocity(ai, &self.u_prev, &mut g0);
-                    self.problem.q[ai * d..(ai + 1) * d].copy_from_slice(&g[..d]);
-                    self.gd_before[ai * d..(ai + 1) * d].copy_from_slice(&g0[..d]);
+                    sp.local_velocity2(ai, &self.u_free, &self.u_prev, &mut g, &mut g0);
+                    // (element-wise: a slice copy of d values is a library call)
+                    for r in 0..d {
+                        self.problem.q[ai * d + r] = g[r];
+                        self.gd_before[ai * d + r] = g0[r];
+                    }
                 }
             } else {
                 self.assemble_rows(model, data);
@@ -574,7 +576,7 @@ impl MoreauJean {
             for (ai, a) in self.act.iter().enumerate() {
                 let (friction, impact, gd_t, prev, prev_state) = match a.source {
                     Source::Point(pt) => {
-                        let con = model.contact_of_point(pt);
+                        let con = &model.contacts[a.contact];
                         let r = &self.results[pt];
                         let prev = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
                         (&con.friction, &con.impact, self.kin[pt].gd_t, prev, r.state)
@@ -630,7 +632,12 @@ impl MoreauJean {
                     !matches!(friction, FrictionLaw::None) && !sliding_in && friction.mu(f64::MIN_POSITIVE) < mu;
                 self.static_mu.push(sliding_less);
                 self.problem.mu.push(mu);
-                self.r.extend_from_slice(&prev[..d]);
+                if d == 3 {
+                    // (a fixed-size copy: a slice of d values is a library call)
+                    self.r.extend_from_slice(&prev);
+                } else {
+                    self.r.extend_from_slice(&prev[..d]);
+                }
             }
             // sweeps from the bottom up along gravity: each contact then sees the newest support
             // below it, and a warm-started pile settles in fewer sweeps than in pair order
@@ -644,7 +651,7 @@ impl MoreauJean {
             // independent islands (sparse assembly only: the dense one couples through M̃⁻¹)
             match self.sparse.as_ref() {
                 Some(sp) => {
-                    self.islands.partition(m, &sp.upper);
+                    self.islands.partition(m, &sp.links);
                     if self.islands.count() > 1 {
                         self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r, &self.height);
                     }
@@ -683,7 +690,7 @@ impl MoreauJean {
                         || self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)? == ContactState::Slip
                     {
                         let law = match self.act[ai].source {
-                            Source::Point(pt) => &model.contact_of_point(pt).friction,
+                            Source::Point(_) => &model.contacts[self.act[ai].contact].friction,
                             Source::Group { group, .. } => &model.contact_groups[group].friction,
                         };
                         self.problem.mu[ai] = law.mu(speed.max(f64::MIN_POSITIVE));
@@ -728,14 +735,16 @@ impl MoreauJean {
             let q_scale = 1.0 + self.problem.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             for ai in 0..m {
                 let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
-                let state = self.problem.contact_state_scaled(ai, &self.r, tol, r_scale, q_scale)?;
+                let state = self.problem.contact_state_unchecked(ai, &self.r, tol, r_scale, q_scale);
                 let code = match state {
                     ContactState::Open => OPEN,
                     ContactState::Stick => STICK,
                     ContactState::Slip => SLIP,
                 };
                 let mut imp = [0.0; 3];
-                imp[..d].copy_from_slice(&self.r[ai * d..(ai + 1) * d]);
+                for (r, v) in imp.iter_mut().enumerate().take(d) {
+                    *v = self.r[ai * d + r];
+                }
                 match self.act[ai].source {
                     Source::Point(pt) => {
                         self.results[pt] = PointResult {

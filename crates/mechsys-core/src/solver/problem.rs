@@ -217,6 +217,15 @@ impl BlockDelassusBuilder {
     }
 }
 
+/// Resizes `v` to `n` entries, filling with `x` only where it grows.
+fn set_len<T: Copy>(v: &mut Vec<T>, n: usize, x: T) {
+    if v.len() > n {
+        v.truncate(n);
+    } else {
+        v.resize(n, x);
+    }
+}
+
 impl Default for BlockDelassus {
     fn default() -> Self {
         BlockDelassus { dim: 3, n: 0, diag: Vec::new(), row_start: vec![0], col: Vec::new(), val: Vec::new() }
@@ -248,23 +257,31 @@ impl BlockDelassus {
             self.row_start[i + 2] += self.row_start[i + 1];
         }
         let m = 2 * upper.len();
-        self.col.clear();
-        self.col.resize(m, 0);
-        self.val.clear();
-        self.val.resize(m * dd, 0.0);
+        // every slot is written below: sized without zeroing what is already there
+        set_len(&mut self.col, m, 0);
+        set_len(&mut self.val, m * dd, 0.0);
         // row_start[i + 1] is the next free slot of row i while filling; afterwards the start of row i + 1
         for (k, &(i, j)) in upper.iter().enumerate() {
             let b = &upper_val[k * dd..(k + 1) * dd];
             let s = self.row_start[i + 1];
             self.row_start[i + 1] += 1;
             self.col[s] = j;
-            self.val[s * dd..(s + 1) * dd].copy_from_slice(b);
-            let s = self.row_start[j + 1];
+            let t = self.row_start[j + 1];
             self.row_start[j + 1] += 1;
-            self.col[s] = i;
-            for a in 0..dim {
-                for c in 0..dim {
-                    self.val[s * dd + a * dim + c] = b[c * dim + a];
+            self.col[t] = i;
+            if let Ok(b) = <&[f64; 9]>::try_from(b) {
+                // fixed-size copies (a slice copy of d² values is a library call)
+                let v: &mut [f64; 9] = (&mut self.val[s * 9..s * 9 + 9]).try_into().unwrap();
+                *v = *b;
+                let v: &mut [f64; 9] = (&mut self.val[t * 9..t * 9 + 9]).try_into().unwrap();
+                *v = [b[0], b[3], b[6], b[1], b[4], b[7], b[2], b[5], b[8]];
+            } else {
+                self.val[s * dd..(s + 1) * dd].copy_from_slice(b);
+                let s = t;
+                for a in 0..dim {
+                    for c in 0..dim {
+                        self.val[s * dd + a * dim + c] = b[c * dim + a];
+                    }
                 }
             }
         }
@@ -588,13 +605,21 @@ impl FrictionContact {
         q_scale: f64,
     ) -> Result<ContactState> {
         let (ri, u) = self.local(i, r)?;
-        Ok(if ri[0] <= tol * r_scale {
-            ContactState::Open
-        } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {
-            ContactState::Slip
-        } else {
-            ContactState::Stick
-        })
+        Ok(classify(&ri, &u, tol, r_scale, q_scale))
+    }
+
+    /// [`FrictionContact::contact_state_scaled`] without the checks of `i` and `r` (a stepper's
+    /// loop over the contacts of the problem it has just solved).
+    pub(crate) fn contact_state_unchecked(&self, i: usize, r: &[f64], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
+        let d = self.dim;
+        let mut u = [0.0; 3];
+        self.w.add_row_product(d, i, r, false, &mut u);
+        let mut ri = [0.0; 3];
+        for a in 0..d {
+            u[a] += self.q[i * d + a];
+            ri[a] = r[i * d + a];
+        }
+        classify(&ri, &u, tol, r_scale, q_scale)
     }
 
     /// Open, stick or slip for contact `i` of the solution `r`.
@@ -613,6 +638,18 @@ impl FrictionContact {
         } else {
             ContactState::Stick
         })
+    }
+}
+
+/// Open if `r_N ≤ tol r_scale`, else slip if `|u_T| > tol q_scale`, else stick.
+#[inline]
+fn classify(ri: &[f64; 3], u: &[f64; 3], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
+    if ri[0] <= tol * r_scale {
+        ContactState::Open
+    } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {
+        ContactState::Slip
+    } else {
+        ContactState::Stick
     }
 }
 

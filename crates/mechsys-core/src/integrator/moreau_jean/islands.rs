@@ -62,7 +62,8 @@ impl Islands {
         self.count = usize::from(n > 0);
     }
 
-    /// Partitions `n` contacts linked by the pairs `upper` (i < j).
+    /// Partitions `n` contacts linked by the pairs `upper` (the coupled pairs, or any set of
+    /// links with the same connected components).
     pub(super) fn partition(&mut self, n: usize, upper: &[(usize, usize)]) {
         self.of.clear();
         self.of.extend(0..n);
@@ -85,6 +86,10 @@ impl Islands {
                 self.local[i] = self.count; // the island's label, for now
                 self.count += 1;
             }
+        }
+        if self.count <= 1 {
+            // one island (or none): the problem is solved whole, the members are not needed
+            return;
         }
         for i in 0..n {
             let root = self.of[i];

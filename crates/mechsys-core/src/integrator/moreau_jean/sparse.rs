@@ -20,73 +20,39 @@ use crate::math::Vec3;
 use crate::model::Model;
 use crate::spatial::Motion;
 
-/// `M = Lᵀ D L` on the velocity tree (the same recursion as the constrained solve's factor,
-/// kept here so that the contact rows can be reduced on their own patterns).
+/// `M = Lᵀ D L` on the velocity tree: a copy of the dynamics stage's factor
+/// ([`crate::dynamics::sparse::Saddle`], the same ancestor layout), with `D^{-1/2}`, so that the
+/// contact rows can be reduced on their own patterns.
 #[derive(Debug, Clone)]
 pub(super) struct TreeFactor {
     nu: usize,
-    depth: Vec<usize>,
     /// Ancestors of velocity k, nearest first: `anc_idx[anc_ptr[k]..anc_ptr[k + 1]]`.
     anc_ptr: Vec<usize>,
     anc_idx: Vec<usize>,
-    /// `M(k, ancestor)`, then `L` after [`TreeFactor::factor`].
+    /// `L(k, ancestor)`.
     off: Vec<f64>,
-    /// Diagonal of M, then D.
+    /// D.
     diag: Vec<f64>,
-    /// `D^{-1/2}` after factoring.
+    /// `D^{-1/2}`.
     inv_sqrt_d: Vec<f64>,
 }
 
 impl TreeFactor {
     fn new(model: &Model) -> Self {
         let nu = model.nu;
-        let (_, depth, anc_ptr, anc_idx) = crate::dynamics::sparse::velocity_ancestors(model);
-        TreeFactor {
-            nu,
-            depth,
-            off: vec![0.0; anc_idx.len()],
-            anc_ptr,
-            anc_idx,
-            diag: vec![0.0; nu],
-            inv_sqrt_d: vec![0.0; nu],
-        }
+        let (_, _, anc_ptr, anc_idx) = crate::dynamics::sparse::velocity_ancestors(model);
+        TreeFactor { nu, off: vec![0.0; anc_idx.len()], anc_ptr, anc_idx, diag: vec![0.0; nu], inv_sqrt_d: vec![0.0; nu] }
     }
 
-    /// Sets `M(r, c)` (either triangle; r and c on one root path).
-    #[inline]
-    pub(super) fn put(&mut self, r: usize, c: usize, v: f64) {
-        if r == c {
-            self.diag[r] = v;
-        } else {
-            let (hi, lo) = if r > c { (r, c) } else { (c, r) };
-            self.off[self.anc_ptr[hi] + self.depth[hi] - 1 - self.depth[lo]] = v;
+    /// Takes the factor of M just computed by [`crate::dynamics::sparse::Saddle::factor_mass`]
+    /// (factoring M a second time here gave the same numbers).
+    pub(super) fn copy_from(&mut self, saddle: &crate::dynamics::sparse::Saddle) {
+        let (off, diag) = saddle.mass_factor();
+        self.off.copy_from_slice(off);
+        self.diag.copy_from_slice(diag);
+        for (s, d) in self.inv_sqrt_d.iter_mut().zip(&self.diag) {
+            *s = 1.0 / d.sqrt();
         }
-    }
-
-    /// Factors in place, leaves first: `M = Lᵀ D L`; false if a pivot is not positive.
-    pub(super) fn factor(&mut self) -> bool {
-        let scale = self.diag.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
-        for k in (0..self.nu).rev() {
-            let d = self.diag[k];
-            if !(d > 1e-14 * scale) {
-                return false;
-            }
-            let (s, e) = (self.anc_ptr[k], self.anc_ptr[k + 1]);
-            for p in 0..e - s {
-                let i = self.anc_idx[s + p];
-                let mk = self.off[s + p];
-                let a = mk / d;
-                self.diag[i] -= a * mk;
-                // M(i, j) -= a M(k, j) for the ancestors j of i (they follow i on k's path)
-                let si = self.anc_ptr[i];
-                for q in p + 1..e - s {
-                    self.off[si + q - p - 1] -= a * self.off[s + q];
-                }
-                self.off[s + p] = a;
-            }
-            self.inv_sqrt_d[k] = 1.0 / d.sqrt();
-        }
-        true
     }
 
     /// `x ← M⁻¹ x`.
@@ -116,6 +82,13 @@ pub(super) struct SparseRows {
     dim: usize,
     /// Root velocity of body b's path (usize::MAX for the ground and bodies without velocities).
     root: Vec<usize>,
+    /// Per body: the first velocity of its joint if its root path is one free joint on the ground
+    /// and it has no elastic coordinates (its rows take [`SparseRows::add_free_contact`]), else
+    /// usize::MAX.
+    free: Vec<usize>,
+    /// Per body: the ground or a free body in the sense of `free`, both without elastic
+    /// coordinates.
+    fast: Vec<bool>,
     /// Pattern of contact a: `pat_idx[pat_ptr[a]..pat_ptr[a + 1]]`, ascending.
     pat_ptr: Vec<usize>,
     pat_idx: Vec<usize>,
@@ -142,6 +115,9 @@ pub(super) struct SparseRows {
     /// Off-diagonal pairs (i < j) and their row-major blocks.
     pub(super) upper: Vec<(usize, usize)>,
     pub(super) upper_val: Vec<f64>,
+    /// Each contact that shares a root with an earlier one, linked to the first contact of that
+    /// root: the same connected components as `upper` with fewer links (for the islands).
+    pub(super) links: Vec<(usize, usize)>,
     /// Scratch (nu).
     f: Vec<f64>,
 }
@@ -152,6 +128,8 @@ impl SparseRows {
         let factor = TreeFactor::new(model);
         let nb = model.nbodies();
         let mut root = vec![usize::MAX; nb];
+        let mut free = vec![usize::MAX; nb];
+        let mut fast = vec![false; nb];
         let (mut body_runs_ptr, mut body_runs) = (vec![0; nb + 1], Vec::new());
         let mut buf = Vec::new();
         for b in 0..nb {
@@ -180,11 +158,20 @@ impl SparseRows {
             }
             buf.sort_unstable();
             root[b] = buf.first().copied().unwrap_or(usize::MAX);
+            if b != 0 && model.bodies[b].elastic.is_none() {
+                let j = &model.joints[b - 1];
+                if j.parent == 0 && matches!(j.kind, crate::model::JointKind::Free) {
+                    free[b] = j.iu;
+                }
+            }
+            fast[b] = model.bodies[b].elastic.is_none() && (b == 0 || free[b] != usize::MAX);
         }
         SparseRows {
             factor,
             dim,
             root,
+            free,
+            fast,
             pat_ptr: vec![0],
             pat_idx: Vec::new(),
             run_ptr: vec![0],
@@ -200,6 +187,7 @@ impl SparseRows {
             diag: Vec::new(),
             upper: Vec::new(),
             upper_val: Vec::new(),
+            links: Vec::new(),
             f: vec![0.0; model.nu],
         }
     }
@@ -224,6 +212,29 @@ impl SparseRows {
     /// on `b2` (world points), and reduces them (the factor must be current).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_contact(
+        &mut self,
+        model: &Model,
+        s_all: &[[Motion; 6]],
+        el: crate::kinematics::ElasticView<'_>,
+        b1: usize,
+        p1: &Vec3,
+        b2: usize,
+        p2: &Vec3,
+        dirs: &[Vec3; 3],
+    ) {
+        if b1 != b2 && self.fast[b1] && self.fast[b2] {
+            match self.dim {
+                3 => self.add_free_contact::<3>(s_all, b1, p1, b2, p2, dirs),
+                _ => self.add_free_contact::<2>(s_all, b1, p1, b2, p2, dirs),
+            }
+        } else {
+            self.add_general_contact(model, s_all, el, b1, p1, b2, p2, dirs);
+        }
+    }
+
+    /// [`SparseRows::add_contact`] on any two bodies (root paths of any joints, elastic points).
+    #[allow(clippy::too_many_arguments)]
+    fn add_general_contact(
         &mut self,
         model: &Model,
         s_all: &[[Motion; 6]],
@@ -316,44 +327,111 @@ impl SparseRows {
         }
     }
 
+    /// [`SparseRows::add_contact`] for two distinct bodies that are each the ground or a free
+    /// body on the ground: the pattern is one block of six velocities per free body, and within
+    /// it `L` is a dense unit triangle (velocity `iu + j` has the ancestors `iu + j - 1, ..., iu`),
+    /// so the rows are built and reduced block by block without the pattern's indirection. The
+    /// same sums in the same order as the general path: the results are identical.
+    fn add_free_contact<const D: usize>(
+        &mut self,
+        s_all: &[[Motion; 6]],
+        b1: usize,
+        p1: &Vec3,
+        b2: usize,
+        p2: &Vec3,
+        dirs: &[Vec3; 3],
+    ) {
+        let start = self.pat_idx.len();
+        // the free sides in ascending velocity order (the pattern's)
+        let mut sides = [(0usize, p1, 1.0f64, usize::MAX); 2];
+        let mut ns = 0;
+        for (b, p, sign) in [(b1, p1, 1.0), (b2, p2, -1.0)] {
+            if b != 0 {
+                sides[ns] = (b, p, sign, self.free[b]);
+                ns += 1;
+            }
+        }
+        if ns == 2 && sides[1].3 < sides[0].3 {
+            sides.swap(0, 1);
+        }
+        for side in &sides[..ns] {
+            let iu = side.3;
+            self.runs.push((iu, 6, self.pat_idx.len()));
+            self.pat_idx.extend(iu..iu + 6);
+        }
+        self.run_ptr.push(self.runs.len());
+        self.pat_ptr.push(self.pat_idx.len());
+        self.roots.push([self.root[b1], self.root[b2]]);
+        let w0 = self.w.len();
+        let f = &self.factor;
+        for &(b, p, sign, iu) in &sides[..ns] {
+            // eq. 2.112 ff.: the six columns of J_P, projected on the directions
+            let mut w = [[0.0; D]; 6];
+            for (k, wk) in w.iter_mut().enumerate() {
+                let s = &s_all[b][k];
+                let v = (s.v + s.w.cross(p)) * sign;
+                for r in 0..D {
+                    // (0 + x as in the general path's accumulation: the same signed zeros)
+                    wk[r] = 0.0 + dirs[r].dot(&v);
+                }
+            }
+            // y = D^{-1/2} L⁻ᵀ w, leaves first; L(iu + j, iu + j - 1 - p) at off[base + j(j-1)/2 + p]
+            let base = f.anc_ptr[iu];
+            let mut y = w;
+            for j in (1..6).rev() {
+                let v = y[j];
+                let lj = base + j * (j - 1) / 2;
+                for p in 0..j {
+                    let l = f.off[lj + p];
+                    for r in 0..D {
+                        y[j - 1 - p][r] -= l * v[r];
+                    }
+                }
+            }
+            for (k, yk) in y.iter_mut().enumerate() {
+                let s = f.inv_sqrt_d[iu + k];
+                for v in yk.iter_mut() {
+                    *v *= s;
+                }
+            }
+            self.w.extend_from_slice(w.as_flattened());
+            self.y.extend_from_slice(y.as_flattened());
+        }
+        debug_assert_eq!(self.w.len(), w0 + (self.pat_idx.len() - start) * D);
+    }
+
     /// The Delassus blocks of the contacts added: `diag` (n d², row-major) and the coupled pairs
     /// in `upper`, `upper_val`. A tangent row that is zero (a direction along which nothing can
     /// move, e.g. out of the plane of a planar mechanism) gets the normal's diagonal value so that
     /// its impulse comes out zero.
     pub(super) fn delassus(&mut self) {
-        let (d, n) = (self.dim, self.len());
-        let dd = d * d;
+        // fixed-size blocks: no loop over the dimension nor library calls for d² copies
+        match self.dim {
+            3 => self.delassus_d::<3>(),
+            _ => self.delassus_d::<2>(),
+        }
+    }
+
+    fn delassus_d<const D: usize>(&mut self) {
+        let n = self.len();
         self.diag.clear();
-        self.diag.resize(n * dd, 0.0);
         for a in 0..n {
             let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
-            let blk = &mut self.diag[a * dd..(a + 1) * dd];
-            if d == 3 {
-                // accumulated in registers (the same sums in the same order as the general loop)
-                let mut acc = [0.0; 9];
-                for y in self.y[s * 3..e * 3].chunks_exact(3) {
-                    for r in 0..3 {
-                        acc[3 * r] += y[r] * y[0];
-                        acc[3 * r + 1] += y[r] * y[1];
-                        acc[3 * r + 2] += y[r] * y[2];
-                    }
-                }
-                blk.copy_from_slice(&acc);
-            } else {
-                for x in s..e {
-                    let y = &self.y[x * d..(x + 1) * d];
-                    for r in 0..d {
-                        for c in 0..d {
-                            blk[r * d + c] += y[r] * y[c];
-                        }
+            // accumulated in registers, every sum from 0 in pattern order
+            let mut acc = [[0.0; D]; D];
+            for y in self.y[s * D..e * D].chunks_exact(D) {
+                for r in 0..D {
+                    for c in 0..D {
+                        acc[r][c] += y[r] * y[c];
                     }
                 }
             }
-            for r in 1..d {
-                if (s..e).all(|x| self.w[x * d + r] == 0.0) {
-                    blk[r * d + r] = blk[0].max(f64::MIN_POSITIVE);
+            for r in 1..D {
+                if self.w[s * D..e * D].chunks_exact(D).all(|w| w[r] == 0.0) {
+                    acc[r][r] = acc[0][0].max(f64::MIN_POSITIVE);
                 }
             }
+            self.diag.extend_from_slice(acc.as_flattened());
         }
         // buckets of contacts by root velocity
         let nu = self.pos.len();
@@ -382,26 +460,36 @@ impl SparseRows {
             }
         }
         // bucket_ptr[r]..bucket_ptr[r + 1] now lists root r's contacts, ascending
+        self.links.clear();
+        for r in 0..nu {
+            let (s, e) = (self.bucket_ptr[r], self.bucket_ptr[r + 1]);
+            for x in s + 1..e {
+                self.links.push((self.bucket[s], self.bucket[x]));
+            }
+        }
         self.upper.clear();
         self.upper_val.clear();
         for r in 0..nu {
             let (s, e) = (self.bucket_ptr[r], self.bucket_ptr[r + 1]);
             for x in s..e {
                 let i = self.bucket[x];
+                let ri = self.roots[i];
                 for z in x + 1..e {
                     let j = self.bucket[z];
+                    let rj = self.roots[j];
                     // the pair is formed at the smallest root the two contacts share
-                    let shared = self.roots[i]
-                        .iter()
-                        .filter(|&&ri| ri != usize::MAX && self.roots[j].contains(&ri))
-                        .min()
-                        .copied();
-                    if shared != Some(r) {
+                    let mut shared = usize::MAX;
+                    for a in ri {
+                        if a != usize::MAX && (a == rj[0] || a == rj[1]) && a < shared {
+                            shared = a;
+                        }
+                    }
+                    if shared != r {
                         continue;
                     }
-                    let off = self.upper_val.len();
-                    self.upper_val.resize(off + dd, 0.0);
-                    // Σ over the shared velocities: the runs both patterns have (ascending)
+                    // Σ over the shared velocities: the runs both patterns have (ascending), the
+                    // block in registers (every sum from 0 in the same order)
+                    let mut acc = [[0.0; D]; D];
                     let (mut p, pe) = (self.run_ptr[i], self.run_ptr[i + 1]);
                     let (mut q, qe) = (self.run_ptr[j], self.run_ptr[j + 1]);
                     while p < pe && q < qe {
@@ -411,33 +499,18 @@ impl SparseRows {
                         } else if kq < kp {
                             q += 1;
                         } else {
-                            let blk = &mut self.upper_val[off..off + dd];
-                            let (ya, yb) = (&self.y[ep * d..(ep + len) * d], &self.y[eq * d..(eq + len) * d]);
-                            if d == 3 {
-                                // in registers, stored once per run (same order of the sums)
-                                let blk: &mut [f64; 9] = blk.try_into().unwrap();
-                                let mut acc = *blk;
-                                for (a, b) in ya.chunks_exact(3).zip(yb.chunks_exact(3)) {
-                                    for r in 0..3 {
-                                        acc[3 * r] += a[r] * b[0];
-                                        acc[3 * r + 1] += a[r] * b[1];
-                                        acc[3 * r + 2] += a[r] * b[2];
-                                    }
-                                }
-                                *blk = acc;
+                            let (ya, yb) = (&self.y[ep * D..(ep + len) * D], &self.y[eq * D..(eq + len) * D]);
+                            if len == 6 {
+                                // a free joint's six velocities: fixed-size, unrolled
+                                add_products::<D>(&mut acc, &ya[..6 * D], &yb[..6 * D]);
                             } else {
-                                for (a, b) in ya.chunks_exact(d).zip(yb.chunks_exact(d)) {
-                                    for r in 0..d {
-                                        for c in 0..d {
-                                            blk[r * d + c] += a[r] * b[c];
-                                        }
-                                    }
-                                }
+                                add_products::<D>(&mut acc, ya, yb);
                             }
                             p += 1;
                             q += 1;
                         }
                     }
+                    self.upper_val.extend_from_slice(acc.as_flattened());
                     self.upper.push((i, j));
                 }
             }
@@ -446,36 +519,165 @@ impl SparseRows {
 
     /// `out[r] = w_{a,r}ᵀ u`, r < dim, for contact `a`.
     pub(super) fn local_velocity(&self, a: usize, u: &[f64], out: &mut [f64; 3]) {
-        let d = self.dim;
-        *out = [0.0; 3];
-        for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
-            let uk = u[self.pat_idx[x]];
-            for r in 0..d {
-                out[r] += self.w[x * d + r] * uk;
+        match self.dim {
+            3 => self.local_velocity_d::<3>(a, u, out),
+            _ => self.local_velocity_d::<2>(a, u, out),
+        }
+    }
+
+    fn local_velocity_d<const D: usize>(&self, a: usize, u: &[f64], out: &mut [f64; 3]) {
+        let mut g = [0.0; 3];
+        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+        for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
+            let uk = u[*k];
+            for r in 0..D {
+                g[r] += w[r] * uk;
             }
         }
+        *out = g;
+    }
+
+    /// [`SparseRows::local_velocity`] at two velocity vectors in one pass over the rows.
+    pub(super) fn local_velocity2(&self, a: usize, u: &[f64], v: &[f64], out_u: &mut [f64; 3], out_v: &mut [f64; 3]) {
+        match self.dim {
+            3 => self.local_velocity2_d::<3>(a, u, v, out_u, out_v),
+            _ => self.local_velocity2_d::<2>(a, u, v, out_u, out_v),
+        }
+    }
+
+    fn local_velocity2_d<const D: usize>(&self, a: usize, u: &[f64], v: &[f64], out_u: &mut [f64; 3], out_v: &mut [f64; 3]) {
+        let (mut gu, mut gv) = ([0.0; 3], [0.0; 3]);
+        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+        for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
+            let (uk, vk) = (u[*k], v[*k]);
+            for r in 0..D {
+                gu[r] += w[r] * uk;
+                gv[r] += w[r] * vk;
+            }
+        }
+        *out_u = gu;
+        *out_v = gv;
     }
 
     /// `u += M⁻¹ Σ_a w_a Λ_a` for the impulses `lambda` (d per contact).
     pub(super) fn apply(&mut self, lambda: &[f64], u: &mut [f64]) {
-        let d = self.dim;
         self.f.fill(0.0);
-        for a in 0..self.len() {
-            let l = &lambda[a * d..(a + 1) * d];
-            if l.iter().all(|v| *v == 0.0) {
-                continue;
-            }
-            for x in self.pat_ptr[a]..self.pat_ptr[a + 1] {
-                let mut s = 0.0;
-                for r in 0..d {
-                    s += self.w[x * d + r] * l[r];
-                }
-                self.f[self.pat_idx[x]] += s;
-            }
+        match self.dim {
+            3 => self.scatter::<3>(lambda),
+            _ => self.scatter::<2>(lambda),
         }
         self.factor.solve(&mut self.f);
         for (ui, fi) in u.iter_mut().zip(&self.f) {
             *ui += fi;
+        }
+    }
+}
+
+impl SparseRows {
+    /// `f += Σ_a w_a Λ_a` on the patterns.
+    fn scatter<const D: usize>(&mut self, lambda: &[f64]) {
+        for a in 0..self.len() {
+            let l: &[f64; D] = lambda[a * D..(a + 1) * D].try_into().unwrap();
+            if l.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+            for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
+                let mut s = 0.0;
+                for r in 0..D {
+                    s += w[r] * l[r];
+                }
+                self.f[*k] += s;
+            }
+        }
+    }
+}
+
+/// `acc += Σ_k a_k b_kᵀ` over the D-vectors of `a` and `b`.
+#[inline(always)]
+fn add_products<const D: usize>(acc: &mut [[f64; D]; D], a: &[f64], b: &[f64]) {
+    for (a, b) in a.chunks_exact(D).zip(b.chunks_exact(D)) {
+        for r in 0..D {
+            for c in 0..D {
+                acc[r][c] += a[r] * b[c];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::Data;
+    use crate::dynamics::sparse::Saddle;
+    use crate::model::ModelDescription;
+
+    /// Two free bodies (off-centre mass) and an arm on a revolute joint.
+    fn model() -> Model {
+        let json = r#"{
+            "name": "free", "gravity": [0, 0, -9.81],
+            "bodies": [
+                {"name": "a", "mass": 1.3, "inertia": [0.01, 0.02, 0.03], "com": [0.05, -0.02, 0.01]},
+                {"name": "b", "mass": 0.7, "inertia": [0.004, 0.005, 0.006]},
+                {"name": "arm", "mass": 0.5, "inertia": [0.001, 0.02, 0.02], "com": [0.2, 0, 0]}
+            ],
+            "joints": [
+                {"name": "fa", "type": "free", "parent": "ground", "child": "a",
+                 "q0": [0.1, 0.2, 0.3, 0.9, 0.1, -0.3, 0.2], "u0": [0.3, -0.2, 0.1, 1.0, -2.0, 0.5]},
+                {"name": "fb", "type": "free", "parent": "ground", "child": "b",
+                 "q0": [-0.2, 0.1, 0.5, 0.7, -0.4, 0.1, 0.5], "u0": [0.1, 0.2, -0.3, 0.4, 0.2, -1.0]},
+                {"name": "j", "type": "revolute", "parent": "ground", "child": "arm", "axis": [0, 1, 0]}
+            ]
+        }"#;
+        Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap()
+    }
+
+    /// The free-body rows and their reduction are the general path's bit for bit (any sign or
+    /// index slip in the fixed-size code shows), and so are the Delassus blocks built from them.
+    #[test]
+    fn free_body_rows_are_the_general_rows_bit_for_bit() {
+        let model = model();
+        let mut data = Data::new(&model);
+        let mut q = model.q0();
+        model.normalize(&mut q);
+        crate::kinematics::forward_pass(&model, &mut data, 0.0, &q, &model.u0());
+        let mut saddle = Saddle::new(&model);
+        {
+            let Data { inertia, s, ic, elastic, .. } = &mut data;
+            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| saddle.put_mass(r, c, v));
+        }
+        assert!(saddle.factor_mass());
+        let n = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let t1 = n.cross(&Vec3::x()).normalize();
+        let dirs = [n, t1, n.cross(&t1)];
+        // (b1, b2): body and ground either way round, two free bodies in both orders
+        let pairs = [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0)];
+        for dim in [3, 2] {
+            let (mut fast, mut general) = (SparseRows::new(&model, dim), SparseRows::new(&model, dim));
+            fast.factor.copy_from(&saddle);
+            general.factor.copy_from(&saddle);
+            for (k, &(b1, b2)) in pairs.iter().enumerate() {
+                let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
+                let p2 = p1 - 1e-3 * n;
+                let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+                fast.add_contact(&model, &data.s, el, b1, &p1, b2, &p2, &dirs);
+                general.add_general_contact(&model, &data.s, el, b1, &p1, b2, &p2, &dirs);
+            }
+            assert_eq!(fast.pat_ptr, general.pat_ptr);
+            assert_eq!(fast.pat_idx, general.pat_idx);
+            assert_eq!(fast.run_ptr, general.run_ptr);
+            assert_eq!(fast.runs, general.runs);
+            assert_eq!(fast.roots, general.roots);
+            assert!(fast.w.iter().any(|v| *v != 0.0) && fast.y.iter().any(|v| *v != 0.0));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&fast.w), bits(&general.w), "rows (dim {dim})");
+            assert_eq!(bits(&fast.y), bits(&general.y), "reduced rows (dim {dim})");
+            fast.delassus();
+            general.delassus();
+            assert_eq!(fast.upper, general.upper);
+            assert!(fast.upper.len() >= 4, "pairs {:?}", fast.upper);
+            assert_eq!(bits(&fast.diag), bits(&general.diag));
+            assert_eq!(bits(&fast.upper_val), bits(&general.upper_val));
         }
     }
 }
