@@ -402,8 +402,9 @@ fn clip_with(rf: &Placed, inc: &Placed, axis: usize, scale: f64, shortcut: bool)
                 *dq = dist(t, k, positive);
             }
             let mut out = 0;
+            // the edge from the previous vertex (cyclic; no integer division in this loop)
+            let mut qp = count - 1;
             for q in 0..count {
-                let qp = (q + count - 1) % count;
                 let (p, qv) = (&src[qp], &src[q]);
                 let (dp, dq) = (d[qp], d[q]);
                 let crossing = |out: &mut usize, dst: &mut [Vertex; POINTS]| {
@@ -433,6 +434,7 @@ fn clip_with(rf: &Placed, inc: &Placed, axis: usize, scale: f64, shortcut: bool)
                 } else if dp < -tol {
                     crossing(&mut out, dst);
                 }
+                qp = q;
             }
             count = out;
             cur = 1 - cur;
