@@ -124,7 +124,7 @@ pub fn contact_kinematics_warm(
     // a moving surface: its material slides over its contour at the body-fixed velocity u_i,
     // so it moves at v_i(P) + A_i u_i; tangential, so ġ_N and the W-part are unchanged
     let surface = pair.surface_velocity();
-    let (ws1, ws2) = (b1.pose.a * surface[0], b2.pose.a * surface[1]);
+    let (ws1, ws2) = surface_motion(surface, b1, b2);
     let dws = ws1 - ws2;
     // the candidates of a face manifold or a box on a plane share their normal (and its rate):
     // their tangents are computed once
@@ -187,8 +187,8 @@ pub fn contact_velocities_warm(
     }
     let (tw1, tw2) = (&b1.twist, &b2.twist);
     // the same expressions as the full kinematics, in the same order (bit-identical results)
-    let surface = pair.surface_velocity();
-    let dws = b1.pose.a * surface[0] - b2.pose.a * surface[1];
+    let (ws1, ws2) = surface_motion(pair.surface_velocity(), b1, b2);
+    let dws = ws1 - ws2;
     let dw = tw1.w - tw2.w;
     let mut shared: Option<(Vec3, Tangents)> = None;
     let each = |k: usize, r: &super::narrow::Raw| {
@@ -217,6 +217,14 @@ pub fn contact_velocities_warm(
         None => pair.each_candidate(&b1.pose, &b2.pose, None, each),
     }
     Ok(())
+}
+
+/// World velocities `A_i u_i` of the contours' moving surfaces (zero, without products, for
+/// contours at rest on their bodies: almost every pair).
+#[inline]
+fn surface_motion(surface: &[Vec3; 2], b1: &BodyMotion, b2: &BodyMotion) -> (Vec3, Vec3) {
+    let world = |b: &BodyMotion, u: &Vec3| if *u == Vec3::zeros() { Vec3::zeros() } else { b.pose.a * u };
+    (world(b1, &surface[0]), world(b2, &surface[1]))
 }
 
 /// The kinematics of every point of `con` into `out[..con.points()]`: from the bodies' motion in

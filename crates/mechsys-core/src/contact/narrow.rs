@@ -895,8 +895,10 @@ fn swept(
     r2: f64,
     across: &Vec3,
 ) -> Raw {
-    let (a1, d1) = (x1.point_to_parent(a1b), x1.a * d1b);
-    let (a2, d2) = (x2.point_to_parent(a2b), x2.a * d2b);
+    // a sphere's or point's segment has no direction to turn (spares two products per pair)
+    let turn = |x: &Pose, d: &Vec3| if *d == Vec3::zeros() { Vec3::zeros() } else { x.a * d };
+    let (a1, d1) = (x1.point_to_parent(a1b), turn(x1, d1b));
+    let (a2, d2) = (x2.point_to_parent(a2b), turn(x2, d2b));
     let r = a1 - a2;
     let (aa, ee, bb, cc, ff) = (d1.dot(&d1), d2.dot(&d2), d1.dot(&d2), d1.dot(&r), d2.dot(&r));
     let clamp01 = |x: f64| x.clamp(0.0, 1.0);
