@@ -43,7 +43,7 @@ use crate::math::Vec3;
 use crate::model::contact::Contact;
 
 use super::narrow::warm::SearchHint;
-use super::narrow::{ContactPair, ContactPoint, Tangents};
+use super::narrow::{ContactPair, ContactPoint, Raw, Tangents};
 
 pub use crate::kinematics::BodyMotion;
 
@@ -129,8 +129,17 @@ pub fn contact_kinematics_warm(
     // the candidates of a face manifold or a box on a plane share their normal (and its rate):
     // their tangents are computed once
     let mut shared: Option<(Vec3, Vec3, Tangents)> = None;
+    let mut last: Option<(usize, Raw)> = None;
     // one evaluation of the pair: shared work (a box–box manifold) is done once for all candidates
-    let each = |k: usize, r: &super::narrow::Raw| {
+    let each = |k: usize, r: &Raw| {
+        // the unused candidates of a manifold are one and the same
+        if let Some((j, p)) = &last {
+            if same_bits(p, r, true) {
+                out[k] = out[*j];
+                return;
+            }
+        }
+        last = Some((k, *r));
         let t = match shared {
             Some((n, nd, t)) if n == r.n && nd == r.nd => t,
             _ => {
@@ -191,7 +200,15 @@ pub fn contact_velocities_warm(
     let dws = ws1 - ws2;
     let dw = tw1.w - tw2.w;
     let mut shared: Option<(Vec3, Tangents)> = None;
-    let each = |k: usize, r: &super::narrow::Raw| {
+    let mut last: Option<(usize, Raw)> = None;
+    let each = |k: usize, r: &Raw| {
+        if let Some((j, p)) = &last {
+            if same_bits(p, r, false) {
+                out[k] = out[*j];
+                return;
+            }
+        }
+        last = Some((k, *r));
         let t = match shared {
             Some((n, t)) if n == r.n => t,
             _ => {
@@ -217,6 +234,18 @@ pub fn contact_velocities_warm(
         None => pair.each_candidate(&b1.pose, &b2.pose, None, each),
     }
     Ok(())
+}
+
+/// Whether two candidates are the same bit for bit: geometry, and with `rates` their rates (a
+/// repeated candidate then has the same kinematics, copied instead of recomputed).
+#[inline]
+fn same_bits(a: &Raw, b: &Raw, rates: bool) -> bool {
+    let eq = |x: &Vec3, y: &Vec3| x.iter().zip(y.iter()).all(|(u, v)| u.to_bits() == v.to_bits());
+    a.g.to_bits() == b.g.to_bits()
+        && eq(&a.n, &b.n)
+        && eq(&a.p1, &b.p1)
+        && eq(&a.p2, &b.p2)
+        && (!rates || (eq(&a.nd, &b.nd) && eq(&a.p1d, &b.p1d) && eq(&a.p2d, &b.p2d)))
 }
 
 /// World velocities `A_i u_i` of the contours' moving surfaces (zero, without products, for

@@ -337,8 +337,8 @@ fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
     clip_with(rf, inc, axis, scale, true)
 }
 
-/// [`clip`]; `shortcut`: an incident face within the reference face's side planes is taken
-/// whole (off in tests, to compare with the clipping passes).
+/// [`clip`]; `shortcut`: a pass that cuts nothing leaves the polygon in place (off in tests:
+/// every pass copies it, the plain Sutherland–Hodgman, to compare with).
 fn clip_with(rf: &Placed, inc: &Placed, axis: usize, scale: f64, shortcut: bool) -> Manifold {
     let tol = TIE * scale;
     let ra = rf.axis(axis);
@@ -366,28 +366,31 @@ fn clip_with(rf: &Placed, inc: &Placed, axis: usize, scale: f64, shortcut: bool)
         let rel = buf[0][n].p - rf.c;
         *pr = [rf.axis(sides[0]).dot(&rel), rf.axis(sides[1]).dot(&rel)];
     }
-    let inside = shortcut && proj.iter().all(|pr| (0..2).all(|s| dist(pr[s], sides[s], true) <= tol && dist(pr[s], sides[s], false) <= tol));
-    if inside {
-        // face on face within the reference face (a stack): nothing is cut, the corners only
-        // learn the side planes they lie on, in the order the clipping passes would add them
-        for (s, &k) in sides.iter().enumerate() {
-            for positive in [true, false] {
-                let label = Label { on_ref: true, axis: k as u8, positive };
-                for (v, pr) in buf[0].iter_mut().zip(&proj) {
-                    if dist(pr[s], k, positive).abs() <= tol {
-                        v.add(label);
-                    }
-                }
-            }
-        }
-        return Manifold { v: buf[0], count: 4, m, p_ref, f, fc };
-    }
     let mut count = 4;
     let mut cur = 0;
+    // the polygon is still the incident face's corners (their projections are at hand)
+    let mut corners = true;
     for (s, &k) in sides.iter().enumerate() {
         let e = rf.axis(k);
         for positive in [true, false] {
             let label = Label { on_ref: true, axis: k as u8, positive };
+            // each vertex's distance once
+            let mut d = [0.0; POINTS];
+            for (q, dq) in d.iter_mut().enumerate().take(count) {
+                let t = if corners { proj[q][s] } else { e.dot(&(buf[cur][q].p - rf.c)) };
+                *dq = dist(t, k, positive);
+            }
+            if shortcut && d[..count].iter().all(|&x| x <= tol) {
+                // nothing is cut (a stack's faces; three of the four planes of a box straddling
+                // two others): the pass would copy every vertex, adding this plane to those on it
+                for (v, dq) in buf[cur][..count].iter_mut().zip(&d) {
+                    if dq.abs() <= tol {
+                        v.add(label);
+                    }
+                }
+                continue;
+            }
+            corners = false;
             let (src, dst) = if cur == 0 {
                 let (a, b) = buf.split_at_mut(1);
                 (&a[0], &mut b[0])
@@ -395,12 +398,6 @@ fn clip_with(rf: &Placed, inc: &Placed, axis: usize, scale: f64, shortcut: bool)
                 let (a, b) = buf.split_at_mut(1);
                 (&b[0], &mut a[0])
             };
-            // each vertex's distance once (the first pass has the corners' already)
-            let mut d = [0.0; POINTS];
-            for (q, dq) in d.iter_mut().enumerate().take(count) {
-                let t = if count == 4 && s == 0 && positive { proj[q][0] } else { e.dot(&(src[q].p - rf.c)) };
-                *dq = dist(t, k, positive);
-            }
             let mut out = 0;
             // the edge from the previous vertex (cyclic; no integer division in this loop)
             let mut qp = count - 1;
@@ -672,8 +669,8 @@ pub(super) fn feature(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale:
 }
 
 /// Whether the face manifold at these placements (if the feature is a face) is the same with
-/// and without the shortcut for an uncut incident face, bit for bit; `None` for edge features,
-/// `Some((same, shortcut taken))` otherwise (tests).
+/// and without the in-place passes, bit for bit; `None` for edge features, `Some((same, the
+/// incident face uncut))` otherwise (tests).
 #[cfg(test)]
 pub(super) fn shortcut_agrees(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> Option<(bool, bool)> {
     let (a, b) = (Placed::new(sa, x1), Placed::new(sb, x2));
@@ -681,7 +678,6 @@ pub(super) fn shortcut_agrees(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape
     let (rf, inc) = if ref_a { (&a, &b) } else { (&b, &a) };
     let (fast, slow) = (clip_with(rf, inc, axis, scale, true), clip_with(rf, inc, axis, scale, false));
     let same = fast.count == slow.count && fast.v[..fast.count] == slow.v[..slow.count];
-    // the shortcut leaves the corners' own labels first and at most two side planes each
     let taken = fast.count == 4 && fast.v[..4].iter().all(|v| v.kind() == Kind::IncidentCorner);
     Some((same, taken))
 }
