@@ -510,7 +510,8 @@ fn velocity_level_equals_the_full_kinematics_bit_for_bit() {
                 for step in 0..4 {
                     let t = 1e-3 * step as f64;
                     let (b1, b2) = (tr1.at(t), tr2.at(t));
-                    let (mut full, mut vel) = (vec![ContactKinematics::default(); n], vec![ContactKinematics::default(); n]);
+                    let (mut full, mut vel) =
+                        (vec![ContactKinematics::default(); n], vec![ContactKinematics::default(); n]);
                     contact_kinematics_warm(&pair, &b1, &b2, &mut full, Some(&mut h_full)).unwrap();
                     contact_velocities_warm(&pair, &b1, &b2, &mut vel, Some(&mut h_vel)).unwrap();
                     let tag = format!("{a}–{b} order {order} #{it} step {step}");
@@ -536,16 +537,21 @@ fn velocity_level_equals_the_full_kinematics_bit_for_bit() {
 fn velocity_level_keeps_the_surface_velocity() {
     // in the sample plane (normal (0.1, 0.2, 1))
     let belt = Vec3::new(0.0, 0.3, -0.06);
-    let pair = ContactPair::new("belt", sample("box"), sample("plane")).unwrap().with_surface_velocity(2, belt).unwrap();
+    let pair =
+        ContactPair::new("belt", sample("box"), sample("plane")).unwrap().with_surface_velocity(2, belt).unwrap();
     let mut rng = Rng::new(5);
     let (x1, x2) = random_poses(&mut rng, false);
-    let (b1, b2) = (Trajectory::random(&mut rng, &x1, 1.0, 0.5).at(0.0), Trajectory::random(&mut rng, &x2, 1.0, 0.5).at(0.0));
+    let (b1, b2) =
+        (Trajectory::random(&mut rng, &x1, 1.0, 0.5).at(0.0), Trajectory::random(&mut rng, &x2, 1.0, 0.5).at(0.0));
     let n = pair.candidates();
     let (mut full, mut vel) = (vec![ContactKinematics::default(); n], vec![ContactKinematics::default(); n]);
     contact_kinematics(&pair, &b1, &b2, &mut full).unwrap();
     contact_velocities_warm(&pair, &b1, &b2, &mut vel, None).unwrap();
     for (f, v) in full.iter().zip(&vel) {
-        assert_eq!((f.point, f.gd_n, f.gd_t, f.w_tilde, f.omega_rel), (v.point, v.gd_n, v.gd_t, v.w_tilde, v.omega_rel));
+        assert_eq!(
+            (f.point, f.gd_n, f.gd_t, f.w_tilde, f.omega_rel),
+            (v.point, v.gd_n, v.gd_t, v.w_tilde, v.omega_rel)
+        );
         assert!(v.w_tilde[1].abs() + v.w_tilde[2].abs() > 0.0);
     }
 }

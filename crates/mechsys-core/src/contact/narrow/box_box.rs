@@ -154,7 +154,8 @@ fn choose(a: &Placed, b: &Placed, scale: f64) -> (Feature, f64) {
     let tol = TIE * scale;
     let (ax, bx) = ([a.axis(0), a.axis(1), a.axis(2)], [b.axis(0), b.axis(1), b.axis(2)]);
     let r: [[f64; 3]; 3] = std::array::from_fn(|k| std::array::from_fn(|l| ax[k].dot(&bx[l])));
-    let (da, db): ([f64; 3], [f64; 3]) = (std::array::from_fn(|k| ax[k].dot(&d)), std::array::from_fn(|l| bx[l].dot(&d)));
+    let (da, db): ([f64; 3], [f64; 3]) =
+        (std::array::from_fn(|k| ax[k].dot(&d)), std::array::from_fn(|l| bx[l].dot(&d)));
     // face axes: |d·u| - h - (the other box's radius along u)
     let (mut sa, mut ia) = (f64::NEG_INFINITY, 0);
     for k in 0..3 {

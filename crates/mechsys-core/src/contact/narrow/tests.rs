@@ -1073,7 +1073,11 @@ fn box_box_pair_is_clipped_once_per_evaluation() {
 fn box_box_axis_test_from_the_relative_rotation_equals_the_direct_one() {
     let mut rng = Rng::new(99);
     let cube = cuboid(Vec3::repeat(0.1));
-    for (c1, c2) in [(sample("box"), sample("box_b")), (cuboid(Vec3::new(0.2, 0.15, 0.1)), cuboid(Vec3::new(0.2, 0.15, 0.1))), (cube.clone(), cube)] {
+    for (c1, c2) in [
+        (sample("box"), sample("box_b")),
+        (cuboid(Vec3::new(0.2, 0.15, 0.1)), cuboid(Vec3::new(0.2, 0.15, 0.1))),
+        (cube.clone(), cube),
+    ] {
         let pair = ContactPair::new("bb", c1, c2).unwrap();
         let Geometry::BoxBox { a, b, scale } = &pair.geometry else { unreachable!() };
         for it in 0..3000 {
@@ -1150,8 +1154,15 @@ fn box_box_in_place_clipping_passes_equal_the_plain_ones() {
                 random_poses(&mut rng, false)
             } else {
                 let angle = if it % 4 == 0 { 0.0 } else { 10f64.powf(rng.uniform(-14.0, -3.0)) };
-                let off = if it % 2 == 0 { Vec3::zeros() } else { Vec3::new(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.0) };
-                (Pose::new(rot(&rng.unit(), angle), Vec3::new(off.x, off.y, 0.2 + rng.uniform(-1e-4, 1e-4))), Pose::IDENTITY)
+                let off = if it % 2 == 0 {
+                    Vec3::zeros()
+                } else {
+                    Vec3::new(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.0)
+                };
+                (
+                    Pose::new(rot(&rng.unit(), angle), Vec3::new(off.x, off.y, 0.2 + rng.uniform(-1e-4, 1e-4))),
+                    Pose::IDENTITY,
+                )
             };
             if let Some((same, t)) = box_box::shortcut_agrees(&x1, &x2, a, b, *scale) {
                 assert!(same, "#{it}: {x1:?}");
