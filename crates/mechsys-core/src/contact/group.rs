@@ -12,7 +12,9 @@
 //!    indices, created the first time the pair comes close and kept for the rest of the run (with
 //!    its candidates' kinematics and last impulses for warm starts), so a step allocates nothing
 //!    unless a pair of contours comes close for the first time;
-//! 4. the narrow phase ([`contact_kinematics`]) runs on those pairs only.
+//! 4. the narrow phase runs on those pairs only, at velocity level ([`contact_velocities_warm`]:
+//!    gaps, frames, relative velocities; no `w̄`, which neither of the users, Moreau–Jean and the
+//!    compliant groups, reads).
 //!
 //! Pair `(i, j)` has member `i` as contour 1 and member `j > i` (or `against[k]`) as contour 2,
 //! so its normal points towards member `i`; live pairs are visited in the order of `(i, j)` (the
@@ -26,7 +28,7 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::contact::ContactGroup;
 
-use super::{contact_kinematics, Aabb, BodyMotion, ContactKinematics, ContactPair, SweepAndPrune};
+use super::{contact_velocities_warm, Aabb, BodyMotion, ContactKinematics, ContactPair, SweepAndPrune};
 
 /// A hasher for the packed `(i, j)` keys of the pair cache (one multiply; the keys are small
 /// distinct integers, no hostile input).
@@ -58,7 +60,7 @@ pub struct PairSlot {
     pub body2: usize,
     /// The prepared pair.
     pub pair: ContactPair,
-    /// Kinematics of its candidates at the last evaluation.
+    /// Kinematics of its candidates at the last evaluation, at velocity level (`w̄` zero).
     pub kin: Vec<ContactKinematics>,
     /// Last impulses `[Λ_N, Λ_T1, Λ_T2]` and state code of each candidate (valid if the pair
     /// took part in the previous step, see `stamp`).
@@ -106,8 +108,8 @@ impl GroupPhase {
     }
 
     /// Broad phase at the state in `data` (placements `x_abs`, twists `v`), boxes grown by the
-    /// motion within `h` plus `margin`, then the kinematics of every live pair's candidates
-    /// (with `data.a` as the accelerations, see [`BodyMotion::from_data`]).
+    /// motion within `h` plus `margin`, then the velocity-level kinematics of every live pair's
+    /// candidates (`data.a` is not read).
     pub fn update(&mut self, group: &ContactGroup, data: &Data, h: f64, margin: f64) -> Result<()> {
         let n = self.boxes.len();
         for k in 0..n {
@@ -174,7 +176,7 @@ impl GroupPhase {
         for &s in &self.live {
             let slot = &mut self.slots[s];
             let (b1, b2) = (BodyMotion::from_data(data, slot.body1), BodyMotion::from_data(data, slot.body2));
-            contact_kinematics(&slot.pair, &b1, &b2, &mut slot.kin)
+            contact_velocities_warm(&slot.pair, &b1, &b2, &mut slot.kin, None)
                 .map_err(|e| Error::Solver(format!("contact group '{}': {e}", group.name)))?;
         }
         Ok(())

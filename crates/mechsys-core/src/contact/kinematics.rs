@@ -43,7 +43,7 @@ use crate::math::Vec3;
 use crate::model::contact::Contact;
 
 use super::narrow::warm::SearchHint;
-use super::narrow::{ContactPair, ContactPoint};
+use super::narrow::{ContactPair, ContactPoint, Raw, Tangents};
 
 pub use crate::kinematics::BodyMotion;
 
@@ -121,15 +121,34 @@ pub fn contact_kinematics_warm(
         pair.check_len(s.len())?;
     }
     let (tw1, tw2) = (&b1.twist, &b2.twist);
+    // a moving surface: its material slides over its contour at the body-fixed velocity u_i,
+    // so it moves at v_i(P) + A_i u_i; tangential, so ġ_N and the W-part are unchanged
     let surface = pair.surface_velocity();
+    let (ws1, ws2) = surface_motion(surface, b1, b2);
+    let dws = ws1 - ws2;
+    // the candidates of a face manifold or a box on a plane share their normal (and its rate):
+    // their tangents are computed once
+    let mut shared: Option<(Vec3, Vec3, Tangents)> = None;
+    let mut last: Option<(usize, Raw)> = None;
     // one evaluation of the pair: shared work (a box–box manifold) is done once for all candidates
-    let each = |k: usize, r: &super::narrow::Raw| {
-        let t = pair.tangents(&b2.pose, &r.n, Some((&tw2.w, &r.nd)));
+    let each = |k: usize, r: &Raw| {
+        // the unused candidates of a manifold are one and the same
+        if let Some((j, p)) = &last {
+            if same_bits(p, r, true) {
+                out[k] = out[*j];
+                return;
+            }
+        }
+        last = Some((k, *r));
+        let t = match shared {
+            Some((n, nd, t)) if n == r.n && nd == r.nd => t,
+            _ => {
+                let t = pair.tangents(&b2.pose, &r.n, Some((&tw2.w, &r.nd)));
+                shared = Some((r.n, r.nd, t));
+                t
+            }
+        };
         let (v1, v2) = (b1.point_velocity(&r.p1), b2.point_velocity(&r.p2));
-        // a moving surface: its material slides over its contour at the body-fixed velocity u_i,
-        // so it moves at v_i(P) + A_i u_i; tangential, so ġ_N and the W-part are unchanged
-        let (ws1, ws2) = (b1.pose.a * surface[0], b2.pose.a * surface[1]);
-        let dws = ws1 - ws2;
         let dv = v1 - v2;
         // σ_i: motion of the contact point over contour i
         let (s1, s2) = (r.p1d - v1, r.p2d - v2);
@@ -160,6 +179,83 @@ pub fn contact_kinematics_warm(
     Ok(())
 }
 
+/// The velocity level of [`contact_kinematics_warm`]: the same `point`, `gd_n`, `gd_t`,
+/// `omega_rel` and `w_tilde` (bit for bit), with `wbar_n`, `wbar_t` left zero. The geometry is
+/// evaluated without its rates (`ṅ`, `Ṗ1`, `Ṗ2`, tangent rates) and no acceleration is read —
+/// all a time-stepping scheme needs at its midpoint, at well under the cost. No allocation.
+pub fn contact_velocities_warm(
+    pair: &ContactPair,
+    b1: &BodyMotion,
+    b2: &BodyMotion,
+    out: &mut [ContactKinematics],
+    search: Option<&mut [SearchHint]>,
+) -> Result<()> {
+    pair.check_len(out.len())?;
+    if let Some(s) = &search {
+        pair.check_len(s.len())?;
+    }
+    let (tw1, tw2) = (&b1.twist, &b2.twist);
+    // the same expressions as the full kinematics, in the same order (bit-identical results)
+    let (ws1, ws2) = surface_motion(pair.surface_velocity(), b1, b2);
+    let dws = ws1 - ws2;
+    let dw = tw1.w - tw2.w;
+    let mut shared: Option<(Vec3, Tangents)> = None;
+    let mut last: Option<(usize, Raw)> = None;
+    let each = |k: usize, r: &Raw| {
+        if let Some((j, p)) = &last {
+            if same_bits(p, r, false) {
+                out[k] = out[*j];
+                return;
+            }
+        }
+        last = Some((k, *r));
+        let t = match shared {
+            Some((n, t)) if n == r.n => t,
+            _ => {
+                let t = pair.tangents(&b2.pose, &r.n, None);
+                shared = Some((r.n, t));
+                t
+            }
+        };
+        let dv = b1.point_velocity(&r.p1) - b2.point_velocity(&r.p2);
+        let surf = [t.t1.dot(&dws), t.t2.dot(&dws)];
+        out[k] = ContactKinematics {
+            point: ContactPoint { g_n: r.g, n: r.n, p1: r.p1, p2: r.p2, t1: t.t1, t2: t.t2 },
+            gd_n: r.n.dot(&dv),
+            gd_t: [t.t1.dot(&dv) + surf[0], t.t2.dot(&dv) + surf[1]],
+            wbar_n: 0.0,
+            wbar_t: [0.0; 2],
+            w_tilde: [0.0, surf[0], surf[1]],
+            omega_rel: [r.n.dot(&dw), t.t1.dot(&dw), t.t2.dot(&dw)],
+        };
+    };
+    match search {
+        Some(s) => pair.each_candidate_warm(&b1.pose, &b2.pose, None, s, each),
+        None => pair.each_candidate(&b1.pose, &b2.pose, None, each),
+    }
+    Ok(())
+}
+
+/// Whether two candidates are the same bit for bit: geometry, and with `rates` their rates (a
+/// repeated candidate then has the same kinematics, copied instead of recomputed).
+#[inline]
+fn same_bits(a: &Raw, b: &Raw, rates: bool) -> bool {
+    let eq = |x: &Vec3, y: &Vec3| x.iter().zip(y.iter()).all(|(u, v)| u.to_bits() == v.to_bits());
+    a.g.to_bits() == b.g.to_bits()
+        && eq(&a.n, &b.n)
+        && eq(&a.p1, &b.p1)
+        && eq(&a.p2, &b.p2)
+        && (!rates || (eq(&a.nd, &b.nd) && eq(&a.p1d, &b.p1d) && eq(&a.p2d, &b.p2d)))
+}
+
+/// World velocities `A_i u_i` of the contours' moving surfaces (zero, without products, for
+/// contours at rest on their bodies: almost every pair).
+#[inline]
+fn surface_motion(surface: &[Vec3; 2], b1: &BodyMotion, b2: &BodyMotion) -> (Vec3, Vec3) {
+    let world = |b: &BodyMotion, u: &Vec3| if *u == Vec3::zeros() { Vec3::zeros() } else { b.pose.a * u };
+    (world(b1, &surface[0]), world(b2, &surface[1]))
+}
+
 /// The kinematics of every point of `con` into `out[..con.points()]`: from the bodies' motion in
 /// `data` (the tree's kinematics at (q, u) done, `data.a` as the caller set it) for a pair of
 /// contours; from the gap function at (t, q, u) for a gap contact, whose `w̄` is always the
@@ -177,6 +273,40 @@ pub fn contact_point_kinematics(
     out: &mut [ContactKinematics],
     search: Option<&mut [SearchHint]>,
 ) -> Result<()> {
+    point_kinematics(con, data, t, q, u, cb, out, search, true)
+}
+
+/// [`contact_point_kinematics`] at velocity level: for a pair of contours
+/// [`contact_velocities_warm`] (no `w̄`, no accelerations read; the other fields bit for bit the
+/// same), for a gap contact the same as the full version. What Moreau–Jean needs at a step's
+/// midpoint.
+#[allow(clippy::too_many_arguments)]
+pub fn contact_point_velocities(
+    con: &Contact,
+    data: &mut Data,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    out: &mut [ContactKinematics],
+    search: Option<&mut [SearchHint]>,
+) -> Result<()> {
+    point_kinematics(con, data, t, q, u, cb, out, search, false)
+}
+
+/// Both levels of [`contact_point_kinematics`]: `full` with the `w̄` terms.
+#[allow(clippy::too_many_arguments)]
+fn point_kinematics(
+    con: &Contact,
+    data: &mut Data,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+    out: &mut [ContactKinematics],
+    search: Option<&mut [SearchHint]>,
+    full: bool,
+) -> Result<()> {
     match con.gap() {
         None => {
             let (mut b1, mut b2) = (BodyMotion::from_data(data, con.body1), BodyMotion::from_data(data, con.body2));
@@ -186,7 +316,12 @@ pub fn contact_point_kinematics(
                     node_motion(data, con.body2, c2, &mut b2);
                 }
             }
-            contact_kinematics_warm(con.pair().expect("a contour contact"), &b1, &b2, out, search)
+            let pair = con.pair().expect("a contour contact");
+            if full {
+                contact_kinematics_warm(pair, &b1, &b2, out, search)
+            } else {
+                contact_velocities_warm(pair, &b1, &b2, out, search)
+            }
         }
         Some((f, slot)) => f.evaluate(t, q, u, cb, &mut data.gap, slot, true, &mut out[0]).map_err(|e| match e {
             Error::Callback(m) => Error::Callback(format!("gap contact '{}': {m}", con.name)),

@@ -9,7 +9,8 @@
 //! - [`group`]: contact groups at run time: broad phase, a cache of prepared pairs, narrow phase
 //!   on the pairs that may touch ([`GroupPhase`]).
 //! - [`kinematics`]: [`contact_kinematics`], the relative velocities `ġ_N`, `ġ_T` and the
-//!   velocity-product terms `w̄_N`, `w̄_T` of the relative accelerations.
+//!   velocity-product terms `w̄_N`, `w̄_T` of the relative accelerations; its velocity level
+//!   [`contact_velocities_warm`] without them, for time stepping.
 //!
 //! # Conventions
 //!
@@ -39,12 +40,15 @@ pub mod narrow;
 #[cfg(test)]
 pub(crate) mod test_util;
 
+#[cfg(test)]
+mod bench;
+
 pub use broad::{Aabb, SweepAndPrune};
 pub use contour::{Contour, ContourKind, Vec2};
 pub use group::GroupPhase;
 pub use kinematics::{
-    at_contact, contact_kinematics, contact_kinematics_warm, contact_point_kinematics, gap_with_accelerations,
-    BodyMotion, ContactKinematics,
+    at_contact, contact_kinematics, contact_kinematics_warm, contact_point_kinematics, contact_point_velocities,
+    contact_velocities_warm, gap_with_accelerations, BodyMotion, ContactKinematics,
 };
 pub use narrow::warm::SearchHint;
 pub use narrow::{candidates, evaluate, ContactPair, ContactPoint};

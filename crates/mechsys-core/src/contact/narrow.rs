@@ -535,6 +535,17 @@ impl ContactPair {
                 return;
             }
         }
+        if let Geometry::PointsHalfSpace { centers, radius, point, normal } = &self.geometry {
+            // the plane is placed once for all centres (a box's eight corners)
+            let (xb, xp, tw) = if self.swapped { (x2, x1, twists.map(|(a, b)| (b, a))) } else { (x1, x2, twists) };
+            let (m, p) = (xp.a * normal, xp.point_to_parent(point));
+            for (k, c) in centers.iter().enumerate() {
+                let c = xb.point_to_parent(c);
+                let r = half_space_at(&c, tw.map(|(t1, _)| vel(t1, &c)), *radius, &m, &p, tw.map(|t| t.1));
+                f(k, &if self.swapped { r.reversed() } else { r });
+            }
+            return;
+        }
         if matches!(self.geometry, Geometry::BoxBox { .. }) {
             let mut buf = [Raw::default(); box_box::POINTS];
             self.candidates_into(x1, x2, twists, &mut buf);
@@ -848,8 +859,13 @@ fn half_space(
     normal: &Vec3,
     t2: Option<&Motion>,
 ) -> Raw {
-    let m = x2.a * normal;
-    let p = x2.point_to_parent(point);
+    half_space_at(c, cd, radius, &(x2.a * normal), &x2.point_to_parent(point), t2)
+}
+
+/// [`half_space`] with the plane placed: world normal `m` through world point `p`.
+#[inline]
+fn half_space_at(c: &Vec3, cd: Option<Vec3>, radius: f64, m: &Vec3, p: &Vec3, t2: Option<&Motion>) -> Raw {
+    let (m, p) = (*m, *p);
     let h = m.dot(&(c - p));
     let mut r = Raw { g: h - radius, n: m, p1: c - m * radius, p2: c - m * h, ..Default::default() };
     if let (Some(cd), Some(t2)) = (cd, t2) {
@@ -879,8 +895,10 @@ fn swept(
     r2: f64,
     across: &Vec3,
 ) -> Raw {
-    let (a1, d1) = (x1.point_to_parent(a1b), x1.a * d1b);
-    let (a2, d2) = (x2.point_to_parent(a2b), x2.a * d2b);
+    // a sphere's or point's segment has no direction to turn (spares two products per pair)
+    let turn = |x: &Pose, d: &Vec3| if *d == Vec3::zeros() { Vec3::zeros() } else { x.a * d };
+    let (a1, d1) = (x1.point_to_parent(a1b), turn(x1, d1b));
+    let (a2, d2) = (x2.point_to_parent(a2b), turn(x2, d2b));
     let r = a1 - a2;
     let (aa, ee, bb, cc, ff) = (d1.dot(&d1), d2.dot(&d2), d1.dot(&d2), d1.dot(&r), d2.dot(&r));
     let clamp01 = |x: f64| x.clamp(0.0, 1.0);

@@ -482,3 +482,76 @@ fn moving_surface_is_refused_off_planes_and_lines_and_out_of_the_surface() {
     let e = pair.with_surface_velocity(2, Vec3::new(f64::NAN, 0.0, 0.0)).unwrap_err().to_string();
     assert!(e.contains("must be finite"), "{e}");
 }
+
+/// The velocity level equals the full kinematics' shared fields bit for bit, for every pair in
+/// both orders at random placements and motions, the planar searches warm-started along a short
+/// motion (each level with its own hints, which must stay equal too); its `w̄` are zero.
+#[test]
+fn velocity_level_equals_the_full_kinematics_bit_for_bit() {
+    let mut rng = Rng::new(4711);
+    let boxes = [("box", "box_b"), ("box_b", "box")];
+    for (a, b) in PAIRS.iter().chain(CURVE_PAIRS.iter()).chain(boxes.iter()) {
+        let (c1, c2) = (sample(a), sample(b));
+        for (order, (ca, cb)) in [(c1.clone(), c2.clone()), (c2, c1)].into_iter().enumerate() {
+            let pair = ContactPair::new("p", ca, cb).unwrap();
+            let n = pair.candidates();
+            for it in 0..6 {
+                let planar = pair.is_planar() && it % 2 == 0;
+                let (x1, x2) = random_poses(&mut rng, planar);
+                let traj = |rng: &mut Rng, x: &Pose| {
+                    if planar {
+                        Trajectory::random_planar(rng, x, 1.0, 0.5)
+                    } else {
+                        Trajectory::random(rng, x, 1.0, 0.5)
+                    }
+                };
+                let (tr1, tr2) = (traj(&mut rng, &x1), traj(&mut rng, &x2));
+                let (mut h_full, mut h_vel) = (vec![SearchHint::default(); n], vec![SearchHint::default(); n]);
+                for step in 0..4 {
+                    let t = 1e-3 * step as f64;
+                    let (b1, b2) = (tr1.at(t), tr2.at(t));
+                    let (mut full, mut vel) =
+                        (vec![ContactKinematics::default(); n], vec![ContactKinematics::default(); n]);
+                    contact_kinematics_warm(&pair, &b1, &b2, &mut full, Some(&mut h_full)).unwrap();
+                    contact_velocities_warm(&pair, &b1, &b2, &mut vel, Some(&mut h_vel)).unwrap();
+                    let tag = format!("{a}–{b} order {order} #{it} step {step}");
+                    for (k, (f, v)) in full.iter().zip(&vel).enumerate() {
+                        let same = f.point == v.point
+                            && f.gd_n.to_bits() == v.gd_n.to_bits()
+                            && f.gd_t.map(f64::to_bits) == v.gd_t.map(f64::to_bits)
+                            && f.omega_rel.map(f64::to_bits) == v.omega_rel.map(f64::to_bits)
+                            && f.w_tilde.map(f64::to_bits) == v.w_tilde.map(f64::to_bits);
+                        assert!(same, "{tag} candidate {k}: {f:?} vs {v:?}");
+                        assert_eq!((v.wbar_n, v.wbar_t), (0.0, [0.0; 2]), "{tag}");
+                    }
+                    assert_eq!(h_full, h_vel, "{tag}: search hints");
+                }
+            }
+        }
+    }
+}
+
+/// A moving surface (conveyor) at velocity level: the belt's speed in `ġ_T` and `w̃` as in the
+/// full kinematics.
+#[test]
+fn velocity_level_keeps_the_surface_velocity() {
+    // in the sample plane (normal (0.1, 0.2, 1))
+    let belt = Vec3::new(0.0, 0.3, -0.06);
+    let pair =
+        ContactPair::new("belt", sample("box"), sample("plane")).unwrap().with_surface_velocity(2, belt).unwrap();
+    let mut rng = Rng::new(5);
+    let (x1, x2) = random_poses(&mut rng, false);
+    let (b1, b2) =
+        (Trajectory::random(&mut rng, &x1, 1.0, 0.5).at(0.0), Trajectory::random(&mut rng, &x2, 1.0, 0.5).at(0.0));
+    let n = pair.candidates();
+    let (mut full, mut vel) = (vec![ContactKinematics::default(); n], vec![ContactKinematics::default(); n]);
+    contact_kinematics(&pair, &b1, &b2, &mut full).unwrap();
+    contact_velocities_warm(&pair, &b1, &b2, &mut vel, None).unwrap();
+    for (f, v) in full.iter().zip(&vel) {
+        assert_eq!(
+            (f.point, f.gd_n, f.gd_t, f.w_tilde, f.omega_rel),
+            (v.point, v.gd_n, v.gd_t, v.w_tilde, v.omega_rel)
+        );
+        assert!(v.w_tilde[1].abs() + v.w_tilde[2].abs() > 0.0);
+    }
+}

@@ -133,11 +133,6 @@ impl Placed {
     fn axis(&self, k: usize) -> Vec3 {
         self.r.column(k).into_owned()
     }
-    /// Half the length of the box's projection on the unit axis `u`.
-    #[inline]
-    fn radius(&self, u: &Vec3) -> f64 {
-        (0..3).map(|k| self.h[k] * self.axis(k).dot(u).abs()).sum()
-    }
 }
 
 /// The feature pair the separating-axis test chose.
@@ -149,15 +144,83 @@ pub(crate) enum Feature {
     Edge { i: usize, j: usize },
 }
 
-/// The separating-axis test: the chosen feature and its separation `s`.
+/// The separating-axis test: the chosen feature and its separation `s`. Every projection of the
+/// 15 axes is a combination of `R_kl = a_k·b_l` and of `d`'s components in either box's axes
+/// (the classic form of the test), so the nine edge axes cost a few products each: with `k', k''`
+/// the indices after `k` (mod 3), `a_i × b_j` has the components `(−R_i''j, R_i'j)` on
+/// `(a_i', a_i'')` and `(R_ij'', −R_ij')` on `(b_j', b_j'')`, and `|a_i × b_j|² = R_i'j² + R_i''j²`.
 fn choose(a: &Placed, b: &Placed, scale: f64) -> (Feature, f64) {
+    let d = a.c - b.c;
+    let tol = TIE * scale;
+    let (ax, bx) = ([a.axis(0), a.axis(1), a.axis(2)], [b.axis(0), b.axis(1), b.axis(2)]);
+    let r: [[f64; 3]; 3] = std::array::from_fn(|k| std::array::from_fn(|l| ax[k].dot(&bx[l])));
+    let (da, db): ([f64; 3], [f64; 3]) =
+        (std::array::from_fn(|k| ax[k].dot(&d)), std::array::from_fn(|l| bx[l].dot(&d)));
+    // face axes: |d·u| - h - (the other box's radius along u)
+    let (mut sa, mut ia) = (f64::NEG_INFINITY, 0);
+    for k in 0..3 {
+        let s = da[k].abs() - a.h[k] - (b.h[0] * r[k][0].abs() + b.h[1] * r[k][1].abs() + b.h[2] * r[k][2].abs());
+        if s > sa {
+            (sa, ia) = (s, k);
+        }
+    }
+    let (mut sb, mut jb) = (f64::NEG_INFINITY, 0);
+    for l in 0..3 {
+        let s = db[l].abs() - b.h[l] - (a.h[0] * r[0][l].abs() + a.h[1] * r[1][l].abs() + a.h[2] * r[2][l].abs());
+        if s > sb {
+            (sb, jb) = (s, l);
+        }
+    }
+    let ref_a = if (sa - sb).abs() <= tol {
+        // a tie: the larger reference face, B's when equal
+        let area = |p: &Placed, k: usize| p.h[(k + 1) % 3] * p.h[(k + 2) % 3];
+        area(a, ia) > area(b, jb) * (1.0 + 1e-12)
+    } else {
+        sa > sb
+    };
+    let (mut feature, s_face) =
+        if ref_a { (Feature::Face { ref_a, axis: ia }, sa) } else { (Feature::Face { ref_a, axis: jb }, sb) };
+    let mut best_edge = (f64::NEG_INFINITY, 0, 0);
+    for i in 0..3 {
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        for j in 0..3 {
+            let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+            // |a_i × b_j| times the axis' components on a_i', a_i'', b_j', b_j''
+            let (ca1, ca2, cb1, cb2) = (r[i2][j].abs(), r[i1][j].abs(), r[i][j2].abs(), r[i][j1].abs());
+            let cn = (r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j]).sqrt();
+            if cn < PARALLEL {
+                continue;
+            }
+            // an edge axis next to a face normal is that face's contact (the edges lie nearly in it)
+            if ca1.max(ca2).max(cb1).max(cb2) > NEAR_FACE * cn {
+                continue;
+            }
+            let dc = da[i2] * r[i1][j] - da[i1] * r[i2][j];
+            let s = (dc.abs() - (a.h[i1] * ca1 + a.h[i2] * ca2) - (b.h[j1] * cb1 + b.h[j2] * cb2)) / cn;
+            if s > best_edge.0 {
+                best_edge = (s, i, j);
+            }
+        }
+    }
+    let mut s = s_face;
+    if best_edge.0 > s_face + tol + EDGE_BIAS * (-s_face).max(0.0) {
+        feature = Feature::Edge { i: best_edge.1, j: best_edge.2 };
+        s = best_edge.0;
+    }
+    (feature, s)
+}
+
+/// The separating-axis test axis by axis in world components (the reference for [`choose`]).
+#[cfg(test)]
+fn choose_direct(a: &Placed, b: &Placed, scale: f64) -> (Feature, f64) {
+    let radius = |p: &Placed, u: &Vec3| (0..3).map(|k| p.h[k] * p.axis(k).dot(u).abs()).sum::<f64>();
     let d = a.c - b.c;
     let tol = TIE * scale;
     let face = |p: &Placed, q: &Placed| {
         let mut best = (f64::NEG_INFINITY, 0);
         for k in 0..3 {
             let u = p.axis(k);
-            let s = d.dot(&u).abs() - p.h[k] - q.radius(&u);
+            let s = d.dot(&u).abs() - p.h[k] - radius(q, &u);
             if s > best.0 {
                 best = (s, k);
             }
@@ -167,7 +230,6 @@ fn choose(a: &Placed, b: &Placed, scale: f64) -> (Feature, f64) {
     let (sa, ia) = face(a, b);
     let (sb, jb) = face(b, a);
     let ref_a = if (sa - sb).abs() <= tol {
-        // a tie: the larger reference face, B's when equal
         let area = |p: &Placed, k: usize| p.h[(k + 1) % 3] * p.h[(k + 2) % 3];
         area(a, ia) > area(b, jb) * (1.0 + 1e-12)
     } else {
@@ -184,11 +246,10 @@ fn choose(a: &Placed, b: &Placed, scale: f64) -> (Feature, f64) {
                 continue;
             }
             let u = c / cn;
-            // an edge axis next to a face normal is that face's contact (the edges lie nearly in it)
             if (0..3).any(|k| a.axis(k).dot(&u).abs() > NEAR_FACE || b.axis(k).dot(&u).abs() > NEAR_FACE) {
                 continue;
             }
-            let s = d.dot(&u).abs() - a.radius(&u) - b.radius(&u);
+            let s = d.dot(&u).abs() - radius(a, &u) - radius(b, &u);
             if s > best_edge.0 {
                 best_edge = (s, i, j);
             }
@@ -213,7 +274,7 @@ struct Label {
 
 /// A vertex of the clipped incident face with the planes it lies on (besides the incident face
 /// itself; the first two define it).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Vertex {
     p: Vec3,
     labels: [Label; 4],
@@ -274,6 +335,12 @@ struct Manifold {
 
 /// Clips the incident box's face most opposed to the reference face `axis` of `rf`.
 fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
+    clip_with(rf, inc, axis, scale, true)
+}
+
+/// [`clip`]; `shortcut`: a pass that cuts nothing leaves the polygon in place (off in tests:
+/// every pass copies it, the plain Sutherland–Hodgman, to compare with).
+fn clip_with(rf: &Placed, inc: &Placed, axis: usize, scale: f64, shortcut: bool) -> Manifold {
     let tol = TIE * scale;
     let ra = rf.axis(axis);
     let sgn = if (inc.c - rf.c).dot(&ra) >= 0.0 { 1.0 } else { -1.0 };
@@ -291,15 +358,40 @@ fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
     for (n, v) in buf[0].iter_mut().take(4).enumerate() {
         *v = corner(&fc, &u1, &u2, inc.h[j1], inc.h[j2], n, j1, j2);
     }
+    // the side planes ±e·(x - c) = h in clipping order; the signed distance of x to the
+    // negative one is exactly the negated projection minus h, so one projection serves both
+    let sides = [(axis + 1) % 3, (axis + 2) % 3];
+    let dist = |t: f64, k: usize, positive: bool| if positive { t - rf.h[k] } else { -t - rf.h[k] };
+    let mut proj = [[0.0; 2]; 4];
+    for (n, pr) in proj.iter_mut().enumerate() {
+        let rel = buf[0][n].p - rf.c;
+        *pr = [rf.axis(sides[0]).dot(&rel), rf.axis(sides[1]).dot(&rel)];
+    }
     let mut count = 4;
     let mut cur = 0;
-    for k in [(axis + 1) % 3, (axis + 2) % 3] {
+    // the polygon is still the incident face's corners (their projections are at hand)
+    let mut corners = true;
+    for (s, &k) in sides.iter().enumerate() {
         let e = rf.axis(k);
         for positive in [true, false] {
-            // the side plane ±e·(x - c) = h
-            let normal = if positive { e } else { -e };
             let label = Label { on_ref: true, axis: k as u8, positive };
-            let dist = |p: &Vec3| normal.dot(&(p - rf.c)) - rf.h[k];
+            // each vertex's distance once
+            let mut d = [0.0; POINTS];
+            for (q, dq) in d.iter_mut().enumerate().take(count) {
+                let t = if corners { proj[q][s] } else { e.dot(&(buf[cur][q].p - rf.c)) };
+                *dq = dist(t, k, positive);
+            }
+            if shortcut && d[..count].iter().all(|&x| x <= tol) {
+                // nothing is cut (a stack's faces; three of the four planes of a box straddling
+                // two others): the pass would copy every vertex, adding this plane to those on it
+                for (v, dq) in buf[cur][..count].iter_mut().zip(&d) {
+                    if dq.abs() <= tol {
+                        v.add(label);
+                    }
+                }
+                continue;
+            }
+            corners = false;
             let (src, dst) = if cur == 0 {
                 let (a, b) = buf.split_at_mut(1);
                 (&a[0], &mut b[0])
@@ -308,9 +400,11 @@ fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
                 (&b[0], &mut a[0])
             };
             let mut out = 0;
+            // the edge from the previous vertex (cyclic; no integer division in this loop)
+            let mut qp = count - 1;
             for q in 0..count {
-                let (p, qv) = (&src[(q + count - 1) % count], &src[q]);
-                let (dp, dq) = (dist(&p.p), dist(&qv.p));
+                let (p, qv) = (&src[qp], &src[q]);
+                let (dp, dq) = (d[qp], d[q]);
                 let crossing = |out: &mut usize, dst: &mut [Vertex; POINTS]| {
                     // the edge p → q lies on their common plane; the new vertex on it and on this one
                     let t = dp / (dp - dq);
@@ -338,6 +432,7 @@ fn clip(rf: &Placed, inc: &Placed, axis: usize, scale: f64) -> Manifold {
                 } else if dp < -tol {
                     crossing(&mut out, dst);
                 }
+                qp = q;
             }
             count = out;
             cur = 1 - cur;
@@ -414,20 +509,18 @@ pub(super) fn box_box_all(
             let mf = clip(rf, inc, axis, scale);
             // the pair's normal, from B towards A
             let n = if ref_a { -mf.m } else { mf.m };
-            for (k, o) in out.iter_mut().enumerate().take(POINTS) {
-                *o = if k < mf.count {
-                    face_point(&mf, &mf.v[k], ref_a, rf, inc, tw)
-                } else {
-                    unused(&a, &b, n, tw, ref_a)
-                };
+            let out = &mut out[..POINTS];
+            for (o, v) in out.iter_mut().zip(&mf.v[..mf.count]) {
+                *o = face_point(&mf, v, ref_a, rf, inc, tw);
+            }
+            if mf.count < POINTS {
+                out[mf.count..].fill(unused(&a, &b, n, tw, ref_a));
             }
         }
         Feature::Edge { i, j } => {
             let e = edge_point(&a, &b, i, j, tw);
             out[0] = e;
-            for o in out.iter_mut().take(POINTS).skip(1) {
-                *o = unused(&a, &b, e.n, tw, false);
-            }
+            out[1..POINTS].fill(unused(&a, &b, e.n, tw, false));
         }
     }
 }
@@ -574,6 +667,26 @@ fn unused(a: &Placed, b: &Placed, n: Vec3, tw: Option<(&Motion, &Motion)>, ref_a
 #[cfg(test)]
 pub(super) fn feature(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> (Feature, f64) {
     choose(&Placed::new(sa, x1), &Placed::new(sb, x2), scale)
+}
+
+/// Whether the face manifold at these placements (if the feature is a face) is the same with
+/// and without the in-place passes, bit for bit; `None` for edge features, `Some((same, the
+/// incident face uncut))` otherwise (tests).
+#[cfg(test)]
+pub(super) fn shortcut_agrees(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> Option<(bool, bool)> {
+    let (a, b) = (Placed::new(sa, x1), Placed::new(sb, x2));
+    let Feature::Face { ref_a, axis } = choose(&a, &b, scale).0 else { return None };
+    let (rf, inc) = if ref_a { (&a, &b) } else { (&b, &a) };
+    let (fast, slow) = (clip_with(rf, inc, axis, scale, true), clip_with(rf, inc, axis, scale, false));
+    let same = fast.count == slow.count && fast.v[..fast.count] == slow.v[..slow.count];
+    let taken = fast.count == 4 && fast.v[..4].iter().all(|v| v.kind() == Kind::IncidentCorner);
+    Some((same, taken))
+}
+
+/// The feature the axis-by-axis test picks (tests: the reference for [`choose`]).
+#[cfg(test)]
+pub(super) fn feature_direct(x1: &Pose, x2: &Pose, sa: &BoxShape, sb: &BoxShape, scale: f64) -> (Feature, f64) {
+    choose_direct(&Placed::new(sa, x1), &Placed::new(sb, x2), scale)
 }
 
 /// The chosen feature and what each candidate is, at body placements `x1`, `x2` (tests).
