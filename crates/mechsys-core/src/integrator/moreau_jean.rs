@@ -457,8 +457,9 @@ impl MoreauJean {
         for (ci, con) in model.contacts.iter().enumerate() {
             let k = &mut self.kin[con.first..con.first + con.points()];
             let s = self.warm_search.then(|| &mut self.search[con.first..con.first + con.points()]);
-            // a gap function reads the step's start velocities (its w̃ does not depend on them)
-            contact_point_kinematics(con, data, tm, &self.q_mid, u, cb, k, s)
+            // a gap function reads the step's start velocities (its w̃ does not depend on them);
+            // the step works at velocity level, so the w̄ terms are not formed
+            crate::contact::contact_point_velocities(con, data, tm, &self.q_mid, u, cb, k, s)
                 .map_err(|e| at_contact(e, &con.name, tm))?;
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
