@@ -264,8 +264,11 @@ fn bench_gears(c: &mut Criterion) {
                 };
                 let r2 = Vec3::new(a, 0.0, 0.0);
                 let w2 = Vec3::new(0.0, 0.0, -w * z1 as f64 / z2 as f64);
-                let b2 =
-                    BodyMotion { pose: Pose::new(rz(t2), r2), twist: Motion::new(w2, -w2.cross(&r2)), acc: Motion::ZERO };
+                let b2 = BodyMotion {
+                    pose: Pose::new(rz(t2), r2),
+                    twist: Motion::new(w2, -w2.cross(&r2)),
+                    acc: Motion::ZERO,
+                };
                 (b1, b2)
             })
             .collect();

@@ -182,7 +182,12 @@ fn mat3(v: &[f64; 9]) -> Mat3 {
 }
 
 fn square(rows: &[Vec<f64>], n: usize, what: &str) -> Result<DMatrix<f64>> {
-    crate::ensure!(rows.len() == n, Model, "{what}: expected {n} rows (one per elastic coordinate), got {}", rows.len());
+    crate::ensure!(
+        rows.len() == n,
+        Model,
+        "{what}: expected {n} rows (one per elastic coordinate), got {}",
+        rows.len()
+    );
     let mut m = DMatrix::zeros(n, n);
     for (r, row) in rows.iter().enumerate() {
         crate::ensure!(row.len() == n, Model, "{what}[{r}]: expected {n} numbers, got {}", row.len());
@@ -310,7 +315,9 @@ pub fn validate(
     // generalized eigenvalues of (K, M_ee): ω² > 0 for every mode, else a rigid-body mode (or a
     // mode without stiffness) is left in the elastic basis
     let not_pd = || {
-        crate::error::Error::Model(format!("{what}: the elastic mass matrix (traces of p2) is too ill-conditioned to factor"))
+        crate::error::Error::Model(format!(
+            "{what}: the elastic mass matrix (traces of p2) is too ill-conditioned to factor"
+        ))
     };
     let l = m_ee.clone().cholesky().ok_or_else(not_pd)?.l();
     let li = l.clone().try_inverse().ok_or_else(not_pd)?;

@@ -35,8 +35,11 @@ pub fn chain_description(n: usize, joint_type: &str) -> ModelDescription {
             "spherical" => vec![(0.5f64).cos(), 0.0, (0.5f64).sin() * 0.6, (0.5f64).sin() * 0.8],
             _ => (0..nq).map(|k| 0.1 + 0.05 * (i + k) as f64).collect(),
         };
-        let (name, parent, child) =
-            (format!("j{}", i + 1), if i == 0 { "ground".to_string() } else { format!("link{i}") }, format!("link{}", i + 1));
+        let (name, parent, child) = (
+            format!("j{}", i + 1),
+            if i == 0 { "ground".to_string() } else { format!("link{i}") },
+            format!("link{}", i + 1),
+        );
         joints.push(JointDescription {
             axis: if joint_type == "revolute" { Some(axes[i % 3]) } else { None },
             parent_frame: FrameDescription { position: [if i == 0 { 0.0 } else { l }, 0.0, 0.0], rotation: None },

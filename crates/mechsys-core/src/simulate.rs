@@ -105,7 +105,12 @@ pub struct Budget {
 impl Budget {
     /// Starts the clock.
     pub fn new(settings: &Settings) -> Self {
-        Budget { start: std::time::Instant::now(), max_steps: settings.max_steps, max_wall: settings.max_wall, steps: 0 }
+        Budget {
+            start: std::time::Instant::now(),
+            max_steps: settings.max_steps,
+            max_wall: settings.max_wall,
+            steps: 0,
+        }
     }
 
     /// An error once the wall-time budget is spent.
@@ -809,11 +814,28 @@ impl OdeSystem for MultibodySystem<'_> {
                 qs.extend_from_slice(q);
                 us.clear();
                 us.extend_from_slice(u);
-                if dynamics::constrained::project(self.model, &mut self.data, &mut self.ws, t, &mut qs, &mut us, self.cb)
-                    .is_ok()
+                if dynamics::constrained::project(
+                    self.model,
+                    &mut self.data,
+                    &mut self.ws,
+                    t,
+                    &mut qs,
+                    &mut us,
+                    self.cb,
+                )
+                .is_ok()
                 {
                     staged = true;
-                    p = dynamics::forward_dynamics(self.model, &mut self.data, &mut self.ws, t, &qs, &us, None, self.cb)?;
+                    p = dynamics::forward_dynamics(
+                        self.model,
+                        &mut self.data,
+                        &mut self.ws,
+                        t,
+                        &qs,
+                        &us,
+                        None,
+                        self.cb,
+                    )?;
                     self.check_singular(t)?;
                 }
             }
@@ -985,7 +1007,11 @@ pub fn check_inertia(model: &Model, t: f64, q: &[f64]) -> Result<()> {
     let big = (0..nu).map(|i| m[(i, i)].abs()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let name = |i: usize| {
         let j = model.joints.iter().find(|j| j.iu <= i && i < j.iu + j.nu()).expect("every velocity has a joint");
-        if j.nu() == 1 { format!("'{}'", j.name) } else { format!("'{}' (velocity {})", j.name, i - j.iu) }
+        if j.nu() == 1 {
+            format!("'{}'", j.name)
+        } else {
+            format!("'{}' (velocity {})", j.name, i - j.iu)
+        }
     };
     let light: Vec<String> = (0..nu).filter(|&i| !(m[(i, i)] > 1e-12 * big)).map(name).collect();
     let singular = !light.is_empty() || m.clone().cholesky().is_none();
@@ -1203,7 +1229,16 @@ pub fn simulate(
                 g.name
             )));
         }
-        return time_stepping(model, settings, cb, progress, &t_out, y0, (dt, solver, continue_on_painleve, project, parallel), rec);
+        return time_stepping(
+            model,
+            settings,
+            cb,
+            progress,
+            &t_out,
+            y0,
+            (dt, solver, continue_on_painleve, project, parallel),
+            rec,
+        );
     }
     crate::ensure!(
         model.contact_groups.is_empty() || matches!(settings.integrator, IntegratorKind::MoreauJean { .. }),
@@ -1220,7 +1255,9 @@ pub fn simulate(
         "integrator: the model has unilateral contacts ('{}'); use MoreauJean (time-stepping) or EventDriven",
         model.contacts[0].name
     );
-    let mut sys = MultibodySystem::new(model, cb).with_stabilization(settings.stabilization).with_on_singular(settings.on_singular);
+    let mut sys = MultibodySystem::new(model, cb)
+        .with_stabilization(settings.stabilization)
+        .with_on_singular(settings.on_singular);
     // a consistent initial state: on the constraint manifolds (assembly from the given q0, u0)
     // (always by projection, whatever the drift control during the run)
     let mut y0 = y0;
@@ -1228,7 +1265,13 @@ pub fn simulate(
     if model.n_compliant_points > 0 {
         // the points closed at the start (their onset speeds, no event)
         let (head, aux) = y0.split_at_mut(model.nq + model.nu + 2);
-        crate::kinematics::forward_pass(model, &mut sys.data, settings.t0, &head[..model.nq], &head[model.nq..model.nq + model.nu]);
+        crate::kinematics::forward_pass(
+            model,
+            &mut sys.data,
+            settings.t0,
+            &head[..model.nq],
+            &head[model.nq..model.nq + model.nu],
+        );
         crate::forces::compliant::commit(model, &sys.data, &mut sys.ws.forces.compliant, settings.t0, aux)?;
     }
     model.normalize(&mut y0[..model.nq]);
@@ -1248,7 +1291,8 @@ pub fn simulate(
     // an explicit fixed step above its stability limit grows the energy geometrically: watched
     // for RK4 (the adaptive and implicit schemes control or damp it); variable-mass bodies carry
     // energy away with the ejected mass, so their balance is not checked
-    let guard = matches!(settings.integrator, IntegratorKind::Rk4 { .. }) && model.bodies.iter().all(|b| b.mass_rate == 0.0);
+    let guard =
+        matches!(settings.integrator, IntegratorKind::Rk4 { .. }) && model.bodies.iter().all(|b| b.mass_rate == 0.0);
     let mut divergence =
         Divergence { floor: 1e-6 * model.bodies.iter().skip(1).map(|b| b.mass).sum::<f64>(), ..Default::default() };
     sys.budget = Some(Budget::new(settings));
@@ -1261,7 +1305,8 @@ pub fn simulate(
             // the Jenkins sliders book their work when a step is committed; a sample inside or at
             // the end of a step (before the commit) adds the work they did since the last one
             let d = &sys.data;
-            let pending: f64 = (0..model.n_sliders).map(|i| d.slider_force[i] * (d.slider_trial[i] - d.slider[i])).sum();
+            let pending: f64 =
+                (0..model.n_sliders).map(|i| d.slider_force[i] * (d.slider_trial[i] - d.slider[i])).sum();
             if let Some(last) = rec.dissipated.last_mut() {
                 *last += pending;
             }

@@ -1,7 +1,6 @@
 //! The box–box narrow phase (separating axes, clipping, rates) allocates nothing per evaluation
 //! (a counting global allocator, per thread).
 
-
 use mechsys_core::contact::{
     contact_kinematics, evaluate, BodyMotion, ContactKinematics, ContactPair, ContactPoint, Contour,
 };

@@ -1,7 +1,6 @@
 //! The Moreau–Jean step on a contact group allocates nothing once every pair has been met and
 //! every buffer has grown to the largest problem (a counting global allocator, per thread).
 
-
 use mechsys_core::contact::group::sphere_pile;
 use mechsys_core::data::Data;
 use mechsys_core::dynamics::Workspace;

@@ -501,7 +501,8 @@ fn contact_geometry<'py>(py: Python<'py>, model: &PyModel, q: &Bound<'py, PyAny>
             // the principal values of the two surfaces' curvature tensors summed in the common
             // tangent plane: what a Hertz contact feels whatever angle the principal directions
             // make (∞ where a contour has no curvature)
-            let tensor = |k: usize, x: &mechsys_core::spatial::Pose, p| contours[k].curvature_tensor_at(x, p, &c.t1, &c.t2);
+            let tensor =
+                |k: usize, x: &mechsys_core::spatial::Pose, p| contours[k].curvature_tensor_at(x, p, &c.t1, &c.t2);
             match (tensor(0, &x1, &c.p1), tensor(1, &x2, &c.p2)) {
                 (Some(a), Some(b)) => {
                     let (s11, s12, s22) = (a[0] + b[0], a[1] + b[1], a[2] + b[2]);

@@ -66,10 +66,18 @@ fn gear_geometry<'py>(py: Python<'py>, description: &str, what: &str, samples: u
 /// For drawing (the viewer).
 #[pyfunction]
 #[pyo3(signature = (description, what, samples = 400))]
-fn curve_outline<'py>(py: Python<'py>, description: &str, what: &str, samples: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn curve_outline<'py>(
+    py: Python<'py>,
+    description: &str,
+    what: &str,
+    samples: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let d: ContourDescription = parse(description, what)?;
     if !(2..=1_000_000).contains(&samples) {
-        return Err(PyMechsysError(mechsys_core::Error::Model(format!("{what}: samples must be 2 to 1e6, got {samples}"))).into());
+        return Err(PyMechsysError(mechsys_core::Error::Model(format!(
+            "{what}: samples must be 2 to 1e6, got {samples}"
+        )))
+        .into());
     }
     let curve = planar_curve(&d, what).map_err(PyMechsysError::from)?;
     let (lo, hi) = curve.range();

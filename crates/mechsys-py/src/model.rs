@@ -321,18 +321,26 @@ impl PyModel {
                 F::JointForce { joint, .. } => ("joint_force", joint_units(*joint).0, ""),
                 F::Servo { joint, position, .. } => {
                     let (a, b) = joint_units(*joint);
-                    ("servo", a, if *position { b } else if b == "rad" { "rad/s" } else { "m/s" })
+                    (
+                        "servo",
+                        a,
+                        if *position {
+                            b
+                        } else if b == "rad" {
+                            "rad/s"
+                        } else {
+                            "m/s"
+                        },
+                    )
                 }
                 F::Callback { .. } => ("python_force", "mixed", ""),
                 // force: F_x, F_y (shell frame), torque; deflection: ε, position angle, attitude angle
                 F::HydrodynamicBearing(_) => ("hydrodynamic_bearing", "N, N, N m", "1, rad, rad"),
                 // per point, force: F_N, F_T1, F_T2, stored and dissipated energy, point (m), friction force (N);
                 // deflection: δ, δ̇, ġ_T1, ġ_T2, α, normal (1), unused
-                F::Contact(_) => (
-                    "compliant_contact",
-                    "N, N, N, J, J, m, m, m, N, N, N",
-                    "m, m/s, m/s, m/s, s/m, 1, 1, 1, 1, 1, 1",
-                ),
+                F::Contact(_) => {
+                    ("compliant_contact", "N, N, N, J, J, m, m, m, N, N, N", "m, m/s, m/s, m/s, s/m, 1, 1, 1, 1, 1, 1")
+                }
                 // force: ΣF_N, stored and dissipated energy, touching pairs, then per drawn point its
                 // position and force; deflection: max δ, max δ̇, broad-phase pairs, touching points
                 F::ContactGroup(_) => ("compliant_group", "N, J, J, 1, (m, N) per point", "m, m/s, 1, 1"),

@@ -119,9 +119,13 @@ impl Callbacks for PyCallbacks {
         let f = self.get(id)?;
         Python::with_gil(|py| {
             let r = f.call1(py, (delta, rate)).map_err(py_err)?;
-            let v: f64 = r.extract(py).map_err(|_| Error::Callback(format!("contact law callback {id}: expected a number (the normal force in N)")))?;
+            let v: f64 = r.extract(py).map_err(|_| {
+                Error::Callback(format!("contact law callback {id}: expected a number (the normal force in N)"))
+            })?;
             if !v.is_finite() {
-                return Err(Error::Callback(format!("contact law callback {id} returned {v} at overlap {delta:e} m, rate {rate:e} m/s")));
+                return Err(Error::Callback(format!(
+                    "contact law callback {id} returned {v} at overlap {delta:e} m, rate {rate:e} m/s"
+                )));
             }
             Ok(v)
         })

@@ -672,8 +672,24 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 add_wrench_row(model, &data.s, rows.body2, &w2, -1.0, &mut data.g, r + k);
                 if let Some((p1, p2)) = rows.points {
                     let view = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
-                    crate::kinematics::add_elastic_point_rows(view, rows.body1, &p1, 1.0, Some(&w1.f), &mut data.g, r + k);
-                    crate::kinematics::add_elastic_point_rows(view, rows.body2, &p2, -1.0, Some(&w2.f), &mut data.g, r + k);
+                    crate::kinematics::add_elastic_point_rows(
+                        view,
+                        rows.body1,
+                        &p1,
+                        1.0,
+                        Some(&w1.f),
+                        &mut data.g,
+                        r + k,
+                    );
+                    crate::kinematics::add_elastic_point_rows(
+                        view,
+                        rows.body2,
+                        &p2,
+                        -1.0,
+                        Some(&w2.f),
+                        &mut data.g,
+                        r + k,
+                    );
                 }
                 add_node_rows(data, &rows, &w1, &w2, r + k);
             }
@@ -687,8 +703,28 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     data.phi[r + k] = d[k];
                     data.b[r + k] = 0.0;
                 }
-                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body1, &w1, 1.0, None, &mut data.g, r);
-                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body2, &w2, -1.0, None, &mut data.g, r);
+                add_point_rows(
+                    model,
+                    &data.s,
+                    (&data.x_abs, &data.elastic, &data.body_elastic),
+                    *body1,
+                    &w1,
+                    1.0,
+                    None,
+                    &mut data.g,
+                    r,
+                );
+                add_point_rows(
+                    model,
+                    &data.s,
+                    (&data.x_abs, &data.elastic, &data.body_elastic),
+                    *body2,
+                    &w2,
+                    -1.0,
+                    None,
+                    &mut data.g,
+                    r,
+                );
             }
             ConstraintKind::Distance { body1, p1, body2, p2, length } => {
                 let (w1, w2) = (point_position(data, *body1, p1), point_position(data, *body2, p2));
@@ -703,8 +739,28 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 let e = d / l;
                 data.phi[r] = l - length;
                 data.b[r] = 0.0;
-                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body1, &w1, 1.0, Some(&e), &mut data.g, r);
-                add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body2, &w2, -1.0, Some(&e), &mut data.g, r);
+                add_point_rows(
+                    model,
+                    &data.s,
+                    (&data.x_abs, &data.elastic, &data.body_elastic),
+                    *body1,
+                    &w1,
+                    1.0,
+                    Some(&e),
+                    &mut data.g,
+                    r,
+                );
+                add_point_rows(
+                    model,
+                    &data.s,
+                    (&data.x_abs, &data.elastic, &data.body_elastic),
+                    *body2,
+                    &w2,
+                    -1.0,
+                    Some(&e),
+                    &mut data.g,
+                    r,
+                );
             }
             ConstraintKind::Contact { body1, body2, pair, .. } => {
                 // g_N = 0 (holonomic), then ġ_T = 0 along each friction direction (rolling)
@@ -713,8 +769,28 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 for (j, e) in std::iter::once(&k.n).chain(tg.iter()).take(rows).enumerate() {
                     data.phi[r + j] = if j == 0 { k.g } else { 0.0 };
                     data.b[r + j] = 0.0;
-                    add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body1, &k.p1, 1.0, Some(e), &mut data.g, r + j);
-                    add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), *body2, &k.p2, -1.0, Some(e), &mut data.g, r + j);
+                    add_point_rows(
+                        model,
+                        &data.s,
+                        (&data.x_abs, &data.elastic, &data.body_elastic),
+                        *body1,
+                        &k.p1,
+                        1.0,
+                        Some(e),
+                        &mut data.g,
+                        r + j,
+                    );
+                    add_point_rows(
+                        model,
+                        &data.s,
+                        (&data.x_abs, &data.elastic, &data.body_elastic),
+                        *body2,
+                        &k.p2,
+                        -1.0,
+                        Some(e),
+                        &mut data.g,
+                        r + j,
+                    );
                 }
             }
             ConstraintKind::Gap { function, slot, .. } => {

@@ -781,8 +781,8 @@ fn model_with_held_contacts() -> Model {
     let base = model_with_new_kinds();
     let mut desc = base.description.clone();
     desc.constraints.clear();
-    let held = |name: &str, b1: &str, c1: ContourDescription, b2: &str, c2: ContourDescription, rolling| {
-        ContactDescription {
+    let held =
+        |name: &str, b1: &str, c1: ContourDescription, b2: &str, c2: ContourDescription, rolling| ContactDescription {
             name: name.into(),
             body1: b1.into(),
             contour1: c1,
@@ -794,8 +794,7 @@ fn model_with_held_contacts() -> Model {
             points: None,
             material1: None,
             material2: None,
-        }
-    };
+        };
     let sphere = |c: [f64; 3], r| ContourDescription::Sphere { center: c, radius: r };
     desc.contacts = vec![
         held(
@@ -823,7 +822,8 @@ fn model_with_held_contacts() -> Model {
 fn held_contacts_have_their_row_counts() {
     let model = model_with_held_contacts();
     assert!(model.contacts.is_empty(), "held contacts are constraints");
-    let rows: Vec<(usize, usize)> = model.constraints.iter().map(|c| (c.kind.rows(), c.kind.holonomic_rows())).collect();
+    let rows: Vec<(usize, usize)> =
+        model.constraints.iter().map(|c| (c.kind.rows(), c.kind.holonomic_rows())).collect();
     assert_eq!(rows, [(3, 1), (3, 1), (1, 1)]);
 }
 

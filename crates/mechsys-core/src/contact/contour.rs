@@ -13,9 +13,9 @@ use crate::spatial::Pose;
 use super::broad::Aabb;
 use crate::geometry::curve::Curve;
 use crate::geometry::mesh::TriMesh;
-use std::sync::Arc;
 use crate::geometry::revolution::Revolution;
 use crate::geometry::surface::Patch;
+use std::sync::Arc;
 
 /// 2-vector of `f64` (the coordinates of planar contours in the body's x-y plane).
 pub type Vec2 = nalgebra::Vector2<f64>;
@@ -699,8 +699,7 @@ impl Contour {
             }
             Contour::Circle { radius, .. } => [1.0 / radius, 0.0],
             Contour::Polygon { vertices } => {
-                let on_vertex =
-                    vertices.iter().any(|v| (Vec2::new(l.x, l.y) - v).norm() <= 1e-9 * (1.0 + v.norm()));
+                let on_vertex = vertices.iter().any(|v| (Vec2::new(l.x, l.y) - v).norm() <= 1e-9 * (1.0 + v.norm()));
                 if on_vertex {
                     [inf, 0.0]
                 } else {

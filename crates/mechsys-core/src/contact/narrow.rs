@@ -53,9 +53,9 @@ use crate::math::{Mat3, Vec3};
 use crate::spatial::{Motion, Pose};
 
 use super::contour::{lift, Contour, ContourKind};
-use box_box::BoxShape;
 use crate::geometry::revolution::Revolution;
 use crate::geometry::surface::Patch;
+use box_box::BoxShape;
 use curve_pair::{CurveGeometry, First};
 use mesh_pair::MeshGeometry;
 use warm::SearchHint;
@@ -353,7 +353,11 @@ impl ContactPair {
             "contact pair {name}: points must be 1 to {}, got {points}",
             curve_pair::MAX_POINTS
         );
-        ensure!(g.shared(), Model, "contact pair {name}: a polygon has one contact point per vertex; points does not apply");
+        ensure!(
+            g.shared(),
+            Model,
+            "contact pair {name}: a polygon has one contact point per vertex; points does not apply"
+        );
         g.check_points(points).map_err(|m| Error::Model(format!("contact pair {name}: {m}")))?;
         g.set_points(points);
         self.count = points;
@@ -690,7 +694,9 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             let first = match f {
                 Contour::Point2 { p } => First::Points { centers: vec![lift(p)], radius: 0.0 },
                 Contour::Circle { center, radius } => First::Points { centers: vec![lift(center)], radius: *radius },
-                Contour::Polygon { vertices } => First::Points { centers: vertices.iter().map(lift).collect(), radius: 0.0 },
+                Contour::Polygon { vertices } => {
+                    First::Points { centers: vertices.iter().map(lift).collect(), radius: 0.0 }
+                }
                 Contour::Curve(c) => First::Curve((**c).clone()),
                 _ => unreachable!("excluded by the dispatch table"),
             };
@@ -720,7 +726,12 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
         }
         if let Contour::Ellipsoid { center, rotation, semi_axes } = f {
             let d = Mat3::from_diagonal(&semi_axes.component_mul(semi_axes));
-            return Geometry::EllipsoidHalfSpace { center: *center, shape: rotation * d * rotation.transpose(), point, normal };
+            return Geometry::EllipsoidHalfSpace {
+                center: *center,
+                shape: rotation * d * rotation.transpose(),
+                point,
+                normal,
+            };
         }
         let (centers, radius) = match f {
             Contour::Point { p } => (vec![*p], 0.0),
@@ -785,7 +796,8 @@ fn build_geometry(f: &Contour, s: &Contour) -> Geometry {
             _ => unreachable!(),
         };
     }
-    let shape = |rotation: &Mat3, semi: &Vec3| rotation * Mat3::from_diagonal(&semi.component_mul(semi)) * rotation.transpose();
+    let shape =
+        |rotation: &Mat3, semi: &Vec3| rotation * Mat3::from_diagonal(&semi.component_mul(semi)) * rotation.transpose();
     if let (
         Contour::Ellipsoid { center: c1, rotation: r1, semi_axes: a1 },
         Contour::Ellipsoid { center: c2, rotation: r2, semi_axes: a2 },

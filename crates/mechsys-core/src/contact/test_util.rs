@@ -196,7 +196,12 @@ pub(crate) fn sample(kind: &str) -> Contour {
             rotation: rot(&Vec3::new(1.0, 0.4, -0.2), -0.6),
             semi_axes: Vec3::new(0.22, 0.35, 0.28),
         },
-        "torus" => Contour::Torus { center: Vec3::new(0.05, 0.1, -0.02), axis: Vec3::new(0.2, 1.0, 0.3), radius: 0.35, tube: 0.05 },
+        "torus" => Contour::Torus {
+            center: Vec3::new(0.05, 0.1, -0.02),
+            axis: Vec3::new(0.2, 1.0, 0.3),
+            radius: 0.35,
+            tube: 0.05,
+        },
         "bowl" => Contour::Bowl { center: Vec3::new(0.05, -0.1, 0.02), radius: 1.3 },
         "bore" => Contour::Bore { center: Vec3::new(0.1, 0.0, -0.05), axis: Vec3::new(0.3, 1.0, 0.2), radius: 1.3 },
         "revolution" => surface_sample("revolution"),
@@ -286,7 +291,8 @@ pub(crate) fn curve_sample(kind: &str) -> Contour {
         }
         // a circular bore of radius 0.9 (solid outside)
         "bore" => {
-            let pts: Vec<Vec2> = (0..40).map(|i| TAU * i as f64 / 40.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.9).collect();
+            let pts: Vec<Vec2> =
+                (0..40).map(|i| TAU * i as f64 / 40.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.9).collect();
             Curve::spline(&pts, true, Solid::Outside, "bore").unwrap()
         }
         // involute gears of about the samples' size, off their body origins

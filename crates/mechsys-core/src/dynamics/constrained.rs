@@ -88,7 +88,10 @@ fn solve_sparse(model: &Model, data: &mut Data, sp: &mut Saddle, t: f64, u: &[f6
         super::crba::composite_inertias(model, inertia, s, ic, elastic, |r, c, v| sp.put_mass(r, c, v));
     }
     if !sp.factor_mass() {
-        return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s{}", crate::elastic::runaway(model, data))));
+        return Err(Error::Solver(format!(
+            "the mass matrix is singular at t = {t:.6} s{}",
+            crate::elastic::runaway(model, data)
+        )));
     }
     sp.solve_mass(&mut data.udot);
     sp.gather_g(&data.g);
@@ -357,12 +360,13 @@ pub fn project(
         crate::kinematics::positions(model, data, q);
         constraints::positions(model, data, t, q, cb)?;
         let skip = &data.skip_rows;
-        worst = data
-            .phi
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| !skip[*k])
-            .fold((0.0, 0), |w, (k, v)| if v.abs() > w.0 { (v.abs(), k) } else { w });
+        worst = data.phi.iter().enumerate().filter(|(k, _)| !skip[*k]).fold((0.0, 0), |w, (k, v)| {
+            if v.abs() > w.0 {
+                (v.abs(), k)
+            } else {
+                w
+            }
+        });
         if worst.0 <= 1e-13 {
             converged = true;
             break;
@@ -409,7 +413,13 @@ pub fn project(
 /// `x ← M̃⁻¹ x`: the accelerations a generalized force `x` causes under the bilateral
 /// constraints (`M⁻¹ x` restricted to their tangent space through the factored Schur complement
 /// in `sp`); `lambda`, if given, receives the multipliers it adds. `data.work2` is scratch.
-pub(crate) fn tangent_inverse_mass(data: &mut Data, sp: &mut Saddle, nc: usize, x: &mut [f64], lambda: Option<&mut [f64]>) {
+pub(crate) fn tangent_inverse_mass(
+    data: &mut Data,
+    sp: &mut Saddle,
+    nc: usize,
+    x: &mut [f64],
+    lambda: Option<&mut [f64]>,
+) {
     sp.solve_mass(x);
     if nc > 0 {
         let mut y = std::mem::take(&mut data.work2);

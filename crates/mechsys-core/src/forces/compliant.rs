@@ -22,8 +22,8 @@ use crate::error::{Error, Result};
 use crate::forces::Callbacks;
 use crate::math::Vec3;
 use crate::model::compliant::{
-    johnson_energy, johnson_x, CompliantContact, CompliantLaw, Dissipation, Elastic, HertzEllipse, Tangential, OUTPUTS_PER_POINT,
-    STATES_PER_POINT,
+    johnson_energy, johnson_x, CompliantContact, CompliantLaw, Dissipation, Elastic, HertzEllipse, Tangential,
+    OUTPUTS_PER_POINT, STATES_PER_POINT,
 };
 use crate::model::{ForceElement, Model};
 use crate::spatial::Force;
@@ -100,7 +100,13 @@ pub(crate) struct PairLaw<'a> {
 
 impl<'a> PairLaw<'a> {
     fn of(c: &'a CompliantContact) -> Self {
-        PairLaw { law: &c.law, contours: [&c.contours[0], &c.contours[1]], body1: c.body1, body2: c.body2, name: &c.name }
+        PairLaw {
+            law: &c.law,
+            contours: [&c.contours[0], &c.contours[1]],
+            body1: c.body1,
+            body2: c.body2,
+            name: &c.name,
+        }
     }
 }
 
@@ -309,8 +315,7 @@ pub fn evaluate(
             ft.y,
             ft.z,
         ]);
-        d[b..b + OUTPUTS_PER_POINT]
-            .copy_from_slice(&[delta, rate, v[0], v[1], pf.alpha, n.x, n.y, n.z, 0.0, 0.0, 0.0]);
+        d[b..b + OUTPUTS_PER_POINT].copy_from_slice(&[delta, rate, v[0], v[1], pf.alpha, n.x, n.y, n.z, 0.0, 0.0, 0.0]);
     }
     Ok(p_diss)
 }

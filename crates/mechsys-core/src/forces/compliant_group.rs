@@ -79,7 +79,14 @@ impl GroupWork {
 
 /// Evaluates group `g` (its recorded values from `o` on): applies the forces of its touching
 /// pairs to `data.f_ext`, writes the rate of its dissipated energy and returns that power.
-pub fn evaluate(g: &CompliantGroup, data: &mut Data, w: &mut Work, o: usize, t: f64, cb: &dyn Callbacks) -> Result<f64> {
+pub fn evaluate(
+    g: &CompliantGroup,
+    data: &mut Data,
+    w: &mut Work,
+    o: usize,
+    t: f64,
+    cb: &dyn Callbacks,
+) -> Result<f64> {
     let Work { groups, rates, states, .. } = w;
     let gw = &mut groups[g.index];
     gw.update(g, data)?;

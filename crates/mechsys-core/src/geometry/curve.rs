@@ -254,14 +254,26 @@ impl Curve {
     pub fn spline(points: &[Vec2], closed: bool, solid: Solid, what: &str) -> Result<Curve> {
         let mut p: Vec<Vec2> = points.to_vec();
         for (i, v) in p.iter().enumerate() {
-            ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}: spline point {i} is not finite ({}, {})", v.x, v.y);
+            ensure!(
+                v.iter().all(|x| x.is_finite()),
+                Model,
+                "{what}: spline point {i} is not finite ({}, {})",
+                v.x,
+                v.y
+            );
         }
         let scale = p.iter().map(|v| v.norm()).fold(0.0, f64::max).max(1e-300);
         if closed && p.len() > 1 && (p[p.len() - 1] - p[0]).norm() <= 1e-12 * scale {
             p.pop();
         }
         let min = if closed { 3 } else { 2 };
-        ensure!(p.len() >= min, Model, "{what}: a {} spline needs at least {min} points, got {}", if closed { "closed" } else { "open" }, p.len());
+        ensure!(
+            p.len() >= min,
+            Model,
+            "{what}: a {} spline needs at least {min} points, got {}",
+            if closed { "closed" } else { "open" },
+            p.len()
+        );
         let n = p.len();
         let segs = if closed { n } else { n - 1 };
         for i in 0..segs {
@@ -308,11 +320,9 @@ impl Curve {
         let sigma = match (solid, closed) {
             (Solid::Left, _) => 1.0,
             (Solid::Right, _) => -1.0,
-            (Solid::Inside | Solid::Outside, false) => {
-                return Err(crate::Error::Model(format!(
-                    "{what}: an open curve has no inside; put its solid on the left or the right of the points' direction"
-                )))
-            }
+            (Solid::Inside | Solid::Outside, false) => return Err(crate::Error::Model(format!(
+                "{what}: an open curve has no inside; put its solid on the left or the right of the points' direction"
+            ))),
             (Solid::Inside | Solid::Outside, true) => {
                 // the shoelace area is positive for counter-clockwise points, whose inside is on the left
                 let area: f64 = (0..n).map(|i| cross(&p[i], &p[(i + 1) % n])).sum();
@@ -347,9 +357,23 @@ impl Curve {
         direction: f64,
         what: &str,
     ) -> Result<Curve> {
-        ensure!(base_radius > 0.0 && base_radius.is_finite(), Model, "{what}: cam base_radius must be > 0, got {base_radius}");
-        ensure!(direction == 1.0 || direction == -1.0, Model, "{what}: cam direction must be +1 or -1, got {direction}");
-        ensure!(angles.len() == lift.len(), Model, "{what}: cam lift table has {} angles but {} lifts", angles.len(), lift.len());
+        ensure!(
+            base_radius > 0.0 && base_radius.is_finite(),
+            Model,
+            "{what}: cam base_radius must be > 0, got {base_radius}"
+        );
+        ensure!(
+            direction == 1.0 || direction == -1.0,
+            Model,
+            "{what}: cam direction must be +1 or -1, got {direction}"
+        );
+        ensure!(
+            angles.len() == lift.len(),
+            Model,
+            "{what}: cam lift table has {} angles but {} lifts",
+            angles.len(),
+            lift.len()
+        );
         ensure!(angles.len() >= 3, Model, "{what}: cam lift table needs at least 3 rows, got {}", angles.len());
         let tau = std::f64::consts::TAU;
         let (mut t, mut h) = (angles.to_vec(), lift.to_vec());
@@ -381,7 +405,11 @@ impl Curve {
         };
         let (eccentricity, radius, flat) = match follower {
             Follower::Roller { radius, eccentricity } => {
-                ensure!(radius >= 0.0 && radius.is_finite(), Model, "{what}: cam roller radius must be ≥ 0, got {radius}");
+                ensure!(
+                    radius >= 0.0 && radius.is_finite(),
+                    Model,
+                    "{what}: cam roller radius must be ≥ 0, got {radius}"
+                );
                 ensure!(
                     eccentricity.abs() < base_radius + radius,
                     Model,
@@ -470,7 +498,16 @@ impl Curve {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn build(shape: Shape, offset: f64, sigma: f64, lo: f64, hi: f64, closed: bool, per: usize, what: &str) -> Result<Curve> {
+    fn build(
+        shape: Shape,
+        offset: f64,
+        sigma: f64,
+        lo: f64,
+        hi: f64,
+        closed: bool,
+        per: usize,
+        what: &str,
+    ) -> Result<Curve> {
         let mut c = Curve {
             shape,
             offset,
@@ -626,12 +663,7 @@ impl Curve {
             }
             Shape::Spline { x, y } => {
                 let (jx, jy) = (x.eval(s), y.eval(s));
-                [
-                    Vec2::new(jx[0], jy[0]),
-                    Vec2::new(jx[1], jy[1]),
-                    Vec2::new(jx[2], jy[2]),
-                    Vec2::new(jx[3], jy[3]),
-                ]
+                [Vec2::new(jx[0], jy[0]), Vec2::new(jx[1], jy[1]), Vec2::new(jx[2], jy[2]), Vec2::new(jx[3], jy[3])]
             }
             Shape::Cam { lift, base, eccentricity, dir, flat } => {
                 let h = lift.eval(s);
@@ -856,13 +888,24 @@ mod tests {
         let (jm, j0, jp) = (c.eval(s - h), c.eval(s), c.eval(s + h));
         for k in 0..3 {
             let fd = (jp[k] - jm[k]) / (2.0 * h);
-            assert!((fd - j0[k + 1]).norm() < 1e-6 * (1.0 + j0[k + 1].norm()), "{} derivative {k} at {s}: {fd} vs {}", c.shape_name(), j0[k + 1]);
+            assert!(
+                (fd - j0[k + 1]).norm() < 1e-6 * (1.0 + j0[k + 1].norm()),
+                "{} derivative {k} at {s}: {fd} vs {}",
+                c.shape_name(),
+                j0[k + 1]
+            );
         }
         // curvature rate per arc length of the contour against differences
         let (fm, f0, fp) = (c.frame(s - h), c.frame(s), c.frame(s + h));
         let dsigma = (fp.point - fm.point).norm();
         let fd = (fp.curvature - fm.curvature) / dsigma;
-        assert!((fd - f0.curvature_rate).abs() < 1e-5 * (1.0 + f0.curvature_rate.abs()), "{} (offset {}) at {s}: κ' {fd} vs {}", c.shape_name(), c.offset(), f0.curvature_rate);
+        assert!(
+            (fd - f0.curvature_rate).abs() < 1e-5 * (1.0 + f0.curvature_rate.abs()),
+            "{} (offset {}) at {s}: κ' {fd} vs {}",
+            c.shape_name(),
+            c.offset(),
+            f0.curvature_rate
+        );
         // outward normal ⟂ tangent, eq. 2.89: t' = -κ ν per arc length (ν outward = -n)
         let tfd = (fp.tangent - fm.tangent) / dsigma;
         assert!((tfd + f0.normal * f0.curvature).norm() < 1e-5 * (1.0 + f0.curvature.abs()));
@@ -886,7 +929,8 @@ mod tests {
 
     #[test]
     fn spline_through_circle_points_approaches_the_circle_and_knows_its_side() {
-        let pts: Vec<Vec2> = (0..48).map(|i| TAU * i as f64 / 48.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.5).collect();
+        let pts: Vec<Vec2> =
+            (0..48).map(|i| TAU * i as f64 / 48.0).map(|t| Vec2::new(t.cos(), t.sin()) * 0.5).collect();
         let c = Curve::spline(&pts, true, Solid::Inside, "ring").unwrap();
         // between knots (r''' jumps at the knots)
         for s in [0.013, 0.37, 1.21, 2.9] {

@@ -241,7 +241,12 @@ fn coefficients(h: &[f64], y: &[f64], m: &[f64]) -> Vec<[f64; 4]> {
     (0..h.len())
         .map(|i| {
             let hi = h[i];
-            [y[i], (y[i + 1] - y[i]) / hi - hi * (2.0 * m[i] + m[i + 1]) / 6.0, m[i] / 2.0, (m[i + 1] - m[i]) / (6.0 * hi)]
+            [
+                y[i],
+                (y[i + 1] - y[i]) / hi - hi * (2.0 * m[i] + m[i + 1]) / 6.0,
+                m[i] / 2.0,
+                (m[i + 1] - m[i]) / (6.0 * hi),
+            ]
         })
         .collect()
 }

@@ -229,7 +229,15 @@ impl Step {
     }
 
     /// Hairer's starting step ([`starting_step_on`]) in the step's coordinates.
-    pub(crate) fn starting_step<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64], rtol: f64, atol: f64, hmax: f64) -> Result<f64> {
+    pub(crate) fn starting_step<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        rtol: f64,
+        atol: f64,
+        hmax: f64,
+    ) -> Result<f64> {
         let (k0, rest) = self.k.split_at_mut(1);
         if self.chart.is_flat() {
             return starting_step(sys, t, y, &k0[0], rtol, atol, hmax, (&mut self.tmp, &mut rest[0]));
@@ -252,7 +260,8 @@ pub(crate) fn starting_step_on<S: OdeSystem>(
 ) -> Result<f64> {
     let nl = chart.local_dim();
     let sc = |i: usize| atol + rtol * chart.magnitude(i, y, y);
-    let norm = |v: &dyn Fn(usize) -> f64| ((0..nl).map(|i| (v(i) / sc(i)).powi(2)).sum::<f64>() / nl.max(1) as f64).sqrt();
+    let norm =
+        |v: &dyn Fn(usize) -> f64| ((0..nl).map(|i| (v(i) / sc(i)).powi(2)).sum::<f64>() / nl.max(1) as f64).sqrt();
     let (d0, d1) = (norm(&|i| chart.magnitude(i, y, y)), norm(&|i| k0[i]));
     let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
     let h0 = h0.min(hmax);

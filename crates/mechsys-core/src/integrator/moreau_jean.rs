@@ -35,9 +35,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::contact::{
-    at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase, SearchHint,
-};
+use crate::contact::{at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase, SearchHint};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -236,6 +234,11 @@ pub struct MoreauJean {
     in_step: Vec<bool>,
     /// Per explicit point: closed (stick or slip) at the start of the step.
     closed_before: Vec<bool>,
+    /// The sparse assembly's off-diagonal blocks are in `problem.w` for this step (they are
+    /// built only when a solve needs them: not for Gauss–Seidel on the factored operator).
+    blocks_ready: bool,
+    /// `W r + q` of the step's solution when the factored solve found it (else empty).
+    local_u: Vec<f64>,
 }
 
 impl MoreauJean {
@@ -329,6 +332,8 @@ impl MoreauJean {
             projection: projection::Projection::new(model),
             in_step: vec![false; np],
             closed_before: vec![false; np],
+            blocks_ready: false,
+            local_u: Vec::with_capacity(dim * np),
         })
     }
 
@@ -408,7 +413,10 @@ impl MoreauJean {
                     saddle.put_mass(r, col, v);
                 });
                 if !ws.saddle.factor_mass() {
-                    return Err(Error::Solver(format!("the mass matrix is singular at t = {tm:.6} s{}", crate::elastic::runaway(model, data))));
+                    return Err(Error::Solver(format!(
+                        "the mass matrix is singular at t = {tm:.6} s{}",
+                        crate::elastic::runaway(model, data)
+                    )));
                 }
                 if let Some(sp) = self.sparse.as_mut() {
                     sp.factor.copy_from(&ws.saddle);
@@ -464,7 +472,13 @@ impl MoreauJean {
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
                 if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
-                    self.act.push(Active { b1: con.body1, b2: con.body2, contact: ci, point: kk.point, source: Source::Point(pt) });
+                    self.act.push(Active {
+                        b1: con.body1,
+                        b2: con.body2,
+                        contact: ci,
+                        point: kk.point,
+                        source: Source::Point(pt),
+                    });
                 }
             }
         }
@@ -499,11 +513,20 @@ impl MoreauJean {
                 sp.clear();
                 for a in &self.act {
                     let k = &a.point;
-                    sp.add_contact(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), a.b1, &k.p1, a.b2, &k.p2, &[k.n, k.t1, k.t2]);
+                    sp.add_contact(
+                        model,
+                        &data.s,
+                        (&data.x_abs, &data.elastic, &data.body_elastic),
+                        a.b1,
+                        &k.p1,
+                        a.b2,
+                        &k.p2,
+                        &[k.n, k.t1, k.t2],
+                    );
                 }
-                sp.delassus();
-                let Delassus::Blocks(bw) = &mut self.problem.w else { unreachable!("block Delassus") };
-                bw.refill(d, m, &sp.diag, &sp.upper, &sp.upper_val);
+                // the diagonal blocks and the couplings now, the pairs' blocks when a solve needs them
+                sp.couplings();
+                self.blocks_ready = false;
                 let (mut g, mut g0) = ([0.0; 3], [0.0; 3]);
                 for ai in 0..m {
                     sp.local_velocity2(ai, &self.u_free, &self.u_prev, &mut g, &mut g0);
@@ -610,7 +633,10 @@ impl MoreauJean {
                         }
                         let mu = friction.mu(speed);
                         let mut blk = [0.0; 9];
-                        self.problem.w.diag_block(d, ai, &mut blk);
+                        match self.sparse.as_ref() {
+                            Some(sp) => sp.diag_block(ai, &mut blk),
+                            None => self.problem.w.diag_block(d, ai, &mut blk),
+                        }
                         let (c, crit) = crate::integrator::events::painleve_margin(&blk[..d * d], d, mu, s);
                         if c <= 1e-12 * blk[0].abs() {
                             // the free normal acceleration times h: at the midpoint ġ⁻ holds
@@ -654,13 +680,17 @@ impl MoreauJean {
                 Some(sp) => {
                     self.islands.partition(m, &sp.links);
                     if self.islands.count() > 1 {
+                        self.ensure_blocks();
+                        let sp = self.sparse.as_ref().expect("sparse assembly");
                         self.islands.fill(&self.problem, &sp.diag, &sp.upper, &sp.upper_val, &self.r, &self.height);
                     }
                 }
                 None => self.islands.single(m),
             }
             let split = self.sparse.is_some() && self.islands.count() > 1;
-            let report = self.solve_contacts(split, false).map_err(|e| {
+            self.local_u.clear();
+            let factored = !split && !self.static_mu.iter().any(|s| *s);
+            let report = self.solve_contacts(split, false, factored).map_err(|e| {
                 let names = self.active_names(model);
                 Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
             })?;
@@ -699,7 +729,7 @@ impl MoreauJean {
                     }
                 }
                 if again {
-                    report = self.solve_contacts(split, true).map_err(|e| {
+                    report = self.solve_contacts(split, true, false).map_err(|e| {
                         let names = self.active_names(model);
                         Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
                     })?;
@@ -736,7 +766,15 @@ impl MoreauJean {
             let q_scale = 1.0 + self.problem.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             for ai in 0..m {
                 let tol = 1e-9 * (1.0 + self.r[ai * d].abs());
-                let state = self.problem.contact_state_unchecked(ai, &self.r, tol, r_scale, q_scale);
+                let state = if self.local_u.is_empty() {
+                    self.problem.contact_state_unchecked(ai, &self.r, tol, r_scale, q_scale)
+                } else {
+                    // the factored solve's W r + q (no blocks were built)
+                    let (mut ri, mut ui) = ([0.0; 3], [0.0; 3]);
+                    ri[..d].copy_from_slice(&self.r[ai * d..(ai + 1) * d]);
+                    ui[..d].copy_from_slice(&self.local_u[ai * d..(ai + 1) * d]);
+                    solver::classify(&ri, &ui, tol, r_scale, q_scale)
+                };
                 let code = match state {
                     ContactState::Open => OPEN,
                     ContactState::Stick => STICK,
@@ -858,7 +896,64 @@ impl MoreauJean {
     /// Solves the step's friction-contact problem into `self.r` (warm-started from it): whole,
     /// or island by island when `split` (after [`islands::Islands::fill`]); `again` marks the
     /// re-solve after a break-away changed friction coefficients.
-    fn solve_contacts(&mut self, split: bool, again: bool) -> Result<solver::Report> {
+    ///
+    /// With `factored` (one island of the sparse assembly) Gauss–Seidel runs on the factored
+    /// operator ([`SparseRows::gauss_seidel`]) without the off-diagonal blocks: all of an NSGS
+    /// solve, or [`Method::Auto`]'s first sweeps, the blocks being built only if Newton follows.
+    fn solve_contacts(&mut self, split: bool, again: bool, factored: bool) -> Result<solver::Report> {
+        if factored && self.sparse.is_some() {
+            let m = self.r.len();
+            // (Auto's sweeps before Newton stop early only well below the tolerance, see
+            // solver::AUTO_SWEEP_MARGIN; relaxed NSGS keeps the block solver's safeguard)
+            let plan = match &self.method {
+                Method::Nsgs(o) if o.relaxation == 1.0 => Some((o.tol, o.max_iter, None)),
+                Method::Auto(o) => match o.pick(m) {
+                    Method::Nsgs(p) => Some((p.tol, p.max_iter, None)),
+                    Method::Newton(p) => {
+                        Some((solver::AUTO_SWEEP_MARGIN * o.tol, solver::AUTO_SWEEPS, Some((o.tol, p))))
+                    }
+                    _ => None,
+                },
+                _ => None,
+            };
+            if let Some((tol, sweeps, then)) = plan {
+                // the block solver's checks of its input (W_NN from the diagonal blocks)
+                let d = self.problem.dim;
+                solver::check_local(d, &self.problem.q, &self.problem.mu)?;
+                let sp = self.sparse.as_mut().expect("sparse assembly");
+                for i in 0..m / d {
+                    solver::check_wnn(i, sp.diag[i * d * d])?;
+                }
+                if let Some(k) = self.r.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::Settings(format!("solver: warm start entry {k} is not finite ({})", self.r[k])));
+                }
+                self.local_u.resize(m, 0.0);
+                let first = sp.gauss_seidel(
+                    &self.problem.q,
+                    &self.problem.mu,
+                    &self.ws.order,
+                    &mut self.r,
+                    tol,
+                    sweeps,
+                    &mut self.local_u,
+                );
+                let Some((auto_tol, newton)) = then else {
+                    return Ok(first);
+                };
+                if first.converged {
+                    return Ok(solver::Report { converged: first.residual <= auto_tol, ..first });
+                }
+                // Newton from the sweeps' impulses, on the blocks
+                self.local_u.clear();
+                self.ensure_blocks();
+                let method = Method::Newton(newton);
+                self.ws.reserve(&self.problem, &method)?;
+                let mut rep = solver::solve(&self.problem, &method, &mut self.r, true, &mut self.ws)?;
+                rep.iterations += first.iterations;
+                return Ok(rep);
+            }
+        }
+        self.ensure_blocks();
         if split {
             if again {
                 self.islands.refresh(&self.problem, &self.r);
@@ -870,6 +965,17 @@ impl MoreauJean {
         self.ws.reserve(&self.problem, &self.method)?;
         let warm = again || self.r.iter().any(|v| *v != 0.0);
         solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws)
+    }
+
+    /// Puts the sparse assembly's Delassus blocks into the step's problem (once per step).
+    fn ensure_blocks(&mut self) {
+        if let (Some(sp), false) = (self.sparse.as_mut(), self.blocks_ready) {
+            sp.pairs();
+            let d = self.problem.dim;
+            let Delassus::Blocks(bw) = &mut self.problem.w else { unreachable!("block Delassus") };
+            bw.refill(d, sp.len(), &sp.diag, &sp.upper, &sp.upper_val);
+            self.blocks_ready = true;
+        }
     }
 
     /// Steps in which the position projection moved a contact back onto its contour.
@@ -926,8 +1032,28 @@ impl MoreauJean {
             let dirs = [k.n, k.t1, k.t2];
             for (row, dir) in dirs.iter().enumerate().take(d) {
                 let r = ai * d + row;
-                crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), a.b1, &k.p1, 1.0, Some(dir), &mut self.w_rows, r);
-                crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), a.b2, &k.p2, -1.0, Some(dir), &mut self.w_rows, r);
+                crate::constraints::add_point_rows(
+                    model,
+                    &data.s,
+                    (&data.x_abs, &data.elastic, &data.body_elastic),
+                    a.b1,
+                    &k.p1,
+                    1.0,
+                    Some(dir),
+                    &mut self.w_rows,
+                    r,
+                );
+                crate::constraints::add_point_rows(
+                    model,
+                    &data.s,
+                    (&data.x_abs, &data.elastic, &data.body_elastic),
+                    a.b2,
+                    &k.p2,
+                    -1.0,
+                    Some(dir),
+                    &mut self.w_rows,
+                    r,
+                );
             }
         }
     }
@@ -949,7 +1075,15 @@ impl MoreauJean {
 
     /// Contact geometry and relative velocities of every candidate at the state in `data`
     /// (after a kinematics pass), for the records.
-    pub fn measure(&mut self, model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64], cb: &dyn Callbacks) -> Result<()> {
+    pub fn measure(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        cb: &dyn Callbacks,
+    ) -> Result<()> {
         for con in &model.contacts {
             let pts = con.first..con.first + con.points();
             let s = self.warm_search.then(|| &mut self.search[pts.clone()]);

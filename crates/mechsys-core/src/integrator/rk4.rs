@@ -179,7 +179,8 @@ fn integrate_on_group<S: OdeSystem>(
                 let (a, b, c, d, yy, zl) = (&k1, &k2, &k3, &k4, &y, &mut zl);
                 let dense = |th: f64, out: &mut [f64]| {
                     let (t2, t3) = (th * th, th * th * th);
-                    let (w1, w23, w4) = (th - 1.5 * t2 + 2.0 / 3.0 * t3, t2 - 2.0 / 3.0 * t3, -0.5 * t2 + 2.0 / 3.0 * t3);
+                    let (w1, w23, w4) =
+                        (th - 1.5 * t2 + 2.0 / 3.0 * t3, t2 - 2.0 / 3.0 * t3, -0.5 * t2 + 2.0 / 3.0 * t3);
                     for i in 0..nl {
                         zl[i] = rem * (w1 * a[i] + w23 * (b[i] + c[i]) + w4 * d[i]);
                     }
@@ -187,7 +188,16 @@ fn integrate_on_group<S: OdeSystem>(
                 };
                 if let Some(th) = switches.locate(sys, tt, rem, &y, &ynew, dense)? {
                     let h1 = th * rem;
-                    group_stages(sys, chart, tt, &y, h1, &k1, (&mut k2, &mut k3, &mut k4), (&mut z, &mut tmp, &mut fy))?;
+                    group_stages(
+                        sys,
+                        chart,
+                        tt,
+                        &y,
+                        h1,
+                        &k1,
+                        (&mut k2, &mut k3, &mut k4),
+                        (&mut z, &mut tmp, &mut fy),
+                    )?;
                     stats.evaluations += 3;
                     for i in 0..nl {
                         z[i] = h1 / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);

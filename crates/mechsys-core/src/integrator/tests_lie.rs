@@ -90,7 +90,11 @@ fn radau5_fixed_on_the_group_is_fifth_order() {
 #[test]
 fn adaptive_schemes_on_the_group_follow_the_tolerance() {
     for (name, kind) in [
-        ("dopri5", (|rtol| IntegratorKind::Dopri5 { rtol, atol: rtol * 1e-2, max_step: 0.0, first_step: 0.0 }) as fn(f64) -> IntegratorKind),
+        (
+            "dopri5",
+            (|rtol| IntegratorKind::Dopri5 { rtol, atol: rtol * 1e-2, max_step: 0.0, first_step: 0.0 })
+                as fn(f64) -> IntegratorKind,
+        ),
         ("radau5", |rtol| IntegratorKind::Radau5 {
             dt: 0.0,
             newton_tol: 1e-10,
@@ -114,6 +118,7 @@ fn adaptive_schemes_on_the_group_follow_the_tolerance() {
 fn the_quaternion_norm_stays_one_over_long_runs() {
     let (_, drift) = run(IntegratorKind::Rk4 { dt: 1e-3 }, 100.0, 100);
     assert!(drift < 1e-14, "RK4: |Q| − 1 = {drift:e}");
-    let (_, drift) = run(IntegratorKind::Dopri5 { rtol: 1e-9, atol: 1e-12, max_step: 0.0, first_step: 0.0 }, 100.0, 1000);
+    let (_, drift) =
+        run(IntegratorKind::Dopri5 { rtol: 1e-9, atol: 1e-12, max_step: 0.0, first_step: 0.0 }, 100.0, 1000);
     assert!(drift < 1e-14, "DOPRI5 (dense output too): |Q| − 1 = {drift:e}");
 }

@@ -400,7 +400,8 @@ pub fn elastic_point_at(el: ElasticView<'_>, body: usize, p: &Vec3) -> Option<(u
     let k = body_elastic.get(body).copied().flatten()?;
     let (w, x) = (&elastic[k], &x_abs[body]);
     let tol = 1e-12 * (1.0 + p.norm());
-    let n = (0..w.nodes.len()).find(|&n| (x.point_to_parent(&(w.nodes[n] + w.node_field(n, &w.q))) - p).amax() <= tol)?;
+    let n =
+        (0..w.nodes.len()).find(|&n| (x.point_to_parent(&(w.nodes[n] + w.node_field(n, &w.q))) - p).amax() <= tol)?;
     Some((k, n))
 }
 

@@ -120,7 +120,10 @@ fn coordinate_axis_revolutes_match_the_general_placement() {
             assert!((data.x_abs[i].a - x.a).amax() < 1e-14, "seed {seed}, body {i}: rotation");
             assert!((data.x_abs[i].r - x.r).amax() < 1e-14, "seed {seed}, body {i}: position");
             assert!((data.s[i][0].w - s_world.w).amax() < 1e-14 && (data.s[i][0].v - s_world.v).amax() < 1e-14);
-            assert_eq!((fused.x_abs[i], fused.s[i][0], fused.v[i], fused.c[i]), (data.x_abs[i], data.s[i][0], data.v[i], data.c[i]));
+            assert_eq!(
+                (fused.x_abs[i], fused.s[i][0], fused.v[i], fused.c[i]),
+                (data.x_abs[i], data.s[i][0], data.v[i], data.c[i])
+            );
             x_prev = x;
         }
     }

@@ -137,7 +137,10 @@ pub fn state_space(
             mass[(i, i)]
         )));
     }
-    let chol = mass.clone().cholesky().ok_or_else(|| Error::Model("linearize: the mass matrix is not positive definite".into()))?;
+    let chol = mass
+        .clone()
+        .cholesky()
+        .ok_or_else(|| Error::Model("linearize: the mass matrix is not positive definite".into()))?;
 
     // the holonomic rows
     let mut holonomic = Vec::with_capacity(nc);
@@ -347,8 +350,7 @@ fn dependent_columns(g: &DMatrix<f64>, prefer: &[usize]) -> Vec<usize> {
     let scale = g.amax().max(f64::MIN_POSITIVE);
     let mut dep = Vec::new();
     loop {
-        let norms: Vec<f64> =
-            (0..r.ncols()).map(|c| if dep.contains(&c) { 0.0 } else { r.column(c).norm() }).collect();
+        let norms: Vec<f64> = (0..r.ncols()).map(|c| if dep.contains(&c) { 0.0 } else { r.column(c).norm() }).collect();
         let best = |pref: bool| {
             (0..r.ncols())
                 .filter(|c| prefer.contains(c) == pref)

@@ -542,7 +542,10 @@ fn chaplygin_sleigh_eigenvalue_and_its_sign() {
                 assert_eq!((s.nq, s.nu), (3, 2), "three configuration, two velocity states");
                 let lam = eigenvalues(&s);
                 let big = lam.iter().max_by(|x, y| x.norm().total_cmp(&y.norm())).unwrap();
-                assert!((big.re - want).abs() < tol * want.abs() && big.im.abs() < tol, "{how:?} {basis:?}: {big} vs {want}");
+                assert!(
+                    (big.re - want).abs() < tol * want.abs() && big.im.abs() < tol,
+                    "{how:?} {basis:?}: {big} vs {want}"
+                );
                 assert!(s.defect < 1e-9, "steady: defect {}", s.defect);
             }
         }
@@ -552,7 +555,8 @@ fn chaplygin_sleigh_eigenvalue_and_its_sign() {
 #[test]
 fn partition_basis_selects_joint_coordinates() {
     let m = sleigh(0.3, 1.0);
-    let s = state_space(&m, 0.0, &m.q0(), &m.u0(), &NoCallbacks, Derivatives::Exact, &Basis::Partition(vec![2])).unwrap();
+    let s =
+        state_space(&m, 0.0, &m.q0(), &m.u0(), &NoCallbacks, Derivatives::Exact, &Basis::Partition(vec![2])).unwrap();
     // all three coordinates are configuration states; the yaw rate (preferred) stays independent
     assert_eq!(s.independent_q, vec![0, 1, 2]);
     assert!(s.independent_u.contains(&2) && s.independent_u.len() == 2, "{:?}", s.independent_u);

@@ -535,12 +535,7 @@ fn so3_jacobian_coefficients(phi: f64) -> [f64; 4] {
     } else {
         let (s, c) = phi.sin_cos();
         let (p3, p4) = (p2 * phi, p2 * p2);
-        [
-            (1.0 - c) / p2,
-            (phi - s) / p3,
-            s / p3 - 2.0 * (1.0 - c) / p4,
-            (1.0 - c) / p4 - 3.0 * (phi - s) / (p4 * phi),
-        ]
+        [(1.0 - c) / p2, (phi - s) / p3, s / p3 - 2.0 * (1.0 - c) / p4, (1.0 - c) / p4 - 3.0 * (phi - s) / (p4 * phi)]
     }
 }
 

@@ -3,14 +3,13 @@
 
 use crate::contact::gap::{GapFunction, GapTerm};
 use crate::contact::{ContactPair, Contour, Vec2};
-use crate::math::expr::Expr;
 use crate::error::{Error, Result};
+use crate::math::expr::Expr;
 use crate::math::Vec3;
 
 use super::contact_description::{
     ContactDescription, ContactGroupDescription, ContourDescription, FrictionDescription, GapContactDescription,
-    GapTermDescription, GearDescription,
-    ImpactDescription, SolidSide,
+    GapTermDescription, GearDescription, ImpactDescription, SolidSide,
 };
 use crate::geometry::curve::{Curve, Follower, Solid};
 use crate::geometry::gear::GearSpec;
@@ -282,7 +281,9 @@ pub fn gear_spec(g: &GearDescription, what: &str) -> Result<GearSpec> {
         }
         (None, None) => return Err(Error::Model(format!("{what}: a gear needs its module (or base_radius)"))),
     };
-    for (k, v) in [("shift", Some(g.shift)), ("backlash", Some(g.backlash)), ("addendum", g.addendum), ("dedendum", g.dedendum)] {
+    for (k, v) in
+        [("shift", Some(g.shift)), ("backlash", Some(g.backlash)), ("addendum", g.addendum), ("dedendum", g.dedendum)]
+    {
         if let Some(v) = v {
             finite(v, &format!("{what}.{k}"))?;
         }
@@ -506,7 +507,11 @@ pub(super) fn compliant_law(
     let (elastic, dissipation, v_reg) = match normal {
         N::KelvinVoigt { k, d: damping, v_reg } => {
             positive(*k, "k")?;
-            crate::ensure!(damping.is_finite() && *damping >= 0.0, Model, "{what}.normal.d: must be >= 0, got {damping}");
+            crate::ensure!(
+                damping.is_finite() && *damping >= 0.0,
+                Model,
+                "{what}.normal.d: must be >= 0, got {damping}"
+            );
             (ElasticSpec::Given(Elastic::KelvinVoigt { k: *k, d: *damping }), Dissipation::None, *v_reg)
         }
         N::User { callback, v_reg } => {
@@ -596,9 +601,10 @@ pub(super) fn validate_compliant(
         Model,
         "{what}: a compliant contact on a moving surface is not supported"
     );
-    let material = |m: &Option<super::contact_description::MaterialDescription>, k: usize| -> Result<Option<cc::Material>> {
-        m.map(|m| cc::Material::new(m.e, m.nu, m.density, &format!("{what}.material{k}"))).transpose()
-    };
+    let material =
+        |m: &Option<super::contact_description::MaterialDescription>, k: usize| -> Result<Option<cc::Material>> {
+            m.map(|m| cc::Material::new(m.e, m.nu, m.density, &format!("{what}.material{k}"))).transpose()
+        };
     let (m1, m2) = (material(&d.material1, 1)?, material(&d.material2, 2)?);
     let materials = match (m1, m2) {
         (Some(a), Some(b)) => Some([a, b]),
@@ -723,9 +729,16 @@ pub(super) fn validate_gap(
                     }
                     let k = match (index, j.nq()) {
                         (None, 1) => 0,
-                        (None, n) => return Err(format!("joint '{name}' has {n} coordinates; write {name}[0] .. {name}[{}]", n.max(1) - 1)),
+                        (None, n) => {
+                            return Err(format!(
+                                "joint '{name}' has {n} coordinates; write {name}[0] .. {name}[{}]",
+                                n.max(1) - 1
+                            ))
+                        }
                         (Some(k), n) if k < n => k,
-                        (Some(k), n) => return Err(format!("joint '{name}' has {n} coordinate(s), [{k}] is out of range")),
+                        (Some(k), n) => {
+                            return Err(format!("joint '{name}' has {n} coordinate(s), [{k}] is out of range"))
+                        }
                     };
                     let c = (j.iq + k, j.iu + k);
                     Ok(coordinates.iter().position(|x| *x == c).unwrap_or_else(|| {
@@ -733,7 +746,8 @@ pub(super) fn validate_gap(
                         coordinates.len() - 1
                     }))
                 };
-                let e = Expr::parse(text, resolve).map_err(|m| Error::Model(format!("{what}.{key}: {m} in \"{text}\"")))?;
+                let e =
+                    Expr::parse(text, resolve).map_err(|m| Error::Model(format!("{what}.{key}: {m} in \"{text}\"")))?;
                 // a function of time alone has no row: nothing the contact force could act on
                 crate::ensure!(
                     !e.slots().is_empty(),
@@ -769,7 +783,9 @@ pub(super) fn validate_gap(
 pub fn planar_curve(c: &ContourDescription, what: &str) -> Result<Curve> {
     match contour(c, true, what, no_rotation)? {
         Contour::Curve(curve) => Ok(*curve),
-        other => Err(Error::Model(format!("{what}: expected a curve (ellipse, spline, cam or gear), got {}", other.kind()))),
+        other => {
+            Err(Error::Model(format!("{what}: expected a curve (ellipse, spline, cam or gear), got {}", other.kind())))
+        }
     }
 }
 
@@ -786,7 +802,11 @@ pub(super) fn validate_visual(
         // a drawn mesh need not be closed or consistently wound (CAD exports often are not):
         // only finite vertices and indices in range
         for (k, v) in vertices.iter().enumerate() {
-            crate::ensure!(v.iter().all(|x| x.is_finite()), Model, "{what}.shape.vertices[{k}]: must be finite, got {v:?}");
+            crate::ensure!(
+                v.iter().all(|x| x.is_finite()),
+                Model,
+                "{what}.shape.vertices[{k}]: must be finite, got {v:?}"
+            );
         }
         for (t, tri) in triangles.iter().enumerate() {
             for (j, &i) in tri.iter().enumerate() {
@@ -927,7 +947,8 @@ pub(super) fn validate_compliant_group(
     for (key, list) in [("members", &d.members), ("against", &d.against)] {
         for (k, m) in list.iter().enumerate() {
             let desc = m.material.or(d.material);
-            let w = if m.material.is_some() { format!("{what}.{key}[{k}].material") } else { format!("{what}.material") };
+            let w =
+                if m.material.is_some() { format!("{what}.{key}[{k}].material") } else { format!("{what}.material") };
             materials.push(desc.map(|x| cc::Material::new(x.e, x.nu, x.density, &w)).transpose()?);
         }
     }
@@ -948,7 +969,9 @@ pub(super) fn validate_compliant_group(
         let c = group.contour(k);
         let same = |r: &usize| {
             let o = group.contour(*r);
-            (*r < members) == (k < members) && o.contour.kind() == c.contour.kind() && group.materials[*r] == group.materials[k]
+            (*r < members) == (k < members)
+                && o.contour.kind() == c.contour.kind()
+                && group.materials[*r] == group.materials[k]
         };
         // a kind seen twice among the members keeps its second member too (member–member pairs)
         let seen = reps.iter().filter(|r| same(r)).count();

@@ -17,8 +17,8 @@ pub mod contact_description;
 pub mod description;
 pub mod jenkins;
 pub mod joint;
-pub mod rotation_description;
 mod planar;
+pub mod rotation_description;
 pub mod validate;
 
 use std::collections::HashMap;

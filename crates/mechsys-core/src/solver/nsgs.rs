@@ -97,18 +97,18 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
 /// When to recompute the full residual (one extra product with `W`): once the change of a sweep
 /// is below the tolerance, but after a check that fails the next waits 1, 2, 4, … up to 64 sweeps,
 /// because with a warm start the change can be small long before the residual is.
-struct CheckSchedule {
+pub(crate) struct CheckSchedule {
     next: usize,
     gap: usize,
 }
 
 impl CheckSchedule {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self { next: 1, gap: 1 }
     }
 
     /// Whether to check at sweep `it`; assumes the check is made (and failed, if the caller goes on).
-    fn due(&mut self, it: usize, small_change: bool) -> bool {
+    pub(crate) fn due(&mut self, it: usize, small_change: bool) -> bool {
         if small_change && it >= self.next {
             self.next = it + self.gap;
             self.gap = (2 * self.gap).min(64);

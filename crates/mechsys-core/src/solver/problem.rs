@@ -490,23 +490,9 @@ impl FrictionContact {
 
     pub(crate) fn check(&self) -> Result<()> {
         let d = self.dim;
-        ensure!(d == 2 || d == 3, Settings, "friction contact: dimension must be 2 or 3, got {d}");
+        check_local(d, &self.q, &self.mu)?;
         let n = self.mu.len();
         let m = d * n;
-        ensure!(self.q.len() == m, Settings, "friction contact: q has {} entries, expected d·n = {m}", self.q.len());
-        if let Some(k) = self.q.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Settings(format!(
-                "friction contact: q[{k}] (contact {}) is not finite ({})",
-                k / d,
-                self.q[k]
-            )));
-        }
-        if let Some(i) = self.mu.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
-            return Err(Error::Settings(format!(
-                "friction contact: contact {i}: μ must be finite and ≥ 0, got {}",
-                self.mu[i]
-            )));
-        }
         match &self.w {
             Delassus::Dense(w) => {
                 ensure!(
@@ -537,12 +523,7 @@ impl FrictionContact {
         let mut blk = [0.0; 9];
         for i in 0..n {
             self.w.diag_block(d, i, &mut blk);
-            ensure!(
-                blk[0] > 0.0,
-                Settings,
-                "friction contact: contact {i}: W_NN = {} must be > 0 (the contact cannot move along its normal)",
-                blk[0]
-            );
+            check_wnn(i, blk[0])?;
         }
         Ok(())
     }
@@ -610,7 +591,14 @@ impl FrictionContact {
 
     /// [`FrictionContact::contact_state_scaled`] without the checks of `i` and `r` (a stepper's
     /// loop over the contacts of the problem it has just solved).
-    pub(crate) fn contact_state_unchecked(&self, i: usize, r: &[f64], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
+    pub(crate) fn contact_state_unchecked(
+        &self,
+        i: usize,
+        r: &[f64],
+        tol: f64,
+        r_scale: f64,
+        q_scale: f64,
+    ) -> ContactState {
         let d = self.dim;
         let mut u = [0.0; 3];
         self.w.add_row_product(d, i, r, false, &mut u);
@@ -641,9 +629,34 @@ impl FrictionContact {
     }
 }
 
+/// The checks of a friction-contact problem that do not read `W`: dimension, sizes, finite
+/// `q`, finite `μ ≥ 0`.
+pub(crate) fn check_local(d: usize, q: &[f64], mu: &[f64]) -> Result<()> {
+    ensure!(d == 2 || d == 3, Settings, "friction contact: dimension must be 2 or 3, got {d}");
+    let m = d * mu.len();
+    ensure!(q.len() == m, Settings, "friction contact: q has {} entries, expected d·n = {m}", q.len());
+    if let Some(k) = q.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Settings(format!("friction contact: q[{k}] (contact {}) is not finite ({})", k / d, q[k])));
+    }
+    if let Some(i) = mu.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
+        return Err(Error::Settings(format!("friction contact: contact {i}: μ must be finite and ≥ 0, got {}", mu[i])));
+    }
+    Ok(())
+}
+
+/// Contact `i`'s `W_NN` must be positive (and finite).
+pub(crate) fn check_wnn(i: usize, wnn: f64) -> Result<()> {
+    ensure!(
+        wnn > 0.0,
+        Settings,
+        "friction contact: contact {i}: W_NN = {wnn} must be > 0 (the contact cannot move along its normal)"
+    );
+    Ok(())
+}
+
 /// Open if `r_N ≤ tol r_scale`, else slip if `|u_T| > tol q_scale`, else stick.
 #[inline]
-fn classify(ri: &[f64; 3], u: &[f64; 3], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
+pub(crate) fn classify(ri: &[f64; 3], u: &[f64; 3], tol: f64, r_scale: f64, q_scale: f64) -> ContactState {
     if ri[0] <= tol * r_scale {
         ContactState::Open
     } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {

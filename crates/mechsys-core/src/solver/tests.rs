@@ -863,7 +863,10 @@ fn regularized_newton_converges_on_a_box_stack_and_carries_the_static_weights() 
         for k in 0..boxes {
             let carried: f64 = (0..4).map(|c| r[3 * (4 * k + c)]).sum();
             let weight = (boxes - k) as f64 * 9.81 * h;
-            assert!((carried - weight).abs() < 1e-9 * weight, "{method:?}: interface {k} carries {carried}, expected {weight}");
+            assert!(
+                (carried - weight).abs() < 1e-9 * weight,
+                "{method:?}: interface {k} carries {carried}, expected {weight}"
+            );
             // the corners may pull against each other (also indeterminate), but not in sum
             for t in 1..3 {
                 let net: f64 = (0..4).map(|c| r[3 * (4 * k + c) + t]).sum();
@@ -936,7 +939,8 @@ fn apgd_agrees_with_lemke_on_planar_problems() {
 
 #[test]
 fn apgd_agrees_with_newton_on_spatial_problems_and_piles() {
-    let mut problems: Vec<FrictionContact> = (1..=6).map(|s| random_friction_contact(3, 10, 0.3, 100 + s).unwrap()).collect();
+    let mut problems: Vec<FrictionContact> =
+        (1..=6).map(|s| random_friction_contact(3, 10, 0.3, 100 + s).unwrap()).collect();
     problems.push(sphere_pile(60, 0.5, 3).unwrap());
     for (k, p) in problems.iter().enumerate() {
         // the reference: Newton on the random problems, Gauss–Seidel on the pile
@@ -992,7 +996,8 @@ fn apgd_options_are_checked_and_lcps_refused() {
     let lcp = Lcp::new(vec![2.0], vec![-1.0]).unwrap();
     assert!(run_lcp(&lcp, Method::apgd()).unwrap_err().to_string().contains("APGD solves friction-contact"));
     // a budget too small is reported, not raised, with the best iterate's residual
-    let (_, rep) = run_fc(&sphere_pile(60, 0.5, 3).unwrap(), Method::Apgd(ApgdOptions { tol: 1e-14, max_iter: 3 })).unwrap();
+    let (_, rep) =
+        run_fc(&sphere_pile(60, 0.5, 3).unwrap(), Method::Apgd(ApgdOptions { tol: 1e-14, max_iter: 3 })).unwrap();
     assert!(!rep.converged && rep.iterations == 3 && rep.residual.is_finite() && rep.residual > 1e-14, "{rep:?}");
     let m: Method = serde_json::from_str(r#"{"type": "apgd", "tol": 1e-6}"#).unwrap();
     assert_eq!(m, Method::Apgd(ApgdOptions { tol: 1e-6, ..Default::default() }));
@@ -1026,4 +1031,33 @@ fn gauss_seidel_sweep_order_is_a_permutation_and_keeps_the_solution() {
     let mut r = vec![0.0; p.unknowns()];
     assert!(solve(&p, &method, &mut r, false, &mut ws).unwrap().converged);
     assert_eq!(r, r_up);
+}
+
+/// Newton takes one step past the first iterate under the tolerance, unless that iterate is
+/// already below a thousandth of it (a time stepper's next warm start then begins well inside
+/// the tolerance); the extra step lowers the residual.
+#[test]
+fn newton_polishes_once_past_the_tolerance() {
+    let problems = [disk_stack(6, 0.3, 0.6, 5).unwrap(), random_friction_contact(3, 8, 0.5, 3).unwrap()];
+    let mut polished = 0;
+    for p in &problems {
+        for tol in [1e-4, 1e-6, 1e-8] {
+            let with = |max_iter| Method::Newton(NewtonOptions { tol, max_iter, ..Default::default() });
+            let (_, full) = run_fc(p, with(200)).unwrap();
+            assert!(full.converged && full.residual <= tol, "{full:?}");
+            // the first iterate under the tolerance (a run capped at k iterations returns it)
+            let (k0, at_k0) = (1..=full.iterations)
+                .map(|k| (k, run_fc(p, with(k)).unwrap().1.residual))
+                .find(|(_, r)| *r <= tol)
+                .unwrap();
+            if at_k0 <= 1e-3 * tol {
+                assert_eq!(full.iterations, k0, "tol {tol}");
+            } else {
+                assert_eq!(full.iterations, k0 + 1, "tol {tol}: no polishing step");
+                assert!(full.residual < at_k0, "tol {tol}: {} after {at_k0}", full.residual);
+                polished += 1;
+            }
+        }
+    }
+    assert!(polished >= 1, "no case took the polishing step");
 }

@@ -153,9 +153,7 @@ fn curve_pair_rates_match_finite_differences() {
                         )
                     } else {
                         // a small tilt: the curves are compared in body 2's plane
-                        let tilt = |x: &Pose, rng: &mut Rng| {
-                            Pose::new(rot(&rng.unit(), 0.2) * x.a, x.r)
-                        };
+                        let tilt = |x: &Pose, rng: &mut Rng| Pose::new(rot(&rng.unit(), 0.2) * x.a, x.r);
                         let (y1, y2) = (tilt(&x1, &mut rng), tilt(&x2, &mut rng));
                         (Trajectory::random(&mut rng, &y1, 0.5, 0.25), Trajectory::random(&mut rng, &y2, 0.5, 0.25))
                     };
@@ -424,8 +422,6 @@ fn degenerate_configurations_give_finite_rates() {
     }
 }
 
-
-
 /// A moving surface (conveyor belt) on a turning, moving body 2: `ġ_T` is the sliding velocity
 /// against the belt's material (the material points' relative velocity plus the belt's speed
 /// `w̃_T`), `ġ_N` is unchanged, and `d ġ_T/dt` matches differences of `ġ_T`.
@@ -464,7 +460,8 @@ fn moving_surface_adds_its_speed_to_the_tangential_velocity() {
                 assert!((m.gd_t[k] - (p.gd_t[k] - t.dot(&w))).abs() < 1e-14, "ġ_T[{k}]");
                 assert!((m.w_tilde[k + 1] + t.dot(&w)).abs() < 1e-14);
                 let h = 1e-5;
-                let fd = (kin(&moving, &tr1.at(h), &tr2.at(h))[0].gd_t[k] - kin(&moving, &tr1.at(-h), &tr2.at(-h))[0].gd_t[k])
+                let fd = (kin(&moving, &tr1.at(h), &tr2.at(h))[0].gd_t[k]
+                    - kin(&moving, &tr1.at(-h), &tr2.at(-h))[0].gd_t[k])
                     / (2.0 * h);
                 assert!(close(m.wbar_t[k], fd, 1e-6), "d ġ_T[{k}]/dt {} vs difference {fd}", m.wbar_t[k]);
             }

@@ -112,8 +112,10 @@ fn roller_on_a_cam_with_a_hollow_flank_finds_the_global_minimum_over_a_revolutio
     // a lift with a sharp rise: the pitch curve has concave flanks
     let n = 180;
     let ang: Vec<f64> = (0..=n).map(|i| TAU * i as f64 / n as f64).collect();
-    let lift: Vec<f64> = ang.iter().map(|t| 0.012 * (-((t - 2.0) / 0.35).powi(2)).exp() + 0.006 * (1.0 - t.cos())).collect();
-    let cam = Curve::cam(&ang, &lift, 0.03, Follower::Roller { radius: 0.008, eccentricity: 0.004 }, 1.0, "cam").unwrap();
+    let lift: Vec<f64> =
+        ang.iter().map(|t| 0.012 * (-((t - 2.0) / 0.35).powi(2)).exp() + 0.006 * (1.0 - t.cos())).collect();
+    let cam =
+        Curve::cam(&ang, &lift, 0.03, Follower::Roller { radius: 0.008, eccentricity: 0.004 }, 1.0, "cam").unwrap();
     assert_eq!(cam.convexity(), crate::geometry::curve::Convexity::Mixed);
     let contour = Contour::Curve(Box::new(cam.clone()));
     let pair = ContactPair::new("cf", Contour::Circle { center: Vec2::zeros(), radius: 0.008 }, contour).unwrap();
@@ -160,10 +162,11 @@ fn disc_in_an_elliptical_hole_touches_at_two_points() {
     gaps.sort_by(f64::total_cmp);
     assert!((gaps[0] - (b - r - 0.01)).abs() < 1e-12 && (gaps[1] - (b - r + 0.01)).abs() < 1e-12, "{gaps:?}");
     // asking a primitive pair for points is an error naming it
-    let e = ContactPair::new("s", Contour::Circle { center: Vec2::zeros(), radius: 1.0 }, Contour::Line {
-        point: Vec2::zeros(),
-        normal: Vec2::y(),
-    })
+    let e = ContactPair::new(
+        "s",
+        Contour::Circle { center: Vec2::zeros(), radius: 1.0 },
+        Contour::Line { point: Vec2::zeros(), normal: Vec2::y() },
+    )
     .unwrap()
     .with_points(2)
     .unwrap_err();
@@ -192,7 +195,11 @@ fn curve_pairs_give_finite_values_in_degenerate_placements() {
 fn ellipsoid_on_a_plane_against_sampled_support_and_curvatures_at_the_axes() {
     let mut rng = Rng::new(21);
     let (a, b, c) = (0.4, 0.25, 0.15);
-    let shape = Contour::Ellipsoid { center: Vec3::new(0.05, 0.0, -0.02), rotation: rot(&Vec3::new(1.0, 2.0, 0.5), 0.7), semi_axes: Vec3::new(a, b, c) };
+    let shape = Contour::Ellipsoid {
+        center: Vec3::new(0.05, 0.0, -0.02),
+        rotation: rot(&Vec3::new(1.0, 2.0, 0.5), 0.7),
+        semi_axes: Vec3::new(a, b, c),
+    };
     let ground = Contour::Plane { point: Vec3::zeros(), normal: Vec3::new(0.1, -0.2, 1.0) };
     let pair = ContactPair::new("egg", shape.clone(), ground.clone()).unwrap();
     let Contour::Ellipsoid { center, rotation, .. } = &shape else { unreachable!() };
@@ -209,7 +216,8 @@ fn ellipsoid_on_a_plane_against_sampled_support_and_curvatures_at_the_axes() {
         let (mut best, mut bu, mut bv) = (f64::INFINITY, 0.0, 0.0);
         for i in 0..720 {
             for j in 0..=360 {
-                let (u, v) = (TAU * i as f64 / 720.0, -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 360.0);
+                let (u, v) =
+                    (TAU * i as f64 / 720.0, -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * j as f64 / 360.0);
                 let h = height(u, v);
                 if h < best {
                     (best, bu, bv) = (h, u, v);

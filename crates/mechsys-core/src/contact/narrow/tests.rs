@@ -59,7 +59,8 @@ fn argmin01_n(f: impl Fn(f64) -> f64, iters: usize) -> f64 {
 
 #[test]
 fn candidate_counts_and_unsupported_pairs() {
-    let expect = [1, 1, 8, 2, 2, 1, 1, 5, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 8, 2];
+    let expect =
+        [1, 1, 8, 2, 2, 1, 1, 5, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 8, 2];
     for ((a, b), n) in PAIRS.iter().zip(expect) {
         let (c1, c2) = (sample(a), sample(b));
         assert_eq!(candidates(&c1, &c2).unwrap(), n, "{a}–{b}");

@@ -69,8 +69,11 @@ impl Phase<'_> {
             let law = &model.contact_of_point(pt).friction;
             self.fc.mu.push(if s <= self.opts.velocity_tol { law.mu0() } else { law.mu(s) });
         }
-        let method =
-            if d == 2 { Method::lemke() } else { Method::Newton(solver::NewtonOptions { tol: 1e-13, max_iter: 500, ..Default::default() }) };
+        let method = if d == 2 {
+            Method::lemke()
+        } else {
+            Method::Newton(solver::NewtonOptions { tol: 1e-13, max_iter: 500, ..Default::default() })
+        };
         let poisson = pts.iter().any(|&pt| matches!(model.contact_of_point(pt).impact, ImpactLaw::Poisson { .. }));
         // a rebound too low to be resolved in floating point (its apex within a few ulps of the
         // contact point's coordinates) would only chatter: such a point's impact is plastic

@@ -153,11 +153,16 @@ impl<'a> Phase<'a> {
         }
         {
             let Data { inertia, s, ic, elastic, .. } = &mut *data;
-            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, elastic, |r, col, v| sp.put_mass(r, col, v));
+            crate::dynamics::crba::composite_inertias(model, inertia, s, ic, elastic, |r, col, v| {
+                sp.put_mass(r, col, v)
+            });
         }
         if !sp.factor_mass() {
             self.a_free = c;
-            return Err(Error::Solver(format!("the mass matrix is singular at t = {t:.6} s{}", crate::elastic::runaway(model, data))));
+            return Err(Error::Solver(format!(
+                "the mass matrix is singular at t = {t:.6} s{}",
+                crate::elastic::runaway(model, data)
+            )));
         }
         sp.solve_mass(&mut c);
         if nc > 0 {
@@ -222,8 +227,28 @@ impl<'a> Phase<'a> {
             return;
         }
         let k = &kin[pt].point;
-        crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), con.body1, &k.p1, 1.0, Some(dir), m, r);
-        crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), con.body2, &k.p2, -1.0, Some(dir), m, r);
+        crate::constraints::add_point_rows(
+            model,
+            &data.s,
+            (&data.x_abs, &data.elastic, &data.body_elastic),
+            con.body1,
+            &k.p1,
+            1.0,
+            Some(dir),
+            m,
+            r,
+        );
+        crate::constraints::add_point_rows(
+            model,
+            &data.s,
+            (&data.x_abs, &data.elastic, &data.body_elastic),
+            con.body2,
+            &k.p2,
+            -1.0,
+            Some(dir),
+            m,
+            r,
+        );
     }
 
     /// World tangent direction of (t1, t2) components `c` at point `pt`.
@@ -518,7 +543,11 @@ impl<'a> Phase<'a> {
             // a closed point whose normal jumps (a mesh's concave edge, where the nearest face
             // changes) starts to approach: an event, which the impact step resolves like any
             // touching approach; a closed point otherwise keeps ġ_N ≈ 0 (its g̈_N = 0)
-            let e0 = if self.status[pt] == OPEN { e0 } else { e0.min(self.kin[pt].gd_n + APPROACH * self.opts.velocity_tol) };
+            let e0 = if self.status[pt] == OPEN {
+                e0
+            } else {
+                e0.min(self.kin[pt].gd_n + APPROACH * self.opts.velocity_tol)
+            };
             out[3 * pt] = e0;
             out[3 * pt + 1] = e1;
         }
@@ -640,7 +669,14 @@ impl OdeSystem for Phase<'_> {
         // schemes do, [`crate::integrator::switching`]); the rigid points have event_values
         let (nq, nu) = (self.model.nq, self.model.nu);
         crate::kinematics::forward_pass(self.model, &mut self.data, t, &y[..nq], &y[nq..nq + nu]);
-        crate::forces::compliant::switching(self.model, &self.data, &mut self.dynamics.forces.compliant, t, self.cb, out)
+        crate::forces::compliant::switching(
+            self.model,
+            &self.data,
+            &mut self.dynamics.forces.compliant,
+            t,
+            self.cb,
+            out,
+        )
     }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> Result<()> {
         let (nq, nu) = (self.model.nq, self.model.nu);
@@ -718,4 +754,3 @@ mod gap_time_tests {
         assert!(time_to_gap(0.1, 1.0, 2.0, -0.1).is_infinite());
     }
 }
-

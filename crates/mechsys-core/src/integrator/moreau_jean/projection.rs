@@ -121,8 +121,28 @@ impl Projection {
                     }
                     None => {
                         let k = &self.kin[pt].point;
-                        crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), con.body1, &k.p1, 1.0, Some(&k.n), &mut self.rows, r);
-                        crate::constraints::add_point_rows(model, &data.s, (&data.x_abs, &data.elastic, &data.body_elastic), con.body2, &k.p2, -1.0, Some(&k.n), &mut self.rows, r);
+                        crate::constraints::add_point_rows(
+                            model,
+                            &data.s,
+                            (&data.x_abs, &data.elastic, &data.body_elastic),
+                            con.body1,
+                            &k.p1,
+                            1.0,
+                            Some(&k.n),
+                            &mut self.rows,
+                            r,
+                        );
+                        crate::constraints::add_point_rows(
+                            model,
+                            &data.s,
+                            (&data.x_abs, &data.elastic, &data.body_elastic),
+                            con.body2,
+                            &k.p2,
+                            -1.0,
+                            Some(&k.n),
+                            &mut self.rows,
+                            r,
+                        );
                     }
                 }
                 let x = &mut self.cols[r * nu..(r + 1) * nu];
@@ -140,7 +160,15 @@ impl Projection {
             // points that cannot move independently (a box's four corners on a face) make A
             // singular: the minimum-norm multipliers share the correction evenly (and keep a
             // symmetric configuration symmetric)
-            solve_min_norm(&self.a[..m * m], m, &mut self.mu[..m], &mut self.aat[..m * m], &mut self.piv[..m], &mut self.work[..m], 1e-12);
+            solve_min_norm(
+                &self.a[..m * m],
+                m,
+                &mut self.mu[..m],
+                &mut self.aat[..m * m],
+                &mut self.piv[..m],
+                &mut self.work[..m],
+                1e-12,
+            );
             self.du.fill(0.0);
             for j in 0..m {
                 // a negative multiplier would pull a contact shut: left to the next iteration

@@ -16,6 +16,8 @@
 //! the blocks, O(nu) for the update — for N free bodies with a bounded number of contacts each,
 //! O(N). All storage grows to the largest problem seen and is reused: no allocation afterwards.
 
+mod factored;
+
 use crate::math::Vec3;
 use crate::model::Model;
 use crate::spatial::Motion;
@@ -41,7 +43,14 @@ impl TreeFactor {
     fn new(model: &Model) -> Self {
         let nu = model.nu;
         let (_, _, anc_ptr, anc_idx) = crate::dynamics::sparse::velocity_ancestors(model);
-        TreeFactor { nu, off: vec![0.0; anc_idx.len()], anc_ptr, anc_idx, diag: vec![0.0; nu], inv_sqrt_d: vec![0.0; nu] }
+        TreeFactor {
+            nu,
+            off: vec![0.0; anc_idx.len()],
+            anc_ptr,
+            anc_idx,
+            diag: vec![0.0; nu],
+            inv_sqrt_d: vec![0.0; nu],
+        }
     }
 
     /// Takes the factor of M just computed by [`crate::dynamics::sparse::Saddle::factor_mass`]
@@ -120,6 +129,8 @@ pub(super) struct SparseRows {
     pub(super) links: Vec<(usize, usize)>,
     /// Scratch (nu).
     f: Vec<f64>,
+    /// `Y r` of the factored Gauss–Seidel solve (nu).
+    z: Vec<f64>,
 }
 
 impl SparseRows {
@@ -189,6 +200,7 @@ impl SparseRows {
             upper_val: Vec::new(),
             links: Vec::new(),
             f: vec![0.0; model.nu],
+            z: vec![0.0; model.nu],
         }
     }
 
@@ -404,15 +416,37 @@ impl SparseRows {
     /// in `upper`, `upper_val`. A tangent row that is zero (a direction along which nothing can
     /// move, e.g. out of the plane of a planar mechanism) gets the normal's diagonal value so that
     /// its impulse comes out zero.
+    #[cfg(test)]
     pub(super) fn delassus(&mut self) {
+        self.couplings();
+        self.pairs();
+    }
+
+    /// The diagonal blocks and which contacts are coupled ([`SparseRows::links`]): all a
+    /// Gauss–Seidel solve on the factored operator needs ([`SparseRows::gauss_seidel`]).
+    pub(super) fn couplings(&mut self) {
         // fixed-size blocks: no loop over the dimension nor library calls for d² copies
         match self.dim {
-            3 => self.delassus_d::<3>(),
-            _ => self.delassus_d::<2>(),
+            3 => self.couplings_d::<3>(),
+            _ => self.couplings_d::<2>(),
         }
     }
 
-    fn delassus_d<const D: usize>(&mut self) {
+    /// The off-diagonal blocks (`upper`, `upper_val`), after [`SparseRows::couplings`].
+    pub(super) fn pairs(&mut self) {
+        match self.dim {
+            3 => self.pairs_d::<3>(),
+            _ => self.pairs_d::<2>(),
+        }
+    }
+
+    /// Contact `a`'s diagonal block, row-major `d × d` in the first `d²` entries.
+    pub(super) fn diag_block(&self, a: usize, out: &mut [f64; 9]) {
+        let dd = self.dim * self.dim;
+        out[..dd].copy_from_slice(&self.diag[a * dd..(a + 1) * dd]);
+    }
+
+    fn couplings_d<const D: usize>(&mut self) {
         let n = self.len();
         self.diag.clear();
         for a in 0..n {
@@ -467,6 +501,10 @@ impl SparseRows {
                 self.links.push((self.bucket[s], self.bucket[x]));
             }
         }
+    }
+
+    fn pairs_d<const D: usize>(&mut self) {
+        let nu = self.pos.len();
         self.upper.clear();
         self.upper_val.clear();
         for r in 0..nu {
@@ -545,7 +583,14 @@ impl SparseRows {
         }
     }
 
-    fn local_velocity2_d<const D: usize>(&self, a: usize, u: &[f64], v: &[f64], out_u: &mut [f64; 3], out_v: &mut [f64; 3]) {
+    fn local_velocity2_d<const D: usize>(
+        &self,
+        a: usize,
+        u: &[f64],
+        v: &[f64],
+        out_u: &mut [f64; 3],
+        out_v: &mut [f64; 3],
+    ) {
         let (mut gu, mut gv) = ([0.0; 3], [0.0; 3]);
         let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
         for (k, w) in self.pat_idx[s..e].iter().zip(self.w[s * D..e * D].chunks_exact(D)) {
@@ -632,6 +677,79 @@ mod tests {
         Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap()
     }
 
+    /// Gauss–Seidel on the factored operator (`W = YᵀY`, no off-diagonal blocks) solves the
+    /// problem the block solver solves: the same impulses and local velocities `W r + q` to
+    /// round-off, sweep for sweep, in 2-D and 3-D, with contacts sliding, sticking and open.
+    #[test]
+    fn factored_gauss_seidel_is_the_block_solver_to_round_off() {
+        use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
+        let model = model();
+        let mut data = Data::new(&model);
+        let mut q = model.q0();
+        model.normalize(&mut q);
+        crate::kinematics::forward_pass(&model, &mut data, 0.0, &q, &model.u0());
+        let mut saddle = Saddle::new(&model);
+        {
+            let Data { inertia, s, ic, elastic, .. } = &mut data;
+            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| {
+                saddle.put_mass(r, c, v)
+            });
+        }
+        assert!(saddle.factor_mass());
+        let pairs = [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0), (3, 1), (0, 3)];
+        for dim in [3, 2] {
+            let mut sp = SparseRows::new(&model, dim);
+            sp.factor.copy_from(&saddle);
+            for (k, &(b1, b2)) in pairs.iter().enumerate() {
+                let n = Vec3::new(0.3 - 0.1 * k as f64, -0.5, 0.8).normalize();
+                let t1 = n.cross(&Vec3::x()).normalize();
+                let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
+                let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+                sp.add_contact(&model, &data.s, el, b1, &p1, b2, &(p1 - 1e-3 * n), &[n, t1, n.cross(&t1)]);
+            }
+            sp.delassus();
+            let nc = sp.len();
+            let mut bw = BlockDelassus::default();
+            bw.refill(dim, nc, &sp.diag, &sp.upper, &sp.upper_val);
+            // approaching, separating and sliding free velocities; one frictionless contact
+            let mut qv: Vec<f64> = (0..dim * nc).map(|i| ((i * 7 % 11) as f64 - 6.0) * 0.1).collect();
+            let mut mu: Vec<f64> = (0..nc).map(|i| if i == 2 { 0.0 } else { 0.2 + 0.1 * i as f64 }).collect();
+            // contact 0 pressed with little tangential motion and much friction: it sticks
+            qv[0] = -0.6;
+            qv[1..dim].fill(0.01);
+            mu[0] = 3.0;
+            let p = FrictionContact::new(dim, Delassus::Blocks(bw), qv.clone(), mu.clone()).unwrap();
+            for sweeps in [1, 3, 200] {
+                let o = NsgsOptions { tol: 1e-14, max_iter: sweeps, relaxation: 1.0 };
+                let method = Method::Nsgs(o);
+                let mut ws = Workspace::default();
+                ws.reserve(&p, &method).unwrap();
+                let mut r_blocks = vec![0.0; dim * nc];
+                let rep = solver::solve(&p, &method, &mut r_blocks, false, &mut ws).unwrap();
+                let (mut r_fact, mut u_fact) = (vec![0.0; dim * nc], vec![0.0; dim * nc]);
+                let fact = sp.gauss_seidel(&qv, &mu, &[], &mut r_fact, 1e-14, sweeps, &mut u_fact);
+                assert_eq!(fact.iterations, rep.iterations, "dim {dim}, {sweeps} sweeps");
+                assert!((fact.residual - rep.residual).abs() <= 1e-12 * (1.0 + rep.residual), "{fact:?} {rep:?}");
+                let mut u_blocks = vec![0.0; dim * nc];
+                p.velocity(&r_blocks, &mut u_blocks).unwrap();
+                let big = r_blocks.iter().chain(&u_blocks).fold(0.0f64, |a, v| a.max(v.abs()));
+                assert!(big > 0.1, "a problem with impulses");
+                for k in 0..dim * nc {
+                    assert!((r_fact[k] - r_blocks[k]).abs() <= 1e-12 * big, "r[{k}]: {} vs {}", r_fact[k], r_blocks[k]);
+                    assert!((u_fact[k] - u_blocks[k]).abs() <= 1e-12 * big, "u[{k}]: {} vs {}", u_fact[k], u_blocks[k]);
+                }
+                if sweeps == 200 {
+                    assert!(fact.converged && fact.residual <= 1e-14, "{fact:?}");
+                    // a sliding, a sticking and an open contact among them
+                    let states: Vec<_> = (0..nc).map(|i| p.contact_state(i, &r_blocks, 1e-9).unwrap()).collect();
+                    for s in [solver::ContactState::Open, solver::ContactState::Stick, solver::ContactState::Slip] {
+                        assert!(states.contains(&s), "dim {dim}: {states:?}");
+                    }
+                }
+            }
+        }
+    }
+
     /// The free-body rows and their reduction are the general path's bit for bit (any sign or
     /// index slip in the fixed-size code shows), and so are the Delassus blocks built from them.
     #[test]
@@ -644,7 +762,9 @@ mod tests {
         let mut saddle = Saddle::new(&model);
         {
             let Data { inertia, s, ic, elastic, .. } = &mut data;
-            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| saddle.put_mass(r, c, v));
+            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| {
+                saddle.put_mass(r, c, v)
+            });
         }
         assert!(saddle.factor_mass());
         let n = Vec3::new(0.3, -0.5, 0.8).normalize();
