@@ -207,6 +207,7 @@ res = ms.simulate(m, 0.5, ms.RK4(dt=1e-4), output_dt=1e-4)
 print("ready", flush=True)
 while True:
     res.save(sys.argv[1])
+    print("saved", flush=True)
 """
 
 
@@ -225,6 +226,11 @@ def test_killing_a_save_at_random_moments_never_damages_the_results_file(tmp_pat
                              text=True)
         try:
             assert p.stdout.readline().strip() == "ready"
+            if k == 0:
+                # one whole save first, so that the file exists (and is checked) after every kill
+                # however slow the machine is (under load, all 20 random kills once came before
+                # the first save had finished)
+                assert p.stdout.readline().strip() == "saved"
             time.sleep(rng.uniform(0.0, 0.6))
             p.send_signal(signal.SIGKILL if k % 2 == 0 else signal.SIGINT)
             try:

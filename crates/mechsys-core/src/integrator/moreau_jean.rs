@@ -35,7 +35,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::contact::{at_contact, contact_point_kinematics, ContactKinematics, ContactPoint, GroupPhase, SearchHint};
+use crate::contact::{at_contact, ContactKinematics, ContactPoint, GroupPhase, SearchHint};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::forces::Callbacks;
@@ -1087,7 +1087,8 @@ impl MoreauJean {
         for con in &model.contacts {
             let pts = con.first..con.first + con.points();
             let s = self.warm_search.then(|| &mut self.search[pts.clone()]);
-            contact_point_kinematics(con, data, t, q, u, cb, &mut self.kin[pts], s)
+            // velocity level: the records hold no w̄
+            crate::contact::contact_point_velocities(con, data, t, q, u, cb, &mut self.kin[pts], s)
                 .map_err(|e| at_contact(e, &con.name, t))?;
         }
         Ok(())
