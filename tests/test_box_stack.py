@@ -195,19 +195,21 @@ def test_the_auto_solver_holds_the_stack_at_its_static_weights_every_step(dt):
         assert np.abs(carried - (n - k) * mass * G).max() < 1e-8, k
 
 
-@pytest.mark.parametrize("dt, share", [(1e-3, 0.75), (1e-2, 0.9)])
-def test_warm_started_steps_of_the_resting_stack_take_one_sweep(dt, share):
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+def test_warm_started_steps_of_the_resting_stack_stay_with_gauss_seidel(dt):
     """At the default tolerance (1e-10) the auto solver leaves each step well inside it (its
     sweeps stop early only at a tenth of it, Newton takes a step past it), so the next warm
-    start converges in one sweep: most steps of the resting stack take exactly one. (Leaving
-    steps just under the tolerance sent every other step to Newton: 61 % one-sweep steps at
-    dt = 1e-2.) Every step converges and the top box stays put."""
+    start converges in a few sweeps: at most 5 % of the resting stack's steps go on to Newton
+    (more than 4 iterations) and most take one sweep. (Leaving steps just under the tolerance
+    sent every other step to Newton: 23 % of the steps at dt = 1e-2, 28 % at 1e-3.) Every step
+    converges and the top box stays put."""
     n = 10
     m = stack_model(n)
     res = ms.simulate(m, 2.0, ms.MoreauJean(dt, solver=ms.Auto()), output_dt=dt)
     assert res["solver/converged"][1:].all() and res["solver/residual"].max() <= 1e-10
     it = res["solver/iterations"][1:]
-    assert (it == 1).mean() >= share, np.unique(it, return_counts=True)
+    counts = np.unique(it, return_counts=True)
+    assert (it > 4).mean() <= 0.05 and (it == 1).mean() >= 0.5, counts
     top = res[f"body/box{n - 1}/position"]
     assert np.abs(top - top[0]).max() < 1e-9
 

@@ -320,9 +320,11 @@ impl Curve {
         let sigma = match (solid, closed) {
             (Solid::Left, _) => 1.0,
             (Solid::Right, _) => -1.0,
-            (Solid::Inside | Solid::Outside, false) => return Err(crate::Error::Model(format!(
+            (Solid::Inside | Solid::Outside, false) => {
+                return Err(crate::Error::Model(format!(
                 "{what}: an open curve has no inside; put its solid on the left or the right of the points' direction"
-            ))),
+            )))
+            }
             (Solid::Inside | Solid::Outside, true) => {
                 // the shoelace area is positive for counter-clockwise points, whose inside is on the left
                 let area: f64 = (0..n).map(|i| cross(&p[i], &p[(i + 1) % n])).sum();

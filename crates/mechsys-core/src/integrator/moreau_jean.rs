@@ -910,7 +910,8 @@ impl MoreauJean {
                 Method::Auto(o) => match o.pick(m) {
                     Method::Nsgs(p) => Some((p.tol, p.max_iter, None)),
                     Method::Newton(p) => {
-                        Some((solver::AUTO_SWEEP_MARGIN * o.tol, solver::AUTO_SWEEPS, Some((o.tol, p))))
+                        let sweeps = solver::auto_sweeps(&self.r);
+                        Some((solver::AUTO_SWEEP_MARGIN * o.tol, sweeps, Some((o.tol, p))))
                     }
                     _ => None,
                 },

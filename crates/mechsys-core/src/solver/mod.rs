@@ -191,6 +191,20 @@ impl Default for ApgdOptions {
 /// 1e-2 were lowest at 4 of 1, 4 and 10).
 pub const AUTO_SWEEPS: usize = 4;
 
+/// Gauss–Seidel sweeps [`Method::Auto`] takes from a cold start (all impulses zero) before it
+/// turns to Newton: nearer the solution, Newton needs fewer fresh factorizations (the first step
+/// of the box stack and of the pyramid cost 2.9 and 1.3 times fewer instructions than with 4).
+pub const AUTO_COLD_SWEEPS: usize = 10;
+
+/// [`AUTO_COLD_SWEEPS`] if the warm start `x` is all zeros, else [`AUTO_SWEEPS`].
+pub fn auto_sweeps(x: &[f64]) -> usize {
+    if x.iter().all(|v| *v == 0.0) {
+        AUTO_COLD_SWEEPS
+    } else {
+        AUTO_SWEEPS
+    }
+}
+
 /// The sweeps of [`Method::Auto`] stop early only below this fraction of the tolerance; between
 /// it and the tolerance Newton polishes (a resting box stack at dt 1e-3: 1.19 G instructions
 /// over 2 s against 2.29 G when the sweeps stopped at the tolerance itself).
@@ -243,7 +257,7 @@ pub enum Method {
     /// Accelerated projected gradient (friction contact only).
     Apgd(ApgdOptions),
     /// Newton for small friction-contact problems (after up to [`AUTO_SWEEPS`] Gauss–Seidel
-    /// sweeps; the report counts both), Gauss–Seidel for large ones, Lemke for LCPs
+    /// sweeps, [`AUTO_COLD_SWEEPS`] from a cold start; the report counts both), Gauss–Seidel for large ones, Lemke for LCPs
     /// ([`AutoOptions::pick`]).
     Auto(AutoOptions),
 }
@@ -411,7 +425,8 @@ impl sealed::Sealed for FrictionContact {
                     // the sweeps must get well below the tolerance: a step left just under it
                     // passes its error on to the next step's free velocity, which then starts
                     // above the tolerance (on a resting stack every other step went to Newton)
-                    let sweeps = NsgsOptions { tol: AUTO_SWEEP_MARGIN * o.tol, max_iter: AUTO_SWEEPS, relaxation: 1.0 };
+                    let sweeps =
+                        NsgsOptions { tol: AUTO_SWEEP_MARGIN * o.tol, max_iter: auto_sweeps(x), relaxation: 1.0 };
                     let first = nsgs::solve_fc(self, &sweeps, x, ws)?;
                     if first.converged {
                         return Ok(first);
