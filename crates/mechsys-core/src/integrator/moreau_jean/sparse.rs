@@ -677,12 +677,8 @@ mod tests {
         Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap()
     }
 
-    /// Gauss–Seidel on the factored operator (`W = YᵀY`, no off-diagonal blocks) solves the
-    /// problem the block solver solves: the same impulses and local velocities `W r + q` to
-    /// round-off, sweep for sweep, in 2-D and 3-D, with contacts sliding, sticking and open.
-    #[test]
-    fn factored_gauss_seidel_is_the_block_solver_to_round_off() {
-        use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
+    /// The test model at its initial state: kinematics done, mass matrix factored.
+    fn factored_mass() -> (Model, Data, Saddle) {
         let model = model();
         let mut data = Data::new(&model);
         let mut q = model.q0();
@@ -696,6 +692,16 @@ mod tests {
             });
         }
         assert!(saddle.factor_mass());
+        (model, data, saddle)
+    }
+
+    /// Gauss–Seidel on the factored operator (`W = YᵀY`, no off-diagonal blocks) solves the
+    /// problem the block solver solves: the same impulses and local velocities `W r + q` to
+    /// round-off, sweep for sweep, in 2-D and 3-D, with contacts sliding, sticking and open.
+    #[test]
+    fn factored_gauss_seidel_is_the_block_solver_to_round_off() {
+        use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
+        let (model, data, saddle) = factored_mass();
         let pairs = [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0), (3, 1), (0, 3)];
         for dim in [3, 2] {
             let mut sp = SparseRows::new(&model, dim);
@@ -754,19 +760,7 @@ mod tests {
     /// index slip in the fixed-size code shows), and so are the Delassus blocks built from them.
     #[test]
     fn free_body_rows_are_the_general_rows_bit_for_bit() {
-        let model = model();
-        let mut data = Data::new(&model);
-        let mut q = model.q0();
-        model.normalize(&mut q);
-        crate::kinematics::forward_pass(&model, &mut data, 0.0, &q, &model.u0());
-        let mut saddle = Saddle::new(&model);
-        {
-            let Data { inertia, s, ic, elastic, .. } = &mut data;
-            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| {
-                saddle.put_mass(r, c, v)
-            });
-        }
-        assert!(saddle.factor_mass());
+        let (model, data, saddle) = factored_mass();
         let n = Vec3::new(0.3, -0.5, 0.8).normalize();
         let t1 = n.cross(&Vec3::x()).normalize();
         let dirs = [n, t1, n.cross(&t1)];
