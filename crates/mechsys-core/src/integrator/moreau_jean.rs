@@ -903,21 +903,18 @@ impl MoreauJean {
     fn solve_contacts(&mut self, split: bool, again: bool, factored: bool) -> Result<solver::Report> {
         if factored && self.sparse.is_some() {
             let m = self.r.len();
-            // (Auto's sweeps before Newton stop early only well below the tolerance, see
-            // solver::AUTO_SWEEP_MARGIN; relaxed NSGS keeps the block solver's safeguard)
+            // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks; relaxed
+            // NSGS keeps the block solver's safeguard
             let plan = match &self.method {
-                Method::Nsgs(o) if o.relaxation == 1.0 => Some((o.tol, o.max_iter, None)),
-                Method::Auto(o) => match o.pick(m) {
-                    Method::Nsgs(p) => Some((p.tol, p.max_iter, None)),
-                    Method::Newton(p) => {
-                        let sweeps = solver::auto_sweeps(&self.r);
-                        Some((solver::AUTO_SWEEP_MARGIN * o.tol, sweeps, Some((o.tol, p))))
-                    }
+                Method::Nsgs(o) if o.relaxation == 1.0 => Some((*o, None)),
+                Method::Auto(o) => match o.plan(m, &self.r) {
+                    solver::AutoPlan { sweeps: Some(s), then } => Some((s, Some(then))),
+                    solver::AutoPlan { sweeps: None, then: Method::Nsgs(p) } => Some((p, None)),
                     _ => None,
                 },
                 _ => None,
             };
-            if let Some((tol, sweeps, then)) = plan {
+            if let Some((sweeps, then)) = plan {
                 // the block solver's checks of its input (W_NN from the diagonal blocks)
                 let d = self.problem.dim;
                 solver::check_local(d, &self.problem.q, &self.problem.mu)?;
@@ -928,30 +925,19 @@ impl MoreauJean {
                 if let Some(k) = self.r.iter().position(|v| !v.is_finite()) {
                     return Err(Error::Settings(format!("solver: warm start entry {k} is not finite ({})", self.r[k])));
                 }
+                // (capacity for every contact point since construction: no allocation)
                 self.local_u.resize(m, 0.0);
-                let first = sp.gauss_seidel(
-                    &self.problem.q,
-                    &self.problem.mu,
-                    &self.ws.order,
-                    &mut self.r,
-                    tol,
-                    sweeps,
-                    &mut self.local_u,
-                );
-                let Some((auto_tol, newton)) = then else {
+                let problem = (&self.problem.q[..], &self.problem.mu[..]);
+                let first = sp.gauss_seidel(problem, &self.ws.order, &mut self.r, &sweeps, &mut self.local_u);
+                let Some(then) = then.filter(|_| !first.converged) else {
                     return Ok(first);
                 };
-                if first.converged {
-                    return Ok(solver::Report { converged: first.residual <= auto_tol, ..first });
-                }
-                // Newton from the sweeps' impulses, on the blocks
+                // the rest from the sweeps' impulses, on the blocks (an empty `local_u` tells
+                // the contact states to come from the problem)
                 self.local_u.clear();
                 self.ensure_blocks();
-                let method = Method::Newton(newton);
-                self.ws.reserve(&self.problem, &method)?;
-                let mut rep = solver::solve(&self.problem, &method, &mut self.r, true, &mut self.ws)?;
-                rep.iterations += first.iterations;
-                return Ok(rep);
+                self.ws.reserve(&self.problem, &then)?;
+                return Ok(solver::solve(&self.problem, &then, &mut self.r, true, &mut self.ws)?.after(&first));
             }
         }
         self.ensure_blocks();

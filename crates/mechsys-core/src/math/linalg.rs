@@ -6,24 +6,7 @@ use crate::error::{Error, Result};
 /// Factors the row-major `n × n` matrix `a` in place (L unit-lower, U upper), pivots into `piv`.
 pub fn lu_factor(a: &mut [f64], n: usize, piv: &mut [usize]) -> Result<()> {
     for k in 0..n {
-        let mut p = k;
-        let mut best = a[k * n + k].abs();
-        for r in k + 1..n {
-            let v = a[r * n + k].abs();
-            if v > best {
-                best = v;
-                p = r;
-            }
-        }
-        piv[k] = p;
-        if best == 0.0 || !best.is_finite() {
-            return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
-        }
-        if p != k {
-            for c in 0..n {
-                a.swap(k * n + c, p * n + c);
-            }
-        }
+        pivot(a, n, k, piv)?;
         let d = a[k * n + k];
         for r in k + 1..n {
             let l = a[r * n + k] / d;
@@ -36,6 +19,31 @@ pub fn lu_factor(a: &mut [f64], n: usize, piv: &mut [usize]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Partial pivoting at column `k`: the row of the largest `|a[r][k]|`, r ≥ k, swapped into row
+/// `k` and recorded in `piv[k]` (also returned); an error if the column is zero or not finite.
+#[inline]
+fn pivot(a: &mut [f64], n: usize, k: usize, piv: &mut [usize]) -> Result<usize> {
+    let mut p = k;
+    let mut best = a[k * n + k].abs();
+    for r in k + 1..n {
+        let v = a[r * n + k].abs();
+        if v > best {
+            best = v;
+            p = r;
+        }
+    }
+    piv[k] = p;
+    if best == 0.0 || !best.is_finite() {
+        return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
+    }
+    if p != k {
+        for c in 0..n {
+            a.swap(k * n + c, p * n + c);
+        }
+    }
+    Ok(p)
 }
 
 /// Solves `A x = b` in place with the factors of [`lu_factor`].
@@ -71,25 +79,8 @@ pub fn lu_factor_profile(a: &mut [f64], n: usize, piv: &mut [usize], ext: &mut [
         e.1 = row.iter().rposition(|v| *v != 0.0).map_or(0, |c| c + 1);
     }
     for k in 0..n {
-        let mut p = k;
-        let mut best = a[k * n + k].abs();
-        for r in k + 1..n {
-            let v = a[r * n + k].abs();
-            if v > best {
-                best = v;
-                p = r;
-            }
-        }
-        piv[k] = p;
-        if best == 0.0 || !best.is_finite() {
-            return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
-        }
-        if p != k {
-            for c in 0..n {
-                a.swap(k * n + c, p * n + c);
-            }
-            ext.swap(k, p);
-        }
+        let p = pivot(a, n, k, piv)?;
+        ext.swap(k, p);
         let d = a[k * n + k];
         let end = ext[k].1.max(k + 1);
         for r in k + 1..n {

@@ -107,6 +107,13 @@ pub struct Report {
     pub converged: bool,
 }
 
+impl Report {
+    /// This report of a method that went on from `first`'s solution, counting both's iterations.
+    pub fn after(self, first: &Report) -> Report {
+        Report { iterations: first.iterations + self.iterations, ..self }
+    }
+}
+
 /// Lemke's method ([`lemke`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -233,7 +240,34 @@ impl Default for AutoOptions {
     }
 }
 
+/// What [`Method::Auto`] does with one friction-contact problem ([`AutoOptions::plan`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutoPlan {
+    /// Gauss–Seidel sweeps first (before Newton), stopping early only at
+    /// [`AUTO_SWEEP_MARGIN`] times the tolerance; their report stands if they converge.
+    pub sweeps: Option<NsgsOptions>,
+    /// The method for the rest ([`AutoOptions::pick`]).
+    pub then: Method,
+}
+
 impl AutoOptions {
+    /// The plan for a friction-contact problem of `unknowns` unknowns warm-started from `x`.
+    ///
+    /// Before Newton a few Gauss–Seidel sweeps ([`auto_sweeps`]): they finish a warm-started
+    /// step that needs little and bring a cold start near enough for Newton's few steps. They
+    /// must get well below the tolerance: a step left just under it passes its error on to the
+    /// next step's free velocity, which then starts above the tolerance (on a resting stack every
+    /// other step went to Newton).
+    pub fn plan(&self, unknowns: usize, x: &[f64]) -> AutoPlan {
+        let then = self.pick(unknowns);
+        let sweeps = matches!(then, Method::Newton(_)).then(|| NsgsOptions {
+            tol: AUTO_SWEEP_MARGIN * self.tol,
+            max_iter: auto_sweeps(x),
+            relaxation: 1.0,
+        });
+        AutoPlan { sweeps, then }
+    }
+
     /// The method it takes for a friction-contact problem of `unknowns` unknowns.
     pub fn pick(&self, unknowns: usize) -> Method {
         if unknowns <= self.newton_max_unknowns {
@@ -418,24 +452,15 @@ impl sealed::Sealed for FrictionContact {
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
             Method::Auto(o) => {
-                let pick = o.pick(self.unknowns());
-                if let Method::Newton(_) = pick {
-                    // a few Gauss–Seidel sweeps first: they finish a warm-started step that
-                    // needs little, and bring a cold start near enough for Newton's few steps
-                    // the sweeps must get well below the tolerance: a step left just under it
-                    // passes its error on to the next step's free velocity, which then starts
-                    // above the tolerance (on a resting stack every other step went to Newton)
-                    let sweeps =
-                        NsgsOptions { tol: AUTO_SWEEP_MARGIN * o.tol, max_iter: auto_sweeps(x), relaxation: 1.0 };
-                    let first = nsgs::solve_fc(self, &sweeps, x, ws)?;
-                    if first.converged {
-                        return Ok(first);
-                    }
-                    let mut rep = self.run(&pick, x, ws)?;
-                    rep.iterations += first.iterations;
-                    return Ok(rep);
+                let plan = o.plan(self.unknowns(), x);
+                let Some(sweeps) = plan.sweeps else {
+                    return self.run(&plan.then, x, ws);
+                };
+                let first = nsgs::solve_fc(self, &sweeps, x, ws)?;
+                if first.converged {
+                    return Ok(first);
                 }
-                self.run(&pick, x, ws)
+                Ok(self.run(&plan.then, x, ws)?.after(&first))
             }
             Method::Lemke(o) => friction_lcp::solve(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_fc(self, o, x, ws),

@@ -553,6 +553,13 @@ impl FrictionContact {
         let (d, n) = (self.dim, self.contacts());
         ensure!(i < n, Settings, "friction contact: contact {i} does not exist ({n} contacts)");
         ensure!(r.len() == d * n, Settings, "friction contact: r has {} entries, expected {}", r.len(), d * n);
+        Ok(self.local_unchecked(i, r))
+    }
+
+    /// [`FrictionContact::local`] without the checks of `i` and `r`'s length.
+    #[inline]
+    fn local_unchecked(&self, i: usize, r: &[f64]) -> ([f64; 3], [f64; 3]) {
+        let d = self.dim;
         let mut u = [0.0; 3];
         self.w.add_row_product(d, i, r, false, &mut u);
         let mut ri = [0.0; 3];
@@ -560,7 +567,7 @@ impl FrictionContact {
             u[a] += self.q[i * d + a];
             ri[a] = r[i * d + a];
         }
-        Ok((ri, u))
+        (ri, u)
     }
 
     /// The local velocity `(W r + q)_i` of contact `i` (normal, then tangents).
@@ -599,14 +606,7 @@ impl FrictionContact {
         r_scale: f64,
         q_scale: f64,
     ) -> ContactState {
-        let d = self.dim;
-        let mut u = [0.0; 3];
-        self.w.add_row_product(d, i, r, false, &mut u);
-        let mut ri = [0.0; 3];
-        for a in 0..d {
-            u[a] += self.q[i * d + a];
-            ri[a] = r[i * d + a];
-        }
+        let (ri, u) = self.local_unchecked(i, r);
         classify(&ri, &u, tol, r_scale, q_scale)
     }
 
@@ -619,13 +619,7 @@ impl FrictionContact {
         let (ri, u) = self.local(i, r)?;
         let r_scale = 1.0 + r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let q_scale = 1.0 + self.q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        Ok(if ri[0] <= tol * r_scale {
-            ContactState::Open
-        } else if (u[1] * u[1] + u[2] * u[2]).sqrt() > tol * q_scale {
-            ContactState::Slip
-        } else {
-            ContactState::Stick
-        })
+        Ok(classify(&ri, &u, tol, r_scale, q_scale))
     }
 }
 
@@ -646,6 +640,7 @@ pub(crate) fn check_local(d: usize, q: &[f64], mu: &[f64]) -> Result<()> {
 
 /// Contact `i`'s `W_NN` must be positive (and finite).
 pub(crate) fn check_wnn(i: usize, wnn: f64) -> Result<()> {
+    ensure!(wnn.is_finite(), Settings, "friction contact: contact {i}: W_NN is not finite ({wnn})");
     ensure!(
         wnn > 0.0,
         Settings,

@@ -1061,3 +1061,32 @@ fn newton_polishes_once_past_the_tolerance() {
     }
     assert!(polished >= 1, "no case took the polishing step");
 }
+
+/// A contact whose `W_NN` is not finite (kinematics gone bad) is named as such, not as one that
+/// cannot move along its normal; a zero or negative one as that.
+#[test]
+fn w_nn_check_names_the_contact_and_the_fault() {
+    for (w, says) in
+        [(f64::NAN, "not finite"), (f64::INFINITY, "not finite"), (0.0, "must be > 0"), (-1.0, "must be > 0")]
+    {
+        let e = check_wnn(4, w).unwrap_err().to_string();
+        assert!(e.contains("contact 4") && e.contains(says), "{w}: {e}");
+    }
+    assert!(check_wnn(4, 1e-30).is_ok());
+}
+
+/// Auto's plan: sweeps before Newton (10 from a cold start, 4 warm, at a tenth of the
+/// tolerance), none before Gauss–Seidel on a large problem.
+#[test]
+fn auto_plan_sweeps_before_newton_only() {
+    let o = AutoOptions { tol: 1e-8, newton_max_unknowns: 30, ..Default::default() };
+    let cold = o.plan(30, &[0.0; 30]);
+    assert!(matches!(cold.then, Method::Newton(p) if p.tol == 1e-8));
+    let s = cold.sweeps.unwrap();
+    assert_eq!((s.max_iter, s.tol, s.relaxation), (AUTO_COLD_SWEEPS, 1e-9, 1.0));
+    let mut warm = [0.0; 30];
+    warm[7] = 0.5;
+    assert_eq!(o.plan(30, &warm).sweeps.unwrap().max_iter, AUTO_SWEEPS);
+    let big = o.plan(33, &[0.0; 33]);
+    assert!(big.sweeps.is_none() && matches!(big.then, Method::Nsgs(p) if p.tol == 1e-8));
+}

@@ -733,7 +733,7 @@ mod tests {
                 let mut r_blocks = vec![0.0; dim * nc];
                 let rep = solver::solve(&p, &method, &mut r_blocks, false, &mut ws).unwrap();
                 let (mut r_fact, mut u_fact) = (vec![0.0; dim * nc], vec![0.0; dim * nc]);
-                let fact = sp.gauss_seidel(&qv, &mu, &[], &mut r_fact, 1e-14, sweeps, &mut u_fact);
+                let fact = sp.gauss_seidel((&qv, &mu), &[], &mut r_fact, &o, &mut u_fact);
                 assert_eq!(fact.iterations, rep.iterations, "dim {dim}, {sweeps} sweeps");
                 assert!((fact.residual - rep.residual).abs() <= 1e-12 * (1.0 + rep.residual), "{fact:?} {rep:?}");
                 let mut u_blocks = vec![0.0; dim * nc];

@@ -16,42 +16,39 @@
 
 use super::SparseRows;
 use crate::solver::nsgs::{local_solve, CheckSchedule};
-use crate::solver::{contact_residual_sq, Report};
+use crate::solver::{contact_residual_sq, NsgsOptions, Report};
 
 impl SparseRows {
-    /// Up to `max_sweeps` sweeps of nonsmooth Gauss–Seidel on the problem `u = W r + q` with
-    /// friction coefficients `mu`, in `order` (a permutation of the contacts, else by index),
-    /// warm-started from `r`; stops at the residual `tol` (the measure of
-    /// [`crate::solver::Report::residual`]). After a full-residual check, the last one of the
-    /// report, `u` holds `W r + q` of the returned `r`; the report's residual is infinite if no
-    /// check was made.
+    /// Nonsmooth Gauss–Seidel on the problem `u = W r + q` with friction coefficients `mu`:
+    /// up to `opts.max_iter` sweeps in `order` (a permutation of the contacts, else by index),
+    /// warm-started from `r`, stopping at the residual `opts.tol` (the measure of
+    /// [`crate::solver::Report::residual`]; no relaxation). After a full-residual check, the last
+    /// one of the report, `u` holds `W r + q` of the returned `r`; the report's residual is
+    /// infinite if no check was made.
     pub(in crate::integrator::moreau_jean) fn gauss_seidel(
         &mut self,
-        q: &[f64],
-        mu: &[f64],
+        (q, mu): (&[f64], &[f64]),
         order: &[usize],
         r: &mut [f64],
-        tol: f64,
-        max_sweeps: usize,
+        opts: &NsgsOptions,
         u: &mut [f64],
     ) -> Report {
         match self.dim {
-            3 => self.gauss_seidel_d::<3>(q, mu, order, r, tol, max_sweeps, u),
-            _ => self.gauss_seidel_d::<2>(q, mu, order, r, tol, max_sweeps, u),
+            3 => self.gauss_seidel_d::<3>(q, mu, order, r, opts, u),
+            _ => self.gauss_seidel_d::<2>(q, mu, order, r, opts, u),
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn gauss_seidel_d<const D: usize>(
         &mut self,
         q: &[f64],
         mu: &[f64],
         order: &[usize],
         r: &mut [f64],
-        tol: f64,
-        max_sweeps: usize,
+        opts: &NsgsOptions,
         u: &mut [f64],
     ) -> Report {
+        let (tol, max_sweeps) = (opts.tol, opts.max_iter);
         let n = self.len();
         let qn = 1.0 + q.iter().map(|v| v * v).sum::<f64>().sqrt();
         let ordered = order.len() == n;
@@ -62,19 +59,10 @@ impl SparseRows {
             let mut change = 0.0;
             for ii in 0..n {
                 let a = if ordered { order[ii] } else { ii };
-                let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
-                let ya = &self.y[s * D..e * D];
-                let idx = &self.pat_idx[s..e];
                 let mut blk = [0.0; 9];
                 blk[..D * D].copy_from_slice(&self.diag[a * D * D..(a + 1) * D * D]);
                 // b = Y_aᵀ z − W_aa r_a + q_a: the velocity of the others' impulses and the free motion
-                let mut b = [0.0; 3];
-                for (k, y) in idx.iter().zip(ya.chunks_exact(D)) {
-                    let zk = self.z[*k];
-                    for c in 0..D {
-                        b[c] += y[c] * zk;
-                    }
-                }
+                let mut b = self.rows_times_z::<D>(a);
                 let mut old = [0.0; 3];
                 old[..D].copy_from_slice(&r[a * D..(a + 1) * D]);
                 for c in 0..D {
@@ -92,13 +80,7 @@ impl SparseRows {
                     change += (blk[0] * delta[c]).powi(2);
                 }
                 if delta.iter().any(|v| *v != 0.0) {
-                    for (k, y) in idx.iter().zip(ya.chunks_exact(D)) {
-                        let mut s = 0.0;
-                        for c in 0..D {
-                            s += y[c] * delta[c];
-                        }
-                        self.z[*k] += s;
-                    }
+                    self.add_rows_times::<D>(a, &delta[..D]);
                     r[a * D..(a + 1) * D].copy_from_slice(&new[..D]);
                 }
             }
@@ -119,18 +101,37 @@ impl SparseRows {
         self.z.fill(0.0);
         for a in 0..self.len() {
             let ra = &r[a * D..(a + 1) * D];
-            if ra.iter().all(|v| *v == 0.0) {
-                continue;
-            }
-            let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
-            for (k, y) in self.pat_idx[s..e].iter().zip(self.y[s * D..e * D].chunks_exact(D)) {
-                let mut v = 0.0;
-                for c in 0..D {
-                    v += y[c] * ra[c];
-                }
-                self.z[*k] += v;
+            if ra.iter().any(|v| *v != 0.0) {
+                self.add_rows_times::<D>(a, ra);
             }
         }
+    }
+
+    /// `z += Y_a v` (`v` has the problem's dimension `D`).
+    #[inline]
+    fn add_rows_times<const D: usize>(&mut self, a: usize, v: &[f64]) {
+        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+        for (k, y) in self.pat_idx[s..e].iter().zip(self.y[s * D..e * D].chunks_exact(D)) {
+            let mut x = 0.0;
+            for c in 0..D {
+                x += y[c] * v[c];
+            }
+            self.z[*k] += x;
+        }
+    }
+
+    /// `Y_aᵀ z` (zero beyond the problem's dimension `D`).
+    #[inline]
+    fn rows_times_z<const D: usize>(&self, a: usize) -> [f64; 3] {
+        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
+        let mut out = [0.0; 3];
+        for (k, y) in self.pat_idx[s..e].iter().zip(self.y[s * D..e * D].chunks_exact(D)) {
+            let zk = self.z[*k];
+            for c in 0..D {
+                out[c] += y[c] * zk;
+            }
+        }
+        out
     }
 
     /// `u = Y_aᵀ z + q` for every contact (after [`SparseRows::factored_product`]) and the
@@ -138,14 +139,7 @@ impl SparseRows {
     fn factored_residual<const D: usize>(&self, q: &[f64], mu: &[f64], r: &[f64], u: &mut [f64]) -> f64 {
         let mut sum = 0.0;
         for a in 0..self.len() {
-            let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
-            let mut ua = [0.0; 3];
-            for (k, y) in self.pat_idx[s..e].iter().zip(self.y[s * D..e * D].chunks_exact(D)) {
-                let zk = self.z[*k];
-                for c in 0..D {
-                    ua[c] += y[c] * zk;
-                }
-            }
+            let ua = self.rows_times_z::<D>(a);
             // (a direction without mobility has zero rows and a zero impulse: the diagonal
             // `couplings` gives it adds nothing to its velocity in the block form either)
             for c in 0..D {
