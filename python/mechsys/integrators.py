@@ -88,9 +88,13 @@ class NSGS:
     tol: float = 1e-10
     max_iter: int = 10_000
     relaxation: float = 1.0
+    #: Anderson acceleration: the number of past sweeps combined (0 = off, at most 8); with
+    #: ``relaxation = 1``. Piles converge in several times fewer sweeps.
+    anderson: int = 0
 
     def describe(self) -> dict:
-        return {"type": "nsgs", "tol": float(self.tol), "max_iter": int(self.max_iter), "relaxation": float(self.relaxation)}
+        return {"type": "nsgs", "tol": float(self.tol), "max_iter": int(self.max_iter), "relaxation": float(self.relaxation),
+                "anderson": int(self.anderson)}
 
 
 @dataclass(frozen=True)
@@ -112,17 +116,19 @@ class Newton:
 class Auto:
     """The contact solver by problem shape: :class:`Newton` (regularized, its factorization reused
     while the contact set rests) for problems of at most ``newton_max_unknowns`` unknowns (3 per
-    contact point in space, 2 in the plane), :class:`NSGS` above; ``solver="auto"`` in
-    :class:`MoreauJean`."""
+    contact point in space, 2 in the plane), :class:`NSGS` above (Anderson-accelerated:
+    ``nsgs_anderson`` past sweeps combined); ``solver="auto"`` in :class:`MoreauJean`."""
 
     tol: float = 1e-10
     newton_max_unknowns: int = 480
     newton_max_iter: int = 200
     nsgs_max_iter: int = 10_000
+    nsgs_anderson: int = 4
 
     def describe(self) -> dict:
         return {"type": "auto", "tol": float(self.tol), "newton_max_unknowns": int(self.newton_max_unknowns),
-                "newton_max_iter": int(self.newton_max_iter), "nsgs_max_iter": int(self.nsgs_max_iter)}
+                "newton_max_iter": int(self.newton_max_iter), "nsgs_max_iter": int(self.nsgs_max_iter),
+                "nsgs_anderson": int(self.nsgs_anderson)}
 
 
 @dataclass(frozen=True)

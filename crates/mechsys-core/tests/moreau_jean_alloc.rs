@@ -7,7 +7,7 @@ use mechsys_core::dynamics::Workspace;
 use mechsys_core::forces::NoCallbacks;
 use mechsys_core::integrator::moreau_jean::MoreauJean;
 use mechsys_core::model::{Model, ModelDescription};
-use mechsys_core::solver::{ApgdOptions, Method, NsgsOptions};
+use mechsys_core::solver::{ApgdOptions, AutoOptions, Method, NsgsOptions};
 
 mod common;
 use common::allocations;
@@ -20,7 +20,22 @@ static A: common::Counting = common::Counting;
 /// solves.
 #[test]
 fn group_steps_do_not_allocate_after_warm_up() {
-    pile_steps_do_not_allocate_after_warm_up(Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0 }));
+    pile_steps_do_not_allocate_after_warm_up(Method::Nsgs(NsgsOptions {
+        tol: 1e-8,
+        max_iter: 500,
+        relaxation: 1.0,
+        anderson: 0,
+    }));
+}
+
+/// The same with Anderson-accelerated sweeps (NSGS with a history of 4, and the auto solver's
+/// Gauss–Seidel above its Newton size).
+#[test]
+fn group_steps_with_anderson_do_not_allocate_after_warm_up() {
+    let nsgs = NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0, anderson: 4 };
+    pile_steps_do_not_allocate_after_warm_up(Method::Nsgs(nsgs));
+    let auto = AutoOptions { tol: 1e-8, newton_max_unknowns: 0, nsgs_max_iter: 500, ..Default::default() };
+    pile_steps_do_not_allocate_after_warm_up(Method::Auto(auto));
 }
 
 /// The same with the accelerated projected gradient (its scratch sized once in the workspace).
@@ -73,7 +88,7 @@ fn projected_steps_do_not_allocate() {
     }"#;
     let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
     let h = 1e-3;
-    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0 });
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0, anderson: 0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();
     st.project = true;
     let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
@@ -97,7 +112,7 @@ fn projected_steps_do_not_allocate() {
 fn curve_contact_steps_do_not_allocate_after_warm_up() {
     let model = mechsys_core::fixtures::ellipse_cam(20.0, 0.061);
     let h = 1e-4;
-    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0 });
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0, anderson: 0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();
     assert!(st.warm_search);
     let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));

@@ -251,6 +251,8 @@ impl MoreauJean {
     /// on a model with bilateral constraints).
     pub fn with_assembly(model: &Model, h: f64, method: Method, assembly: Assembly) -> Result<Self> {
         crate::ensure!(h.is_finite() && h > 0.0, Settings, "integrator.dt: must be > 0, got {h}");
+        // bad solver settings stop the run before its first step, not at its first contact
+        method.validate()?;
         let (nu, np) = (model.nu, model.n_contact_points);
         let planar = model.contacts.iter().all(|c| c.is_planar()) && model.contact_groups.iter().all(|g| g.planar);
         let dim = if planar { 2 } else { 3 };
@@ -323,7 +325,18 @@ impl MoreauJean {
                 .map(|g| Vec::with_capacity(GROUP_POINTS_PER_CONTOUR * (g.members.len() + g.against.len()).max(8)))
                 .collect(),
             act: Vec::with_capacity(np),
-            sparse: if use_sparse { Some(SparseRows::new(model, dim)) } else { None },
+            sparse: use_sparse.then(|| {
+                let mut sp = SparseRows::new(model, dim);
+                let accelerated = match method {
+                    Method::Nsgs(o) => o.anderson > 0,
+                    Method::Auto(o) => o.nsgs_anderson > 0,
+                    _ => false,
+                };
+                if accelerated {
+                    sp.reserve_acceleration(dim * np);
+                }
+                sp
+            }),
             islands: islands::Islands::default(),
             height: Vec::new(),
             parallel: true,
@@ -903,10 +916,9 @@ impl MoreauJean {
     fn solve_contacts(&mut self, split: bool, again: bool, factored: bool) -> Result<solver::Report> {
         if factored && self.sparse.is_some() {
             let m = self.r.len();
-            // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks; relaxed
-            // NSGS keeps the block solver's safeguard
+            // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks
             let plan = match &self.method {
-                Method::Nsgs(o) if o.relaxation == 1.0 => Some((*o, None)),
+                Method::Nsgs(o) => Some((*o, None)),
                 Method::Auto(o) => match o.plan(m, &self.r) {
                     solver::AutoPlan { sweeps: Some(s), then } => Some((s, Some(then))),
                     solver::AutoPlan { sweeps: None, then: Method::Nsgs(p) } => Some((p, None)),

@@ -66,6 +66,7 @@
 //! for the modified velocity; Acary & Brogliato, *Numerical Methods for Nonsmooth Dynamical Systems*
 //! (2008), for the merit function.
 
+pub(crate) mod anderson;
 pub mod apgd;
 pub mod fixtures;
 pub mod friction_lcp;
@@ -145,11 +146,17 @@ pub struct NsgsOptions {
     /// extrapolates (projected onto the cone, and back to 1 for the rest of the solve when a
     /// sweep changes the impulses more than the one before).
     pub relaxation: f64,
+    /// Anderson acceleration of the sweeps (friction contact, `ω = 1`): the number of past
+    /// sweeps combined, `0` (off) to [`anderson::MAX_DEPTH`]. Each sweep's result is replaced by
+    /// the combination of the last ones whose changes cancel best, restarting whenever a sweep
+    /// changes the impulses more than the one before. On a settling pile of 100 spheres it
+    /// halved the sweeps (tol 1e-4: mean 127 to 58, worst 10 000 to about 1000).
+    pub anderson: usize,
 }
 
 impl Default for NsgsOptions {
     fn default() -> Self {
-        Self { tol: 1e-10, max_iter: 10_000, relaxation: 1.0 }
+        Self { tol: 1e-10, max_iter: 10_000, relaxation: 1.0, anderson: 0 }
     }
 }
 
@@ -232,11 +239,24 @@ pub struct AutoOptions {
     pub newton_max_iter: usize,
     /// Cap on Gauss–Seidel sweeps.
     pub nsgs_max_iter: usize,
+    /// Anderson acceleration of Gauss–Seidel on problems above `newton_max_unknowns`
+    /// ([`NsgsOptions::anderson`]).
+    pub nsgs_anderson: usize,
 }
+
+/// Anderson depth of [`Method::Auto`]'s Gauss–Seidel on large problems (on the settling pile of
+/// 100 spheres at tol 1e-4, depths 2 to 8 all took about 58 sweeps a step against 127 without).
+pub const AUTO_ANDERSON: usize = 4;
 
 impl Default for AutoOptions {
     fn default() -> Self {
-        Self { tol: 1e-10, newton_max_unknowns: 480, newton_max_iter: 200, nsgs_max_iter: 10_000 }
+        Self {
+            tol: 1e-10,
+            newton_max_unknowns: 480,
+            newton_max_iter: 200,
+            nsgs_max_iter: 10_000,
+            nsgs_anderson: AUTO_ANDERSON,
+        }
     }
 }
 
@@ -263,7 +283,7 @@ impl AutoOptions {
         let sweeps = matches!(then, Method::Newton(_)).then(|| NsgsOptions {
             tol: AUTO_SWEEP_MARGIN * self.tol,
             max_iter: auto_sweeps(x),
-            relaxation: 1.0,
+            ..Default::default()
         });
         AutoPlan { sweeps, then }
     }
@@ -273,7 +293,12 @@ impl AutoOptions {
         if unknowns <= self.newton_max_unknowns {
             Method::Newton(NewtonOptions { tol: self.tol, max_iter: self.newton_max_iter, ..Default::default() })
         } else {
-            Method::Nsgs(NsgsOptions { tol: self.tol, max_iter: self.nsgs_max_iter, ..Default::default() })
+            Method::Nsgs(NsgsOptions {
+                tol: self.tol,
+                max_iter: self.nsgs_max_iter,
+                anderson: self.nsgs_anderson,
+                ..Default::default()
+            })
         }
     }
 }
@@ -318,7 +343,7 @@ impl Method {
         Method::Auto(AutoOptions::default())
     }
 
-    fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         match self {
             Method::Lemke(o) => {
                 ensure!(
@@ -345,6 +370,13 @@ impl Method {
                     "NSGS: relaxation must be in (0, 2), got {}",
                     o.relaxation
                 );
+                ensure!(
+                    o.anderson <= anderson::MAX_DEPTH,
+                    Settings,
+                    "NSGS: anderson (sweeps combined) must be in 0..={}, got {}",
+                    anderson::MAX_DEPTH,
+                    o.anderson
+                );
             }
             Method::Auto(o) => {
                 ensure!(o.tol > 0.0, Settings, "auto solver: tol must be > 0, got {}", o.tol);
@@ -352,6 +384,13 @@ impl Method {
                     o.newton_max_iter > 0 && o.nsgs_max_iter > 0,
                     Settings,
                     "auto solver: newton_max_iter and nsgs_max_iter must be > 0"
+                );
+                ensure!(
+                    o.nsgs_anderson <= anderson::MAX_DEPTH,
+                    Settings,
+                    "auto solver: nsgs_anderson (sweeps combined) must be in 0..={}, got {}",
+                    anderson::MAX_DEPTH,
+                    o.nsgs_anderson
                 );
             }
             Method::Apgd(o) => {
@@ -441,9 +480,11 @@ impl sealed::Sealed for FrictionContact {
             Method::Lemke(o) => {
                 let nl = (friction_lcp::directions(self.dim, o) + 2) * n;
                 let dense = if matches!(self.w, Delassus::Blocks(_)) { m } else { 0 };
-                Needs { u: m, diag: n, lemke: nl, lcp: nl, dense, newton: 0, apgd: 0 }
+                Needs { u: m, diag: n, lemke: nl, lcp: nl, dense, newton: 0, apgd: 0, anderson: 0 }
             }
-            Method::Nsgs(_) => Needs { u: m, diag: n, ..Needs::default() },
+            Method::Nsgs(o) => {
+                Needs { u: m, diag: n, anderson: if o.anderson > 0 { m } else { 0 }, ..Needs::default() }
+            }
             Method::Newton(_) => Needs { u: m, diag: n, newton: m, ..Needs::default() },
             Method::Apgd(_) => Needs { u: m, diag: n, apgd: m, ..Needs::default() },
             Method::Auto(o) => return self.needs(&o.pick(m)),

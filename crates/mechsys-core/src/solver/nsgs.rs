@@ -76,7 +76,14 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
     // one before, the extrapolation overshoots; the solve goes on with plain sweeps (ω = 1)
     let mut omega = o.relaxation;
     let mut last_change = f64::INFINITY;
+    if o.anderson > 0 {
+        ws.anderson.begin(m, 0, o.anderson);
+    }
     for it in 1..=o.max_iter {
+        let accelerate = o.anderson > 0 && omega == 1.0;
+        if accelerate {
+            ws.anderson.before_sweep(r);
+        }
         let change = sweep(p, &ws.diag[..n], &ws.order, r, omega);
         if omega > 1.0 && change > last_change {
             omega = 1.0;
@@ -89,6 +96,10 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
             if residual <= o.tol {
                 return Ok(Report { iterations: it, residual, converged: true });
             }
+        }
+        if accelerate && it < o.max_iter {
+            let (d, diag) = (p.dim, &ws.diag);
+            ws.anderson.step(r, &mut [], |i| diag[i / d][0]);
         }
     }
     Ok(Report { iterations: o.max_iter, residual, converged: false })

@@ -612,7 +612,7 @@ fn workspace_must_fit_and_reserving_again_is_free() {
 
 #[test]
 fn method_options_round_trip_through_json() {
-    let m = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 50, relaxation: 0.9 });
+    let m = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 50, relaxation: 0.9, anderson: 0 });
     let s = serde_json::to_string(&m).unwrap();
     assert_eq!(serde_json::from_str::<Method>(&s).unwrap(), m);
     let m: Method = serde_json::from_str(r#"{"type": "lemke", "facets": 16}"#).unwrap();
@@ -1089,4 +1089,29 @@ fn auto_plan_sweeps_before_newton_only() {
     assert_eq!(o.plan(30, &warm).sweeps.unwrap().max_iter, AUTO_SWEEPS);
     let big = o.plan(33, &[0.0; 33]);
     assert!(big.sweeps.is_none() && matches!(big.then, Method::Nsgs(p) if p.tol == 1e-8));
+}
+
+/// Anderson-accelerated Gauss–Seidel solves the same problems (the returned impulses satisfy
+/// the contact conditions to the tolerance, checked by an independent residual evaluation) in
+/// fewer sweeps on piles, where plain sweeps crawl; a depth above the limit is refused.
+#[test]
+fn anderson_sweeps_converge_in_fewer_sweeps_on_piles() {
+    let mut ratios = Vec::new();
+    for (n, seed) in [(60, 3), (150, 5), (300, 7)] {
+        let p = sphere_pile(n, 0.5, seed).unwrap();
+        let plain = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 100_000, ..Default::default() });
+        let fast = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 100_000, anderson: 4, ..Default::default() });
+        let (_, rp) = run_fc(&p, plain).unwrap();
+        let (r, ra) = run_fc(&p, fast).unwrap();
+        assert!(rp.converged && ra.converged, "{n}: {rp:?} {ra:?}");
+        // the residual recomputed from the returned impulses alone
+        let again = p.residual(&r).unwrap();
+        assert!(again <= 1e-8 && (again - ra.residual).abs() <= 1e-12, "{n}: {again} vs {ra:?}");
+        ratios.push(ra.iterations as f64 / rp.iterations as f64);
+    }
+    // (measured: 0.21, 0.09, 0.13)
+    assert!(ratios.iter().all(|x| *x < 0.5), "sweep ratios (accelerated / plain) {ratios:?}");
+    let bad = Method::Nsgs(NsgsOptions { anderson: anderson::MAX_DEPTH + 1, ..Default::default() });
+    let e = run_fc(&sphere_pile(10, 0.5, 1).unwrap(), bad).unwrap_err().to_string();
+    assert!(e.contains("anderson") && e.contains("0..=8"), "{e}");
 }

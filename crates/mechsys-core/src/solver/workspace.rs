@@ -1,5 +1,6 @@
 //! Scratch storage of the solvers, sized once so that solves do not allocate.
 
+use super::anderson::Anderson;
 use super::apgd::ApgdWork;
 use super::lemke::LemkeWork;
 use super::newton::NewtonWork;
@@ -23,6 +24,8 @@ pub struct Needs {
     pub newton: usize,
     /// Unknowns of an APGD solve (0 if none).
     pub apgd: usize,
+    /// Unknowns of an Anderson-accelerated Gauss–Seidel solve (0 if none).
+    pub anderson: usize,
 }
 
 impl Needs {
@@ -35,6 +38,7 @@ impl Needs {
             dense: self.dense.max(o.dense),
             newton: self.newton.max(o.newton),
             apgd: self.apgd.max(o.apgd),
+            anderson: self.anderson.max(o.anderson),
         }
     }
 
@@ -60,6 +64,7 @@ pub struct Workspace {
     pub(crate) dense: Vec<f64>,
     pub(crate) newton: NewtonWork,
     pub(crate) apgd: ApgdWork,
+    pub(crate) anderson: Anderson,
     /// Gauss–Seidel's visiting order of the contacts (empty: by index), see [`Workspace::set_order`].
     pub(crate) order: Vec<usize>,
 }
@@ -97,6 +102,7 @@ impl Workspace {
         grow(&mut self.dense, cap.dense * cap.dense);
         self.newton.reserve(cap.newton);
         self.apgd.reserve(cap.apgd);
+        self.anderson.reserve(cap.anderson, 0);
         self.cap = cap;
         Ok(())
     }

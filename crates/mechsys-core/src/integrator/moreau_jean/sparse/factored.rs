@@ -15,14 +15,24 @@
 //! only (`W r` is summed in another order).
 
 use super::SparseRows;
+
+/// One contact's reduced rows on one or two free bodies, transposed for contiguous products:
+/// direction `c`'s six entries on body `k` at `y[k][c]`, body `k`'s velocities from `iu[k]`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Packed {
+    iu: [usize; 2],
+    bodies: usize,
+    y: [[[f64; 6]; 3]; 2],
+}
 use crate::solver::nsgs::{local_solve, CheckSchedule};
-use crate::solver::{contact_residual_sq, NsgsOptions, Report};
+use crate::solver::{contact_residual_sq, project_onto_cone, NsgsOptions, Report};
 
 impl SparseRows {
     /// Nonsmooth Gauss–Seidel on the problem `u = W r + q` with friction coefficients `mu`:
     /// up to `opts.max_iter` sweeps in `order` (a permutation of the contacts, else by index),
     /// warm-started from `r`, stopping at the residual `opts.tol` (the measure of
-    /// [`crate::solver::Report::residual`]; no relaxation). After a full-residual check, the last
+    /// [`crate::solver::Report::residual`]), relaxed by `opts.relaxation` with the safeguard of
+    /// [`crate::solver::nsgs`]). After a full-residual check, the last
     /// one of the report, `u` holds `W r + q` of the returned `r`; the report's residual is
     /// infinite if no check was made.
     pub(in crate::integrator::moreau_jean) fn gauss_seidel(
@@ -54,15 +64,28 @@ impl SparseRows {
         let ordered = order.len() == n;
         let mut check = CheckSchedule::new();
         let mut residual = f64::INFINITY;
+        let (mut omega, mut last_change) = (opts.relaxation, f64::INFINITY);
+        let packed = self.pack::<D>();
         self.factored_product::<D>(r);
+        if opts.anderson > 0 {
+            // (room for every contact point since the integrator's construction; beyond that,
+            // e.g. points of contact groups, it grows once)
+            self.aa.reserve(n * D, self.z.len());
+            self.aa.begin(n * D, self.z.len(), opts.anderson);
+        }
         for it in 1..=max_sweeps {
+            // Anderson's combination of past sweeps (z = Y r is linear in r: it takes the same)
+            let accelerate = opts.anderson > 0 && omega == 1.0;
+            if accelerate {
+                self.aa.before_sweep(r);
+            }
             let mut change = 0.0;
             for ii in 0..n {
                 let a = if ordered { order[ii] } else { ii };
                 let mut blk = [0.0; 9];
                 blk[..D * D].copy_from_slice(&self.diag[a * D * D..(a + 1) * D * D]);
                 // b = Y_aᵀ z − W_aa r_a + q_a: the velocity of the others' impulses and the free motion
-                let mut b = self.rows_times_z::<D>(a);
+                let mut b = if packed { self.packed[a].times::<D>(&self.z) } else { self.rows_times_z::<D>(a) };
                 let mut old = [0.0; 3];
                 old[..D].copy_from_slice(&r[a * D..(a + 1) * D]);
                 for c in 0..D {
@@ -74,16 +97,36 @@ impl SparseRows {
                 }
                 let mut new = old;
                 local_solve(D, &blk, mu[a], &b, &mut new);
+                if omega != 1.0 {
+                    // over- or under-relaxed as in nsgs::sweep (back onto the cone if extrapolated)
+                    let mut v = [0.0; 3];
+                    for c in 0..D {
+                        v[c] = omega * new[c] + (1.0 - omega) * old[c];
+                    }
+                    new = v;
+                    if omega > 1.0 {
+                        project_onto_cone(mu[a], &v[..D], &mut new[..D]);
+                    }
+                }
                 let mut delta = [0.0; 3];
                 for c in 0..D {
                     delta[c] = new[c] - old[c];
                     change += (blk[0] * delta[c]).powi(2);
                 }
                 if delta.iter().any(|v| *v != 0.0) {
-                    self.add_rows_times::<D>(a, &delta[..D]);
+                    if packed {
+                        self.packed[a].add_to::<D>(&mut self.z, &delta);
+                    } else {
+                        self.add_rows_times::<D>(a, &delta[..D]);
+                    }
                     r[a * D..(a + 1) * D].copy_from_slice(&new[..D]);
                 }
             }
+            // the safeguard of nsgs::solve_fc: plain sweeps once the extrapolation overshoots
+            if omega > 1.0 && change > last_change {
+                omega = 1.0;
+            }
+            last_change = change;
             if check.due(it, change.sqrt() / qn <= tol) || it == max_sweeps {
                 // a fresh z (the updates' round-off does not accumulate into the residual)
                 self.factored_product::<D>(r);
@@ -92,8 +135,45 @@ impl SparseRows {
                     return Report { iterations: it, residual, converged: true };
                 }
             }
+            if accelerate && it < max_sweeps {
+                let diag = &self.diag;
+                self.aa.step(r, &mut self.z, |i| diag[(i / D) * D * D]);
+            }
         }
         Report { iterations: max_sweeps, residual, converged: false }
+    }
+
+    /// Room for the Anderson acceleration of problems of up to `unknowns` unknowns.
+    pub(in crate::integrator::moreau_jean) fn reserve_acceleration(&mut self, unknowns: usize) {
+        self.aa.reserve(unknowns, self.z.len());
+    }
+
+    /// Packs the rows into `packed` if every contact is on free bodies and the ground (runs of
+    /// six velocities, at most two); returns whether it did.
+    pub(super) fn pack<const D: usize>(&mut self) -> bool {
+        let n = self.len();
+        let free = (0..n).all(|a| {
+            let runs = &self.runs[self.run_ptr[a]..self.run_ptr[a + 1]];
+            runs.len() <= 2 && runs.iter().all(|r| r.1 == 6)
+        });
+        if !free {
+            return false;
+        }
+        self.packed.clear();
+        for a in 0..n {
+            let mut p = Packed { iu: [0; 2], bodies: 0, y: [[[0.0; 6]; 3]; 2] };
+            for (k, &(iu, _, e0)) in self.runs[self.run_ptr[a]..self.run_ptr[a + 1]].iter().enumerate() {
+                p.iu[k] = iu;
+                for j in 0..6 {
+                    for c in 0..D {
+                        p.y[k][c][j] = self.y[(e0 + j) * D + c];
+                    }
+                }
+            }
+            p.bodies = self.run_ptr[a + 1] - self.run_ptr[a];
+            self.packed.push(p);
+        }
+        true
     }
 
     /// `z = Σ_a Y_a r_a`.
@@ -110,25 +190,36 @@ impl SparseRows {
     /// `z += Y_a v` (`v` has the problem's dimension `D`).
     #[inline]
     fn add_rows_times<const D: usize>(&mut self, a: usize, v: &[f64]) {
-        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
-        for (k, y) in self.pat_idx[s..e].iter().zip(self.y[s * D..e * D].chunks_exact(D)) {
-            let mut x = 0.0;
-            for c in 0..D {
-                x += y[c] * v[c];
+        let v: [f64; D] = v.try_into().expect("D values");
+        // run by run: contiguous slices of z and y (a free body's run of 6 fully unrolled)
+        for &(iu, len, e0) in &self.runs[self.run_ptr[a]..self.run_ptr[a + 1]] {
+            let (z, y) = (&mut self.z[iu..iu + len], &self.y[e0 * D..(e0 + len) * D]);
+            if len == 6 {
+                let z: &mut [f64; 6] = z.try_into().expect("run of 6");
+                add_times::<D, 6>(z, y, &v);
+            } else {
+                for (zk, yk) in z.iter_mut().zip(y.chunks_exact(D)) {
+                    *zk += dot::<D>(yk, &v);
+                }
             }
-            self.z[*k] += x;
         }
     }
 
     /// `Y_aᵀ z` (zero beyond the problem's dimension `D`).
     #[inline]
     fn rows_times_z<const D: usize>(&self, a: usize) -> [f64; 3] {
-        let (s, e) = (self.pat_ptr[a], self.pat_ptr[a + 1]);
         let mut out = [0.0; 3];
-        for (k, y) in self.pat_idx[s..e].iter().zip(self.y[s * D..e * D].chunks_exact(D)) {
-            let zk = self.z[*k];
-            for c in 0..D {
-                out[c] += y[c] * zk;
+        for &(iu, len, e0) in &self.runs[self.run_ptr[a]..self.run_ptr[a + 1]] {
+            let (z, y) = (&self.z[iu..iu + len], &self.y[e0 * D..(e0 + len) * D]);
+            if len == 6 {
+                let z: &[f64; 6] = z.try_into().expect("run of 6");
+                transpose_times::<D, 6>(y, z, &mut out);
+            } else {
+                for (zk, yk) in z.iter().zip(y.chunks_exact(D)) {
+                    for c in 0..D {
+                        out[c] += yk[c] * zk;
+                    }
+                }
             }
         }
         out
@@ -149,5 +240,65 @@ impl SparseRows {
             sum += contact_residual_sq(D, mu[a], wnn, &r[a * D..(a + 1) * D], &u[a * D..(a + 1) * D]);
         }
         sum.sqrt()
+    }
+}
+
+/// `Σ_c y[c] v[c]` over `D` values.
+#[inline(always)]
+fn dot<const D: usize>(y: &[f64], v: &[f64; D]) -> f64 {
+    let mut x = 0.0;
+    for c in 0..D {
+        x += y[c] * v[c];
+    }
+    x
+}
+
+/// `z[k] += y_kᵀ v` for the `L` rows `y_k` of `D` values each (fixed sizes: unrolled).
+#[inline(always)]
+fn add_times<const D: usize, const L: usize>(z: &mut [f64; L], y: &[f64], v: &[f64; D]) {
+    for (k, zk) in z.iter_mut().enumerate() {
+        *zk += dot::<D>(&y[k * D..(k + 1) * D], v);
+    }
+}
+
+/// `out[c] += Σ_k y_k[c] z[k]` for the `L` rows `y_k` of `D` values each.
+#[inline(always)]
+fn transpose_times<const D: usize, const L: usize>(y: &[f64], z: &[f64; L], out: &mut [f64; 3]) {
+    for (k, zk) in z.iter().enumerate() {
+        for c in 0..D {
+            out[c] += y[k * D + c] * zk;
+        }
+    }
+}
+
+impl Packed {
+    /// `Y_aᵀ z` (zero beyond `D`).
+    #[inline(always)]
+    fn times<const D: usize>(&self, z: &[f64]) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        for k in 0..self.bodies {
+            let zs: &[f64; 6] = z[self.iu[k]..self.iu[k] + 6].try_into().expect("six velocities");
+            for c in 0..D {
+                let y = &self.y[k][c];
+                // two independent sums of three (shorter dependency chains)
+                out[c] += (y[0] * zs[0] + y[1] * zs[1] + y[2] * zs[2]) + (y[3] * zs[3] + y[4] * zs[4] + y[5] * zs[5]);
+            }
+        }
+        out
+    }
+
+    /// `z += Y_a v`.
+    #[inline(always)]
+    fn add_to<const D: usize>(&self, z: &mut [f64], v: &[f64; 3]) {
+        for k in 0..self.bodies {
+            let zs: &mut [f64; 6] = (&mut z[self.iu[k]..self.iu[k] + 6]).try_into().expect("six velocities");
+            for j in 0..6 {
+                let mut x = 0.0;
+                for c in 0..D {
+                    x += self.y[k][c][j] * v[c];
+                }
+                zs[j] += x;
+            }
+        }
     }
 }
