@@ -44,6 +44,24 @@ pub use crate::model::constraint::{Constraint, ConstraintKind, LoopJoint, Reach}
 
 /// Adds `sign · dirᵀ J_T(point)` (or all three rows of `sign · J_T` when `dir` is None) of the
 /// world point `p` attached to `body` into the rows of `g` starting at `row`.
+/// [`add_point_rows`] of the relative motion of world point `p1` on body `b1` and `p2` on
+/// `b2`: row `row` of `g` gains `dirᵀ (J_P1 − J_P2)` (three rows for `dir = None`), the rows of a
+/// contact or of a point-to-point constraint.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn add_relative_rows(
+    model: &Model,
+    s_all: &[[Motion; 6]],
+    el: crate::kinematics::ElasticView<'_>,
+    (b1, p1): (usize, &Vec3),
+    (b2, p2): (usize, &Vec3),
+    dir: Option<&Vec3>,
+    g: &mut DMatrix<f64>,
+    row: usize,
+) {
+    add_point_rows(model, s_all, el, b1, p1, 1.0, dir, g, row);
+    add_point_rows(model, s_all, el, b2, p2, -1.0, dir, g, row);
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn add_point_rows(
     model: &Model,
@@ -703,24 +721,12 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     data.phi[r + k] = d[k];
                     data.b[r + k] = 0.0;
                 }
-                add_point_rows(
+                add_relative_rows(
                     model,
                     &data.s,
                     (&data.x_abs, &data.elastic, &data.body_elastic),
-                    *body1,
-                    &w1,
-                    1.0,
-                    None,
-                    &mut data.g,
-                    r,
-                );
-                add_point_rows(
-                    model,
-                    &data.s,
-                    (&data.x_abs, &data.elastic, &data.body_elastic),
-                    *body2,
-                    &w2,
-                    -1.0,
+                    (*body1, &w1),
+                    (*body2, &w2),
                     None,
                     &mut data.g,
                     r,
@@ -739,24 +745,12 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 let e = d / l;
                 data.phi[r] = l - length;
                 data.b[r] = 0.0;
-                add_point_rows(
+                add_relative_rows(
                     model,
                     &data.s,
                     (&data.x_abs, &data.elastic, &data.body_elastic),
-                    *body1,
-                    &w1,
-                    1.0,
-                    Some(&e),
-                    &mut data.g,
-                    r,
-                );
-                add_point_rows(
-                    model,
-                    &data.s,
-                    (&data.x_abs, &data.elastic, &data.body_elastic),
-                    *body2,
-                    &w2,
-                    -1.0,
+                    (*body1, &w1),
+                    (*body2, &w2),
                     Some(&e),
                     &mut data.g,
                     r,
@@ -769,24 +763,12 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                 for (j, e) in std::iter::once(&k.n).chain(tg.iter()).take(rows).enumerate() {
                     data.phi[r + j] = if j == 0 { k.g } else { 0.0 };
                     data.b[r + j] = 0.0;
-                    add_point_rows(
+                    add_relative_rows(
                         model,
                         &data.s,
                         (&data.x_abs, &data.elastic, &data.body_elastic),
-                        *body1,
-                        &k.p1,
-                        1.0,
-                        Some(e),
-                        &mut data.g,
-                        r + j,
-                    );
-                    add_point_rows(
-                        model,
-                        &data.s,
-                        (&data.x_abs, &data.elastic, &data.body_elastic),
-                        *body2,
-                        &k.p2,
-                        -1.0,
+                        (*body1, &k.p1),
+                        (*body2, &k.p2),
                         Some(e),
                         &mut data.g,
                         r + j,

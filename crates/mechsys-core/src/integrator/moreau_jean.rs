@@ -1031,24 +1031,12 @@ impl MoreauJean {
             let dirs = [k.n, k.t1, k.t2];
             for (row, dir) in dirs.iter().enumerate().take(d) {
                 let r = ai * d + row;
-                crate::constraints::add_point_rows(
+                crate::constraints::add_relative_rows(
                     model,
                     &data.s,
                     (&data.x_abs, &data.elastic, &data.body_elastic),
-                    a.b1,
-                    &k.p1,
-                    1.0,
-                    Some(dir),
-                    &mut self.w_rows,
-                    r,
-                );
-                crate::constraints::add_point_rows(
-                    model,
-                    &data.s,
-                    (&data.x_abs, &data.elastic, &data.body_elastic),
-                    a.b2,
-                    &k.p2,
-                    -1.0,
+                    (a.b1, &k.p1),
+                    (a.b2, &k.p2),
                     Some(dir),
                     &mut self.w_rows,
                     r,

@@ -227,24 +227,12 @@ impl<'a> Phase<'a> {
             return;
         }
         let k = &kin[pt].point;
-        crate::constraints::add_point_rows(
+        crate::constraints::add_relative_rows(
             model,
             &data.s,
             (&data.x_abs, &data.elastic, &data.body_elastic),
-            con.body1,
-            &k.p1,
-            1.0,
-            Some(dir),
-            m,
-            r,
-        );
-        crate::constraints::add_point_rows(
-            model,
-            &data.s,
-            (&data.x_abs, &data.elastic, &data.body_elastic),
-            con.body2,
-            &k.p2,
-            -1.0,
+            (con.body1, &k.p1),
+            (con.body2, &k.p2),
             Some(dir),
             m,
             r,

@@ -121,24 +121,12 @@ impl Projection {
                     }
                     None => {
                         let k = &self.kin[pt].point;
-                        crate::constraints::add_point_rows(
+                        crate::constraints::add_relative_rows(
                             model,
                             &data.s,
                             (&data.x_abs, &data.elastic, &data.body_elastic),
-                            con.body1,
-                            &k.p1,
-                            1.0,
-                            Some(&k.n),
-                            &mut self.rows,
-                            r,
-                        );
-                        crate::constraints::add_point_rows(
-                            model,
-                            &data.s,
-                            (&data.x_abs, &data.elastic, &data.body_elastic),
-                            con.body2,
-                            &k.p2,
-                            -1.0,
+                            (con.body1, &k.p1),
+                            (con.body2, &k.p2),
                             Some(&k.n),
                             &mut self.rows,
                             r,
