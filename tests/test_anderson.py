@@ -76,9 +76,23 @@ def test_accelerated_pile_settles_to_the_same_state(runs):
     assert abs(z[0].mean() - z[1].mean()) < 0.01 * R, (z[0].mean(), z[1].mean())
     closed = [int(res["contact/pile/closed"][-1]) for res in runs.values()]
     assert abs(closed[0] - closed[1]) <= 3 and min(closed) >= n, closed
+    # independent of the solver's own residual: at rest the floor and the walls carry the whole
+    # weight and no net horizontal force (measured: 35.31575 N against 35.31600 N in both runs)
+    weight = n * M * 9.81
+    for res in runs.values():
+        f = res["contact/pile/force_against"][-1]
+        assert abs(f[2] - weight) < 1e-4 * weight and np.hypot(f[0], f[1]) < 1e-4 * weight, (f, weight)
 
 
 @pytest.mark.parametrize("solver, key", [(ms.NSGS(anderson=9), "anderson"), (ms.Auto(nsgs_anderson=20), "nsgs_anderson")])
 def test_a_depth_above_eight_is_refused_naming_the_key(solver, key):
     with pytest.raises(SettingsError, match=rf"{key} \(sweeps combined\) must be in 0\.\.=8, got"):
+        ms.simulate(pile(4), 0.01, ms.MoreauJean(1e-3, solver=solver), progress=False)
+
+
+@pytest.mark.parametrize("solver, key", [(ms.NSGS(anderson=2.5), "NSGS.anderson"), (ms.NSGS(max_iter=float("nan")), "NSGS.max_iter"),
+                                         (ms.Auto(nsgs_anderson=None), "Auto.nsgs_anderson"), (ms.Lemke(facets="8"), "Lemke.facets")])
+def test_a_count_that_is_not_a_whole_number_is_refused_naming_the_key(solver, key):
+    """(int() alone turned 2.5 sweeps combined into 2 without a word.)"""
+    with pytest.raises(SettingsError, match=rf"{key}: expected a whole number, got"):
         ms.simulate(pile(4), 0.01, ms.MoreauJean(1e-3, solver=solver), progress=False)

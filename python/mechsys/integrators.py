@@ -14,7 +14,22 @@ contacts, Moreau-Jean time-stepping (:class:`MoreauJean`) with a choice of conta
 
 from __future__ import annotations
 
+import math
 from dataclasses import KW_ONLY, asdict, dataclass
+
+
+def _whole(owner: object, key: str, value) -> int:
+    """``value`` as an int if it is a whole number (``3`` or ``3.0``); otherwise a SettingsError
+    naming the setting (``int()`` alone would turn 2.5 into 2 without a word)."""
+    from .errors import SettingsError
+
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not math.isfinite(x) or x != int(x) or isinstance(value, (bool, str, bytes)):
+        raise SettingsError(f"{type(owner).__name__}.{key}: expected a whole number, got {value!r}")
+    return int(x)
 
 
 @dataclass(frozen=True)
@@ -93,8 +108,8 @@ class NSGS:
     anderson: int = 0
 
     def describe(self) -> dict:
-        return {"type": "nsgs", "tol": float(self.tol), "max_iter": int(self.max_iter), "relaxation": float(self.relaxation),
-                "anderson": int(self.anderson)}
+        return {"type": "nsgs", "tol": float(self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
+                "relaxation": float(self.relaxation), "anderson": _whole(self, "anderson", self.anderson)}
 
 
 @dataclass(frozen=True)
@@ -108,7 +123,7 @@ class Newton:
     regularization: float = 1e-4
 
     def describe(self) -> dict:
-        return {"type": "newton", "tol": float(self.tol), "max_iter": int(self.max_iter),
+        return {"type": "newton", "tol": float(self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
                 "regularization": float(self.regularization)}
 
 
@@ -126,9 +141,11 @@ class Auto:
     nsgs_anderson: int = 4
 
     def describe(self) -> dict:
-        return {"type": "auto", "tol": float(self.tol), "newton_max_unknowns": int(self.newton_max_unknowns),
-                "newton_max_iter": int(self.newton_max_iter), "nsgs_max_iter": int(self.nsgs_max_iter),
-                "nsgs_anderson": int(self.nsgs_anderson)}
+        return {"type": "auto", "tol": float(self.tol),
+                "newton_max_unknowns": _whole(self, "newton_max_unknowns", self.newton_max_unknowns),
+                "newton_max_iter": _whole(self, "newton_max_iter", self.newton_max_iter),
+                "nsgs_max_iter": _whole(self, "nsgs_max_iter", self.nsgs_max_iter),
+                "nsgs_anderson": _whole(self, "nsgs_anderson", self.nsgs_anderson)}
 
 
 @dataclass(frozen=True)
@@ -142,7 +159,7 @@ class APGD:
     max_iter: int = 10_000
 
     def describe(self) -> dict:
-        return {"type": "apgd", "tol": float(self.tol), "max_iter": int(self.max_iter)}
+        return {"type": "apgd", "tol": float(self.tol), "max_iter": _whole(self, "max_iter", self.max_iter)}
 
 
 @dataclass(frozen=True)
@@ -153,7 +170,7 @@ class Lemke:
     pivot_tol: float = 1e-12
 
     def describe(self) -> dict:
-        return {"type": "lemke", "facets": int(self.facets), "pivot_tol": float(self.pivot_tol)}
+        return {"type": "lemke", "facets": _whole(self, "facets", self.facets), "pivot_tol": float(self.pivot_tol)}
 
 
 @dataclass(frozen=True)
@@ -211,7 +228,7 @@ class EventDriven:
 
     def describe(self) -> dict:
         d = {k: float(v) for k, v in asdict(self).items() if k not in ("max_events", "continue_on_painleve")}
-        return {"type": "event_driven", **d, "max_events": int(self.max_events),
+        return {"type": "event_driven", **d, "max_events": _whole(self, "max_events", self.max_events),
                 "continue_on_painleve": bool(self.continue_on_painleve)}
 
 
