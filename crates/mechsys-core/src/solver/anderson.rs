@@ -8,6 +8,12 @@
 //! it needs no recomputation. The history restarts whenever a residual grows (the safeguard:
 //! the nonsmooth map is only piecewise smooth, and across a kink the old differences mislead),
 //! and the acceleration stops for the rest of a solve when the residual stalls.
+//!
+//! The sweep itself writes the weighted residual `f` ([`Anderson::set_residual`]: it has each
+//! unknown's change in hand) and its squared norm is the sweep's change, so no pass over the
+//! iterate before the sweep is needed. The right-hand side `ΔFᵀ f_k` is updated rather than
+//! recomputed: for a held column `b`, `Δf_bᵀ f_k = Δf_bᵀ f_{k−1} + Δf_bᵀ Δf_new`, and the second
+//! term is the new Gram row; only the new column takes a product with `f_k`.
 
 /// History and scratch of the acceleration (preallocated by [`Anderson::reserve`]).
 #[derive(Debug, Clone, Default)]
@@ -18,8 +24,6 @@ pub(crate) struct Anderson {
     /// Columns held (≤ depth) and the ring position of the next one.
     cols: usize,
     head: usize,
-    /// The iterate before the sweep.
-    x: Vec<f64>,
     f_prev: Vec<f64>,
     g_prev: Vec<f64>,
     z_prev: Vec<f64>,
@@ -31,6 +35,8 @@ pub(crate) struct Anderson {
     dz: Vec<f64>,
     /// `ΔFᵀ ΔF` of the held columns (ring positions).
     gram: [[f64; MAX_DEPTH]; MAX_DEPTH],
+    /// `ΔFᵀ f` of the held columns against the latest residual.
+    rhs: [f64; MAX_DEPTH],
     /// The smallest change so far and the sweeps since; off once it stalls.
     best: f64,
     since_best: usize,
@@ -50,7 +56,6 @@ impl Anderson {
     /// columns; never shrinks (a solve then allocates nothing).
     pub(crate) fn reserve(&mut self, n: usize, nz: usize) {
         for (v, len) in [
-            (&mut self.x, n),
             (&mut self.f_prev, n),
             (&mut self.g_prev, n),
             (&mut self.f, n),
@@ -68,16 +73,17 @@ impl Anderson {
     /// Starts a solve of `n` unknowns with a companion of `nz` entries, keeping `depth` columns
     /// (1..=[`MAX_DEPTH`]); [`Anderson::reserve`] must have made room.
     pub(crate) fn begin(&mut self, n: usize, nz: usize, depth: usize) {
-        debug_assert!(self.x.len() >= n && self.z_prev.len() >= nz && (1..=MAX_DEPTH).contains(&depth));
+        debug_assert!(self.f.len() >= n && self.z_prev.len() >= nz && (1..=MAX_DEPTH).contains(&depth));
         (self.n, self.nz, self.depth) = (n, nz, depth);
         (self.best, self.since_best, self.off) = (f64::INFINITY, 0, false);
         self.restart();
     }
 
-    /// Before a sweep: remembers its starting iterate `r`.
-    #[inline]
-    pub(crate) fn before_sweep(&mut self, r: &[f64]) {
-        self.x[..self.n].copy_from_slice(&r[..self.n]);
+    /// During a sweep: unknown `i`'s weighted change `w_i (G(x)_i − x_i)`; every unknown's
+    /// must be set before [`Anderson::step`].
+    #[inline(always)]
+    pub(crate) fn set_residual(&mut self, i: usize, f: f64) {
+        self.f[i] = f;
     }
 
     /// Forgets the history.
@@ -88,20 +94,14 @@ impl Anderson {
         self.last_norm = f64::INFINITY;
     }
 
-    /// After a sweep from the iterate of [`Anderson::before_sweep`] to `g` with companion `z`: records the step
-    /// (residual weighted by `weight(i)` per unknown) and replaces `g` and `z` by the
-    /// accelerated iterate. Returns whether it extrapolated.
-    pub(crate) fn step(&mut self, g: &mut [f64], z: &mut [f64], weight: impl Fn(usize) -> f64) -> bool {
+    /// After a sweep to `g` with companion `z` whose weighted residual was set by
+    /// [`Anderson::set_residual`] with squared norm `norm`: records the step and replaces `g` and
+    /// `z` by the accelerated iterate. Returns whether it extrapolated.
+    pub(crate) fn step(&mut self, g: &mut [f64], z: &mut [f64], norm: f64) -> bool {
         if self.off {
             return false;
         }
         let (n, nz) = (self.n, self.nz);
-        let mut norm = 0.0;
-        for i in 0..n {
-            let f = (g[i] - self.x[i]) * weight(i);
-            self.f[i] = f;
-            norm += f * f;
-        }
         if norm < self.best {
             (self.best, self.since_best) = (norm, 0);
         } else {
@@ -119,24 +119,33 @@ impl Anderson {
         self.last_norm = norm;
         if self.has_prev {
             let c = self.head;
-            for i in 0..n {
-                self.df[c * n + i] = self.f[i] - self.f_prev[i];
-                self.dg[c * n + i] = g[i] - self.g_prev[i];
-            }
-            for i in 0..nz {
-                self.dz[c * nz + i] = z[i] - self.z_prev[i];
+            {
+                let (df, dg) = (&mut self.df[c * n..(c + 1) * n], &mut self.dg[c * n..(c + 1) * n]);
+                for i in 0..n {
+                    df[i] = self.f[i] - self.f_prev[i];
+                    dg[i] = g[i] - self.g_prev[i];
+                }
+                let dz = &mut self.dz[c * nz..(c + 1) * nz];
+                for i in 0..nz {
+                    dz[i] = z[i] - self.z_prev[i];
+                }
             }
             self.cols = (self.cols + 1).min(self.depth);
-            // the new column's products with the others (and itself)
+            // the new column's products with the others (and itself); the others' right-hand
+            // sides move from f_{k−1} to f_k = f_{k−1} + Δf_c
             let dc = &self.df[c * n..(c + 1) * n];
             for b in 0..self.cols {
                 let v = dot(dc, &self.df[b * n..(b + 1) * n]);
                 self.gram[c][b] = v;
                 self.gram[b][c] = v;
+                if b != c {
+                    self.rhs[b] += v;
+                }
             }
+            self.rhs[c] = dot(dc, &self.f[..n]);
             self.head = (self.head + 1) % self.depth;
         }
-        // (f is recomputed in full at the next step: a swap instead of a copy)
+        // (f is rewritten in full by the next sweep: a swap instead of a copy)
         std::mem::swap(&mut self.f_prev, &mut self.f);
         self.g_prev[..n].copy_from_slice(&g[..n]);
         self.z_prev[..nz].copy_from_slice(&z[..nz]);
@@ -147,10 +156,7 @@ impl Anderson {
         }
         // normal equations of min ‖f − ΔF γ‖ (k ≤ 8), slightly regularized
         let mut gram = self.gram;
-        let mut rhs = [0.0; MAX_DEPTH];
-        for (a, ra) in rhs.iter_mut().enumerate().take(k) {
-            *ra = dot(&self.df[a * n..(a + 1) * n], &self.f_prev[..n]);
-        }
+        let mut rhs = self.rhs;
         let trace: f64 = (0..k).map(|a| gram[a][a]).sum();
         if !(trace > 0.0 && trace.is_finite()) {
             self.restart();

@@ -317,7 +317,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             fresh = true;
         }
         if !accepted {
-            sweep(p, diag, order, r, 1.0);
+            sweep(p, diag, order, r, 1.0, None);
         }
     }
 }

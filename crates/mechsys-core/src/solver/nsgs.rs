@@ -27,6 +27,7 @@
 //! exceed the first sweep that met the tolerance by that much.
 
 use super::problem::{dot, fc_residual, lcp_residual, lcp_w, norm, project_onto_cone, FrictionContact, Lcp};
+use super::anderson::Anderson;
 use super::{NsgsOptions, Report, Workspace};
 use crate::ensure;
 use crate::error::Result;
@@ -81,10 +82,8 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
     }
     for it in 1..=o.max_iter {
         let accelerate = o.anderson > 0 && omega == 1.0;
-        if accelerate {
-            ws.anderson.before_sweep(r);
-        }
-        let change = sweep(p, &ws.diag[..n], &ws.order, r, omega);
+        let steps = if accelerate { Some(&mut ws.anderson) } else { None };
+        let change = sweep(p, &ws.diag[..n], &ws.order, r, omega, steps);
         if omega > 1.0 && change > last_change {
             omega = 1.0;
         }
@@ -98,8 +97,7 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
             }
         }
         if accelerate && it < o.max_iter {
-            let (d, diag) = (p.dim, &ws.diag);
-            ws.anderson.step(r, &mut [], |i| diag[i / d][0]);
+            ws.anderson.step(r, &mut [], change);
         }
     }
     Ok(Report { iterations: o.max_iter, residual, converged: false })
@@ -138,8 +136,16 @@ pub(crate) fn cache_diagonal(p: &FrictionContact, diag: &mut [[f64; 9]]) {
 }
 
 /// One Gauss–Seidel sweep over the contacts, in `order` if it holds a permutation of them
-/// ([`Workspace::set_order`]), else by index; returns `Σ_i ‖W_NN,i Δr_i‖²`.
-pub(crate) fn sweep(p: &FrictionContact, diag: &[[f64; 9]], order: &[usize], r: &mut [f64], relaxation: f64) -> f64 {
+/// ([`Workspace::set_order`]), else by index; returns `Σ_i ‖W_NN,i Δr_i‖²` and gives each
+/// unknown's term `W_NN,i Δr_i` to the Anderson acceleration `aa` if there is one.
+pub(crate) fn sweep(
+    p: &FrictionContact,
+    diag: &[[f64; 9]],
+    order: &[usize],
+    r: &mut [f64],
+    relaxation: f64,
+    mut aa: Option<&mut Anderson>,
+) -> f64 {
     let d = p.dim;
     let mut change = 0.0;
     let nc = p.contacts();
@@ -166,8 +172,12 @@ pub(crate) fn sweep(p: &FrictionContact, diag: &[[f64; 9]], order: &[usize], r: 
             project_onto_cone(p.mu[i], &x[..d], &mut v[..d]);
         }
         for a in 0..d {
-            change += (diag[i][0] * (v[a] - old[a])).powi(2);
+            let f = diag[i][0] * (v[a] - old[a]);
+            change += f * f;
             r[i * d + a] = v[a];
+            if let Some(aa) = aa.as_deref_mut() {
+                aa.set_residual(i * d + a, f);
+            }
         }
     }
     change

@@ -76,9 +76,6 @@ impl SparseRows {
         for it in 1..=max_sweeps {
             // Anderson's combination of past sweeps (z = Y r is linear in r: it takes the same)
             let accelerate = opts.anderson > 0 && omega == 1.0;
-            if accelerate {
-                self.aa.before_sweep(r);
-            }
             let mut change = 0.0;
             for ii in 0..n {
                 let a = if ordered { order[ii] } else { ii };
@@ -111,7 +108,11 @@ impl SparseRows {
                 let mut delta = [0.0; 3];
                 for c in 0..D {
                     delta[c] = new[c] - old[c];
-                    change += (blk[0] * delta[c]).powi(2);
+                    let f = blk[0] * delta[c];
+                    change += f * f;
+                    if accelerate {
+                        self.aa.set_residual(a * D + c, f);
+                    }
                 }
                 if delta.iter().any(|v| *v != 0.0) {
                     if packed {
@@ -136,8 +137,7 @@ impl SparseRows {
                 }
             }
             if accelerate && it < max_sweeps {
-                let diag = &self.diag;
-                self.aa.step(r, &mut self.z, |i| diag[(i / D) * D * D]);
+                self.aa.step(r, &mut self.z, change);
             }
         }
         Report { iterations: max_sweeps, residual, converged: false }
