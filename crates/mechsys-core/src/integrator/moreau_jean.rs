@@ -920,8 +920,8 @@ impl MoreauJean {
             let plan = match &self.method {
                 Method::Nsgs(o) => Some((*o, None)),
                 Method::Auto(o) => match o.plan(m, &self.r) {
-                    solver::AutoPlan { sweeps: Some(s), then } => Some((s, Some(then))),
-                    solver::AutoPlan { sweeps: None, then: Method::Nsgs(p) } => Some((p, None)),
+                    solver::AutoPlan { sweeps: Some(s), then, rescue } => Some((s, Some((then, rescue)))),
+                    solver::AutoPlan { sweeps: None, then: Method::Nsgs(p), .. } => Some((p, None)),
                     _ => None,
                 },
                 _ => None,
@@ -941,7 +941,7 @@ impl MoreauJean {
                 self.local_u.resize(m, 0.0);
                 let problem = (&self.problem.q[..], &self.problem.mu[..]);
                 let first = sp.gauss_seidel(problem, &self.ws.order, &mut self.r, &sweeps, &mut self.local_u);
-                let Some(then) = then.filter(|_| !first.converged) else {
+                let Some((then, rescue)) = then.filter(|_| !first.converged) else {
                     return Ok(first);
                 };
                 // the rest from the sweeps' impulses, on the blocks (an empty `local_u` tells
@@ -949,7 +949,15 @@ impl MoreauJean {
                 self.local_u.clear();
                 self.ensure_blocks();
                 self.ws.reserve(&self.problem, &then)?;
-                return Ok(solver::solve(&self.problem, &then, &mut self.r, true, &mut self.ws)?.after(&first));
+                let second = solver::solve(&self.problem, &then, &mut self.r, true, &mut self.ws)?.after(&first);
+                let Some(rescue) = rescue.filter(|_| !second.converged) else {
+                    return Ok(second);
+                };
+                // Newton stalled (a pile): sweeps on the factored operator from its iterate
+                let sp = self.sparse.as_mut().expect("sparse assembly");
+                self.local_u.resize(m, 0.0);
+                let problem = (&self.problem.q[..], &self.problem.mu[..]);
+                return Ok(sp.gauss_seidel(problem, &self.ws.order, &mut self.r, &rescue, &mut self.local_u).after(&second));
             }
         }
         self.ensure_blocks();

@@ -1089,6 +1089,35 @@ fn auto_plan_sweeps_before_newton_only() {
     assert_eq!(o.plan(30, &warm).sweeps.unwrap().max_iter, AUTO_SWEEPS);
     let big = o.plan(33, &[0.0; 33]);
     assert!(big.sweeps.is_none() && matches!(big.then, Method::Nsgs(p) if p.tol == 1e-8));
+    // a Newton plan carries the rescue sweeps (Anderson-accelerated, the full sweep budget)
+    let rescue = cold.rescue.unwrap();
+    assert_eq!((rescue.tol, rescue.max_iter, rescue.anderson), (1e-8, o.nsgs_max_iter, o.nsgs_anderson));
+    assert!(big.rescue.is_none());
+}
+
+/// When Auto's Newton ends above the tolerance (here forced: one iteration), Gauss–Seidel from
+/// its iterate finishes the solve; the report counts all three stages, and the residual
+/// recomputed from the returned impulses meets the tolerance. Without the rescue the report
+/// would say unconverged after 1 + the first sweeps.
+#[test]
+fn auto_rescues_a_stalled_newton_with_sweeps() {
+    let p = sphere_pile(60, 0.5, 3).unwrap();
+    for anderson in [0, 4] {
+        let o = AutoOptions { tol: 1e-8, newton_max_iter: 1, nsgs_anderson: anderson, ..Default::default() };
+        assert!(matches!(o.pick(p.unknowns()), Method::Newton(_)), "a Newton-sized problem");
+        let (r, rep) = run_fc(&p, Method::Auto(o)).unwrap();
+        assert!(rep.converged, "{anderson}: {rep:?}");
+        assert!(rep.iterations > 1 + AUTO_COLD_SWEEPS, "{anderson}: the rescue ran: {rep:?}");
+        let again = p.residual(&r).unwrap();
+        assert!(again <= 1e-8 && (again - rep.residual).abs() <= 1e-12, "{anderson}: {again} vs {rep:?}");
+        // Newton alone at this cap does not get there
+        let newton = Method::Newton(NewtonOptions { tol: 1e-8, max_iter: 1, ..Default::default() });
+        let mut ws = Workspace::for_problem(&p, &newton).unwrap();
+        let mut x = vec![0.0; p.unknowns()];
+        let sw = Method::Nsgs(NsgsOptions { tol: 1e-9, max_iter: AUTO_COLD_SWEEPS, ..Default::default() });
+        solve(&p, &sw, &mut x, false, &mut Workspace::for_problem(&p, &sw).unwrap()).unwrap();
+        assert!(!solve(&p, &newton, &mut x, true, &mut ws).unwrap().converged);
+    }
 }
 
 /// Anderson-accelerated Gauss–Seidel solves the same problems (the returned impulses satisfy
