@@ -35,8 +35,11 @@
 //! When the LU fails or no step is accepted, one nonsmooth Gauss–Seidel sweep is taken instead:
 //! it makes progress where the Newton model is wrong (at the kinks of the projection and with
 //! redundant contacts, where `J` is singular). Stops when the residual of [`Report::residual`]
-//! reaches the tolerance, after one more step unless it is already below a thousandth of it. Cost per iteration `O((d n)³)`, so this is the method for accuracy on
-//! moderate sizes; NSGS is the one for large ones.
+//! reaches the tolerance, after one more step unless it is already below a thousandth of it,
+//! or (with [`NewtonOptions::stall`], as [`super::Method::Auto`] sets it) unconverged once the
+//! residual has not halved for that many iterations: on piles the method can stall far from the
+//! solution, and sweeps do better from there. Cost per iteration `O((d n)³)`, so this is the
+//! method for accuracy on moderate sizes; NSGS is the one for large ones.
 
 use super::nsgs::{cache_diagonal, sweep};
 use super::problem::{fc_residual, Delassus, FrictionContact};
@@ -234,14 +237,20 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
     let dblk = &mut nw.dblk[..n];
     let mut iterations = 0;
     let mut polished = false;
+    // the stall rule: the residual last halved at iteration `since`, from `anchor`
+    let (mut anchor, mut since) = (f64::INFINITY, 0);
     loop {
         p.w.velocity(d, r, &p.q, u);
         let residual = fc_residual(p, r, u);
+        if residual <= 0.5 * anchor {
+            (anchor, since) = (residual, iterations);
+        }
+        let stalled = o.stall > 0 && iterations - since >= o.stall;
         // one step past the tolerance (nearly free with the factors reused): a time-stepping
         // scheme passes the error left here on to the next step's free velocity, and a solution
         // well inside the tolerance lets the next warm start finish in a sweep
         let done = residual <= o.tol && (polished || residual <= POLISH * o.tol);
-        if done || iterations >= o.max_iter {
+        if done || iterations >= o.max_iter || (stalled && residual > o.tol) {
             return Ok(Report { iterations, residual, converged: residual <= o.tol });
         }
         polished = residual <= o.tol;
