@@ -119,17 +119,10 @@ impl Anderson {
         self.last_norm = norm;
         if self.has_prev {
             let c = self.head;
-            {
-                let (df, dg) = (&mut self.df[c * n..(c + 1) * n], &mut self.dg[c * n..(c + 1) * n]);
-                for i in 0..n {
-                    df[i] = self.f[i] - self.f_prev[i];
-                    dg[i] = g[i] - self.g_prev[i];
-                }
-                let dz = &mut self.dz[c * nz..(c + 1) * nz];
-                for i in 0..nz {
-                    dz[i] = z[i] - self.z_prev[i];
-                }
-            }
+            // (zipped slices: no bounds checks, so the loops vectorize)
+            difference(&mut self.df[c * n..(c + 1) * n], &self.f[..n], &self.f_prev[..n]);
+            difference(&mut self.dg[c * n..(c + 1) * n], &g[..n], &self.g_prev[..n]);
+            difference(&mut self.dz[c * nz..(c + 1) * nz], &z[..nz], &self.z_prev[..nz]);
             self.cols = (self.cols + 1).min(self.depth);
             // the new column's products with the others (and itself); the others' right-hand
             // sides move from f_{k−1} to f_k = f_{k−1} + Δf_c
@@ -169,17 +162,38 @@ impl Anderson {
             self.restart();
             return false;
         };
-        for (a, ga) in gamma.iter().enumerate().take(k) {
-            let dg = &self.dg[a * n..(a + 1) * n];
-            for (x, d) in g[..n].iter_mut().zip(dg) {
-                *x -= ga * d;
-            }
-            let dz = &self.dz[a * nz..(a + 1) * nz];
-            for (x, d) in z[..nz].iter_mut().zip(dz) {
-                *x -= ga * d;
-            }
-        }
+        combine(&mut g[..n], &self.dg, n, &gamma[..k]);
+        combine(&mut z[..nz], &self.dz, nz, &gamma[..k]);
         true
+    }
+}
+
+/// `out = a − b`.
+#[inline]
+fn difference(out: &mut [f64], a: &[f64], b: &[f64]) {
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = x - y;
+    }
+}
+
+/// `x −= Σ_a γ_a col_a` over the columns of length `n` in `cols`, two columns per pass (half
+/// the passes over `x`; the sum per entry in the same order as one column at a time).
+#[inline]
+fn combine(x: &mut [f64], cols: &[f64], n: usize, gamma: &[f64]) {
+    let mut a = 0;
+    while a + 1 < gamma.len() {
+        let (g0, g1) = (gamma[a], gamma[a + 1]);
+        let (c0, c1) = (&cols[a * n..(a + 1) * n], &cols[(a + 1) * n..(a + 2) * n]);
+        for ((xi, d0), d1) in x.iter_mut().zip(c0).zip(c1) {
+            *xi = (*xi - g0 * d0) - g1 * d1;
+        }
+        a += 2;
+    }
+    if a < gamma.len() {
+        let (g0, c0) = (gamma[a], &cols[a * n..(a + 1) * n]);
+        for (xi, d0) in x.iter_mut().zip(c0) {
+            *xi -= g0 * d0;
+        }
     }
 }
 
