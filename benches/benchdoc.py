@@ -68,6 +68,21 @@ def machine() -> dict:
     return {"nproc": os.cpu_count(), "cpu": cpu, "os": platform.platform(), "python": platform.python_version(), "load": load}
 
 
+def revision(root: Path, output: Path | None = None) -> str:
+    """The checked-out commit, "(with local changes)" if tracked files differ from it — not
+    counting ``output``, the results file the benchmarks themselves are writing — or "unknown"."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True, check=True, timeout=10)
+        spec = ["--", "."] + ([f":(exclude){Path(output).resolve().relative_to(Path(root).resolve())}"] if output else [])
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", *spec], cwd=root,
+                               capture_output=True, text=True, timeout=10)
+        return out.stdout.strip() + (" (with local changes)" if dirty.stdout.strip() else "")
+    except (OSError, ValueError, subprocess.SubprocessError):
+        return "unknown"
+
+
 def write_doc(path: Path, section: str, begin: str, end: str, heading: str | None = None) -> None:
     """Replaces the text between a script's markers in ``path``, or appends the marked section
     (under ``heading`` if given); the rest of the file is kept."""

@@ -68,7 +68,6 @@ import os
 import platform
 import re
 import statistics
-import subprocess
 import sys
 import time
 import warnings
@@ -76,7 +75,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchdoc import fmt_time, machine, ratio, write_doc  # noqa: E402  (shared report helpers)
+from benchdoc import fmt_time, machine, ratio, revision, write_doc  # noqa: E402  (shared report helpers)
 
 ROOT = Path(__file__).resolve().parent.parent
 DT = 1e-3
@@ -583,10 +582,7 @@ def versions(mods: dict) -> dict:
     import mechsys
 
     v = {"mechsys": mechsys.__version__, "numpy": np.__version__}
-    with contextlib.suppress(OSError, subprocess.SubprocessError):
-        rev = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT, capture_output=True, text=True, timeout=10)
-        if rev.returncode == 0:
-            v["mechsys"] += f" (git {rev.stdout.strip()})"
+    v["mechsys"] += f" (git {revision(ROOT, ROOT / 'docs' / 'benchmarks.md')})"
     so = Path(mechsys._core.__file__)
     newer = [f for f in (ROOT / "crates").rglob("*.rs") if f.stat().st_mtime > so.stat().st_mtime]
     if newer:

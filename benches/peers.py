@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchdoc import fmt_time, machine, ratio, write_doc  # noqa: E402  (shared report helpers)
+from benchdoc import fmt_time, machine, ratio, revision, write_doc  # noqa: E402  (shared report helpers)
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -432,14 +432,8 @@ def versions(peers: dict) -> dict:
     import mechsys
 
     v = {"mechsys": mechsys.__version__, "numpy": numpy.__version__}
-    try:  # which sources: the commit, and whether the working tree had changes
-        import subprocess
-
-        rev = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT, capture_output=True, text=True, timeout=10)
-        if rev.returncode == 0:
-            v["mechsys"] += f" (git {rev.stdout.strip()})"
-    except (OSError, subprocess.SubprocessError):
-        pass
+    # which sources: the commit, and whether the working tree had changes (the results file aside)
+    v["mechsys"] += f" (git {revision(ROOT, ROOT / 'docs' / 'benchmarks.md')})"
     # the timed extension must be built from the sources the Rust benchmark compiled
     so = Path(mechsys._core.__file__)
     newer = [f for f in (ROOT / "crates").rglob("src/**/*.rs") if f.stat().st_mtime > so.stat().st_mtime]

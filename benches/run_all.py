@@ -19,7 +19,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from benchdoc import machine, write_doc  # noqa: E402
+from benchdoc import machine, revision, write_doc  # noqa: E402
 
 BEGIN, END = "<!-- run_all:begin -->", "<!-- run_all:end -->"
 
@@ -48,15 +48,6 @@ SCRIPTS: list[tuple[str, list[str]]] = [
 ]
 
 
-def _rev() -> str:
-    try:
-        out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True, text=True, check=True)
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=HERE, capture_output=True, text=True)
-        return out.stdout.strip() + (" (with local changes)" if dirty.stdout.strip() else "")
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def _names(arg: str | None) -> set[str]:
     if not arg:
         return set()
@@ -77,6 +68,8 @@ def main(argv=None) -> int:
             ap.error(f"unknown benchmark script '{n}' (known: {', '.join(sorted(known))})")
     todo = [(s, x) for s, x in SCRIPTS if (not only or s in only) and s not in skip]
     m = machine()
+    # (the revision before the scripts write their sections into the output)
+    rev = revision(HERE.parent, a.out)
     start = dt.datetime.now()
     rows, failed = [], []
     for script, extra in todo:
@@ -95,7 +88,7 @@ def main(argv=None) -> int:
     text = "\n".join(
         [
             f"Last regeneration by `benches/run_all.py` ({scope}, one after another in one run): "
-            f"{start:%Y-%m-%d %H:%M} to {dt.datetime.now():%H:%M}, {total / 60:.0f} min, git {_rev()}, "
+            f"{start:%Y-%m-%d %H:%M} to {dt.datetime.now():%H:%M}, {total / 60:.0f} min, git {rev}, "
             f"{m['nproc']} × {m['cpu']}, {m['os']}, Python {m['python']}."
             + (" Run with `--quick` (one repeat per cell)." if a.quick else ""),
             "",

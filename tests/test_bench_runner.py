@@ -39,3 +39,27 @@ def test_failing_script_gives_exit_1(tmp_path):
     r = run("--only", "planar", "--quick", "--out", str(out))
     assert r.returncode == 1
     assert "failed: planar.py" in r.stderr
+
+
+def test_revision_ignores_the_results_file_being_written(tmp_path):
+    """The scripts of one run write their sections into the results file one after another, so
+    the later ones found the tree changed and marked the figures "dirty" (a280e3f-dirty in the
+    constraints section of a clean run); only other changes count."""
+    sys.path.insert(0, str(ROOT / "benches"))
+    from benchdoc import revision
+
+    git = lambda *a: subprocess.run(["git", *a], cwd=tmp_path, check=True, capture_output=True)  # noqa: E731
+    git("init", "-q")
+    (tmp_path / "docs").mkdir()
+    results, source = tmp_path / "docs" / "benchmarks.md", tmp_path / "model.py"
+    results.write_text("# Benchmarks\n")
+    source.write_text("x = 1\n")
+    git("add", ".")
+    git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "start")
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=tmp_path, capture_output=True, text=True).stdout.strip()
+    results.write_text("# Benchmarks\nnew figures\n")
+    assert revision(tmp_path, results) == head
+    assert revision(tmp_path) == f"{head} (with local changes)"
+    source.write_text("x = 2\n")
+    assert revision(tmp_path, results) == f"{head} (with local changes)"
+    assert revision(tmp_path / "nowhere") == "unknown"
