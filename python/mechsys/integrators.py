@@ -133,8 +133,8 @@ class Auto:
     while the contact set rests) for problems of at most ``newton_max_unknowns`` unknowns (3 per
     contact point in space, 2 in the plane), :class:`NSGS` above (Anderson-accelerated:
     ``nsgs_anderson`` past sweeps combined, up to ``nsgs_max_iter`` sweeps); where Newton stops at
-    ``newton_max_iter`` or stalls (indeterminate piles), those sweeps go on from its iterate and
-    come first for the next 100 steps; ``solver="auto"`` in :class:`MoreauJean`."""
+    ``newton_max_iter`` above the tolerance (indeterminate piles), those sweeps go on from its
+    iterate; ``solver="auto"`` in :class:`MoreauJean`."""
 
     tol: float = 1e-10
     newton_max_unknowns: int = 480

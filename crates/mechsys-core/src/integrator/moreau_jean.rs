@@ -919,7 +919,7 @@ impl MoreauJean {
             // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks
             let plan = match &self.method {
                 Method::Nsgs(o) => Some((*o, None)),
-                Method::Auto(o) => match o.plan(m, &self.r, self.ws.sweeps_first > 0) {
+                Method::Auto(o) => match o.plan(m, &self.r) {
                     solver::AutoPlan { sweeps: Some(s), then, rescue } => Some((s, Some((then, rescue)))),
                     solver::AutoPlan { sweeps: None, then: Method::Nsgs(p), .. } => Some((p, None)),
                     _ => None,
@@ -927,7 +927,6 @@ impl MoreauJean {
                 _ => None,
             };
             if let Some((sweeps, then)) = plan {
-                self.ws.sweeps_first = self.ws.sweeps_first.saturating_sub(1);
                 // the block solver's checks of its input (W_NN from the diagonal blocks)
                 let d = self.problem.dim;
                 solver::check_local(d, &self.problem.q, &self.problem.mu)?;
@@ -954,9 +953,7 @@ impl MoreauJean {
                 let Some(rescue) = rescue.filter(|_| !second.converged) else {
                     return Ok(second);
                 };
-                // Newton stalled (a pile): sweeps on the factored operator from its iterate, and
-                // for the next steps sweeps first
-                self.ws.sweeps_first = solver::AUTO_SWEEPS_FIRST;
+                // Newton stalled (a pile): sweeps on the factored operator from its iterate
                 let sp = self.sparse.as_mut().expect("sparse assembly");
                 self.local_u.resize(m, 0.0);
                 let problem = (&self.problem.q[..], &self.problem.mu[..]);

@@ -195,13 +195,6 @@ impl Default for NewtonOptions {
 /// ran to the cap of 200, each with fresh factorizations.
 pub const AUTO_NEWTON_STALL: usize = 30;
 
-/// Solves (steps, for a time-stepping scheme reusing its workspace) in which [`Method::Auto`]
-/// sweeps to the tolerance first, before Newton, after its Newton stalled: a problem where Newton
-/// stalls once (a pile rather than a stack) tends to make it stall again, each time after its
-/// dense factorizations. On a pour of 36 spheres at tol 1e-6 this took the run from 4.5 s to
-/// 3.0 s with the same share of converged steps.
-pub const AUTO_SWEEPS_FIRST: usize = 100;
-
 /// Accelerated projected gradient ([`apgd`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -304,16 +297,9 @@ impl AutoOptions {
     /// must get well below the tolerance: a step left just under it passes its error on to the
     /// next step's free velocity, which then starts above the tolerance (on a resting stack every
     /// other step went to Newton).
-    ///
-    /// With `sweeps_first` (its Newton stalled on a recent solve: [`AUTO_SWEEPS_FIRST`]) the
-    /// sweeps go all the way, to the tolerance with the whole budget, and Newton follows only if
-    /// they fail (without a rescue: the sweeps had their budget).
-    pub fn plan(&self, unknowns: usize, x: &[f64], sweeps_first: bool) -> AutoPlan {
+    pub fn plan(&self, unknowns: usize, x: &[f64]) -> AutoPlan {
         let then = self.pick(unknowns);
         let newton = matches!(then, Method::Newton(_));
-        if newton && sweeps_first {
-            return AutoPlan { sweeps: Some(self.sweeps()), then, rescue: None };
-        }
         let sweeps = newton.then(|| NsgsOptions {
             tol: AUTO_SWEEP_MARGIN * self.tol,
             max_iter: auto_sweeps(x),
@@ -541,8 +527,7 @@ impl sealed::Sealed for FrictionContact {
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
             Method::Auto(o) => {
-                let plan = o.plan(self.unknowns(), x, ws.sweeps_first > 0);
-                ws.sweeps_first = ws.sweeps_first.saturating_sub(1);
+                let plan = o.plan(self.unknowns(), x);
                 let Some(sweeps) = plan.sweeps else {
                     return self.run(&plan.then, x, ws);
                 };
@@ -552,10 +537,7 @@ impl sealed::Sealed for FrictionContact {
                 }
                 let second = self.run(&plan.then, x, ws)?.after(&first);
                 match plan.rescue {
-                    Some(rescue) if !second.converged => {
-                        ws.sweeps_first = AUTO_SWEEPS_FIRST;
-                        Ok(nsgs::solve_fc(self, &rescue, x, ws)?.after(&second))
-                    }
+                    Some(rescue) if !second.converged => Ok(nsgs::solve_fc(self, &rescue, x, ws)?.after(&second)),
                     _ => Ok(second),
                 }
             }

@@ -1080,24 +1080,19 @@ fn w_nn_check_names_the_contact_and_the_fault() {
 #[test]
 fn auto_plan_sweeps_before_newton_only() {
     let o = AutoOptions { tol: 1e-8, newton_max_unknowns: 30, ..Default::default() };
-    let cold = o.plan(30, &[0.0; 30], false);
+    let cold = o.plan(30, &[0.0; 30]);
     assert!(matches!(cold.then, Method::Newton(p) if p.tol == 1e-8));
     let s = cold.sweeps.unwrap();
     assert_eq!((s.max_iter, s.tol, s.relaxation), (AUTO_COLD_SWEEPS, 1e-9, 1.0));
     let mut warm = [0.0; 30];
     warm[7] = 0.5;
-    assert_eq!(o.plan(30, &warm, false).sweeps.unwrap().max_iter, AUTO_SWEEPS);
-    let big = o.plan(33, &[0.0; 33], false);
+    assert_eq!(o.plan(30, &warm).sweeps.unwrap().max_iter, AUTO_SWEEPS);
+    let big = o.plan(33, &[0.0; 33]);
     assert!(big.sweeps.is_none() && matches!(big.then, Method::Nsgs(p) if p.tol == 1e-8));
     // a Newton plan carries the rescue sweeps (Anderson-accelerated, the full sweep budget)
     let rescue = cold.rescue.unwrap();
     assert_eq!((rescue.tol, rescue.max_iter, rescue.anderson), (1e-8, o.nsgs_max_iter, o.nsgs_anderson));
     assert!(big.rescue.is_none());
-    // after a stall: the sweeps to the tolerance with the whole budget, Newton only behind them
-    let after = o.plan(30, &warm, true);
-    assert_eq!(after.sweeps, Some(rescue));
-    assert!(matches!(after.then, Method::Newton(_)) && after.rescue.is_none());
-    assert_eq!(o.plan(33, &[0.0; 33], true), big);
 }
 
 /// Newton's stall rule on pile fixtures, where the regularized Newton often stalls near 1e-3
@@ -1147,15 +1142,6 @@ fn auto_rescues_a_stalled_newton_with_sweeps() {
         assert!(rep.iterations > 1 + AUTO_COLD_SWEEPS, "{anderson}: the rescue ran: {rep:?}");
         let again = p.residual(&r).unwrap();
         assert!(again <= 1e-8 && (again - rep.residual).abs() <= 1e-12, "{anderson}: {again} vs {rep:?}");
-        // the stall is remembered: the workspace's next solves sweep first (here from the
-        // solution: one sweep, no Newton), counting down
-        let mut ws = Workspace::for_problem(&p, &Method::Auto(o)).unwrap();
-        let mut x = vec![0.0; p.unknowns()];
-        solve(&p, &Method::Auto(o), &mut x, false, &mut ws).unwrap();
-        assert_eq!(ws.sweeps_first, AUTO_SWEEPS_FIRST);
-        let next = solve(&p, &Method::Auto(o), &mut x, true, &mut ws).unwrap();
-        assert!(next.converged && next.iterations == 1, "{anderson}: {next:?}");
-        assert_eq!(ws.sweeps_first, AUTO_SWEEPS_FIRST - 1);
         // Newton alone at this cap does not get there
         let newton = Method::Newton(NewtonOptions { tol: 1e-8, max_iter: 1, ..Default::default() });
         let mut ws = Workspace::for_problem(&p, &newton).unwrap();

@@ -67,9 +67,6 @@ pub struct Workspace {
     pub(crate) anderson: Anderson,
     /// Gauss–Seidel's visiting order of the contacts (empty: by index), see [`Workspace::set_order`].
     pub(crate) order: Vec<usize>,
-    /// [`Method::Auto`]: solves left in which it sweeps to the tolerance before trying Newton,
-    /// set when its Newton stalled ([`crate::solver::AUTO_SWEEPS_FIRST`]).
-    pub(crate) sweeps_first: usize,
 }
 
 impl Workspace {
