@@ -132,9 +132,10 @@ class Auto:
     """The contact solver by problem shape: :class:`Newton` (regularized, its factorization reused
     while the contact set rests) for problems of at most ``newton_max_unknowns`` unknowns (3 per
     contact point in space, 2 in the plane), :class:`NSGS` above (Anderson-accelerated:
-    ``nsgs_anderson`` past sweeps combined, up to ``nsgs_max_iter`` sweeps); where Newton stops at
-    ``newton_max_iter`` above the tolerance (indeterminate piles), those sweeps go on from its
-    iterate; ``solver="auto"`` in :class:`MoreauJean`."""
+    ``nsgs_anderson`` past sweeps combined, up to ``nsgs_max_iter`` sweeps); where Newton ends
+    above the tolerance (its cap ``newton_max_iter``, or 30 iterations without halving its
+    residual: indeterminate piles), those sweeps go on from its iterate; ``solver="auto"`` in
+    :class:`MoreauJean`."""
 
     tol: float = 1e-10
     newton_max_unknowns: int = 480

@@ -42,8 +42,6 @@ use crate::spatial::{Force, Motion, Pose};
 
 pub use crate::model::constraint::{Constraint, ConstraintKind, LoopJoint, Reach};
 
-/// Adds `sign · dirᵀ J_T(point)` (or all three rows of `sign · J_T` when `dir` is None) of the
-/// world point `p` attached to `body` into the rows of `g` starting at `row`.
 /// [`add_point_rows`] of the relative motion of world point `p1` on body `b1` and `p2` on
 /// `b2`: row `row` of `g` gains `dirᵀ (J_P1 − J_P2)` (three rows for `dir = None`), the rows of a
 /// contact or of a point-to-point constraint.
@@ -62,6 +60,8 @@ pub(crate) fn add_relative_rows(
     add_point_rows(model, s_all, el, b2, p2, -1.0, dir, g, row);
 }
 
+/// Adds `sign · dirᵀ J_T(point)` (or all three rows of `sign · J_T` when `dir` is None) of the
+/// world point `p` attached to `body` into the rows of `g` starting at `row`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn add_point_rows(
     model: &Model,

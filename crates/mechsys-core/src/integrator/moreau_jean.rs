@@ -918,46 +918,38 @@ impl MoreauJean {
             let m = self.r.len();
             // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks
             let plan = match &self.method {
-                Method::Nsgs(o) => Some((*o, None)),
-                Method::Auto(o) => match o.plan(m, &self.r) {
-                    solver::AutoPlan { sweeps: Some(s), then, rescue } => Some((s, Some((then, rescue)))),
-                    solver::AutoPlan { sweeps: None, then: Method::Nsgs(p), .. } => Some((p, None)),
-                    _ => None,
-                },
+                Method::Nsgs(o) => Some(solver::AutoPlan { sweeps: None, then: Method::Nsgs(*o), rescue: None }),
+                Method::Auto(o) => Some(o.plan(m, &self.r)).filter(|p| p.sweeps.is_some() || matches!(p.then, Method::Nsgs(_))),
                 _ => None,
             };
-            if let Some((sweeps, then)) = plan {
+            if let Some(plan) = plan {
                 // the block solver's checks of its input (W_NN from the diagonal blocks)
                 let d = self.problem.dim;
                 solver::check_local(d, &self.problem.q, &self.problem.mu)?;
-                let sp = self.sparse.as_mut().expect("sparse assembly");
+                let sp = self.sparse.as_ref().expect("sparse assembly");
                 for i in 0..m / d {
                     solver::check_wnn(i, sp.diag[i * d * d])?;
                 }
                 if let Some(k) = self.r.iter().position(|v| !v.is_finite()) {
                     return Err(Error::Settings(format!("solver: warm start entry {k} is not finite ({})", self.r[k])));
                 }
-                // (capacity for every contact point since construction: no allocation)
-                self.local_u.resize(m, 0.0);
-                let problem = (&self.problem.q[..], &self.problem.mu[..]);
-                let first = sp.gauss_seidel(problem, &self.ws.order, &mut self.r, &sweeps, &mut self.local_u);
-                let Some((then, rescue)) = then.filter(|_| !first.converged) else {
-                    return Ok(first);
-                };
-                // the rest from the sweeps' impulses, on the blocks (an empty `local_u` tells
-                // the contact states to come from the problem)
-                self.local_u.clear();
-                self.ensure_blocks();
-                self.ws.reserve(&self.problem, &then)?;
-                let second = solver::solve(&self.problem, &then, &mut self.r, true, &mut self.ws)?.after(&first);
-                let Some(rescue) = rescue.filter(|_| !second.converged) else {
-                    return Ok(second);
-                };
-                // Newton stalled (a pile): sweeps on the factored operator from its iterate
-                let sp = self.sparse.as_mut().expect("sparse assembly");
-                self.local_u.resize(m, 0.0);
-                let problem = (&self.problem.q[..], &self.problem.mu[..]);
-                return Ok(sp.gauss_seidel(problem, &self.ws.order, &mut self.r, &rescue, &mut self.local_u).after(&second));
+                return plan.run(|stage| match stage {
+                    solver::Stage::Sweeps(o) => {
+                        // (capacity for every contact point since construction: no allocation)
+                        self.local_u.resize(m, 0.0);
+                        let sp = self.sparse.as_mut().expect("sparse assembly");
+                        let problem = (&self.problem.q[..], &self.problem.mu[..]);
+                        Ok(sp.gauss_seidel(problem, &self.ws.order, &mut self.r, o, &mut self.local_u))
+                    }
+                    solver::Stage::Solve(method) => {
+                        // on the blocks (an empty `local_u` tells the contact states to come
+                        // from the problem)
+                        self.local_u.clear();
+                        self.ensure_blocks();
+                        self.ws.reserve(&self.problem, method)?;
+                        solver::solve(&self.problem, method, &mut self.r, true, &mut self.ws)
+                    }
+                });
             }
         }
         self.ensure_blocks();

@@ -289,6 +289,38 @@ pub struct AutoPlan {
     pub rescue: Option<NsgsOptions>,
 }
 
+/// One stage of an [`AutoPlan`]: Gauss–Seidel sweeps, or another method.
+#[derive(Debug, Clone, Copy)]
+pub enum Stage<'a> {
+    /// Gauss–Seidel with these settings.
+    Sweeps(&'a NsgsOptions),
+    /// This method (Newton, for Auto).
+    Solve(&'a Method),
+}
+
+impl AutoPlan {
+    /// Runs the plan through `stage` (the caller's solver for each kind of stage: blocks, or the
+    /// factored operator for sweeps): the sweeps, then `then` unless they converged, then the
+    /// rescue unless that converged; the report counts every stage's iterations.
+    pub fn run<E>(&self, mut stage: impl FnMut(Stage<'_>) -> std::result::Result<Report, E>) -> std::result::Result<Report, E> {
+        let Some(sweeps) = &self.sweeps else {
+            return match &self.then {
+                Method::Nsgs(o) => stage(Stage::Sweeps(o)),
+                m => stage(Stage::Solve(m)),
+            };
+        };
+        let first = stage(Stage::Sweeps(sweeps))?;
+        if first.converged {
+            return Ok(first);
+        }
+        let second = stage(Stage::Solve(&self.then))?.after(&first);
+        match &self.rescue {
+            Some(rescue) if !second.converged => Ok(stage(Stage::Sweeps(rescue))?.after(&second)),
+            _ => Ok(second),
+        }
+    }
+}
+
 impl AutoOptions {
     /// The plan for a friction-contact problem of `unknowns` unknowns warm-started from `x`.
     ///
@@ -526,21 +558,10 @@ impl sealed::Sealed for FrictionContact {
     }
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
-            Method::Auto(o) => {
-                let plan = o.plan(self.unknowns(), x);
-                let Some(sweeps) = plan.sweeps else {
-                    return self.run(&plan.then, x, ws);
-                };
-                let first = nsgs::solve_fc(self, &sweeps, x, ws)?;
-                if first.converged {
-                    return Ok(first);
-                }
-                let second = self.run(&plan.then, x, ws)?.after(&first);
-                match plan.rescue {
-                    Some(rescue) if !second.converged => Ok(nsgs::solve_fc(self, &rescue, x, ws)?.after(&second)),
-                    _ => Ok(second),
-                }
-            }
+            Method::Auto(o) => o.plan(self.unknowns(), x).run(|stage| match stage {
+                Stage::Sweeps(s) => nsgs::solve_fc(self, s, x, ws),
+                Stage::Solve(m) => self.run(m, x, ws),
+            }),
             Method::Lemke(o) => friction_lcp::solve(self, o, x, ws),
             Method::Nsgs(o) => nsgs::solve_fc(self, o, x, ws),
             Method::Newton(o) => newton::solve(self, o, x, ws),
