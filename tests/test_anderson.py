@@ -118,3 +118,13 @@ def test_a_count_that_is_not_a_whole_number_is_refused_naming_the_key(solver, ke
     """(int() alone turned 2.5 sweeps combined into 2 without a word.)"""
     with pytest.raises(SettingsError, match=rf"{key}: expected a whole number, got"):
         ms.simulate(pile(4), 0.01, ms.MoreauJean(1e-3, solver=solver), progress=False)
+
+
+@pytest.mark.parametrize("integrator, key", [(ms.MoreauJean(1e-3, solver=ms.Auto(tol=float("nan"))), "Auto.tol"),
+                                             (ms.MoreauJean(1e-3, solver=ms.NSGS(relaxation=float("inf"))), "NSGS.relaxation"),
+                                             (ms.MoreauJean(1e-3, solver=ms.Newton(regularization="1e-4")), "Newton.regularization")])
+def test_a_setting_that_is_not_a_finite_number_is_refused_naming_the_key(integrator, key):
+    """(A NaN tolerance reached the engine's settings as a value it could not read: the error
+    named the key but said only 'expected value'.)"""
+    with pytest.raises(SettingsError, match=rf"{key}: expected a finite number, got"):
+        ms.simulate(pile(4), 0.01, integrator, progress=False)

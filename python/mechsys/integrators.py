@@ -32,6 +32,20 @@ def _whole(owner: object, key: str, value) -> int:
     return int(x)
 
 
+def _number(owner: object, key: str, value) -> float:
+    """``value`` as a float if it is a finite number; otherwise a SettingsError naming the setting
+    (a NaN would reach the engine's settings file as a value it cannot read)."""
+    from .errors import SettingsError
+
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not math.isfinite(x) or isinstance(value, (bool, str, bytes)):
+        raise SettingsError(f"{type(owner).__name__}.{key}: expected a finite number, got {value!r}")
+    return x
+
+
 @dataclass(frozen=True)
 class RK4:
     """Fixed-step classical Runge-Kutta of order 4 with step ``dt`` (s)."""
@@ -39,7 +53,7 @@ class RK4:
     dt: float
 
     def describe(self) -> dict:
-        return {"type": "rk4", "dt": float(self.dt)}
+        return {"type": "rk4", "dt": _number(self, "dt", self.dt)}
 
 
 @dataclass(frozen=True)
@@ -90,10 +104,10 @@ class Radau5:
 
     def describe(self) -> dict:
         if not self.adaptive:
-            return {"type": "radau5", "dt": float(self.dt), "newton_tol": float(self.newton_tol)}
-        return {"type": "radau5", "rtol": float(self.rtol), "atol": float(self.atol),
-                "newton_tol": float(self.newton_tol), "max_step": float(self.max_step),
-                "first_step": float(self.first_step)}
+            return {"type": "radau5", "dt": _number(self, "dt", self.dt), "newton_tol": _number(self, "newton_tol", self.newton_tol)}
+        return {"type": "radau5", "rtol": _number(self, "rtol", self.rtol), "atol": _number(self, "atol", self.atol),
+                "newton_tol": _number(self, "newton_tol", self.newton_tol), "max_step": _number(self, "max_step", self.max_step),
+                "first_step": _number(self, "first_step", self.first_step)}
 
 
 @dataclass(frozen=True)
@@ -108,8 +122,8 @@ class NSGS:
     anderson: int = 0
 
     def describe(self) -> dict:
-        return {"type": "nsgs", "tol": float(self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
-                "relaxation": float(self.relaxation), "anderson": _whole(self, "anderson", self.anderson)}
+        return {"type": "nsgs", "tol": _number(self, "tol", self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
+                "relaxation": _number(self, "relaxation", self.relaxation), "anderson": _whole(self, "anderson", self.anderson)}
 
 
 @dataclass(frozen=True)
@@ -123,8 +137,8 @@ class Newton:
     regularization: float = 1e-4
 
     def describe(self) -> dict:
-        return {"type": "newton", "tol": float(self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
-                "regularization": float(self.regularization)}
+        return {"type": "newton", "tol": _number(self, "tol", self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
+                "regularization": _number(self, "regularization", self.regularization)}
 
 
 @dataclass(frozen=True)
@@ -144,7 +158,7 @@ class Auto:
     nsgs_anderson: int = 4
 
     def describe(self) -> dict:
-        return {"type": "auto", "tol": float(self.tol),
+        return {"type": "auto", "tol": _number(self, "tol", self.tol),
                 "newton_max_unknowns": _whole(self, "newton_max_unknowns", self.newton_max_unknowns),
                 "newton_max_iter": _whole(self, "newton_max_iter", self.newton_max_iter),
                 "nsgs_max_iter": _whole(self, "nsgs_max_iter", self.nsgs_max_iter),
@@ -162,7 +176,7 @@ class APGD:
     max_iter: int = 10_000
 
     def describe(self) -> dict:
-        return {"type": "apgd", "tol": float(self.tol), "max_iter": _whole(self, "max_iter", self.max_iter)}
+        return {"type": "apgd", "tol": _number(self, "tol", self.tol), "max_iter": _whole(self, "max_iter", self.max_iter)}
 
 
 @dataclass(frozen=True)
@@ -173,7 +187,7 @@ class Lemke:
     pivot_tol: float = 1e-12
 
     def describe(self) -> dict:
-        return {"type": "lemke", "facets": _whole(self, "facets", self.facets), "pivot_tol": float(self.pivot_tol)}
+        return {"type": "lemke", "facets": _whole(self, "facets", self.facets), "pivot_tol": _number(self, "pivot_tol", self.pivot_tol)}
 
 
 @dataclass(frozen=True)
@@ -204,7 +218,7 @@ class MoreauJean:
             object.__setattr__(self, "solver", _solver(self.solver, "MoreauJean.solver"))
 
     def describe(self) -> dict:
-        return {"type": "moreau_jean", "dt": float(self.dt), "solver": self.solver.describe(),
+        return {"type": "moreau_jean", "dt": _number(self, "dt", self.dt), "solver": self.solver.describe(),
                 "continue_on_painleve": bool(self.continue_on_painleve), "project": bool(self.project),
                 "parallel": bool(self.parallel)}
 

@@ -222,6 +222,12 @@ pub const AUTO_SWEEPS: usize = 4;
 /// of the box stack and of the pyramid cost 2.9 and 1.3 times fewer instructions than with 4).
 pub const AUTO_COLD_SWEEPS: usize = 10;
 
+/// Sweeps worth one fresh Newton factorization are about `m² / AUTO_SWEEPS_PER_FACTOR` for `m`
+/// unknowns (the profile LU of the 408-unknown pyramid problem costs 12.7 M instructions, one
+/// sweep about 70 k: 180 sweeps). Without a factorization to reuse [`Method::Auto`] sweeps up to
+/// that many, Anderson-accelerated, before Newton.
+pub const AUTO_SWEEPS_PER_FACTOR: usize = 1500;
+
 /// [`AUTO_COLD_SWEEPS`] if the warm start `x` is all zeros, else [`AUTO_SWEEPS`].
 pub fn auto_sweeps(x: &[f64]) -> usize {
     if x.iter().all(|v| *v == 0.0) {
@@ -329,13 +335,16 @@ impl AutoOptions {
     /// must get well below the tolerance: a step left just under it passes its error on to the
     /// next step's free velocity, which then starts above the tolerance (on a resting stack every
     /// other step went to Newton).
-    pub fn plan(&self, unknowns: usize, x: &[f64]) -> AutoPlan {
+    pub fn plan(&self, unknowns: usize, x: &[f64], factored: bool) -> AutoPlan {
         let then = self.pick(unknowns);
         let newton = matches!(then, Method::Newton(_));
-        let sweeps = newton.then(|| NsgsOptions {
-            tol: AUTO_SWEEP_MARGIN * self.tol,
-            max_iter: auto_sweeps(x),
-            ..Default::default()
+        let sweeps = newton.then(|| {
+            let few = auto_sweeps(x);
+            // without a factorization of this size to reuse Newton's first step pays a fresh
+            // one: sweeps up to about its cost come first, accelerated when there are many
+            let budget = if factored { few } else { few.max(unknowns * unknowns / AUTO_SWEEPS_PER_FACTOR) };
+            let anderson = if budget > few { self.nsgs_anderson } else { 0 };
+            NsgsOptions { tol: AUTO_SWEEP_MARGIN * self.tol, max_iter: budget, anderson, ..Default::default() }
         });
         let rescue = newton.then(|| self.sweeps());
         AutoPlan { sweeps, then, rescue }
@@ -558,7 +567,7 @@ impl sealed::Sealed for FrictionContact {
     }
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
-            Method::Auto(o) => o.plan(self.unknowns(), x).run(|stage| match stage {
+            Method::Auto(o) => o.plan(self.unknowns(), x, ws.newton.factored(self.unknowns())).run(|stage| match stage {
                 Stage::Sweeps(s) => nsgs::solve_fc(self, s, x, ws),
                 Stage::Solve(m) => self.run(m, x, ws),
             }),

@@ -67,6 +67,12 @@ pub(crate) struct NewtonWork {
 }
 
 impl NewtonWork {
+    /// Whether it holds a factorization of an `m`-unknown problem (the next solve of that size
+    /// starts from it as a chord).
+    pub(crate) fn factored(&self, m: usize) -> bool {
+        self.lu_size == m && m > 0
+    }
+
     pub(crate) fn reserve(&mut self, m: usize) {
         if self.phi.len() < m {
             self.jac.resize(m * m, 0.0);

@@ -1076,23 +1076,37 @@ fn w_nn_check_names_the_contact_and_the_fault() {
 }
 
 /// Auto's plan: sweeps before Newton (10 from a cold start, 4 warm, at a tenth of the
-/// tolerance), none before Gauss–Seidel on a large problem.
+/// tolerance; more, accelerated, on a problem large enough that a fresh factorization costs more,
+/// unless one of its size is held for reuse), none before Gauss–Seidel on a large problem.
 #[test]
 fn auto_plan_sweeps_before_newton_only() {
     let o = AutoOptions { tol: 1e-8, newton_max_unknowns: 30, ..Default::default() };
-    let cold = o.plan(30, &[0.0; 30]);
-    assert!(matches!(cold.then, Method::Newton(p) if p.tol == 1e-8));
-    let s = cold.sweeps.unwrap();
-    assert_eq!((s.max_iter, s.tol, s.relaxation), (AUTO_COLD_SWEEPS, 1e-9, 1.0));
-    let mut warm = [0.0; 30];
-    warm[7] = 0.5;
-    assert_eq!(o.plan(30, &warm).sweeps.unwrap().max_iter, AUTO_SWEEPS);
-    let big = o.plan(33, &[0.0; 33]);
-    assert!(big.sweeps.is_none() && matches!(big.then, Method::Nsgs(p) if p.tol == 1e-8));
-    // a Newton plan carries the rescue sweeps (Anderson-accelerated, the full sweep budget)
-    let rescue = cold.rescue.unwrap();
-    assert_eq!((rescue.tol, rescue.max_iter, rescue.anderson), (1e-8, o.nsgs_max_iter, o.nsgs_anderson));
-    assert!(big.rescue.is_none());
+    for held in [false, true] {
+        let cold = o.plan(30, &[0.0; 30], held);
+        assert!(matches!(cold.then, Method::Newton(p) if p.tol == 1e-8));
+        let s = cold.sweeps.unwrap();
+        assert_eq!((s.max_iter, s.tol, s.relaxation, s.anderson), (AUTO_COLD_SWEEPS, 1e-9, 1.0, 0));
+        let mut warm = [0.0; 30];
+        warm[7] = 0.5;
+        assert_eq!(o.plan(30, &warm, held).sweeps.unwrap().max_iter, AUTO_SWEEPS);
+        let big = o.plan(33, &[0.0; 33], held);
+        assert!(big.sweeps.is_none() && matches!(big.then, Method::Nsgs(p) if p.tol == 1e-8));
+        // a Newton plan carries the rescue sweeps (Anderson-accelerated, the full sweep budget)
+        let rescue = cold.rescue.unwrap();
+        assert_eq!((rescue.tol, rescue.max_iter, rescue.anderson), (1e-8, o.nsgs_max_iter, o.nsgs_anderson));
+        assert!(big.rescue.is_none());
+    }
+    // 408 unknowns (the pyramid): 110 accelerated sweeps unless a factorization is held
+    let o = AutoOptions::default();
+    let mut warm = vec![0.0; 408];
+    warm[3] = 1.0;
+    for x in [&vec![0.0; 408], &warm] {
+        let s = o.plan(408, x, false).sweeps.unwrap();
+        assert_eq!((s.max_iter, s.anderson), (408 * 408 / AUTO_SWEEPS_PER_FACTOR, AUTO_ANDERSON));
+        assert_eq!(s.max_iter, 110);
+    }
+    let s = o.plan(408, &warm, true).sweeps.unwrap();
+    assert_eq!((s.max_iter, s.anderson), (AUTO_SWEEPS, 0));
 }
 
 /// Newton's stall rule on pile fixtures, where the regularized Newton often stalls near 1e-3
