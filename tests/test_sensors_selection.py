@@ -54,14 +54,14 @@ def test_patterns_choose_what_the_engine_records():
     core = chain(loop=True).build()
     # a marker needs its body's states only; no accelerations, constraints or forces
     rec, names = record_selection(core, ["marker/b3/tip/position"])
-    assert rec == {"bodies": ["b3"], "accelerations": False, "constraints": False, "forces": False}
+    assert rec == {"bodies": ["b3"], "accelerations": False, "constraints": False, "forces": False, "contacts": False}
     assert names == ["marker/b3/tip/position"]
     # the model's centre of mass needs every body; an acceleration switches accelerations on
     rec, _ = record_selection(core, ["com/acceleration"])
     assert rec["bodies"] == [f"b{i}" for i in range(6)] and rec["accelerations"]
     # reactions come from the accelerations; constraint and force values from their groups
     rec, names = record_selection(core, ["joint/j2/reaction_*", "constraint/rope/*", "force/*/force"])
-    assert rec == {"bodies": [], "accelerations": True, "constraints": True, "forces": True}
+    assert rec == {"bodies": [], "accelerations": True, "constraints": True, "forces": True, "contacts": False}
     assert "constraint/rope/velocity_violation" in names and "force/brake/force" in names
     # the engine's arrays shrink with the selection
     res = ms.simulate(chain(loop=True), 0.2, ms.RK4(dt=1e-3), sensors=["joint/j2/reaction_force", "constraint/rope/lambda"])
@@ -78,6 +78,47 @@ def test_a_selection_without_accelerations_gives_positions_and_velocities_only(f
     assert set(sel2.names()) == {"t", "marker/b1/tip/velocity", "body/b1/com_position"}
     assert np.array_equal(sel2["marker/b1/tip/velocity"], full["marker/b1/tip/velocity"])
     assert np.array_equal(sel2["body/b1/com_position"], full["body/b1/com_position"])
+
+
+def sliding_boxes():
+    """Two boxes on the floor, one stacked on the other, the pair thrown sideways: the lower one
+    slides, the upper sticks, both come to rest (contact states change during the run)."""
+    m = ms.Model("boxes", gravity=(0.0, 0.0, -9.81))
+    shape = ms.contours.Box(half_extents=(0.1, 0.1, 0.05))
+    low = m.add_body("low", 1.0, ms.inertia.box(1.0, (0.2, 0.2, 0.1)))
+    m.add_joint(ms.joints.Free("free_low", m.ground, low, q0=[0, 0, 0.05, 1, 0, 0, 0], u0=[0.8, 0, 0, 0, 0, 0]))
+    top = m.add_body("top", 1.0, ms.inertia.box(1.0, (0.2, 0.2, 0.1)))
+    m.add_joint(ms.joints.Free("free_top", m.ground, top, q0=[0, 0, 0.15, 1, 0, 0, 0], u0=[0.8, 0, 0, 0, 0, 0]))
+    m.add_contact(ms.Contact("floor", low.contour(shape), m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))),
+                             friction=ms.laws.Coulomb(0.3)))
+    m.add_contact(ms.Contact("on", top.contour(shape), low.contour(shape), friction=ms.laws.Coulomb(0.8)))
+    return m
+
+
+def test_a_selection_without_contact_signals_skips_them_and_leaves_the_motion_alone():
+    """Moreau-Jean skips the contact points' kinematics at the samples when no contact signal is
+    chosen: the bodies move the same bit for bit, the solver's signals and the contact energies
+    are there, no contact point signal is, and the engine's arrays hold none (a 1000-sphere pile
+    records thousands of candidate points per sample)."""
+    integ = ms.MoreauJean(1e-3, solver="auto")
+    full = ms.simulate(sliding_boxes(), 0.5, integ, output_dt=1e-3)
+    # the scene changes state: the lower box slides, then stops
+    slid = full["body/low/position"][-1, 0] - full["body/low/position"][0, 0]
+    assert 0.05 < slid < 0.5 and abs(full["body/low/velocity"][-1, 0]) < 1e-6
+    want = ["body/*/position", "body/*/velocity", "solver/*", "energy/dissipated_friction"]
+    sel = ms.simulate(sliding_boxes(), 0.5, integ, output_dt=1e-3, sensors=want)
+    assert not [n for n in sel.names() if n.startswith("contact/")]
+    for n in ["body/low/position", "body/top/velocity", "solver/residual", "solver/iterations", "energy/dissipated_friction"]:
+        assert np.array_equal(sel[n], full[n]), n
+    assert full["energy/dissipated_friction"][-1] > 0.1
+    core = sliding_boxes().build()
+    assert record_selection(core, want)[0]["contacts"] is False
+    # one contact signal brings the points back, equal to the full recording's
+    sel = ms.simulate(sliding_boxes(), 0.5, integ, output_dt=1e-3, sensors=["contact/on/lambda_n", "body/top/position"])
+    assert np.array_equal(sel["contact/on/lambda_n"], full["contact/on/lambda_n"])
+    assert np.array_equal(sel["body/top/position"], full["body/top/position"])
+    # the weight of the upper box rests on its four corners at the end
+    np.testing.assert_allclose(sel["contact/on/lambda_n"][-1].sum(), 9.81, rtol=1e-6)
 
 
 def test_selective_results_save_and_load(tmp_path):

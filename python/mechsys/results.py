@@ -321,7 +321,7 @@ class Results:
                 else:
                     put(f"force/{name}/force", raw["force_value"][:, sl], f["force_unit"])
                     put(f"force/{name}/deflection", raw["force_deflection"][:, sl], f["deflection_unit"])
-        if engine is not None and "contact_gap" in raw:
+        if engine is not None and "dissipated_impact" in raw:
             put("energy/dissipated_impact", raw["dissipated_impact"], "J")
             put("energy/dissipated_friction", raw["dissipated_friction"], "J")
             if "solver" in raw:
@@ -332,7 +332,8 @@ class Results:
                 put("solver/converged", sv[:, 2].astype(np.int8), "1")
                 put("solver/contacts", sv[:, 3], "1")
                 put("solver/islands", sv[:, 4], "1")
-            for c in engine.contacts():
+            # (the points' signals are left out of a recording that chose none of them)
+            for c in engine.contacts() if "contact_gap" in raw else ():
                 k, n, nt = c["first"], c["points"], c["tangents"]
                 sl = slice(k, k + n) if n > 1 else k
                 pre = f"contact/{c['name']}"
@@ -930,6 +931,7 @@ def record_selection(engine, patterns) -> tuple[dict, list[str]]:
         "accelerations": any(n.endswith(_ACCELERATION_SUFFIXES) for n in chosen),
         "constraints": any(n.startswith("constraint/") for n in chosen),
         "forces": any(n.startswith("force/") for n in chosen),
+        "contacts": any(n.startswith("contact/") for n in chosen),
     }
     return selection, chosen
 

@@ -81,6 +81,11 @@ pub struct RecordSelection {
     /// Force elements' forces and deflections.
     #[serde(default = "yes")]
     pub forces: bool,
+    /// The contact points' signals (gap, point, normal, rates, forces, impulses, state, reserve):
+    /// without them Moreau–Jean skips the contact kinematics at each sample (a narrow phase per
+    /// pair). The solver's signals and the contact energies are recorded either way.
+    #[serde(default = "yes")]
+    pub contacts: bool,
 }
 
 fn yes() -> bool {
@@ -89,7 +94,7 @@ fn yes() -> bool {
 
 impl Default for RecordSelection {
     fn default() -> Self {
-        RecordSelection { bodies: None, accelerations: true, constraints: true, forces: true }
+        RecordSelection { bodies: None, accelerations: true, constraints: true, forces: true, contacts: true }
     }
 }
 
@@ -1472,7 +1477,8 @@ fn time_stepping(
         let (q, rest) = y.split_at_mut(nq);
         crate::dynamics::constrained::project(model, &mut data, &mut ws, settings.t0, q, &mut rest[..nu], cb)?;
     }
-    rec.reserve_contacts(t_out.len(), np);
+    let contact_signals = rec.selection.contacts;
+    rec.reserve_contacts(t_out.len(), if contact_signals { np } else { 0 });
     let mut udot = vec![0.0; nu];
     let mut u_start = vec![0.0; nu];
     // impulses summed over each sample interval (so that impacts between samples are not lost)
@@ -1578,29 +1584,32 @@ fn time_stepping(
         crate::kinematics::accelerations(model, &mut data, &ud);
         data.udot = ud;
         record(model, &data, &ws.saddle, t_rec, &y, &mut rec);
-        stepper.measure(model, &mut data, t_rec, q, u, cb)?;
-        for (pt, kk) in stepper.kinematics().iter().enumerate() {
-            let r = &stepper.results[pt];
-            // over the interval since the last sample (one step at the first sample)
-            let span = if k == 0 { dt } else { settings.output_dt };
-            let (in_, it) = (acc_n[pt], acc_t[pt]);
-            rec.contact_gap.push(kk.point.g_n);
-            rec.contact_point.extend_from_slice(kk.point.p1.as_slice());
-            rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
-            rec.contact_gd_n.push(kk.gd_n);
-            rec.contact_gd_t.extend_from_slice(&kk.gd_t);
-            rec.contact_omega.extend_from_slice(&kk.omega_rel);
-            rec.contact_impulse_n.push(in_);
-            rec.contact_impulse_t.extend_from_slice(&it);
-            rec.contact_lambda_n.push(in_ / span);
-            rec.contact_lambda_t.extend_from_slice(&[it[0] / span, it[1] / span]);
-            let f_t = (kk.point.t1 * it[0] + kk.point.t2 * it[1]) / span;
-            rec.contact_friction.extend_from_slice(f_t.as_slice());
-            rec.contact_state.push(r.state);
-            let con = model.contact_of_point(pt);
-            // the reserve of the last step (forces of that step)
-            let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
-            rec.contact_reserve.push((con.friction.mu0() * r.impulse_n - lt) / dt);
+        // the contact points at the sample (skipped when no contact signal is recorded)
+        if contact_signals {
+            stepper.measure(model, &mut data, t_rec, q, u, cb)?;
+            for (pt, kk) in stepper.kinematics().iter().enumerate() {
+                let r = &stepper.results[pt];
+                // over the interval since the last sample (one step at the first sample)
+                let span = if k == 0 { dt } else { settings.output_dt };
+                let (in_, it) = (acc_n[pt], acc_t[pt]);
+                rec.contact_gap.push(kk.point.g_n);
+                rec.contact_point.extend_from_slice(kk.point.p1.as_slice());
+                rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
+                rec.contact_gd_n.push(kk.gd_n);
+                rec.contact_gd_t.extend_from_slice(&kk.gd_t);
+                rec.contact_omega.extend_from_slice(&kk.omega_rel);
+                rec.contact_impulse_n.push(in_);
+                rec.contact_impulse_t.extend_from_slice(&it);
+                rec.contact_lambda_n.push(in_ / span);
+                rec.contact_lambda_t.extend_from_slice(&[it[0] / span, it[1] / span]);
+                let f_t = (kk.point.t1 * it[0] + kk.point.t2 * it[1]) / span;
+                rec.contact_friction.extend_from_slice(f_t.as_slice());
+                rec.contact_state.push(r.state);
+                let con = model.contact_of_point(pt);
+                // the reserve of the last step (forces of that step)
+                let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
+                rec.contact_reserve.push((con.friction.mu0() * r.impulse_n - lt) / dt);
+            }
         }
         acc_n.fill(0.0);
         acc_t.fill([0.0; 2]);

@@ -373,7 +373,9 @@ fn recording_dict<'py>(
     }
     d.set_item("events", events)?;
     let np = m.n_contact_points;
-    if !m.contacts.is_empty() || !m.contact_groups.is_empty() {
+    // (the points' signals only where recorded: a selection without contact signals skips them)
+    let points = rec.selection.contacts;
+    if (!m.contacts.is_empty() || !m.contact_groups.is_empty()) && points {
         put("contact_gap", rec.contact_gap, &[n, np])?;
         put("contact_point", rec.contact_point, &[n, np, 3])?;
         put("contact_normal", rec.contact_normal, &[n, np, 3])?;
@@ -387,6 +389,8 @@ fn recording_dict<'py>(
         put("contact_impulse_t", rec.contact_impulse_t, &[n, np, 2])?;
         put("contact_state", rec.contact_state, &[n, np])?;
         put("contact_reserve", rec.contact_reserve, &[n, np])?;
+    }
+    if !m.contacts.is_empty() || !m.contact_groups.is_empty() {
         put("dissipated_impact", rec.dissipated_impact, &[n])?;
         put("dissipated_friction", rec.dissipated_friction, &[n])?;
         if !rec.solver.is_empty() {
