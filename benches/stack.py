@@ -9,7 +9,8 @@ Coulomb friction 0.5 everywhere (PyBullet multiplies the two bodies' coefficient
 Measured per run:
 - wall time per simulated second, from the Python call until the run is done, model built
   beforehand; min (median) over repeats. mechsys: one `ms.simulate` call (it records its signals
-  every 10 ms); MuJoCo: `mujoco.rollout.rollout` (its C loop) from the initial state; PyBullet: a
+  every 10 ms: all of them, and in a second run with `solver="auto"` only the bodies' states and
+  the solver's signals, what the rollout returns); MuJoCo: `mujoco.rollout.rollout` (its C loop) from the initial state; PyBullet: a
   Python loop of `stepSimulation` (it has no batch call; the loop costs < 1 us per step);
 - largest penetration over the run: mechsys from its gap signals at every step (a separate run
   recording every step, not timed), MuJoCo from `-min(contact.dist)` after every step, PyBullet
@@ -109,12 +110,16 @@ def ms_solvers():
             "auto (tol 1e-10)": ms.Auto(), "APGD (tol 1e-10)": ms.APGD()}
 
 
-def run_ms(model, dt, t_end, solver, output_dt=1e-2):
+#: what MuJoCo's rollout returns, as mechsys signals: the bodies' states (and the solver's report)
+STATES = ["body/*/position", "body/*/orientation", "body/*/velocity", "body/*/angular_velocity", "solver/*"]
+
+
+def run_ms(model, dt, t_end, solver, output_dt=1e-2, sensors=None):
     import mechsys as ms
 
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        res = ms.simulate(model, t_end, ms.MoreauJean(dt, solver=solver), output_dt=output_dt)
+        res = ms.simulate(model, t_end, ms.MoreauJean(dt, solver=solver), output_dt=output_dt, sensors=sensors)
     note = next((str(x.message) for x in w if "tolerance" in str(x.message)), "")
     return res, note
 
@@ -247,6 +252,14 @@ def main(argv=None) -> int:
                 extra = (f"worst residual {worst:.1e}, unconverged {unconv}; the floor carries {floor:.10f} × {nb} m g")
                 rows.append((kind, dt, f"mechsys MoreauJean, {label}", tmin, tmed, pen, dr, extra))
                 print(f"{kind} dt {dt:g} {label:32s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}  {extra}")
+                if label.startswith("auto"):
+                    # the same run recording what the rollout returns: no contact-point signals, so
+                    # no contact kinematics at the samples (the motion is the same bit for bit)
+                    tmin, tmed, _ = timed(lambda: run_ms(model, dt, T, solver, sensors=STATES), repeat)
+                    rows.append((kind, dt, "mechsys MoreauJean, auto, states only", tmin, tmed, pen, dr,
+                                 "`sensors=` the bodies' states and `solver/*` (what MuJoCo's rollout returns); "
+                                 "the same motion as the row above"))
+                    print(f"{kind} dt {dt:g} {'auto, states only':32s} {fmt_time(tmin / T)}/s")
             try:
                 setup = mj_setup(dt, kind)
                 tmin, tmed, _ = timed(lambda: run_mj(setup, dt, T), repeat)
@@ -282,13 +295,19 @@ def main(argv=None) -> int:
               "simulated. *stack*: ten boxes in a column; *pyramid*: rows of 6, 5, 4, 3, 2 boxes 1 cm apart, each upper "
               "box straddling the two below it (34 box-box or box-floor pairs, 136 closed points). Settings and fairness "
               f"notes in the script's docstring. Wall time per simulated second: min (median) over {repeat} run(s); "
-              "“mechsys auto vs it”: mechsys with `solver=\"auto\"` against that row at the same step.", "",
+              "“mechsys auto vs it”: mechsys with `solver=\"auto\"` against that row at the same step (recording "
+              "every signal, and in the MuJoCo rows also recording only the bodies' states, as the rollout does).", "",
               f"Command: `.venv/bin/python benches/stack.py {' '.join(sys.argv[1:] if argv is None else argv)}`", "",
               "| scene | dt | engine | wall time per simulated second | mechsys auto vs it | largest penetration | top box drift, 0 → T | top box drift over the last 1 s | notes |",
               "|---|---:|---|---:|---:|---:|---:|---:|---|"]
         for kind, dt, engine, tmin, tmed, pen, dr, extra in rows:
             ref = next((r[3] for r in rows if r[0] == kind and r[1] == dt and "auto" in r[2]), None)
             cell = ratio(ref / T, tmin / T) if ref is not None and "auto" not in engine else "–"
+            if "MuJoCo" in engine:
+                # and the run recording what the rollout returns, against it
+                lean = next((r[3] for r in rows if r[0] == kind and r[1] == dt and "states only" in r[2]), None)
+                if lean is not None:
+                    cell += f"; states only: {ratio(lean / T, tmin / T)}"
             L.append(f"| {kind} | {dt:g} | {engine} | {fmt_time(tmin / T)} ({fmt_time(tmed / T)}) | {cell} | "
                      f"{pen:.1e} m | {dr[0]:.1e} m | {dr[1]:.1e} m | {extra} |")
         L += ["", "Reading the table:", "",
