@@ -75,6 +75,34 @@ pub fn prepare(
     cb: &dyn Callbacks,
 ) -> Result<Powers> {
     kinematics::forward_pass(model, data, t, q, u);
+    forces_at(model, data, ws, t, q, u, cb)
+}
+
+/// [`prepare`] at the positions of the last one (the same `t` and `q`) with new velocities `u`:
+/// the placements, subspaces and inertias stand, the velocities and the forces are redone.
+pub fn prepare_rates(
+    model: &Model,
+    data: &mut Data,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+) -> Result<Powers> {
+    kinematics::velocities(model, data, q, u);
+    forces_at(model, data, ws, t, q, u, cb)
+}
+
+/// The force elements (and the elastic bodies' material damping) at the kinematics in `data`.
+fn forces_at(
+    model: &Model,
+    data: &mut Data,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    cb: &dyn Callbacks,
+) -> Result<Powers> {
     let mut p = forces::evaluate(model, data, &mut ws.forces, t, q, u, cb)?;
     for e in &model.elastic {
         // the elastic bodies' material damping q̇ᵀ D q̇

@@ -411,8 +411,12 @@ impl MoreauJean {
                     self.u_free[i] = 0.5 * (u[i] + self.u_free[i]);
                 }
             }
-            let ubar = if pass == 0 { &*u } else { &self.u_free };
-            p = crate::dynamics::prepare(model, data, ws, tm, &self.q_mid, ubar, cb)?;
+            p = if pass == 0 {
+                crate::dynamics::prepare(model, data, ws, tm, &self.q_mid, u, cb)?
+            } else {
+                // (the same midpoint positions: only the velocities and forces are redone)
+                crate::dynamics::prepare_rates(model, data, ws, tm, &self.q_mid, &self.u_free, cb)?
+            };
             data.a[0] = Motion::ZERO;
             let zero = std::mem::take(&mut data.zero_u);
             crate::kinematics::accelerations(model, data, &zero);
