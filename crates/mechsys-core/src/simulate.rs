@@ -371,6 +371,32 @@ impl Recording {
         self.dissipated_friction.reserve(samples);
         self.solver.reserve(5 * samples);
     }
+
+    /// One sample of one contact point: its kinematics `kk`, the impulses since the last sample
+    /// (normal, tangential), the forces, the friction force (world), its state code and reserve.
+    fn push_contact_point(
+        &mut self,
+        kk: &crate::contact::ContactKinematics,
+        impulse: (f64, [f64; 2]),
+        lambda: (f64, [f64; 2]),
+        friction: crate::math::Vec3,
+        state: f64,
+        reserve: f64,
+    ) {
+        self.contact_gap.push(kk.point.g_n);
+        self.contact_point.extend_from_slice(kk.point.p1.as_slice());
+        self.contact_normal.extend_from_slice(kk.point.n.as_slice());
+        self.contact_gd_n.push(kk.gd_n);
+        self.contact_gd_t.extend_from_slice(&kk.gd_t);
+        self.contact_omega.extend_from_slice(&kk.omega_rel);
+        self.contact_impulse_n.push(impulse.0);
+        self.contact_impulse_t.extend_from_slice(&impulse.1);
+        self.contact_lambda_n.push(lambda.0);
+        self.contact_lambda_t.extend_from_slice(&lambda.1);
+        self.contact_friction.extend_from_slice(friction.as_slice());
+        self.contact_state.push(state);
+        self.contact_reserve.push(reserve);
+    }
 }
 
 impl EventRecord {
@@ -1592,23 +1618,13 @@ fn time_stepping(
                 // over the interval since the last sample (one step at the first sample)
                 let span = if k == 0 { dt } else { settings.output_dt };
                 let (in_, it) = (acc_n[pt], acc_t[pt]);
-                rec.contact_gap.push(kk.point.g_n);
-                rec.contact_point.extend_from_slice(kk.point.p1.as_slice());
-                rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
-                rec.contact_gd_n.push(kk.gd_n);
-                rec.contact_gd_t.extend_from_slice(&kk.gd_t);
-                rec.contact_omega.extend_from_slice(&kk.omega_rel);
-                rec.contact_impulse_n.push(in_);
-                rec.contact_impulse_t.extend_from_slice(&it);
-                rec.contact_lambda_n.push(in_ / span);
-                rec.contact_lambda_t.extend_from_slice(&[it[0] / span, it[1] / span]);
                 let f_t = (kk.point.t1 * it[0] + kk.point.t2 * it[1]) / span;
-                rec.contact_friction.extend_from_slice(f_t.as_slice());
-                rec.contact_state.push(r.state);
                 let con = model.contact_of_point(pt);
                 // the reserve of the last step (forces of that step)
                 let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
-                rec.contact_reserve.push((con.friction.mu0() * r.impulse_n - lt) / dt);
+                let reserve = (con.friction.mu0() * r.impulse_n - lt) / dt;
+                let lambda = (in_ / span, [it[0] / span, it[1] / span]);
+                rec.push_contact_point(kk, (in_, it), lambda, f_t, r.state, reserve);
             }
         }
         acc_n.fill(0.0);
@@ -1719,22 +1735,12 @@ fn event_driven(
             prev[3 * pt] = now_n;
             prev[3 * pt + 1] = now_t[0];
             prev[3 * pt + 2] = now_t[1];
-            rec.contact_gap.push(kk.point.g_n);
-            rec.contact_point.extend_from_slice(kk.point.p1.as_slice());
-            rec.contact_normal.extend_from_slice(kk.point.n.as_slice());
-            rec.contact_gd_n.push(kk.gd_n);
-            rec.contact_gd_t.extend_from_slice(&kk.gd_t);
-            rec.contact_omega.extend_from_slice(&kk.omega_rel);
-            rec.contact_impulse_n.push(i_n);
-            rec.contact_impulse_t.extend_from_slice(&i_t);
-            rec.contact_lambda_n.push(ph.lam_n[pt]);
-            rec.contact_lambda_t.extend_from_slice(&ph.lam_t[pt]);
             let f_t = kk.point.t1 * ph.lam_t[pt][0] + kk.point.t2 * ph.lam_t[pt][1];
-            rec.contact_friction.extend_from_slice(f_t.as_slice());
-            rec.contact_state.push(ph.state_code(pt));
             let con = model.contact_of_point(pt);
             let lt = (ph.lam_t[pt][0].powi(2) + ph.lam_t[pt][1].powi(2)).sqrt();
-            rec.contact_reserve.push(con.friction.mu0() * ph.lam_n[pt] - lt);
+            let reserve = con.friction.mu0() * ph.lam_n[pt] - lt;
+            let lambda = (ph.lam_n[pt], ph.lam_t[pt]);
+            rec.push_contact_point(kk, (i_n, i_t), lambda, f_t, ph.state_code(pt), reserve);
         }
         rec.dissipated_impact.push(e_impact);
         rec.dissipated_friction.push(y[e + 2] + e_impulsive_friction);

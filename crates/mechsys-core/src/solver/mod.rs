@@ -225,7 +225,7 @@ pub const AUTO_COLD_SWEEPS: usize = 10;
 /// Sweeps worth one fresh Newton factorization are about `m² / AUTO_SWEEPS_PER_FACTOR` for `m`
 /// unknowns (the profile LU of the 408-unknown pyramid problem costs 12.7 M instructions, one
 /// sweep about 70 k: 180 sweeps). Without a factorization to reuse [`Method::Auto`] sweeps up to
-/// that many, Anderson-accelerated, before Newton.
+/// that many before Newton (Anderson-accelerated from a cold start).
 pub const AUTO_SWEEPS_PER_FACTOR: usize = 1500;
 
 /// [`AUTO_COLD_SWEEPS`] if the warm start `x` is all zeros, else [`AUTO_SWEEPS`].
@@ -341,9 +341,13 @@ impl AutoOptions {
         let sweeps = newton.then(|| {
             let few = auto_sweeps(x);
             // without a factorization of this size to reuse Newton's first step pays a fresh
-            // one: sweeps up to about its cost come first, accelerated when there are many
+            // one: sweeps up to about its cost come first. From a cold start they are
+            // Anderson-accelerated; from a warm one plain, so that where they fail Newton starts
+            // from a Gauss–Seidel iterate (from an accelerated one, on a pyramid of spheres in a
+            // box at tol 1e-9, it stalled and the rescue ended at 1.02e-9)
             let budget = if factored { few } else { few.max(unknowns * unknowns / AUTO_SWEEPS_PER_FACTOR) };
-            let anderson = if budget > few { self.nsgs_anderson } else { 0 };
+            let cold = few == AUTO_COLD_SWEEPS;
+            let anderson = if budget > few && cold { self.nsgs_anderson } else { 0 };
             NsgsOptions { tol: AUTO_SWEEP_MARGIN * self.tol, max_iter: budget, anderson, ..Default::default() }
         });
         let rescue = newton.then(|| self.sweeps());

@@ -1096,13 +1096,14 @@ fn auto_plan_sweeps_before_newton_only() {
         assert_eq!((rescue.tol, rescue.max_iter, rescue.anderson), (1e-8, o.nsgs_max_iter, o.nsgs_anderson));
         assert!(big.rescue.is_none());
     }
-    // 408 unknowns (the pyramid): 110 accelerated sweeps unless a factorization is held
+    // 408 unknowns (the pyramid): 110 sweeps unless a factorization is held, accelerated from a
+    // cold start
     let o = AutoOptions::default();
     let mut warm = vec![0.0; 408];
     warm[3] = 1.0;
-    for x in [&vec![0.0; 408], &warm] {
+    for (x, anderson) in [(&vec![0.0; 408], AUTO_ANDERSON), (&warm, 0)] {
         let s = o.plan(408, x, false).sweeps.unwrap();
-        assert_eq!((s.max_iter, s.anderson), (408 * 408 / AUTO_SWEEPS_PER_FACTOR, AUTO_ANDERSON));
+        assert_eq!((s.max_iter, s.anderson), (408 * 408 / AUTO_SWEEPS_PER_FACTOR, anderson));
         assert_eq!(s.max_iter, 110);
     }
     let s = o.plan(408, &warm, true).sweeps.unwrap();
