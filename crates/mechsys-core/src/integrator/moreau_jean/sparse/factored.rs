@@ -27,6 +27,9 @@ pub(super) struct Packed {
 use crate::solver::nsgs::{local_solve, CheckSchedule};
 use crate::solver::{contact_residual_sq, project_onto_cone, NsgsOptions, Report};
 
+/// Sweeps after which a convergence check recomputes `z = Y r` instead of trusting the updated one.
+const FRESH_Z_AFTER: usize = 4;
+
 impl SparseRows {
     /// Nonsmooth Gauss–Seidel on the problem `u = W r + q` with friction coefficients `mu`:
     /// up to `opts.max_iter` sweeps in `order` (a permutation of the contacts, else by index),
@@ -129,8 +132,12 @@ impl SparseRows {
             }
             last_change = change;
             if check.due(it, change.sqrt() / qn <= tol) || it == max_sweeps {
-                // a fresh z (the updates' round-off does not accumulate into the residual)
-                self.factored_product::<D>(r);
+                // a fresh z once many sweeps' updates could have accumulated round-off into it
+                // (after a warm step's one or two sweeps the updated z is as good, and the
+                // product would be a third of the step's solve)
+                if it > FRESH_Z_AFTER {
+                    self.factored_product::<D>(r);
+                }
                 residual = self.factored_residual::<D>(q, mu, r, u) / qn;
                 if residual <= tol {
                     return Report { iterations: it, residual, converged: true };
