@@ -923,7 +923,7 @@ impl MoreauJean {
             // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks
             let plan = match &self.method {
                 Method::Nsgs(o) => Some(solver::AutoPlan { sweeps: None, then: Method::Nsgs(*o), rescue: None }),
-                Method::Auto(o) => Some(o.plan(m, &self.r, self.ws.newton.factored(m))).filter(|p| p.sweeps.is_some() || matches!(p.then, Method::Nsgs(_))),
+                Method::Auto(o) => Some(o.plan(m, &self.r, self.ws.newton.holds_factorization())).filter(|p| p.sweeps.is_some() || matches!(p.then, Method::Nsgs(_))),
                 _ => None,
             };
             if let Some(plan) = plan {

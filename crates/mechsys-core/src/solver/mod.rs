@@ -225,7 +225,8 @@ pub const AUTO_COLD_SWEEPS: usize = 10;
 /// Sweeps worth one fresh Newton factorization are about `m² / AUTO_SWEEPS_PER_FACTOR` for `m`
 /// unknowns (the profile LU of the 408-unknown pyramid problem costs 12.7 M instructions, one
 /// sweep about 70 k: 180 sweeps). Without a factorization to reuse [`Method::Auto`] sweeps up to
-/// that many before Newton (Anderson-accelerated from a cold start).
+/// that many before Newton until Newton has factored a problem in the workspace (Anderson-accelerated
+/// from a cold start).
 pub const AUTO_SWEEPS_PER_FACTOR: usize = 1500;
 
 /// [`AUTO_COLD_SWEEPS`] if the warm start `x` is all zeros, else [`AUTO_SWEEPS`].
@@ -335,17 +336,20 @@ impl AutoOptions {
     /// must get well below the tolerance: a step left just under it passes its error on to the
     /// next step's free velocity, which then starts above the tolerance (on a resting stack every
     /// other step went to Newton).
-    pub fn plan(&self, unknowns: usize, x: &[f64], factored: bool) -> AutoPlan {
+    pub fn plan(&self, unknowns: usize, x: &[f64], held: bool) -> AutoPlan {
         let then = self.pick(unknowns);
         let newton = matches!(then, Method::Newton(_));
         let sweeps = newton.then(|| {
             let few = auto_sweeps(x);
-            // without a factorization of this size to reuse Newton's first step pays a fresh
-            // one: sweeps up to about its cost come first. From a cold start they are
-            // Anderson-accelerated; from a warm one plain, so that where they fail Newton starts
-            // from a Gauss–Seidel iterate (from an accelerated one, on a pyramid of spheres in a
-            // box at tol 1e-9, it stalled and the rescue ended at 1.02e-9)
-            let budget = if factored { few } else { few.max(unknowns * unknowns / AUTO_SWEEPS_PER_FACTOR) };
+            // until Newton has factored a problem in this workspace (`held`), its first step would
+            // pay a fresh factorization: sweeps up to about its cost come first. From a cold
+            // start they are Anderson-accelerated; from a warm one plain, so that where they fail
+            // Newton starts from a Gauss–Seidel iterate (from an accelerated one, on a pyramid of
+            // spheres in a box at tol 1e-9, it stalled and the rescue ended at 1.02e-9). Once a
+            // factorization is held the few sweeps as before: a workspace whose problems reach
+            // Newton and change size (the islands of a pile) lost more to the extra sweeps than
+            // it saved (1000-sphere pour: 230 -> 333 s/s, unconverged steps 2.7 -> 5.7 %)
+            let budget = if held { few } else { few.max(unknowns * unknowns / AUTO_SWEEPS_PER_FACTOR) };
             let cold = few == AUTO_COLD_SWEEPS;
             let anderson = if budget > few && cold { self.nsgs_anderson } else { 0 };
             NsgsOptions { tol: AUTO_SWEEP_MARGIN * self.tol, max_iter: budget, anderson, ..Default::default() }
@@ -571,7 +575,7 @@ impl sealed::Sealed for FrictionContact {
     }
     fn run(&self, method: &Method, x: &mut [f64], ws: &mut Workspace) -> Result<Report> {
         match method {
-            Method::Auto(o) => o.plan(self.unknowns(), x, ws.newton.factored(self.unknowns())).run(|stage| match stage {
+            Method::Auto(o) => o.plan(self.unknowns(), x, ws.newton.holds_factorization()).run(|stage| match stage {
                 Stage::Sweeps(s) => nsgs::solve_fc(self, s, x, ws),
                 Stage::Solve(m) => self.run(m, x, ws),
             }),

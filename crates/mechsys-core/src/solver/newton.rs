@@ -67,10 +67,9 @@ pub(crate) struct NewtonWork {
 }
 
 impl NewtonWork {
-    /// Whether it holds a factorization of an `m`-unknown problem (the next solve of that size
-    /// starts from it as a chord).
-    pub(crate) fn factored(&self, m: usize) -> bool {
-        self.lu_size == m && m > 0
+    /// Whether it holds a factorization (of any size): once Newton has factored a problem here.
+    pub(crate) fn holds_factorization(&self) -> bool {
+        self.lu_size != 0
     }
 
     pub(crate) fn reserve(&mut self, m: usize) {

@@ -1076,8 +1076,8 @@ fn w_nn_check_names_the_contact_and_the_fault() {
 }
 
 /// Auto's plan: sweeps before Newton (10 from a cold start, 4 warm, at a tenth of the
-/// tolerance; more, accelerated, on a problem large enough that a fresh factorization costs more,
-/// unless one of its size is held for reuse), none before Gauss–Seidel on a large problem.
+/// tolerance; more on a problem large enough that a fresh factorization costs more, until Newton
+/// has factored a problem in the workspace), none before Gauss–Seidel on a large problem.
 #[test]
 fn auto_plan_sweeps_before_newton_only() {
     let o = AutoOptions { tol: 1e-8, newton_max_unknowns: 30, ..Default::default() };
@@ -1097,7 +1097,7 @@ fn auto_plan_sweeps_before_newton_only() {
         assert!(big.rescue.is_none());
     }
     // 408 unknowns (the pyramid): 110 sweeps unless a factorization is held, accelerated from a
-    // cold start
+    // cold start; with one held (of any size) the few sweeps
     let o = AutoOptions::default();
     let mut warm = vec![0.0; 408];
     warm[3] = 1.0;
