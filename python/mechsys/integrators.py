@@ -18,16 +18,24 @@ import math
 from dataclasses import KW_ONLY, asdict, dataclass
 
 
+def _as_float(value) -> float:
+    """``value`` as a float; NaN for what is not a number (strings and bools included: a "3" or
+    True in a setting is a mistake, not a count)."""
+    if isinstance(value, (bool, str, bytes)):
+        return math.nan
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
 def _whole(owner: object, key: str, value) -> int:
     """``value`` as an int if it is a whole number (``3`` or ``3.0``); otherwise a SettingsError
     naming the setting (``int()`` alone would turn 2.5 into 2 without a word)."""
     from .errors import SettingsError
 
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        x = math.nan
-    if not math.isfinite(x) or x != int(x) or isinstance(value, (bool, str, bytes)):
+    x = _as_float(value)
+    if not math.isfinite(x) or x != int(x):
         raise SettingsError(f"{type(owner).__name__}.{key}: expected a whole number, got {value!r}")
     return int(x)
 
@@ -37,11 +45,8 @@ def _number(owner: object, key: str, value) -> float:
     (a NaN would reach the engine's settings file as a value it cannot read)."""
     from .errors import SettingsError
 
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        x = math.nan
-    if not math.isfinite(x) or isinstance(value, (bool, str, bytes)):
+    x = _as_float(value)
+    if not math.isfinite(x):
         raise SettingsError(f"{type(owner).__name__}.{key}: expected a finite number, got {value!r}")
     return x
 
@@ -146,8 +151,9 @@ class Auto:
     """The contact solver by problem shape: :class:`Newton` (regularized, its factorization reused
     while the contact set rests) for problems of at most ``newton_max_unknowns`` unknowns (3 per
     contact point in space, 2 in the plane), :class:`NSGS` above (Anderson-accelerated:
-    ``nsgs_anderson`` past sweeps combined, up to ``nsgs_max_iter`` sweeps); where Newton ends
-    above the tolerance (its cap ``newton_max_iter``, or 30 iterations without halving its
+    ``nsgs_anderson`` past sweeps combined, up to ``nsgs_max_iter`` sweeps). Before Newton a few
+    sweeps (4, 10 from a cold start; until Newton has factored a problem, up to n²/1500 for n
+    unknowns, about one factorization's cost); where Newton ends above the tolerance (its cap ``newton_max_iter``, or 30 iterations without halving its
     residual: indeterminate piles), those sweeps go on from its iterate; ``solver="auto"`` in
     :class:`MoreauJean`."""
 

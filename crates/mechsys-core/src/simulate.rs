@@ -82,8 +82,8 @@ pub struct RecordSelection {
     #[serde(default = "yes")]
     pub forces: bool,
     /// The contact points' signals (gap, point, normal, rates, forces, impulses, state, reserve):
-    /// without them Moreau–Jean skips the contact kinematics at each sample (a narrow phase per
-    /// pair). The solver's signals and the contact energies are recorded either way.
+    /// without them Moreau–Jean also skips the contact kinematics at each sample (a narrow phase
+    /// per pair). The solver's signals and the contact energies are recorded either way.
     #[serde(default = "yes")]
     pub contacts: bool,
 }
@@ -1714,7 +1714,8 @@ fn event_driven(
     let e = nq + nu;
     // integrals of the forces at the previous sample, and the energy taken by impacts so far
     let mut prev = vec![0.0; 3 * np];
-    rec.reserve_contacts(rec.n_out, np);
+    let contact_signals = rec.selection.contacts;
+    rec.reserve_contacts(rec.n_out, if contact_signals { np } else { 0 });
     let (mut e_impact, mut e_impulsive_friction, mut w_impulsive) = (0.0, 0.0, 0.0);
     let mut warnings = Vec::new();
     let mut sample = |ph: &mut Phase, t: f64, y: &[f64], imp: &[f64], d: event_driven::Dissipation| -> Result<()> {
@@ -1735,6 +1736,10 @@ fn event_driven(
             prev[3 * pt] = now_n;
             prev[3 * pt + 1] = now_t[0];
             prev[3 * pt + 2] = now_t[1];
+            // (the impulse integrals above run either way; the points' signals only if recorded)
+            if !contact_signals {
+                continue;
+            }
             let f_t = kk.point.t1 * ph.lam_t[pt][0] + kk.point.t2 * ph.lam_t[pt][1];
             let con = model.contact_of_point(pt);
             let lt = (ph.lam_t[pt][0].powi(2) + ph.lam_t[pt][1].powi(2)).sqrt();

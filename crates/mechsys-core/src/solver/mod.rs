@@ -391,7 +391,8 @@ pub enum Method {
     /// Accelerated projected gradient (friction contact only).
     Apgd(ApgdOptions),
     /// Newton for small friction-contact problems (after up to [`AUTO_SWEEPS`] Gauss–Seidel
-    /// sweeps, [`AUTO_COLD_SWEEPS`] from a cold start, and followed by sweeps if it stalls: see
+    /// sweeps, [`AUTO_COLD_SWEEPS`] from a cold start, more until Newton has factored a problem
+    /// in the workspace ([`AUTO_SWEEPS_PER_FACTOR`]), and followed by sweeps if it stalls: see
     /// [`AutoPlan`]; the report counts every stage), Gauss–Seidel for large ones, Lemke for LCPs
     /// ([`AutoOptions::pick`]).
     Auto(AutoOptions),
@@ -420,6 +421,9 @@ impl Method {
     }
 
     pub(crate) fn validate(&self) -> Result<()> {
+        // (an infinite tolerance, `tol = inf` in a model file, would pass `> 0` and stop every
+        // solve at once with its warm start)
+        let tol_ok = |tol: f64| tol > 0.0 && tol.is_finite();
         match self {
             Method::Lemke(o) => {
                 ensure!(
@@ -438,7 +442,7 @@ impl Method {
                 );
             }
             Method::Nsgs(o) => {
-                ensure!(o.tol > 0.0, Settings, "NSGS: tol must be > 0, got {}", o.tol);
+                ensure!(tol_ok(o.tol), Settings, "NSGS: tol must be a finite number > 0, got {}", o.tol);
                 ensure!(o.max_iter > 0, Settings, "NSGS: max_iter must be > 0");
                 ensure!(
                     o.relaxation > 0.0 && o.relaxation < 2.0,
@@ -455,7 +459,7 @@ impl Method {
                 );
             }
             Method::Auto(o) => {
-                ensure!(o.tol > 0.0, Settings, "auto solver: tol must be > 0, got {}", o.tol);
+                ensure!(tol_ok(o.tol), Settings, "auto solver: tol must be a finite number > 0, got {}", o.tol);
                 ensure!(
                     o.newton_max_iter > 0 && o.nsgs_max_iter > 0,
                     Settings,
@@ -470,11 +474,11 @@ impl Method {
                 );
             }
             Method::Apgd(o) => {
-                ensure!(o.tol > 0.0, Settings, "APGD: tol must be > 0, got {}", o.tol);
+                ensure!(tol_ok(o.tol), Settings, "APGD: tol must be a finite number > 0, got {}", o.tol);
                 ensure!(o.max_iter > 0, Settings, "APGD: max_iter must be > 0");
             }
             Method::Newton(o) => {
-                ensure!(o.tol > 0.0, Settings, "Newton: tol must be > 0, got {}", o.tol);
+                ensure!(tol_ok(o.tol), Settings, "Newton: tol must be a finite number > 0, got {}", o.tol);
                 ensure!(o.max_iter > 0, Settings, "Newton: max_iter must be > 0");
                 ensure!(
                     o.regularization >= 0.0 && o.regularization < 1.0,

@@ -1191,3 +1191,23 @@ fn anderson_sweeps_converge_in_fewer_sweeps_on_piles() {
     let e = run_fc(&sphere_pile(10, 0.5, 1).unwrap(), bad).unwrap_err().to_string();
     assert!(e.contains("anderson") && e.contains("0..=8"), "{e}");
 }
+
+/// A tolerance that is not a finite number > 0 is refused before a solve, naming the solver: an
+/// infinite one (`tol = inf` in a model file) passed the old `> 0` test and ended every solve at
+/// its warm start, reported converged.
+#[test]
+fn a_tolerance_that_is_not_finite_and_positive_is_refused() {
+    for tol in [f64::INFINITY, f64::NAN, 0.0, -1e-8] {
+        let methods = [
+            ("NSGS", Method::Nsgs(NsgsOptions { tol, ..Default::default() })),
+            ("auto solver", Method::Auto(AutoOptions { tol, ..Default::default() })),
+            ("APGD", Method::Apgd(ApgdOptions { tol, ..Default::default() })),
+            ("Newton", Method::Newton(NewtonOptions { tol, ..Default::default() })),
+        ];
+        for (name, m) in methods {
+            let e = m.validate().unwrap_err().to_string();
+            assert!(e.contains(&format!("{name}: tol must be a finite number > 0, got {tol}")), "{e}");
+        }
+    }
+    assert!(Method::Auto(AutoOptions { tol: 1e300, ..Default::default() }).validate().is_ok());
+}
