@@ -70,7 +70,7 @@ def test_apgd_by_name_table_and_bad_settings():
         _solver({"type": "apgd", "max_iter": 0})
     with pytest.raises(SettingsError, match=r"integrator\.solver\.relaxation: unknown key for apgd"):
         _solver({"type": "apgd", "relaxation": 1.2})
-    with pytest.raises(Exception, match="APGD: tol must be > 0"):
+    with pytest.raises(Exception, match="APGD: tol must be a finite number > 0"):
         ms.simulate(stack_model(1), 0.01, ms.MoreauJean(1e-3, solver=ms.APGD(tol=-1.0)))
 
 
