@@ -10,6 +10,10 @@
 //! - `newton/blocks/100`: semismooth Newton from zero, tol 1e-8 (dense Jacobian and LU; at
 //!   1000 contacts one LU of 3000 × 3000 alone takes seconds, so that size is NSGS only).
 //!
+//! - `block_lu/grid3d/N`, N = 125, 1000: [`BlockLu`] on the `k × k × k` grid graph of 6 × 6
+//!   blocks (each block row coupled to its up to six neighbours, like the bodies of a settled pile
+//!   of spheres): `analyze` (minimum-degree ordering and fill), `factor` and `solve`.
+//!
 //! Before timing, each case prints its report (iterations, residual) once.
 //! Run with `cargo bench -p mechsys-core --bench solver` (add `-- --quick` for a short run).
 
@@ -17,6 +21,7 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
+use mechsys_core::math::block_sparse::BlockLu;
 use mechsys_core::solver::fixtures::{dense_copy, sphere_pile};
 use mechsys_core::solver::{solve, FrictionContact, Method, NewtonOptions, NsgsOptions, Problem, Workspace};
 
@@ -77,5 +82,63 @@ fn bench_solvers(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench_solvers);
+/// The pairs of the `k × k × k` grid graph.
+fn grid3d(k: usize) -> Vec<(usize, usize)> {
+    let id = |x: usize, y: usize, z: usize| (x * k + y) * k + z;
+    let mut pairs = vec![];
+    for x in 0..k {
+        for y in 0..k {
+            for z in 0..k {
+                if x + 1 < k {
+                    pairs.push((id(x, y, z), id(x + 1, y, z)));
+                }
+                if y + 1 < k {
+                    pairs.push((id(x, y, z), id(x, y + 1, z)));
+                }
+                if z + 1 < k {
+                    pairs.push((id(x, y, z), id(x, y, z + 1)));
+                }
+            }
+        }
+    }
+    pairs
+}
+
+fn bench_block_lu(c: &mut Criterion) {
+    let mut g = c.benchmark_group("block_lu");
+    for k in [5usize, 10] {
+        let (n, pairs) = (k * k * k, grid3d(k));
+        let mut lu = BlockLu::<6>::default();
+        let load = |lu: &mut BlockLu<6>| {
+            lu.zero();
+            let mut d = [0.0; 36];
+            for r in 0..6 {
+                d[r * 7] = 10.0;
+            }
+            for i in 0..n {
+                lu.add(i, i, &d);
+            }
+            for &(i, j) in &pairs {
+                lu.add(i, j, &[0.1; 36]);
+                lu.add(j, i, &[-0.1; 36]);
+            }
+        };
+        lu.analyze(n, &pairs);
+        println!("block_lu/grid3d/{n}: {} filled blocks, {:.2e} multiply-adds per factorization", lu.filled(), lu.factor_cost() as f64);
+        g.bench_with_input(BenchmarkId::new("analyze", n), &n, |b, _| b.iter(|| lu.analyze(n, black_box(&pairs))));
+        g.bench_with_input(BenchmarkId::new("factor", n), &n, |b, _| {
+            b.iter(|| {
+                load(&mut lu);
+                lu.factor().expect("nonsingular")
+            })
+        });
+        load(&mut lu);
+        lu.factor().expect("nonsingular");
+        let (mut x, mut w) = (vec![1.0; 6 * n], vec![0.0; 6 * n]);
+        g.bench_with_input(BenchmarkId::new("solve", n), &n, |b, _| b.iter(|| lu.solve(black_box(&mut x), &mut w)));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_solvers, bench_block_lu);
 criterion_main!(benches);

@@ -4,6 +4,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+pub mod block_sparse;
 pub mod expr;
 pub mod frames;
 pub mod fresnel;
