@@ -113,10 +113,12 @@ def test_a_depth_above_eight_is_refused_naming_the_key(solver, key):
 
 
 @pytest.mark.parametrize("solver, key", [(ms.NSGS(anderson=2.5), "NSGS.anderson"), (ms.NSGS(max_iter=float("nan")), "NSGS.max_iter"),
-                                         (ms.Auto(nsgs_anderson=None), "Auto.nsgs_anderson"), (ms.Lemke(facets="8"), "Lemke.facets")])
+                                         (ms.Auto(nsgs_anderson=None), "Auto.nsgs_anderson"), (ms.Lemke(facets="8"), "Lemke.facets"),
+                                         (ms.NSGS(max_iter=-1), "NSGS.max_iter"), (ms.Auto(newton_max_unknowns=-3), "Auto.newton_max_unknowns")])
 def test_a_count_that_is_not_a_whole_number_is_refused_naming_the_key(solver, key):
-    """(int() alone turned 2.5 sweeps combined into 2 without a word.)"""
-    with pytest.raises(SettingsError, match=rf"{key}: expected a whole number, got"):
+    """(int() alone turned 2.5 sweeps combined into 2 without a word; a negative count reached the
+    engine, whose message did not name the setting.)"""
+    with pytest.raises(SettingsError, match=rf"{key}: expected a whole number >= 0, got"):
         ms.simulate(pile(4), 0.01, ms.MoreauJean(1e-3, solver=solver), progress=False)
 
 

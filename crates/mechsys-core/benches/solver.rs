@@ -124,7 +124,11 @@ fn bench_block_lu(c: &mut Criterion) {
             }
         };
         lu.analyze(n, &pairs);
-        println!("block_lu/grid3d/{n}: {} filled blocks, {:.2e} multiply-adds per factorization", lu.filled(), lu.factor_cost() as f64);
+        println!(
+            "block_lu/grid3d/{n}: {} filled blocks, {:.2e} multiply-adds per factorization",
+            lu.filled(),
+            lu.factor_cost() as f64
+        );
         g.bench_with_input(BenchmarkId::new("analyze", n), &n, |b, _| b.iter(|| lu.analyze(n, black_box(&pairs))));
         g.bench_with_input(BenchmarkId::new("factor", n), &n, |b, _| {
             b.iter(|| {

@@ -7,7 +7,7 @@ use mechsys_core::dynamics::Workspace;
 use mechsys_core::forces::NoCallbacks;
 use mechsys_core::integrator::moreau_jean::MoreauJean;
 use mechsys_core::model::{Model, ModelDescription};
-use mechsys_core::solver::{ApgdOptions, AutoOptions, Method, NsgsOptions};
+use mechsys_core::solver::{ApgdOptions, AutoOptions, Method, NewtonOptions, NsgsOptions};
 
 mod common;
 use common::allocations;
@@ -36,6 +36,14 @@ fn group_steps_with_anderson_do_not_allocate_after_warm_up() {
     pile_steps_do_not_allocate_after_warm_up(Method::Nsgs(nsgs));
     let auto = AutoOptions { tol: 1e-8, newton_max_unknowns: 0, nsgs_max_iter: 500, ..Default::default() };
     pile_steps_do_not_allocate_after_warm_up(Method::Auto(auto));
+}
+
+/// The same with Newton's direction in body space (its ordering, fill pattern and factors grown
+/// to the largest contact graph of the run).
+#[test]
+fn group_steps_with_body_space_newton_do_not_allocate_after_warm_up() {
+    let newton = NewtonOptions { tol: 1e-8, body_space_above: 0, ..Default::default() };
+    pile_steps_do_not_allocate_after_warm_up(Method::Newton(newton));
 }
 
 /// The same with the accelerated projected gradient (its scratch sized once in the workspace).

@@ -237,6 +237,8 @@ pub struct MoreauJean {
     /// The sparse assembly's off-diagonal blocks are in `problem.w` for this step (they are
     /// built only when a solve needs them: not for Gauss–Seidel on the factored operator).
     blocks_ready: bool,
+    /// This step's problem goes whole to the body-space Newton method (see `sparse::body_newton`).
+    body_space: bool,
     /// `W r + q` of the step's solution when the factored solve found it (else empty).
     local_u: Vec<f64>,
 }
@@ -346,6 +348,7 @@ impl MoreauJean {
             in_step: vec![false; np],
             closed_before: vec![false; np],
             blocks_ready: false,
+            body_space: false,
             local_u: Vec::with_capacity(dim * np),
         })
     }
@@ -704,7 +707,14 @@ impl MoreauJean {
                 }
                 None => self.islands.single(m),
             }
-            let split = self.sparse.is_some() && self.islands.count() > 1;
+            // Newton on a large problem of free bodies: solved whole, its direction in body space
+            self.body_space = match (&self.method, self.sparse.as_ref()) {
+                (Method::Newton(o), Some(sp)) => {
+                    m * d > o.body_space_above && !self.static_mu.iter().any(|s| *s) && sp.all_free()
+                }
+                _ => false,
+            };
+            let split = self.sparse.is_some() && self.islands.count() > 1 && !self.body_space;
             self.local_u.clear();
             let factored = !split && !self.static_mu.iter().any(|s| *s);
             let report = self.solve_contacts(split, false, factored).map_err(|e| {
@@ -923,7 +933,11 @@ impl MoreauJean {
             // Gauss–Seidel on the factored operator, then (Auto's Newton) on the blocks
             let plan = match &self.method {
                 Method::Nsgs(o) => Some(solver::AutoPlan { sweeps: None, then: Method::Nsgs(*o), rescue: None }),
-                Method::Auto(o) => Some(o.plan(m, &self.r, self.ws.newton.holds_factorization())).filter(|p| p.sweeps.is_some() || matches!(p.then, Method::Nsgs(_))),
+                Method::Newton(o) if self.body_space => {
+                    Some(solver::AutoPlan { sweeps: None, then: Method::Newton(*o), rescue: None })
+                }
+                Method::Auto(o) => Some(o.plan(m, &self.r, self.ws.newton.holds_factorization()))
+                    .filter(|p| p.sweeps.is_some() || matches!(p.then, Method::Nsgs(_))),
                 _ => None,
             };
             if let Some(plan) = plan {
@@ -944,6 +958,14 @@ impl MoreauJean {
                         let sp = self.sparse.as_mut().expect("sparse assembly");
                         let problem = (&self.problem.q[..], &self.problem.mu[..]);
                         Ok(sp.gauss_seidel(problem, &self.ws.order, &mut self.r, o, &mut self.local_u))
+                    }
+                    solver::Stage::Solve(Method::Newton(o)) if self.body_space => {
+                        self.local_u.resize(m, 0.0);
+                        let sp = self.sparse.as_mut().expect("sparse assembly");
+                        let problem = (&self.problem.q[..], &self.problem.mu[..]);
+                        Ok(sp
+                            .body_newton(problem, &self.ws.order, &mut self.r, o, &mut self.local_u)
+                            .expect("free bodies"))
                     }
                     solver::Stage::Solve(method) => {
                         // on the blocks (an empty `local_u` tells the contact states to come
@@ -979,6 +1001,12 @@ impl MoreauJean {
             bw.refill(d, sp.len(), &sp.diag, &sp.upper, &sp.upper_val);
             self.blocks_ready = true;
         }
+    }
+
+    /// Factorizations of the body-space Newton method so far (see
+    /// [`crate::solver::NewtonOptions::body_space_above`]).
+    pub fn body_space_factorizations(&self) -> usize {
+        self.sparse.as_ref().map_or(0, |sp| sp.newton.factorizations())
     }
 
     /// Steps in which the position projection moved a contact back onto its contour.

@@ -9,7 +9,7 @@
 //! - **Numeric factorization** ([`BlockLu::factor`]): right-looking block LU without pivoting
 //!   between blocks, `K = L U` with `L` block lower triangular (its diagonal blocks the pivot
 //!   blocks) and `U` unit block upper triangular, `U_kj = A_kk⁻¹ A_kj`. Within a pivot block, LU
-//!   with partial pivoting. Without pivoting between blocks this is stable for block diagonally
+//!   with partial pivoting, inverted once. Without pivoting between blocks this is stable for block diagonally
 //!   dominant and for symmetric positive definite matrices (the body-space matrix is the identity
 //!   plus a positive semidefinite term where contacts stick or are open).
 //! - **Solve** ([`BlockLu::solve`]): forward and back substitution over the pattern.
@@ -30,7 +30,7 @@ pub struct BlockLu<const B: usize> {
     /// Later positions coupled to position k (ascending): `idx[ptr[k]..ptr[k + 1]]`.
     ptr: Vec<usize>,
     idx: Vec<usize>,
-    /// Pivot blocks (row-major `B × B` each) and their LU pivots.
+    /// Inverses of the pivot blocks (row-major `B × B` each), and the pivots of their LU.
     diag: Vec<f64>,
     piv: Vec<usize>,
     /// Block (idx[e], k) of L and block (k, idx[e]) of U at entry `e`, row-major `B × B`.
@@ -204,22 +204,37 @@ impl<const B: usize> BlockLu<B> {
         const { assert!(B <= 8, "blocks of up to 8 × 8") };
         let bb = Self::BB;
         for k in 0..self.n {
+            // the pivot block's inverse (by its LU with partial pivoting), kept in its place
             let (d, p) = (&mut self.diag[k * bb..(k + 1) * bb], &mut self.piv[k * B..(k + 1) * B]);
             if lu_factor(d, B, p).is_err() || d.iter().any(|v| !v.is_finite()) {
                 return Err(self.order[k]);
             }
+            let mut inv = [0.0; 64];
+            for c in 0..B {
+                let mut col = [0.0; B];
+                col[c] = 1.0;
+                lu_solve(d, B, p, &mut col);
+                for r in 0..B {
+                    inv[r * B + c] = col[r];
+                }
+            }
+            if inv[..bb].iter().any(|v| !v.is_finite()) {
+                return Err(self.order[k]);
+            }
+            d.copy_from_slice(&inv[..bb]);
             let (lo, hi) = (self.ptr[k], self.ptr[k + 1]);
-            // U_kj = A_kk⁻¹ A_kj, column by column
+            // U_kj = A_kk⁻¹ A_kj
             for e in lo..hi {
                 let blk = &mut self.upper[e * bb..(e + 1) * bb];
-                for c in 0..B {
-                    let mut col = [0.0; B];
-                    for r in 0..B {
-                        col[r] = blk[r * B + c];
-                    }
-                    lu_solve(&self.diag[k * bb..(k + 1) * bb], B, &self.piv[k * B..(k + 1) * B], &mut col);
-                    for r in 0..B {
-                        blk[r * B + c] = col[r];
+                let mut a = [0.0; 64];
+                a[..bb].copy_from_slice(blk);
+                for r in 0..B {
+                    for c in 0..B {
+                        let mut x = 0.0;
+                        for t in 0..B {
+                            x += inv[r * B + t] * a[t * B + c];
+                        }
+                        blk[r * B + c] = x;
                     }
                 }
             }
@@ -266,7 +281,16 @@ impl<const B: usize> BlockLu<B> {
         for k in 0..n {
             let (head, tail) = z.split_at_mut((k + 1) * B);
             let zk = &mut head[k * B..];
-            lu_solve(&self.diag[k * bb..(k + 1) * bb], B, &self.piv[k * B..(k + 1) * B], zk);
+            let inv = &self.diag[k * bb..(k + 1) * bb];
+            let mut b = [0.0; B];
+            b.copy_from_slice(zk);
+            for r in 0..B {
+                let mut x = 0.0;
+                for c in 0..B {
+                    x += inv[r * B + c] * b[c];
+                }
+                zk[r] = x;
+            }
             for e in self.ptr[k]..self.ptr[k + 1] {
                 let pi = self.idx[e];
                 let l = &self.lower[e * bb..(e + 1) * bb];

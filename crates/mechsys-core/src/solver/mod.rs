@@ -180,11 +180,28 @@ pub struct NewtonOptions {
     /// 0: never. Set by [`Method::Auto`] ([`AUTO_NEWTON_STALL`]), whose sweeps then go on.
     #[serde(skip)]
     pub stall: usize,
+    /// A Moreau–Jean problem of more unknowns than this whose contacts are all on free bodies
+    /// and the ground (a pile) takes its Newton direction in body space: one sparse
+    /// factorization in the bodies' velocities, 6 per body, instead of a dense one of the
+    /// contact Jacobian (see `integrator::moreau_jean::sparse::body_newton`). The iterates are
+    /// the same up to round-off.
+    pub body_space_above: usize,
 }
+
+/// [`NewtonOptions::body_space_above`]'s default: the size up to which [`Method::Auto`] takes
+/// Newton's dense factorization.
+pub const BODY_SPACE_ABOVE: usize = 480;
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        Self { tol: 1e-10, max_iter: 200, regularization: 1e-4, reuse: true, stall: 0 }
+        Self {
+            tol: 1e-10,
+            max_iter: 200,
+            regularization: 1e-4,
+            reuse: true,
+            stall: 0,
+            body_space_above: BODY_SPACE_ABOVE,
+        }
     }
 }
 
@@ -309,7 +326,10 @@ impl AutoPlan {
     /// Runs the plan through `stage` (the caller's solver for each kind of stage: blocks, or the
     /// factored operator for sweeps): the sweeps, then `then` unless they converged, then the
     /// rescue unless that converged; the report counts every stage's iterations.
-    pub fn run<E>(&self, mut stage: impl FnMut(Stage<'_>) -> std::result::Result<Report, E>) -> std::result::Result<Report, E> {
+    pub fn run<E>(
+        &self,
+        mut stage: impl FnMut(Stage<'_>) -> std::result::Result<Report, E>,
+    ) -> std::result::Result<Report, E> {
         let Some(sweeps) = &self.sweeps else {
             return match &self.then {
                 Method::Nsgs(o) => stage(Stage::Sweeps(o)),

@@ -26,8 +26,8 @@
 //! confirmation the next one waits 1, 2, 4, … up to 64 sweeps, so the reported sweep count can
 //! exceed the first sweep that met the tolerance by that much.
 
-use super::problem::{dot, fc_residual, lcp_residual, lcp_w, norm, project_onto_cone, FrictionContact, Lcp};
 use super::anderson::Anderson;
+use super::problem::{dot, fc_residual, lcp_residual, lcp_w, norm, project_onto_cone, FrictionContact, Lcp};
 use super::{NsgsOptions, Report, Workspace};
 use crate::ensure;
 use crate::error::Result;

@@ -1126,7 +1126,10 @@ fn newton_gives_up_when_its_residual_stops_halving() {
             let (r1, with) = run_fc(&p, rule).unwrap();
             if plain.converged {
                 ok += 1;
-                assert!(with.converged && with.iterations == plain.iterations && r0 == r1, "{n} {seed}: {plain:?} {with:?}");
+                assert!(
+                    with.converged && with.iterations == plain.iterations && r0 == r1,
+                    "{n} {seed}: {plain:?} {with:?}"
+                );
             } else {
                 capped += 1;
                 assert_eq!(plain.iterations, 200);

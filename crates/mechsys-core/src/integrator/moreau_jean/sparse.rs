@@ -16,6 +16,7 @@
 //! the blocks, O(nu) for the update — for N free bodies with a bounded number of contacts each,
 //! O(N). All storage grows to the largest problem seen and is reused: no allocation afterwards.
 
+mod body_newton;
 mod factored;
 
 use crate::math::Vec3;
@@ -136,6 +137,8 @@ pub(super) struct SparseRows {
     packed: Vec<factored::Packed>,
     /// Anderson acceleration of the factored sweeps.
     aa: crate::solver::anderson::Anderson,
+    /// The body-space Newton method's scratch and held factorization.
+    pub(super) newton: body_newton::BodyNewton,
 }
 
 impl SparseRows {
@@ -208,6 +211,7 @@ impl SparseRows {
             z: vec![0.0; model.nu],
             packed: Vec::new(),
             aa: Default::default(),
+            newton: Default::default(),
         }
     }
 

@@ -159,11 +159,7 @@ impl SparseRows {
     /// six velocities, at most two); returns whether it did.
     pub(super) fn pack<const D: usize>(&mut self) -> bool {
         let n = self.len();
-        let free = (0..n).all(|a| {
-            let runs = &self.runs[self.run_ptr[a]..self.run_ptr[a + 1]];
-            runs.len() <= 2 && runs.iter().all(|r| r.1 == 6)
-        });
-        if !free {
+        if !self.all_free() {
             return false;
         }
         self.packed.clear();
@@ -183,8 +179,17 @@ impl SparseRows {
         true
     }
 
+    /// Whether every contact is on free bodies and the ground (its pattern is one or two runs of
+    /// six velocities).
+    pub(in crate::integrator::moreau_jean) fn all_free(&self) -> bool {
+        (0..self.len()).all(|a| {
+            let runs = &self.runs[self.run_ptr[a]..self.run_ptr[a + 1]];
+            runs.len() <= 2 && runs.iter().all(|r| r.1 == 6)
+        })
+    }
+
     /// `z = Σ_a Y_a r_a`.
-    fn factored_product<const D: usize>(&mut self, r: &[f64]) {
+    pub(super) fn factored_product<const D: usize>(&mut self, r: &[f64]) {
         self.z.fill(0.0);
         for a in 0..self.len() {
             let ra = &r[a * D..(a + 1) * D];
@@ -234,7 +239,7 @@ impl SparseRows {
 
     /// `u = Y_aᵀ z + q` for every contact (after [`SparseRows::factored_product`]) and the
     /// unscaled natural-map residual `‖·‖₂` of the solution `r`.
-    fn factored_residual<const D: usize>(&self, q: &[f64], mu: &[f64], r: &[f64], u: &mut [f64]) -> f64 {
+    pub(super) fn factored_residual<const D: usize>(&self, q: &[f64], mu: &[f64], r: &[f64], u: &mut [f64]) -> f64 {
         let mut sum = 0.0;
         for a in 0..self.len() {
             let ua = self.rows_times_z::<D>(a);
@@ -279,9 +284,25 @@ fn transpose_times<const D: usize, const L: usize>(y: &[f64], z: &[f64; L], out:
 }
 
 impl Packed {
+    /// Its bodies (1 or 2).
+    #[inline(always)]
+    pub(super) fn bodies(&self) -> usize {
+        self.bodies
+    }
+    /// The first velocity of each body.
+    #[inline(always)]
+    pub(super) fn iu(&self) -> [usize; 2] {
+        self.iu
+    }
+    /// Entry `j` (of six) of direction `c`'s reduced row on body `k`.
+    #[inline(always)]
+    pub(super) fn y(&self, k: usize, c: usize, j: usize) -> f64 {
+        self.y[k][c][j]
+    }
+
     /// `Y_aᵀ z` (zero beyond `D`).
     #[inline(always)]
-    fn times<const D: usize>(&self, z: &[f64]) -> [f64; 3] {
+    pub(super) fn times<const D: usize>(&self, z: &[f64]) -> [f64; 3] {
         let mut out = [0.0; 3];
         for k in 0..self.bodies {
             let zs: &[f64; 6] = z[self.iu[k]..self.iu[k] + 6].try_into().expect("six velocities");

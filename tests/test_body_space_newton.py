@@ -1,0 +1,40 @@
+"""Newton's direction in body space (``ms.Newton(body_space_above=...)``): a pile of free spheres
+solved with one sparse factorization in the bodies' velocities instead of a dense one of the
+contact Jacobian. The reference is the dense method itself (the same Newton iterates up to
+round-off), and the container's impulse on the pile (its weight)."""
+
+import numpy as np
+import pytest
+
+import mechsys as ms
+from test_contact_groups import G, MASS, square_pyramid
+
+
+def _run(above, t_end=0.3):
+    m, n = square_pyramid()
+    solver = ms.Newton(tol=1e-9, body_space_above=above)
+    return ms.simulate(m, t_end, ms.MoreauJean(1e-3, solver=solver), output_dt=1e-3, progress=False), n
+
+
+def test_body_space_newton_moves_the_pyramid_as_the_dense_newton_does():
+    body, n = _run(0)
+    dense, _ = _run(10**9)
+    # every step converged in body space; the dense method (plain Newton, up to 200 iterations)
+    # ends one step just above the tolerance
+    assert body["solver/converged"][1:].all()
+    assert (dense["solver/converged"][1:] == 0).sum() <= 1 and dense["solver/residual"].max() < 2e-9
+    # about as many Newton iterations (a wrong direction fails the line search and falls back to
+    # one sweep per iteration: many more)
+    it_body, it_dense = body["solver/iterations"].sum(), dense["solver/iterations"].sum()
+    assert it_body <= 1.2 * it_dense + 20, (it_body, it_dense)
+    assert np.abs(np.asarray(body["q"]) - np.asarray(dense["q"])).max() < 1e-7
+    # settled: the container carries the weight of the 14 spheres (momentum balance)
+    f = body["contact/pile/force_against"][-20:, 2]
+    np.testing.assert_allclose(f, n * MASS * G, rtol=1e-6)
+
+
+@pytest.mark.parametrize("bad", [-1, 2.5, float("nan")])
+def test_a_body_space_size_that_is_not_a_whole_number_from_zero_is_refused(bad):
+    m, _ = square_pyramid()
+    with pytest.raises(ms.SettingsError, match=r"Newton\.body_space_above: expected a whole number >= 0, got"):
+        ms.simulate(m, 0.01, ms.MoreauJean(1e-3, solver=ms.Newton(body_space_above=bad)), progress=False)
