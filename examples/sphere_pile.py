@@ -13,7 +13,8 @@ nothing resists rolling), the largest penetration, and the energy balance (impac
 take what the spheres lose).
 
 ``python examples/sphere_pile.py [N] [SOLVER]`` (default 100 spheres, 1.5 s simulated; a few seconds).
-SOLVER names the contact solver instead of the budgeted Gauss-Seidel: ``nsgs``, ``newton``, ``apgd``
+SOLVER names the contact solver instead of the budgeted Gauss-Seidel: ``nsgs``, ``newton`` (its
+direction solved in body space, a sparse factorization in the spheres' velocities), ``apgd``
 (accelerated projected gradient), ``auto``, each at tol 1e-4. From the command line the same is
 ``mechsys run examples/sphere_pile.py --solver apgd``.
 """
