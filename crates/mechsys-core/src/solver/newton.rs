@@ -98,7 +98,77 @@ const ARMIJO: f64 = 1e-4;
 const POLISH: f64 = 1e-3;
 const MAX_BACKTRACKS: usize = 30;
 /// Passes of iterative refinement of the regularized Newton direction.
-const REFINEMENTS: usize = 3;
+pub(crate) const REFINEMENTS: usize = 3;
+
+/// The stopping rules of the Newton iteration (shared with the body-space variant of the
+/// Moreau–Jean scheme): the tolerance with one step past it, the iteration cap, and the stall
+/// rule of [`NewtonOptions::stall`].
+pub(crate) struct Stopping {
+    iterations: usize,
+    polished: bool,
+    /// The residual last halved at iteration `since`, from `anchor`.
+    anchor: f64,
+    since: usize,
+}
+
+impl Stopping {
+    pub(crate) fn new() -> Self {
+        Self { iterations: 0, polished: false, anchor: f64::INFINITY, since: 0 }
+    }
+
+    /// The report if the iteration stops at `residual`; otherwise counts the next iteration.
+    pub(crate) fn check(&mut self, residual: f64, o: &NewtonOptions) -> Option<Report> {
+        let iterations = self.iterations;
+        if residual <= 0.5 * self.anchor {
+            (self.anchor, self.since) = (residual, iterations);
+        }
+        let stalled = o.stall > 0 && iterations - self.since >= o.stall;
+        // one step past the tolerance (nearly free with the factors reused): a time-stepping
+        // scheme passes the error left here on to the next step's free velocity, and a solution
+        // well inside the tolerance lets the next warm start finish in a sweep
+        let done = residual <= o.tol && (self.polished || residual <= POLISH * o.tol);
+        if done || iterations >= o.max_iter || (stalled && residual > o.tol) {
+            return Some(Report { iterations, residual, converged: residual <= o.tol });
+        }
+        self.polished = residual <= o.tol;
+        self.iterations += 1;
+        None
+    }
+}
+
+/// Armijo's backtracking from `r` (with `u = W r + q`) along `dir` (with `W dir` in `wdir`) for the
+/// merit `ψ = ½|Φ|²`, `psi` at `r`; `merit` gives ψ at a trial point. On success `r` takes the
+/// step and it returns true. A reused factorization (`fresh` false) gets the full step only.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn line_search(
+    r: &mut [f64],
+    u: &[f64],
+    dir: &[f64],
+    wdir: &[f64],
+    r_t: &mut [f64],
+    u_t: &mut [f64],
+    psi: f64,
+    fresh: bool,
+    mut merit: impl FnMut(&[f64], &[f64]) -> f64,
+) -> bool {
+    let mut alpha = 1.0;
+    for _ in 0..MAX_BACKTRACKS {
+        for k in 0..r.len() {
+            r_t[k] = r[k] + alpha * dir[k];
+            u_t[k] = u[k] + alpha * wdir[k];
+        }
+        if merit(r_t, u_t) <= (1.0 - 2.0 * ARMIJO * alpha) * psi {
+            r.copy_from_slice(r_t);
+            return true;
+        }
+        alpha *= 0.5;
+        // a reused factorization gets one full step's chance, then a fresh one
+        if !fresh {
+            break;
+        }
+    }
+    false
+}
 
 /// Alart–Curnier function of one contact into `phi`, and optionally `D = ∂P(x)` into `dmat`.
 pub(crate) fn alart_curnier(
@@ -240,26 +310,12 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
     let (phi, dir, wdir) = (&mut nw.phi[..m], &mut nw.dir[..m], &mut nw.wdir[..m]);
     let (r_t, u_t, phi_t) = (&mut nw.r_trial[..m], &mut nw.u_trial[..m], &mut nw.phi_trial[..m]);
     let dblk = &mut nw.dblk[..n];
-    let mut iterations = 0;
-    let mut polished = false;
-    // the stall rule: the residual last halved at iteration `since`, from `anchor`
-    let (mut anchor, mut since) = (f64::INFINITY, 0);
+    let mut stopping = Stopping::new();
     loop {
         p.w.velocity(d, r, &p.q, u);
-        let residual = fc_residual(p, r, u);
-        if residual <= 0.5 * anchor {
-            (anchor, since) = (residual, iterations);
+        if let Some(report) = stopping.check(fc_residual(p, r, u), o) {
+            return Ok(report);
         }
-        let stalled = o.stall > 0 && iterations - since >= o.stall;
-        // one step past the tolerance (nearly free with the factors reused): a time-stepping
-        // scheme passes the error left here on to the next step's free velocity, and a solution
-        // well inside the tolerance lets the next warm start finish in a sweep
-        let done = residual <= o.tol && (polished || residual <= POLISH * o.tol);
-        if done || iterations >= o.max_iter || (stalled && residual > o.tol) {
-            return Ok(Report { iterations, residual, converged: residual <= o.tol });
-        }
-        polished = residual <= o.tol;
-        iterations += 1;
         let psi = evaluate(p, diag, r, u, phi, Some(&mut *dblk));
         // the factorization of the last solve of this size is reused as a chord direction: for
         // the same projection derivatives D (a resting contact set) it is nearly exact, for a
@@ -306,24 +362,9 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             if dir.iter().all(|v| v.is_finite()) {
                 // W Δ once; trial velocities are then u + α W Δ
                 matvec(&p.w, d, dir, wdir);
-                let mut alpha = 1.0;
-                for _ in 0..MAX_BACKTRACKS {
-                    for k in 0..m {
-                        r_t[k] = r[k] + alpha * dir[k];
-                        u_t[k] = u[k] + alpha * wdir[k];
-                    }
-                    let psi_t = evaluate(p, diag, r_t, u_t, phi_t, None);
-                    if psi_t <= (1.0 - 2.0 * ARMIJO * alpha) * psi {
-                        r.copy_from_slice(r_t);
-                        accepted = true;
-                        break;
-                    }
-                    alpha *= 0.5;
-                    // a reused factorization gets one full step's chance, then a fresh one
-                    if !fresh {
-                        break;
-                    }
-                }
+                accepted = line_search(r, u, dir, wdir, r_t, u_t, psi, fresh, |rt, ut| {
+                    evaluate(p, diag, rt, ut, phi_t, None)
+                });
             }
             if accepted || fresh {
                 break;

@@ -28,15 +28,8 @@
 use super::factored::Packed;
 use super::SparseRows;
 use crate::math::block_sparse::BlockLu;
-use crate::solver::newton::alart_curnier;
+use crate::solver::newton::{alart_curnier, line_search, Stopping, REFINEMENTS};
 use crate::solver::{NewtonOptions, NsgsOptions, Report};
-
-const ARMIJO: f64 = 1e-4;
-/// Below `POLISH · tol` Newton stops without the extra step.
-const POLISH: f64 = 1e-3;
-const MAX_BACKTRACKS: usize = 30;
-/// Passes of iterative refinement of the regularized direction against the exact Jacobian.
-const REFINEMENTS: usize = 3;
 
 /// Scratch and the held factorization of the body-space Newton method.
 #[derive(Debug, Clone, Default)]
@@ -119,6 +112,17 @@ fn invert(d: usize, a: &[f64; 9]) -> Option<[f64; 9]> {
     Some(out)
 }
 
+/// `ψ = ½|Φ|²` at `r` with `u = W r + q` (`Φ` into `phi`), `W`'s diagonal blocks in `diag`.
+fn merit<const D: usize>(mu: &[f64], diag: &[f64], r: &[f64], u: &[f64], phi: &mut [f64]) -> f64 {
+    let mut psi = 0.0;
+    for a in 0..mu.len() {
+        let s = a * D..(a + 1) * D;
+        alart_curnier(D, mu[a], 1.0 / diag[a * D * D], &r[s.clone()], &u[s.clone()], &mut phi[s.clone()], None);
+        psi += phi[s].iter().map(|v| v * v).sum::<f64>();
+    }
+    0.5 * psi
+}
+
 /// `y = A x` for a `d × d` block (stride `d`).
 #[inline]
 fn block_times(d: usize, a: &[f64; 9], x: &[f64]) -> [f64; 3] {
@@ -173,22 +177,12 @@ impl SparseRows {
         bn.v.resize(nv, 0.0);
         bn.work.resize(nv, 0.0);
         let qn = 1.0 + q.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let mut iterations = 0;
-        let mut polished = false;
-        let (mut anchor, mut since) = (f64::INFINITY, 0);
+        let mut stopping = Stopping::new();
         loop {
             self.factored_product::<D>(r);
-            let residual = self.factored_residual::<D>(q, mu, r, u) / qn;
-            if residual <= 0.5 * anchor {
-                (anchor, since) = (residual, iterations);
+            if let Some(report) = stopping.check(self.factored_residual::<D>(q, mu, r, u) / qn, opts) {
+                return Some(report);
             }
-            let stalled = opts.stall > 0 && iterations - since >= opts.stall;
-            let done = residual <= opts.tol && (polished || residual <= POLISH * opts.tol);
-            if done || iterations >= opts.max_iter || (stalled && residual > opts.tol) {
-                return Some(Report { iterations, residual, converged: residual <= opts.tol });
-            }
-            polished = residual <= opts.tol;
-            iterations += 1;
             let psi = self.alart_curnier_all::<D>(mu, r, u, true);
             let mut fresh = !(opts.reuse && self.newton.held);
             let mut accepted = false;
@@ -221,24 +215,11 @@ impl SparseRows {
                 }
                 if self.newton.dir.iter().all(|v| v.is_finite()) {
                     self.w_times_dir::<D>();
-                    let mut alpha = 1.0;
-                    for _ in 0..MAX_BACKTRACKS {
-                        let bn = &mut self.newton;
-                        for k in 0..m {
-                            bn.r_t[k] = r[k] + alpha * bn.dir[k];
-                            bn.u_t[k] = u[k] + alpha * bn.wdir[k];
-                        }
-                        let psi_t = self.trial_merit::<D>(mu);
-                        if psi_t <= (1.0 - 2.0 * ARMIJO * alpha) * psi {
-                            r.copy_from_slice(&self.newton.r_t[..m]);
-                            accepted = true;
-                            break;
-                        }
-                        alpha *= 0.5;
-                        if !fresh {
-                            break;
-                        }
-                    }
+                    let bn = &mut self.newton;
+                    let (diag, phi_t) = (&self.diag, &mut bn.phi_t);
+                    accepted = line_search(r, u, &bn.dir, &bn.wdir, &mut bn.r_t, &mut bn.u_t, psi, fresh, |rt, ut| {
+                        merit::<D>(mu, diag, rt, ut, phi_t)
+                    });
                 }
                 if accepted || fresh {
                     break;
@@ -301,19 +282,6 @@ impl SparseRows {
             let dm = derivative.then(|| &mut bn.dblk[a]);
             alart_curnier(D, mu[a], rho, &r[s.clone()], &u[s.clone()], &mut bn.phi[s.clone()], dm);
             psi += bn.phi[s].iter().map(|v| v * v).sum::<f64>();
-        }
-        0.5 * psi
-    }
-
-    /// `ψ` at the trial point `newton.r_t`, `newton.u_t`.
-    fn trial_merit<const D: usize>(&mut self, mu: &[f64]) -> f64 {
-        let bn = &mut self.newton;
-        let mut psi = 0.0;
-        for a in 0..self.packed.len() {
-            let s = a * D..(a + 1) * D;
-            let rho = 1.0 / self.diag[a * D * D];
-            alart_curnier(D, mu[a], rho, &bn.r_t[s.clone()], &bn.u_t[s.clone()], &mut bn.phi_t[s.clone()], None);
-            psi += bn.phi_t[s].iter().map(|v| v * v).sum::<f64>();
         }
         0.5 * psi
     }
