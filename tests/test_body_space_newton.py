@@ -27,10 +27,11 @@ def test_body_space_newton_moves_the_pyramid_as_the_dense_newton_does():
     # one sweep per iteration: many more)
     it_body, it_dense = body["solver/iterations"].sum(), dense["solver/iterations"].sum()
     assert it_body <= 1.2 * it_dense + 20, (it_body, it_dense)
-    assert np.abs(np.asarray(body["q"]) - np.asarray(dense["q"])).max() < 1e-7
+    # (6e-11 m measured: round-off of the two factorizations over 300 steps)
+    assert np.abs(np.asarray(body["q"]) - np.asarray(dense["q"])).max() < 1e-9
     # settled: the container carries the weight of the 14 spheres (momentum balance)
     f = body["contact/pile/force_against"][-20:, 2]
-    np.testing.assert_allclose(f, n * MASS * G, rtol=1e-6)
+    np.testing.assert_allclose(f, n * MASS * G, rtol=1e-9)
 
 
 @pytest.mark.parametrize("bad", [-1, 2.5, float("nan")])

@@ -963,9 +963,10 @@ impl MoreauJean {
                         self.local_u.resize(m, 0.0);
                         let sp = self.sparse.as_mut().expect("sparse assembly");
                         let problem = (&self.problem.q[..], &self.problem.mu[..]);
-                        Ok(sp
-                            .body_newton(problem, &self.ws.order, &mut self.r, o, &mut self.local_u)
-                            .expect("free bodies"))
+                        // (`body_space` was set only where every contact is on free bodies)
+                        sp.body_newton(problem, &self.ws.order, &mut self.r, o, &mut self.local_u).ok_or_else(|| {
+                            Error::Solver("Newton in body space: a contact is not on free bodies and the ground".into())
+                        })
                     }
                     solver::Stage::Solve(method) => {
                         // on the blocks (an empty `local_u` tells the contact states to come

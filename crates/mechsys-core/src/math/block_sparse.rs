@@ -63,7 +63,8 @@ impl<const B: usize> BlockLu<B> {
 
     /// Orders the `n` block rows and forms the filled pattern for the coupled pairs `pairs`
     /// (`(i, j)` with `i ≠ j`, each pair once in either order or both; the diagonal is always
-    /// present). Entries are left to [`BlockLu::zero`] and [`BlockLu::add`].
+    /// present). Entries are left to [`BlockLu::zero`] and [`BlockLu::add`]. Panics if a pair
+    /// names a block row `≥ n`.
     pub fn analyze(&mut self, n: usize, pairs: &[(usize, usize)]) {
         self.n = n;
         if self.adj.len() < n {
@@ -184,9 +185,12 @@ impl<const B: usize> BlockLu<B> {
         seg.binary_search(&other).ok().map(|e| (lower, ptr[k] + e))
     }
 
-    /// Adds `blk` (row-major `B × B`) to block (i, j); false if the pair is not in the pattern.
+    /// Adds `blk` (row-major `B × B`) to block (i, j); false if the pair is not in the pattern
+    /// (or names a block row beyond it, or `blk` is not `B × B`).
     pub fn add(&mut self, i: usize, j: usize, blk: &[f64]) -> bool {
-        debug_assert_eq!(blk.len(), Self::BB);
+        if i >= self.n || j >= self.n || blk.len() != Self::BB {
+            return false;
+        }
         match self.block_mut(i, j) {
             Some(dst) => {
                 for (d, s) in dst.iter_mut().zip(blk) {
@@ -449,5 +453,6 @@ mod tests {
         // block row 1 is all zero
         assert_eq!(lu.factor(), Err(1));
         assert!(!lu.add(0, 2, &[1.0; 4]));
+        assert!(!lu.add(0, 3, &[1.0; 4]) && !lu.add(0, 0, &[1.0; 9]));
     }
 }

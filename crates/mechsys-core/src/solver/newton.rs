@@ -362,9 +362,8 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             if dir.iter().all(|v| v.is_finite()) {
                 // W Δ once; trial velocities are then u + α W Δ
                 matvec(&p.w, d, dir, wdir);
-                accepted = line_search(r, u, dir, wdir, r_t, u_t, psi, fresh, |rt, ut| {
-                    evaluate(p, diag, rt, ut, phi_t, None)
-                });
+                accepted =
+                    line_search(r, u, dir, wdir, r_t, u_t, psi, fresh, |rt, ut| evaluate(p, diag, rt, ut, phi_t, None));
             }
             if accepted || fresh {
                 break;

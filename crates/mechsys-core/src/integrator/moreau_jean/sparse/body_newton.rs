@@ -112,12 +112,21 @@ fn invert(d: usize, a: &[f64; 9]) -> Option<[f64; 9]> {
     Some(out)
 }
 
-/// `ψ = ½|Φ|²` at `r` with `u = W r + q` (`Φ` into `phi`), `W`'s diagonal blocks in `diag`.
-fn merit<const D: usize>(mu: &[f64], diag: &[f64], r: &[f64], u: &[f64], phi: &mut [f64]) -> f64 {
+/// `ψ = ½|Φ|²` at `r` with `u = W r + q` (`Φ` into `phi`, and the projection derivatives `D`
+/// into `dblk` if given), `W`'s diagonal blocks in `diag`.
+fn merit<const D: usize>(
+    mu: &[f64],
+    diag: &[f64],
+    r: &[f64],
+    u: &[f64],
+    phi: &mut [f64],
+    mut dblk: Option<&mut [[f64; 9]]>,
+) -> f64 {
     let mut psi = 0.0;
     for a in 0..mu.len() {
         let s = a * D..(a + 1) * D;
-        alart_curnier(D, mu[a], 1.0 / diag[a * D * D], &r[s.clone()], &u[s.clone()], &mut phi[s.clone()], None);
+        let dm = dblk.as_deref_mut().map(|b| &mut b[a]);
+        alart_curnier(D, mu[a], 1.0 / diag[a * D * D], &r[s.clone()], &u[s.clone()], &mut phi[s.clone()], dm);
         psi += phi[s].iter().map(|v| v * v).sum::<f64>();
     }
     0.5 * psi
@@ -183,7 +192,8 @@ impl SparseRows {
             if let Some(report) = stopping.check(self.factored_residual::<D>(q, mu, r, u) / qn, opts) {
                 return Some(report);
             }
-            let psi = self.alart_curnier_all::<D>(mu, r, u, true);
+            let bn = &mut self.newton;
+            let psi = merit::<D>(mu, &self.diag, r, u, &mut bn.phi, Some(&mut bn.dblk));
             let mut fresh = !(opts.reuse && self.newton.held);
             let mut accepted = false;
             loop {
@@ -218,7 +228,7 @@ impl SparseRows {
                     let bn = &mut self.newton;
                     let (diag, phi_t) = (&self.diag, &mut bn.phi_t);
                     accepted = line_search(r, u, &bn.dir, &bn.wdir, &mut bn.r_t, &mut bn.u_t, psi, fresh, |rt, ut| {
-                        merit::<D>(mu, diag, rt, ut, phi_t)
+                        merit::<D>(mu, diag, rt, ut, phi_t, None)
                     });
                 }
                 if accepted || fresh {
@@ -269,21 +279,6 @@ impl SparseRows {
             bn.analyzed = true;
             bn.held = false;
         }
-    }
-
-    /// `Φ` (into `newton.phi`) and, with `derivative`, the `D` blocks, at `r` with `u = W r + q`;
-    /// returns `ψ = ½ |Φ|²`.
-    fn alart_curnier_all<const D: usize>(&mut self, mu: &[f64], r: &[f64], u: &[f64], derivative: bool) -> f64 {
-        let bn = &mut self.newton;
-        let mut psi = 0.0;
-        for a in 0..self.packed.len() {
-            let s = a * D..(a + 1) * D;
-            let rho = 1.0 / self.diag[a * D * D];
-            let dm = derivative.then(|| &mut bn.dblk[a]);
-            alart_curnier(D, mu[a], rho, &r[s.clone()], &u[s.clone()], &mut bn.phi[s.clone()], dm);
-            psi += bn.phi[s].iter().map(|v| v * v).sum::<f64>();
-        }
-        0.5 * psi
     }
 
     /// Forms and factors `I + Y E Yᵀ` for the current `D` blocks; false if a block is singular.
@@ -447,7 +442,8 @@ mod tests {
         assert_eq!(none, 0);
         assert_eq!((unconverged_body, unconverged_dense), (0, 0));
         let diff = q_body.iter().zip(&q_dense).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-        assert!(diff < 1e-7, "positions differ by {diff:e}");
+        // (2.7e-12 m measured: round-off of the two factorizations, amplified by the pour)
+        assert!(diff < 1e-9, "positions differ by {diff:e}");
         // the spheres have fallen onto the floor or each other (not floating where they started)
         let lowest = (0..27).map(|i| q_body[7 * i + 2]).fold(f64::INFINITY, f64::min);
         assert!((lowest - 0.05).abs() < 1e-3, "lowest sphere centre at {lowest}");
