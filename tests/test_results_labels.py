@@ -87,3 +87,41 @@ def test_to_pandas_and_to_xarray(res):
     assert ds["joint/hinge/q"].attrs["units"] == "rad" and ds["q"].attrs["column_units"][4] == "1"
     with pytest.raises(ms.ResultsError, match="unknown signal 'body/nobody/position'"):
         res.to_pandas(["body/nobody/position"])
+
+
+def test_signals_are_laid_out_on_first_use_and_every_way_in_gives_the_same_tables():
+    """`simulate` hands back results whose names, units and columns are laid out on first use
+    (a parameter study reading one number does not pay for naming every signal). Whatever is
+    touched first (a signal, the names, a pickle, a file, a selective recording), the tables are
+    those of a layout done at once."""
+    import pickle
+
+    model, integ = mixed_model(), ms.RK4(dt=1e-3)
+    ref = ms.simulate(model, 0.05, integ, output_dt=0.01)
+    names = ref.names()
+    assert "body/ball/position" in names and "energy/total" in names and len(names) > 30
+    firsts = {
+        "item": lambda r: r["joint/float/q"],
+        "names": lambda r: r.names(),
+        "pickle": lambda r: pickle.loads(pickle.dumps(r)),
+        "repr": repr,
+        "columns": lambda r: r.columns("q"),
+    }
+    for what, touch in firsts.items():
+        r = ms.simulate(model, 0.05, integ, output_dt=0.01)
+        assert "_signals" not in r.__dict__, what  # nothing laid out before the first use
+        out = touch(r)
+        got = out if isinstance(out, ms.Results) else r
+        assert got.names() == names, what
+        assert [got.unit(n) for n in names] == [ref.unit(n) for n in names], what
+        np.testing.assert_array_equal(got["q"], ref["q"], err_msg=what)
+        assert got.columns("u") == ref.columns("u"), what
+    # a selective recording keeps only what it chose, however it is first read
+    sel = ms.simulate(model, 0.05, integ, output_dt=0.01, sensors=["joint/hinge/*"])
+    assert sel.names() == ["t", "joint/hinge/q", "joint/hinge/u", "joint/hinge/udot", "joint/hinge/reaction_force",
+                           "joint/hinge/reaction_torque"]
+    with pytest.raises(ms.ResultsError, match="unknown signal 'q'"):
+        sel["q"]
+    # a missing attribute is still an AttributeError naming it
+    with pytest.raises(AttributeError, match="no_such_thing"):
+        ms.simulate(model, 0.05, integ, output_dt=0.01).no_such_thing

@@ -233,9 +233,8 @@ def simulate_batch(
         }
         if chosen is not None:
             attrs["sensors"] = json.dumps(list(sensors) if not isinstance(sensors, str) else [sensors])
-        res = Results.from_raw(raw, c.joints(), c.body_names[1:], attrs, engine=c, callbacks=m.callbacks or None)
-        if chosen is not None:
-            res._keep_only(chosen)
+        res = Results.from_raw(raw, c.joints(), c.body_names[1:], attrs, engine=c, callbacks=m.callbacks or None,
+                               keep=chosen)
         return res
 
     return BatchResults(raws, errors, make)

@@ -119,8 +119,37 @@ class Results:
     # ---- construction from a simulation --------------------------------------------------------
     @classmethod
     def from_raw(
-        cls, raw: dict, joints: list[dict], body_names: list[str], attrs: dict, engine=None, callbacks=None
+        cls, raw: dict, joints: list[dict], body_names: list[str], attrs: dict, engine=None, callbacks=None,
+        keep: Iterable[str] | None = None,
     ) -> "Results":
+        """The results of a run from the engine's recording ``raw``. The named signals (views into
+        the recorded blocks), their units and columns are laid out on first use: a run whose
+        results are read by a few names, or not at all (a parameter study keeping one number),
+        does not pay for naming the others (a few tenths of a millisecond for a chain of 16
+        bodies). ``keep``: the names of a selective recording (``simulate(sensors=...)``)."""
+        out = cls.__new__(cls)
+        out.attrs = dict(attrs or {})
+        out._pending = (raw, joints, body_names, engine, callbacks, None if keep is None else list(keep))
+        return out
+
+    def __getattr__(self, name: str):
+        # only reached for attributes not set yet: the signal tables of results still to be laid out
+        if name in ("_signals", "_units", "_columns", "_lazy") and "_pending" in self.__dict__:
+            raw, joints, body_names, engine, callbacks, keep = self.__dict__.pop("_pending")
+            try:
+                s, u, cols, lazy = Results._lay_out(raw, joints, body_names, engine, callbacks)
+            except AttributeError as e:  # not to be mistaken for a missing attribute by the caller
+                raise ResultsError(f"laying out the recorded signals failed: {e}") from e
+            self._signals, self._units, self._lazy, self._columns = s, u, lazy, cols
+            if keep is not None:
+                self._keep_only(keep)
+            return self.__dict__[name]
+        raise AttributeError(f"'{type(self).__name__}' object has no attribute '{name}'")
+
+    @staticmethod
+    def _lay_out(raw: dict, joints: list[dict], body_names: list[str], engine, callbacks):
+        """Names, units and columns of every recorded signal, and the derived groups computed on
+        first access: ``(signals, units, columns, lazy)``."""
         s: dict[str, np.ndarray] = {}
         u: dict[str, str] = {}
         cols: dict[str, tuple[list, list]] = {}
@@ -403,9 +432,7 @@ class Results:
             for j in joints:
                 lazy[f"joint/{j['name']}/reaction_force"] = ("N", group)
                 lazy[f"joint/{j['name']}/reaction_torque"] = ("N m", group)
-        out = cls(s, u, attrs, lazy)
-        out._columns = cols
-        return out
+        return s, u, cols, lazy
 
     def _keep_only(self, names) -> None:
         """Drops every signal but ``t`` and ``names`` (a selective recording; names the run

@@ -199,9 +199,7 @@ def simulate(
     cancelled = raw.pop("cancelled", None)
     if chosen is not None:
         attrs["sensors"] = json.dumps(list(sensors) if not isinstance(sensors, str) else [sensors])
-    res = Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks)
-    if chosen is not None:
-        res._keep_only(chosen)
+    res = Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks, keep=chosen)
     if cancelled is not None:
         # Ctrl-C: the samples before it are kept on the interrupt (`except KeyboardInterrupt as e:
         # e.results`)
