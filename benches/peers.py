@@ -531,7 +531,7 @@ def report(calls, sims, notes, peers, missing, mach, vers, rust, argv) -> str:
             L.append("| " + " | ".join(c) + " |")
         L.append("")
         L.append("mechsys records every step (1001 samples of q, u, u̇, body poses, velocities, accelerations, "
-                 "energies, momenta); MuJoCo returns its full physics state at each of the 1000 steps "
+                 "energies, momenta; the `Results` name and unit them on first use, after the timing); MuJoCo returns its full physics state at each of the 1000 steps "
                  f"(loop: {notes.get('mujoco_loop', '–')}); Exudyn keeps only the final state "
                  "(no solution file, no sensors, no end-of-step accelerations).")
         for e in notes.get("exudyn_errors", []):
