@@ -77,7 +77,22 @@ fn radau5_is_stable_on_a_stiff_oscillator_and_accurate_on_a_smooth_one() {
     // stiff: ω dt = 100, an explicit scheme explodes, Radau IIA damps (L-stable) and stays bounded
     let (_, y, _) = run(radau_fixed(0.1, 1e-10), 1000.0, 2.0, 20);
     assert!(y.iter().all(|v| v[0].abs() <= 1.0 + 1e-9));
-    assert!(y.last().unwrap()[0].abs() < 1e-3);
+    // each step is the stability function R(Z) = (I + 2Z/5 + Z²/20)(I − 3Z/5 + 3Z²/20 − Z³/60)⁻¹
+    // of Z = h A, A = [[0, 1], [−ω², 0]]: |R(100 i)| ≈ 0.030, so 20 steps leave ≈ 3.5e-31
+    let z = nalgebra::Matrix2::<f64>::new(0.0, 1.0, -1e6, 0.0) * 0.1;
+    let i = nalgebra::Matrix2::identity();
+    let num = i + z * 0.4 + z * z / 20.0;
+    let den = i - z * 0.6 + z * z * 0.15 - z * z * z / 60.0;
+    let r = num * den.try_inverse().unwrap();
+    let mut exact = nalgebra::Vector2::<f64>::new(1.0, 0.0);
+    for (k, yk) in y.iter().enumerate().skip(1) {
+        exact = r * exact;
+        // (x and v/ω to round-off of the first step's size, 1e-13, and relative 1e-9 after)
+        let tol = 1e-13 * 0.031f64.powi(k as i32 - 1) + 1e-9 * exact[0].abs();
+        assert!((yk[0] - exact[0]).abs() <= tol, "step {k}: x {} vs R^k x0 = {}", yk[0], exact[0]);
+        assert!((yk[1] - exact[1]).abs() <= 1e3 * tol, "step {k}: v {} vs {}", yk[1], exact[1]);
+    }
+    assert!(y.last().unwrap()[0].abs() < 1e-25, "{}", y.last().unwrap()[0]);
 }
 
 #[test]
