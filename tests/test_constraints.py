@@ -155,8 +155,9 @@ def test_drift_control_options_from_python():
         res = ms.simulate(m, 10.0, ms.RK4(1e-2), stabilization=stab)
         worst[name] = np.abs(res["constraint/rod/violation"]).max()
     assert worst["projection"] < 1e-12
-    # RK4 drift grows without control; Baumgarte feedback keeps it an order of magnitude lower
-    assert worst["baumgarte"] < 0.3 * worst["none"]
+    # RK4 drift grows without control; Baumgarte feedback keeps it about nine times lower (measured
+    # 0.110 of it)
+    assert worst["baumgarte"] < 0.13 * worst["none"]
     with pytest.raises(ms.SettingsError):
         ms.simulate(m, 0.1, ms.RK4(1e-3), stabilization="magic")
     with pytest.raises(ms.SettingsError) as e:
