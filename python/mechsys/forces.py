@@ -91,7 +91,10 @@ class Bushing:
     """Six-component bushing between ``frame1`` on ``body1`` and ``frame2`` on ``body2``.
 
     The deflection x = [dr; theta] (translation and rotation vector of frame 2 relative to frame 1,
-    frame-1 components) gives the wrench -K x - D x_dot on frame 2 and its opposite on body1.
+    frame-1 components) and its rate v = [dr_dot; omega_rel] (the translation's rate and frame 2's
+    angular velocity relative to frame 1, frame-1 components) give the wrench -K x - D v on frame 2
+    (the rotational stiffness part through the rotation vector's Jacobian, so that it stays
+    conservative) and its opposite on body1. The signal ``force/<name>/force`` records K x + D v.
     ``k``, ``d``: 6 diagonal values (N/m, N/m, N/m, N m/rad, ...) or symmetric 6x6 matrices.
     ``travel``: 6 stop travels (m, rad) making each component progressive, as an elastomer mount:
     k_i and d_i are divided by 1 - (x_i/s_i)^2 (diagonal k and d only).
