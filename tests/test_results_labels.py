@@ -89,7 +89,7 @@ def test_to_pandas_and_to_xarray(res):
         res.to_pandas(["body/nobody/position"])
 
 
-def test_signals_are_laid_out_on_first_use_and_every_way_in_gives_the_same_tables():
+def test_signals_are_laid_out_on_first_use_and_every_way_in_gives_the_same_tables(tmp_path):
     """`simulate` hands back results whose names, units and columns are laid out on first use
     (a parameter study reading one number does not pay for naming every signal). Whatever is
     touched first (a signal, the names, a pickle, a file, a selective recording), the tables are
@@ -106,6 +106,7 @@ def test_signals_are_laid_out_on_first_use_and_every_way_in_gives_the_same_table
         "pickle": lambda r: pickle.loads(pickle.dumps(r)),
         "repr": repr,
         "columns": lambda r: r.columns("q"),
+        "file": lambda r: ms.load(r.save(tmp_path / "first.h5")),
     }
     for what, touch in firsts.items():
         r = ms.simulate(model, 0.05, integ, output_dt=0.01)
@@ -122,6 +123,22 @@ def test_signals_are_laid_out_on_first_use_and_every_way_in_gives_the_same_table
                            "joint/hinge/reaction_torque"]
     with pytest.raises(ms.ResultsError, match="unknown signal 'q'"):
         sel["q"]
+    # (also when a file or a pickle is the first use)
+    sel = ms.simulate(model, 0.05, integ, output_dt=0.01, sensors=["joint/hinge/*"])
+    assert ms.load(sel.save(tmp_path / "sel.h5")).names()[:4] == ["t", "joint/hinge/q", "joint/hinge/u", "joint/hinge/udot"]
+    sel = ms.simulate(model, 0.05, integ, output_dt=0.01, sensors=["joint/hinge/*"])
+    assert "q" not in pickle.loads(pickle.dumps(sel)).names()
     # a missing attribute is still an AttributeError naming it
     with pytest.raises(AttributeError, match="no_such_thing"):
         ms.simulate(model, 0.05, integ, output_dt=0.01).no_such_thing
+
+
+def test_a_layout_that_fails_fails_the_same_way_each_time():
+    """A recording that cannot be laid out (here: no time column) raises on every use, not once
+    and then an AttributeError about missing tables."""
+    from mechsys.results import Results
+
+    broken = Results.from_raw({}, [], [], {})
+    for _ in range(2):
+        with pytest.raises(KeyError, match="'t'"):
+            broken.names()

@@ -135,11 +135,14 @@ class Results:
     def __getattr__(self, name: str):
         # only reached for attributes not set yet: the signal tables of results still to be laid out
         if name in ("_signals", "_units", "_columns", "_lazy") and "_pending" in self.__dict__:
-            raw, joints, body_names, engine, callbacks, keep = self.__dict__.pop("_pending")
+            raw, joints, body_names, engine, callbacks, keep = self.__dict__["_pending"]
             try:
                 s, u, cols, lazy = Results._lay_out(raw, joints, body_names, engine, callbacks)
             except AttributeError as e:  # not to be mistaken for a missing attribute by the caller
                 raise ResultsError(f"laying out the recorded signals failed: {e}") from e
+            # (the recording is let go only once laid out: a failed layout fails the same way again
+            # instead of leaving results without tables)
+            del self.__dict__["_pending"]
             self._signals, self._units, self._lazy, self._columns = s, u, lazy, cols
             if keep is not None:
                 self._keep_only(keep)
