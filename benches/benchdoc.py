@@ -38,6 +38,32 @@ def timed(fn, repeat: int):
     return min(times), statistics.median(times), out
 
 
+def interleaved(fns: dict, rounds: int, budget: float = 0.0) -> dict:
+    """Times several calls side by side: one warm-up each, then rounds in which every call runs
+    once (the order turned by one each round, the garbage collector off during a call), so that
+    a machine whose speed drifts or jumps between modes (a shared VM) slows them alike instead of
+    whichever happened to run in its slow spell. At least ``rounds`` rounds, more while the
+    rounds so far took less than ``budget`` seconds. ``{name: (min, median, last result)}``."""
+    import gc
+
+    names = list(fns)
+    out = {n: fns[n]() for n in names}
+    times: dict = {n: [] for n in names}
+    t_start = time.perf_counter()
+    k = 0
+    while k < rounds or (time.perf_counter() - t_start < budget and k < 50 * max(rounds, 1)):
+        for i in range(len(names)):
+            n = names[(i + k) % len(names)]
+            gc.collect()
+            gc.disable()
+            t0 = time.perf_counter()
+            out[n] = fns[n]()
+            times[n].append(time.perf_counter() - t0)
+            gc.enable()
+        k += 1
+    return {n: (min(times[n]), statistics.median(times[n]), out[n]) for n in names}
+
+
 def fmt_time(s: float | None) -> str:
     """A duration in µs, ms or s with three significant digits ("–" for none)."""
     if s is None or not math.isfinite(s):

@@ -8,7 +8,9 @@ Coulomb friction 0.5 everywhere (PyBullet multiplies the two bodies' coefficient
 
 Measured per run:
 - wall time per simulated second, from the Python call until the run is done, model built
-  beforehand; min (median) over repeats. mechsys: one `ms.simulate` call (it records its signals
+  beforehand; min (median) over repeats. mechsys auto (both recordings) and MuJoCo take turns
+  (`benchdoc.interleaved`: one run of each per round, for at least 3 s), so that a drift of the
+  machine's speed weighs on both sides alike. mechsys: one `ms.simulate` call (it records its signals
   every 10 ms: all of them, and in a second run with `solver="auto"` only the bodies' states and
   the solver's signals, what the rollout returns); MuJoCo: `mujoco.rollout.rollout` (its C loop) from the initial state; PyBullet: a
   Python loop of `stepSimulation` (it has no batch call; the loop costs < 1 us per step);
@@ -40,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchdoc import fmt_time, machine, ratio, timed, write_doc  # noqa: E402
+from benchdoc import fmt_time, interleaved, machine, ratio, timed, write_doc  # noqa: E402
 
 G, N, MASS, MU = 9.81, 10, 1.0, 0.5
 HALF = (0.1, 0.1, 0.05)
@@ -244,10 +246,25 @@ def main(argv=None) -> int:
         model = ms_model(kind)
         nb = len(scene(kind)[0])
         for dt in ([1e-3] if a.quick else [1e-3, 1e-2]):
+            # the headline comparison, side by side: mechsys auto (every signal, and the bodies'
+            # states only) and MuJoCo's rollout take turns (see benchdoc.interleaved)
+            auto = ms_solvers()["auto (tol 1e-10)"]
+            side = {"auto": lambda: run_ms(model, dt, T, auto),
+                    "states": lambda: run_ms(model, dt, T, auto, sensors=STATES)}
+            try:
+                setup = mj_setup(dt, kind)
+                side["mujoco"] = lambda: run_mj(setup, dt, T)
+            except Exception as e:  # noqa: BLE001 - a missing peer is reported, not fatal
+                setup = None
+                print(f"MuJoCo: {e}")
+            paired = interleaved(side, repeat, budget=0.0 if a.quick else 3.0)
             for label, solver in ms_solvers().items():
                 if kind == "pyramid" and label.startswith("NSGS tol"):
                     continue  # 10^5 sweeps per step on the pyramid's 136 points: minutes per run
-                tmin, tmed, _ = timed(lambda: run_ms(model, dt, T, solver), repeat)
+                if label.startswith("auto"):
+                    tmin, tmed, _ = paired["auto"]
+                else:
+                    tmin, tmed, _ = timed(lambda: run_ms(model, dt, T, solver), repeat)
                 pen, dr, floor, unconv, worst = ms_measure(model, dt, T, solver, kind)
                 extra = (f"worst residual {worst:.1e}, unconverged {unconv}; the floor carries {floor:.10f} × {nb} m g")
                 rows.append((kind, dt, f"mechsys MoreauJean, {label}", tmin, tmed, pen, dr, extra))
@@ -255,19 +272,16 @@ def main(argv=None) -> int:
                 if label.startswith("auto"):
                     # the same run recording what the rollout returns: no contact-point signals, so
                     # no contact kinematics at the samples (the motion is the same bit for bit)
-                    tmin, tmed, _ = timed(lambda: run_ms(model, dt, T, solver, sensors=STATES), repeat)
+                    tmin, tmed, _ = paired["states"]
                     rows.append((kind, dt, "mechsys MoreauJean, auto, states only", tmin, tmed, pen, dr,
                                  "`sensors=` the bodies' states and `solver/*` (what MuJoCo's rollout returns); "
                                  "the same motion as the row above"))
                     print(f"{kind} dt {dt:g} {'auto, states only':32s} {fmt_time(tmin / T)}/s")
-            try:
-                setup = mj_setup(dt, kind)
-                tmin, tmed, _ = timed(lambda: run_mj(setup, dt, T), repeat)
+            if setup is not None:
+                tmin, tmed, _ = paired["mujoco"]
                 pen, dr = mj_measure(setup, dt, T)
                 rows.append((kind, dt, "MuJoCo (defaults, rollout)", tmin, tmed, pen, dr, ""))
                 print(f"{kind} dt {dt:g} {'MuJoCo':32s} {fmt_time(tmin / T)}/s  pen {pen:.1e}  drift {dr[0]:.1e} / {dr[1]:.1e}")
-            except Exception as e:  # noqa: BLE001 - a missing peer is reported, not fatal
-                print(f"MuJoCo: {e}")
             if kind == "stack":
                 try:
                     tmin, tmed, _ = timed(lambda: run_pb(dt, T), repeat)
@@ -294,7 +308,9 @@ def main(argv=None) -> int:
         L += ["", f"Boxes 0.2 × 0.2 × 0.1 m, 1 kg, face on face, touching and at rest at t = 0, friction 0.5, {T:g} s "
               "simulated. *stack*: ten boxes in a column; *pyramid*: rows of 6, 5, 4, 3, 2 boxes 1 cm apart, each upper "
               "box straddling the two below it (34 box-box or box-floor pairs, 136 closed points). Settings and fairness "
-              f"notes in the script's docstring. Wall time per simulated second: min (median) over {repeat} run(s); "
+              f"notes in the script's docstring. Wall time per simulated second: min (median) over {repeat} run(s); the "
+              "three rows of the headline comparison (auto, auto states only, MuJoCo) taken in turns, one run of each "
+              f"per round, {repeat} rounds and more for 3 s (a shared VM's speed jumps between modes); "
               "“mechsys auto vs it”: mechsys with `solver=\"auto\"` against that row at the same step (recording "
               "every signal, and in the MuJoCo rows also recording only the bodies' states, as the rollout does).", "",
               f"Command: `.venv/bin/python benches/stack.py {' '.join(sys.argv[1:] if argv is None else argv)}`", "",

@@ -63,3 +63,29 @@ def test_revision_ignores_the_results_file_being_written(tmp_path):
     source.write_text("x = 2\n")
     assert revision(tmp_path, results) == f"{head} (with local changes)"
     assert revision(tmp_path / "nowhere") == "unknown"
+
+
+def test_interleaved_timing_takes_turns_and_times_every_call():
+    """benchdoc.interleaved: one warm-up each, then rounds in which every call runs once, the
+    order turned by one each round; min <= median per call, and the last results returned."""
+    sys.path.insert(0, str(ROOT / "benches"))
+    import time
+
+    from benchdoc import interleaved
+
+    order = []
+
+    def make(name, pause):
+        def fn():
+            order.append(name)
+            time.sleep(pause)
+            return len(order)
+        return fn
+
+    out = interleaved({"a": make("a", 0.002), "b": make("b", 0.0), "c": make("c", 0.0)}, rounds=3)
+    # warm-ups a b c, then rounds a b c / b c a / c a b
+    assert order == list("abc" + "abc" + "bca" + "cab")
+    assert (out["a"][2], out["b"][2], out["c"][2]) == (11, 12, 10)  # each one's last call
+    for name, (tmin, tmed, _) in out.items():
+        assert 0 < tmin <= tmed, name
+    assert out["a"][0] >= 0.002 > out["b"][1]

@@ -1613,16 +1613,23 @@ fn time_stepping(
         // the contact points at the sample (skipped when no contact signal is recorded)
         if contact_signals {
             stepper.measure(model, &mut data, t_rec, q, u, cb)?;
+            // the points' contact (as `Model::contact_of_point`, walked along: points ascend) and
+            // its static coefficient, once per contact
+            let mut ci = 0;
+            let mut mu0 = model.contacts.first().map_or(0.0, |c| c.friction.mu0());
             for (pt, kk) in stepper.kinematics().iter().enumerate() {
+                while ci + 1 < model.contacts.len() && model.contacts[ci + 1].first <= pt {
+                    ci += 1;
+                    mu0 = model.contacts[ci].friction.mu0();
+                }
                 let r = &stepper.results[pt];
                 // over the interval since the last sample (one step at the first sample)
                 let span = if k == 0 { dt } else { settings.output_dt };
                 let (in_, it) = (acc_n[pt], acc_t[pt]);
                 let f_t = (kk.point.t1 * it[0] + kk.point.t2 * it[1]) / span;
-                let con = model.contact_of_point(pt);
                 // the reserve of the last step (forces of that step)
                 let lt = (r.impulse_t[0].powi(2) + r.impulse_t[1].powi(2)).sqrt();
-                let reserve = (con.friction.mu0() * r.impulse_n - lt) / dt;
+                let reserve = (mu0 * r.impulse_n - lt) / dt;
                 let lambda = (in_ / span, [it[0] / span, it[1] / span]);
                 rec.push_contact_point(kk, (in_, it), lambda, f_t, r.state, reserve);
             }

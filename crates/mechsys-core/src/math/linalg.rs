@@ -70,21 +70,62 @@ pub fn lu_solve(a: &[f64], n: usize, piv: &[usize], b: &mut [f64]) {
 /// [`lu_factor`] for a matrix whose rows end early (a banded or profile matrix, such as the
 /// Jacobian of a contact problem ordered along a stack): `ext[r] = (lo, hi)` receives, for row `r`
 /// of the factors, the first column of L's nonzeros and one past the last of U's, and the
-/// elimination and [`lu_solve_profile`] skip the exact zeros outside them. Same factors, bit for
-/// bit, as [`lu_factor`]: only products with entries that are exactly zero are left out.
+/// elimination, the pivot search, the row exchanges and [`lu_solve_profile`] skip the exact zeros
+/// outside them (a banded matrix costs its band, not n² per column). The same pivots and factors
+/// as [`lu_factor`], every entry equal: only products with entries that are exactly zero are left
+/// out (where the dense routine writes a multiplier 0/d, a zero stays as it was).
 pub fn lu_factor_profile(a: &mut [f64], n: usize, piv: &mut [usize], ext: &mut [(usize, usize)]) -> Result<()> {
-    // one past the last nonzero of each row; an update by row k extends row r to row k's end
+    // per row its first nonzero (in ext.0 until the end) and one past its last; an update by row
+    // k extends row r to row k's end, never to the left of r's first nonzero (row k's entries
+    // left of column k are L's, not used in updates)
     for (r, e) in ext[..n].iter_mut().enumerate() {
         let row = &a[r * n..(r + 1) * n];
         e.1 = row.iter().rposition(|v| *v != 0.0).map_or(0, |c| c + 1);
+        e.0 = row.iter().position(|v| *v != 0.0).unwrap_or(n);
+    }
+    // piv[k] until step k: the last row that can hold a nonzero in column k (rows below it start
+    // right of k and have not moved: every exchange so far was above it), so the pivot search and
+    // the elimination of a banded matrix cost its band, not n
+    piv[..n].fill(0);
+    for (r, e) in ext[..n].iter().enumerate() {
+        if e.0 < n {
+            piv[e.0] = piv[e.0].max(r);
+        }
+    }
+    for k in 1..n {
+        piv[k] = piv[k].max(piv[k - 1]);
     }
     for k in 0..n {
-        let p = pivot(a, n, k, piv)?;
-        ext.swap(k, p);
+        let last = piv[k].max(k);
+        let mut p = k;
+        let mut best = a[k * n + k].abs();
+        for r in k + 1..=last {
+            let v = a[r * n + k].abs();
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        piv[k] = p;
+        if best == 0.0 || !best.is_finite() {
+            return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
+        }
+        if p != k {
+            // both rows are zero outside their extents
+            let (lo, hi) = (ext[k].0.min(ext[p].0), ext[k].1.max(ext[p].1));
+            for c in lo..hi {
+                a.swap(k * n + c, p * n + c);
+            }
+            ext.swap(k, p);
+        }
         let d = a[k * n + k];
         let end = ext[k].1.max(k + 1);
-        for r in k + 1..n {
-            let l = a[r * n + k] / d;
+        for r in k + 1..=last {
+            let v = a[r * n + k];
+            if v == 0.0 {
+                continue;
+            }
+            let l = v / d;
             a[r * n + k] = l;
             if l != 0.0 {
                 let (top, bottom) = a.split_at_mut(r * n);
@@ -97,7 +138,8 @@ pub fn lu_factor_profile(a: &mut [f64], n: usize, piv: &mut [usize], ext: &mut [
         }
     }
     for (r, e) in ext[..n].iter_mut().enumerate() {
-        e.0 = a[r * n..r * n + r].iter().position(|v| *v != 0.0).unwrap_or(r);
+        let first = e.0.min(r);
+        e.0 = a[r * n + first..r * n + r].iter().position(|v| *v != 0.0).map_or(r, |c| first + c);
     }
     Ok(())
 }
@@ -346,13 +388,22 @@ mod tests {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         };
-        for (kl, ku) in [(2usize, 3usize), (5, 1), (0, 0), (n, n)] {
+        // (kl, ku, rows exchanged before factoring: the rows' first nonzeros then do not grow
+        // down the matrix, and rows below a pivot's column reach left of it)
+        for (kl, ku, shuffle) in [(2usize, 3usize, false), (5, 1, false), (0, 0, false), (n, n, false), (2, 2, true)] {
             let mut a0 = vec![0.0; n * n];
             for r in 0..n {
                 for c in r.saturating_sub(kl)..(r + ku + 1).min(n) {
                     a0[r * n + c] = rnd();
                 }
                 a0[r * n + r] *= 0.01;
+            }
+            if shuffle {
+                for (x, y) in [(0, 9), (3, 17), (5, 6), (12, 23)] {
+                    for c in 0..n {
+                        a0.swap(x * n + c, y * n + c);
+                    }
+                }
             }
             let b0: Vec<f64> = (0..n).map(|_| rnd()).collect();
             let (mut a1, mut a2) = (a0.clone(), a0.clone());
@@ -370,7 +421,7 @@ mod tests {
                 let ax: f64 = (0..n).map(|c| a0[r * n + c] * x2[c]).sum();
                 assert!((ax - b0[r]).abs() < 1e-9, "residual row {r}, band ({kl}, {ku})");
             }
-            if kl < n {
+            if kl < n && !shuffle {
                 // U keeps the band grown by the row exchanges (kl + ku), so the solves skip work
                 for (r, &(_, hi)) in ext.iter().enumerate() {
                     assert!(hi <= (r + kl + ku + 1).min(n), "row {r}: U ends at {hi}");

@@ -388,31 +388,33 @@ impl SparseRows {
         let w0 = self.w.len();
         let f = &self.factor;
         for &(b, p, sign, iu) in &sides[..ns] {
+            // fixed-size views: the loops below then run without bounds checks
+            let s_b: &[Motion; 6] = &s_all[b];
+            let base = f.anc_ptr[iu];
+            let off: &[f64; 15] = f.off[base..base + 15].try_into().expect("a free joint's factor block");
+            let isd: &[f64; 6] = f.inv_sqrt_d[iu..iu + 6].try_into().expect("a free joint's six velocities");
             // eq. 2.112 ff.: the six columns of J_P, projected on the directions
             let mut w = [[0.0; D]; 6];
-            for (k, wk) in w.iter_mut().enumerate() {
-                let s = &s_all[b][k];
+            for (wk, s) in w.iter_mut().zip(s_b) {
                 let v = (s.v + s.w.cross(p)) * sign;
                 for r in 0..D {
                     // (0 + x as in the general path's accumulation: the same signed zeros)
                     wk[r] = 0.0 + dirs[r].dot(&v);
                 }
             }
-            // y = D^{-1/2} L⁻ᵀ w, leaves first; L(iu + j, iu + j - 1 - p) at off[base + j(j-1)/2 + p]
-            let base = f.anc_ptr[iu];
+            // y = D^{-1/2} L⁻ᵀ w, leaves first; L(iu + j, iu + j - 1 - p) at off[j(j-1)/2 + p]
             let mut y = w;
             for j in (1..6).rev() {
                 let v = y[j];
-                let lj = base + j * (j - 1) / 2;
+                let lj = j * (j - 1) / 2;
                 for p in 0..j {
-                    let l = f.off[lj + p];
+                    let l = off[lj + p];
                     for r in 0..D {
                         y[j - 1 - p][r] -= l * v[r];
                     }
                 }
             }
-            for (k, yk) in y.iter_mut().enumerate() {
-                let s = f.inv_sqrt_d[iu + k];
+            for (yk, s) in y.iter_mut().zip(isd) {
                 for v in yk.iter_mut() {
                     *v *= s;
                 }
