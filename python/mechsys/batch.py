@@ -227,7 +227,7 @@ def simulate_batch(
             "model": c.description_json(),
             "settings": texts[i],
             "stats": json.dumps(raw.pop("stats")),
-            "events": json.dumps(raw.pop("events", [])),
+            "events": raw.pop("events_json", "[]"),
             "mechsys_version": _core.__version__,
             "case": i,
         }

@@ -192,7 +192,7 @@ def simulate(
         "model": core.description_json(),
         "settings": text,
         "stats": json.dumps(raw.pop("stats")),
-        "events": json.dumps(raw.pop("events", [])),
+        "events": raw.pop("events_json", "[]"),
         "mechsys_version": _core.__version__,
     }
     body_names = core.body_names[1:]

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 /// Factors the row-major `n × n` matrix `a` in place (L unit-lower, U upper), pivots into `piv`.
 pub fn lu_factor(a: &mut [f64], n: usize, piv: &mut [usize]) -> Result<()> {
     for k in 0..n {
-        pivot(a, n, k, piv)?;
+        pivot(a, n, k, n - 1, |_| 0..n, piv)?;
         let d = a[k * n + k];
         for r in k + 1..n {
             let l = a[r * n + k] / d;
@@ -21,13 +21,22 @@ pub fn lu_factor(a: &mut [f64], n: usize, piv: &mut [usize]) -> Result<()> {
     Ok(())
 }
 
-/// Partial pivoting at column `k`: the row of the largest `|a[r][k]|`, r ≥ k, swapped into row
-/// `k` and recorded in `piv[k]` (also returned); an error if the column is zero or not finite.
+/// Partial pivoting at column `k`: the row of the largest `|a[r][k]|`, k ≤ r ≤ `last` (the rows
+/// below are zero in the column), swapped into row `k` over the columns `cols` (the two rows are
+/// zero outside them) and recorded in `piv[k]` (also returned); an error if the column is zero or
+/// not finite. `cols` gets the chosen row.
 #[inline]
-fn pivot(a: &mut [f64], n: usize, k: usize, piv: &mut [usize]) -> Result<usize> {
+fn pivot(
+    a: &mut [f64],
+    n: usize,
+    k: usize,
+    last: usize,
+    cols: impl FnOnce(usize) -> std::ops::Range<usize>,
+    piv: &mut [usize],
+) -> Result<usize> {
     let mut p = k;
     let mut best = a[k * n + k].abs();
-    for r in k + 1..n {
+    for r in k + 1..=last {
         let v = a[r * n + k].abs();
         if v > best {
             best = v;
@@ -39,7 +48,7 @@ fn pivot(a: &mut [f64], n: usize, k: usize, piv: &mut [usize]) -> Result<usize> 
         return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
     }
     if p != k {
-        for c in 0..n {
+        for c in cols(p) {
             a.swap(k * n + c, p * n + c);
         }
     }
@@ -97,27 +106,10 @@ pub fn lu_factor_profile(a: &mut [f64], n: usize, piv: &mut [usize], ext: &mut [
     }
     for k in 0..n {
         let last = piv[k].max(k);
-        let mut p = k;
-        let mut best = a[k * n + k].abs();
-        for r in k + 1..=last {
-            let v = a[r * n + k].abs();
-            if v > best {
-                best = v;
-                p = r;
-            }
-        }
-        piv[k] = p;
-        if best == 0.0 || !best.is_finite() {
-            return Err(Error::Solver(format!("singular matrix in LU factorization (column {k})")));
-        }
-        if p != k {
-            // both rows are zero outside their extents
-            let (lo, hi) = (ext[k].0.min(ext[p].0), ext[k].1.max(ext[p].1));
-            for c in lo..hi {
-                a.swap(k * n + c, p * n + c);
-            }
-            ext.swap(k, p);
-        }
+        // both rows are zero outside their extents
+        let ext_k = ext[k];
+        let p = pivot(a, n, k, last, |p| ext_k.0.min(ext[p].0)..ext_k.1.max(ext[p].1), piv)?;
+        ext.swap(k, p);
         let d = a[k * n + k];
         let end = ext[k].1.max(k + 1);
         for r in k + 1..=last {
