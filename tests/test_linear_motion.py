@@ -366,3 +366,19 @@ def test_check_refuses_settings_that_would_fit_nothing():
                      (dict(cycles=-1.0), "cycles"), (dict(samples=3), "samples")):
         with pytest.raises(ms.SettingsError, match=f"check: {name}"):
             ms.linear.check(lin, **kw)
+
+
+def test_a_rolling_disc_in_a_chain_has_no_second_order_form_and_says_why():
+    """The disc on a circle, carried by a chain of joints: its coordinates' rates are tied by the
+    rolling constraints, so their kinetic metric e M_eta^-1 e^T is singular (rank 2 of 3). The
+    linearization keeps the first-order form and says why, on every rounding: the metric came out
+    exactly singular on one machine (numpy's inverse raised) and as noise on another (an M built
+    from its inverse); both are refused by its singular values."""
+    m, ref = steady_case("circular_disc", dict(carrier="chain"))
+    lin = ms.linear.linearize(m)
+    assert lin.M is None and "not independent velocities" in lin.state.why_first_order
+    with pytest.raises(ms.SettingsError, match="no second-order form"):
+        lin.frf([1.0])
+    # the first-order form is the reference's, as in the parametrized test above
+    np.testing.assert_allclose(nontrivial(np.linalg.eigvals(lin.A)), nontrivial(ref.all_eigenvalues), rtol=1e-6,
+                               atol=1e-9 * np.abs(ref.all_eigenvalues).max())

@@ -1007,7 +1007,14 @@ def _second_order_form(a: np.ndarray, n_cfg: int, cfg_names: list, v: np.ndarray
     # the least kinetic energy among them
     e = a[sel, n_cfg:]
     m_eta = v.T @ mass @ v
-    my = np.linalg.inv(e @ np.linalg.solve(m_eta, e.T))
+    metric = e @ np.linalg.solve(m_eta, e.T)
+    # dependent rates (a rolling disc's x, y and heading rates tied by its constraints) make this
+    # metric singular: exactly so with some rounding, and with other rounding a matrix whose
+    # inverse is noise; both are the same answer, no second-order form in these coordinates
+    sv = np.linalg.svd(metric, compute_uv=False)
+    if not np.all(np.isfinite(sv)) or sv[-1] <= 1e-9 * sv[0]:
+        return "the coordinates' rates are not independent velocities (their kinetic metric is singular)"
+    my = np.linalg.inv(metric)
     my = 0.5 * (my + my.T)
     return my, -my @ az[m:, m:], -my @ az[m:, :m]
 
