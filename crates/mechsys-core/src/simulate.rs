@@ -5,7 +5,11 @@
 //! carries the energy dissipated by dampers and the work of external loads, so that the energy
 //! balance `T + V + E_diss - W_ext = const` can be checked on any result.
 
+mod events_json;
+
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+pub use events_json::events_json;
 
 use serde::{Deserialize, Serialize};
 

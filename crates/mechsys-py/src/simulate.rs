@@ -296,87 +296,6 @@ fn simulate_batch<'py>(
     Ok(list)
 }
 
-/// The events as JSON text, what `Results.attrs["events"]` holds: a list of objects with the keys
-/// and order of `Results.events` (written here, not as Python dicts that Python then dumps: for
-/// the 40 closing points of a stack that was a few tenths of a millisecond per run). Non-finite
-/// numbers are written as Python's `json` writes and reads them (NaN, Infinity).
-fn events_json(events: &[mechsys_core::simulate::EventRecord]) -> String {
-    fn num(out: &mut String, x: f64) {
-        if x.is_finite() {
-            out.push_str(&serde_json::to_string(&x).unwrap_or_else(|_| "NaN".into()));
-        } else if x.is_nan() {
-            out.push_str("NaN");
-        } else {
-            out.push_str(if x > 0.0 { "Infinity" } else { "-Infinity" });
-        }
-    }
-    fn text(out: &mut String, s: &str) {
-        out.push_str(&serde_json::to_string(s).unwrap_or_else(|_| "\"?\"".into()));
-    }
-    fn nums(out: &mut String, xs: &[f64]) {
-        out.push('[');
-        for (k, x) in xs.iter().enumerate() {
-            if k > 0 {
-                out.push_str(", ");
-            }
-            num(out, *x);
-        }
-        out.push(']');
-    }
-    let mut out = String::with_capacity(200 * events.len() + 2);
-    out.push('[');
-    for (k, e) in events.iter().enumerate() {
-        if k > 0 {
-            out.push_str(", ");
-        }
-        out.push_str("{\"t\": ");
-        num(&mut out, e.t);
-        out.push_str(", \"contact\": ");
-        text(&mut out, &e.contact);
-        out.push_str(&format!(", \"point\": {}, \"event\": ", e.point));
-        text(&mut out, e.kind);
-        out.push_str(", \"impulse_n\": ");
-        num(&mut out, e.impulse[0]);
-        out.push_str(", \"impulse_t\": ");
-        nums(&mut out, &e.impulse[1..]);
-        out.push_str(", \"energy\": ");
-        num(&mut out, e.energy);
-        out.push_str(&format!(", \"steps\": {}", e.steps));
-        if !e.u_before.is_empty() {
-            out.push_str(", \"u_before\": ");
-            nums(&mut out, &e.u_before);
-            out.push_str(", \"u_after\": ");
-            nums(&mut out, &e.u_after);
-        }
-        if let Some(p) = &e.painleve {
-            out.push_str(", \"mu\": ");
-            num(&mut out, p.mu);
-            out.push_str(", \"mu_critical\": ");
-            num(&mut out, p.mu_critical);
-            out.push_str(", \"situation\": ");
-            text(&mut out, if p.non_unique { "non-unique" } else { "inconsistent" });
-            out.push_str(", \"solutions\": [");
-            for (j, sol) in p.solutions.iter().enumerate() {
-                if j > 0 {
-                    out.push_str(", ");
-                }
-                out.push('[');
-                for (i, name) in sol.iter().enumerate() {
-                    if i > 0 {
-                        out.push_str(", ");
-                    }
-                    text(&mut out, name);
-                }
-                out.push(']');
-            }
-            out.push_str(&format!("], \"resolved_by_impulse\": {}", p.resolved_by_impulse));
-        }
-        out.push('}');
-    }
-    out.push(']');
-    out
-}
-
 /// The recorded signals of a run as a dict of numpy arrays, its events and statistics.
 fn recording_dict<'py>(
     py: Python<'py>,
@@ -428,7 +347,7 @@ fn recording_dict<'py>(
     if let Some(msg) = &rec.cancelled {
         d.set_item("cancelled", msg)?;
     }
-    d.set_item("events_json", events_json(&rec.events))?;
+    d.set_item("events_json", mechsys_core::simulate::events_json(&rec.events))?;
     let np = m.n_contact_points;
     // (the points' signals only where recorded: a selection without contact signals skips them)
     let points = rec.selection.contacts;
