@@ -123,3 +123,21 @@ def test_recorded_body_motion_matches_the_chain_kinematics():
         scale_v, scale_a = np.abs(vel).max(), np.abs(acc).max()
         assert np.abs(vel[1:-1] - fd_v).max() < 1e-5 * max(scale_v, 1.0), f"link{i + 1} velocity"
         assert np.abs(acc[1:-1] - fd_a).max() < 1e-3 * max(scale_a, 1.0), f"link{i + 1} acceleration"
+
+
+def test_the_run_metadata_is_made_once_per_build_and_follows_a_changed_model():
+    # the description and joint table every run's results carry are cached with the build: two
+    # runs share them, and a model changed after a run gets them anew (a stale table would name
+    # the wrong joints and q columns)
+    m = chain(2)
+    a = ms.simulate(m, 0.01, integrator=ms.RK4(1e-3))
+    b = ms.simulate(m, 0.01, integrator=ms.RK4(1e-3))
+    assert m.run_metadata() is m.run_metadata()
+    assert a.attrs["model"] == b.attrs["model"] == m.build().description_json()
+    assert a.names() == b.names()
+    body = m.add_body("link3", mass=1.0, inertia=[2e-4, 0.0209, 0.0209], com=(0.5 * L, 0, 0))
+    m.add_joint(joints.Revolute("j3", "link2", body, parent_frame=(L, 0, 0), axis=(0.0, 0.0, 1.0), q0=0.3))
+    c = ms.simulate(m, 0.01, integrator=ms.RK4(1e-3))
+    assert '"j3"' in c.attrs["model"] and '"j3"' not in a.attrs["model"]
+    assert c["joint/j3/q"][0] == pytest.approx(0.3, abs=1e-12)
+    assert c["q"].shape[1] == 3

@@ -221,10 +221,11 @@ def simulate_batch(
     def make(i: int, raw: dict) -> Results:
         m = models[i] if values is not None else model
         c = cores[i] if values is not None else core
+        description, joints = m.run_metadata()
         raw = dict(raw)
         raw.pop("warnings", None)
         attrs = {
-            "model": c.description_json(),
+            "model": description,
             "settings": texts[i],
             "stats": json.dumps(raw.pop("stats")),
             "events": raw.pop("events_json", "[]"),
@@ -233,7 +234,7 @@ def simulate_batch(
         }
         if chosen is not None:
             attrs["sensors"] = json.dumps(list(sensors) if not isinstance(sensors, str) else [sensors])
-        res = Results.from_raw(raw, c.joints(), c.body_names[1:], attrs, engine=c, callbacks=m.callbacks or None,
+        res = Results.from_raw(raw, joints, c.body_names[1:], attrs, engine=c, callbacks=m.callbacks or None,
                                keep=chosen)
         return res
 

@@ -188,8 +188,9 @@ def simulate(
 
     for note in raw.pop("warnings", []):
         warnings.warn(f"model '{model.name}': {note}", UserWarning, stacklevel=2)
+    description, joints = model.run_metadata()
     attrs = {
-        "model": core.description_json(),
+        "model": description,
         "settings": text,
         "stats": json.dumps(raw.pop("stats")),
         "events": raw.pop("events_json", "[]"),
@@ -199,7 +200,7 @@ def simulate(
     cancelled = raw.pop("cancelled", None)
     if chosen is not None:
         attrs["sensors"] = json.dumps(list(sensors) if not isinstance(sensors, str) else [sensors])
-    res = Results.from_raw(raw, core.joints(), body_names, attrs, engine=core, callbacks=callbacks, keep=chosen)
+    res = Results.from_raw(raw, joints, body_names, attrs, engine=core, callbacks=callbacks, keep=chosen)
     if cancelled is not None:
         # Ctrl-C: the samples before it are kept on the interrupt (`except KeyboardInterrupt as e:
         # e.results`)
