@@ -48,63 +48,73 @@ fn dot6(a: &V6, b: &V6) -> f64 {
 /// actuation (length nu). Writes `data.udot` and the body accelerations `data.a` (without gravity).
 pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
     let nb = model.nbodies();
+    let nu_all = model.nu;
+    // every per-body array cut to nb and every per-velocity array to nu: all index checks by a
+    // body then compare with one bound, which the loops already imply (they were a tenth of the
+    // instructions of a chain's pass, each with its own length reloaded from the stack)
+    let Data { ia, pa, s, c, v, inertia, f_ext, tau_applied, u_mat, d_inv, u_bias, a, udot, .. } = data;
+    let (ia, pa, u_mat, d_inv, u_bias, acc) =
+        (&mut ia[..nb], &mut pa[..nb], &mut u_mat[..nb], &mut d_inv[..nb], &mut u_bias[..nb], &mut a[..nb]);
+    let (s, c, v, inertia, f_ext) = (&s[..nb], &c[..nb], &v[..nb], &inertia[..nb], &f_ext[..nb]);
+    let (tau_applied, udot) = (&tau_applied[..nu_all], &mut udot[..nu_all]);
+    let tau = tau.map(|t| &t[..nu_all]);
     for i in 1..nb {
-        data.ia[i].set_rigid(&data.inertia[i]);
-        let iv = data.inertia[i].mul_motion(&data.v[i]);
-        data.pa[i] = data.v[i].cross_force(&iv) - data.f_ext[i];
+        ia[i].set_rigid(&inertia[i]);
+        let iv = inertia[i].mul_motion(&v[i]);
+        pa[i] = v[i].cross_force(&iv) - f_ext[i];
     }
     for (ji, j) in model.joints.iter().enumerate().rev() {
         let i = ji + 1;
         let nu = j.nu();
         let parent = j.parent;
-        let (lo, hi) = data.ia.split_at_mut(i);
-        let ia = &mut hi[0];
+        let (lo, hi) = ia.split_at_mut(i);
+        let ia_i = &mut hi[0];
         if nu == 1 {
             // the common case: U = I^A S and I^A c in one sweep of I^A, then I^a = I^A - U Uᵀ/D
             // added to the parent in a second sweep (I^a itself is never stored)
-            let s = data.s[i][0].v6();
-            let c = data.c[i].v6();
-            let u_col = ia.mul(&s);
-            let ic = ia.mul(&c);
-            let d_inv = 1.0 / dot6(&s, &u_col);
-            let t = data.tau_applied[j.iu] + tau.map_or(0.0, |t| t[j.iu]);
-            let ub = t - data.s[i][0].dot(&data.pa[i]);
-            data.u_mat[i][0] = u_col;
-            data.d_inv[i][0][0] = d_inv;
-            data.u_bias[i][0] = ub;
+            let s0 = s[i][0].v6();
+            let ci = c[i].v6();
+            let u_col = ia_i.mul(&s0);
+            let ic = ia_i.mul(&ci);
+            let d_i = 1.0 / dot6(&s0, &u_col);
+            let t = tau_applied[j.iu] + tau.map_or(0.0, |t| t[j.iu]);
+            let ub = t - s[i][0].dot(&pa[i]);
+            u_mat[i][0] = u_col;
+            d_inv[i][0][0] = d_i;
+            u_bias[i][0] = ub;
             if parent != 0 {
                 // p^a = p^A + I^a c + U D⁻¹ u, with I^a c = I^A c - U D⁻¹ (Uᵀ c)
-                let k = d_inv * (ub - dot6(&u_col, &c));
-                let mut pa = data.pa[i].v6();
+                let k = d_i * (ub - dot6(&u_col, &ci));
+                let mut p = pa[i].v6();
                 for r in 0..6 {
-                    pa[r] += ic[r] + u_col[r] * k;
+                    p[r] += ic[r] + u_col[r] * k;
                 }
-                lo[parent].add_minus_outer(ia, d_inv, &u_col);
-                data.pa[parent] += Force::from_v6(&pa);
+                lo[parent].add_minus_outer(ia_i, d_i, &u_col);
+                pa[parent] += Force::from_v6(&p);
             }
             continue;
         }
         if nu == 0 {
             if parent != 0 {
-                let ic = ia.mul_motion(&data.c[i]);
-                let pa = data.pa[i] + Force::from_v6(&ic);
-                lo[parent].add(ia);
-                data.pa[parent] += pa;
+                let ic = ia_i.mul_motion(&c[i]);
+                let p = pa[i] + Force::from_v6(&ic);
+                lo[parent].add(ia_i);
+                pa[parent] += p;
             }
             continue;
         }
         let mut u_cols = [[0.0; 6]; 6];
         let mut ub = [0.0; 6];
         for k in 0..nu {
-            let s = &data.s[i][k];
-            u_cols[k] = ia.mul_motion(s);
-            let t = data.tau_applied[j.iu + k] + tau.map_or(0.0, |t| t[j.iu + k]);
-            ub[k] = t - s.dot(&data.pa[i]);
+            let sk = &s[i][k];
+            u_cols[k] = ia_i.mul_motion(sk);
+            let t = tau_applied[j.iu + k] + tau.map_or(0.0, |t| t[j.iu + k]);
+            ub[k] = t - sk.dot(&pa[i]);
         }
         let mut d = [[0.0; 6]; 6];
         for r in 0..nu {
-            for c in 0..nu {
-                d[r][c] = data.s[i][r].dot6(&u_cols[c]);
+            for col in 0..nu {
+                d[r][col] = s[i][r].dot6(&u_cols[col]);
             }
         }
         // D is positive definite for a physical body; NaN propagates otherwise and the integrator
@@ -116,60 +126,60 @@ pub fn aba_prepared(model: &Model, data: &mut Data, tau: Option<&[f64]>) {
             // I^a = I^A - U D⁻¹ Uᵀ, subtracted as Σ_r (U D⁻¹)_r U_rᵀ
             let mut w = [[0.0; 6]; 6]; // W = U D⁻¹
             for r in 0..nu {
-                for c in 0..nu {
+                for col in 0..nu {
                     for e in 0..6 {
-                        w[r][e] += u_cols[c][e] * d[c][r];
+                        w[r][e] += u_cols[col][e] * d[col][r];
                     }
                 }
             }
             for r in 0..nu {
-                ia.sub_product(&w[r], &u_cols[r]);
+                ia_i.sub_product(&w[r], &u_cols[r]);
             }
-            let ic = ia.mul_motion(&data.c[i]);
-            let mut pa = data.pa[i].v6();
+            let ic = ia_i.mul_motion(&c[i]);
+            let mut p = pa[i].v6();
             for r in 0..nu {
-                let coef: f64 = (0..nu).map(|c| d[r][c] * ub[c]).sum();
+                let coef: f64 = (0..nu).map(|col| d[r][col] * ub[col]).sum();
                 for e in 0..6 {
-                    pa[e] += u_cols[r][e] * coef;
+                    p[e] += u_cols[r][e] * coef;
                 }
             }
             for e in 0..6 {
-                pa[e] += ic[e];
+                p[e] += ic[e];
             }
-            lo[parent].add(ia);
-            data.pa[parent] += Force::from_v6(&pa);
+            lo[parent].add(ia_i);
+            pa[parent] += Force::from_v6(&p);
         }
-        data.u_mat[i] = u_cols;
-        data.d_inv[i] = d;
-        data.u_bias[i] = ub;
+        u_mat[i] = u_cols;
+        d_inv[i] = d;
+        u_bias[i] = ub;
     }
-    data.a[0] = Motion::new(crate::math::Vec3::zeros(), -model.gravity);
+    acc[0] = Motion::new(crate::math::Vec3::zeros(), -model.gravity);
     for (ji, j) in model.joints.iter().enumerate() {
         let i = ji + 1;
         let nu = j.nu();
-        let mut a = data.a[j.parent] + data.c[i];
+        let mut ai = acc[j.parent] + c[i];
         if nu == 1 {
-            let ud = data.d_inv[i][0][0] * (data.u_bias[i][0] - a.dot6(&data.u_mat[i][0]));
-            data.udot[j.iu] = ud;
-            a += data.s[i][0] * ud;
+            let ud = d_inv[i][0][0] * (u_bias[i][0] - ai.dot6(&u_mat[i][0]));
+            udot[j.iu] = ud;
+            ai += s[i][0] * ud;
         } else if nu > 1 {
-            let ap = a.v6();
+            let ap = ai.v6();
             let mut rhs = [0.0; 6];
             for k in 0..nu {
-                rhs[k] = data.u_bias[i][k] - dot6(&data.u_mat[i][k], &ap);
+                rhs[k] = u_bias[i][k] - dot6(&u_mat[i][k], &ap);
             }
             for r in 0..nu {
-                let ud: f64 = (0..nu).map(|c| data.d_inv[i][r][c] * rhs[c]).sum();
-                data.udot[j.iu + r] = ud;
-                a += data.s[i][r] * ud;
+                let ud: f64 = (0..nu).map(|col| d_inv[i][r][col] * rhs[col]).sum();
+                udot[j.iu + r] = ud;
+                ai += s[i][r] * ud;
             }
         }
-        data.a[i] = a;
+        acc[i] = ai;
     }
     // report accelerations without the gravity offset: the ground's a = -g was added to all
-    data.a[0] = Motion::ZERO;
-    for i in 1..nb {
-        data.a[i].v += model.gravity;
+    acc[0] = Motion::ZERO;
+    for ai in acc[1..].iter_mut() {
+        ai.v += model.gravity;
     }
 }
 
