@@ -23,7 +23,9 @@ Measured:
     ``SolveDynamic(RK44)`` (1000 steps, no solution file, no sensors). Final states are compared.
 
 Timings use ``time.perf_counter`` with the garbage collector off: per-call timings are batches
-calibrated to >= 20 ms, repeated; whole simulations are single calls, repeated. Each cell shows
+calibrated to >= 20 ms (each call its own count), one batch of each call per round
+(mechsys's and Pinocchio's taking turns, ``benchdoc.interleaved``); whole simulations are single
+calls, repeated. Each cell shows
 min (median); ratios use the minimum, the least disturbed by other load on the machine.
 
 Reproduce (after ``make build``)::
@@ -216,17 +218,24 @@ def _timed(fn, number: int) -> float:
             gc.enable()
 
 
-def per_call(fn, repeat: int, batch_time: float = 0.02) -> tuple[float, float]:
-    """(min, median) seconds per call over ``repeat`` batches of >= ``batch_time`` each."""
-    fn()
-    number = 1
-    while True:
-        t = _timed(fn, number)
-        if t >= batch_time:
-            break
-        number = max(number * 2, int(number * batch_time / max(t, 1e-9) * 1.2))
-    times = [_timed(fn, number) / number for _ in range(repeat)]
-    return min(times), statistics.median(times)
+def per_call_turns(fns: dict, repeat: int, batch_time: float = 0.02) -> dict:
+    """``{name: (min, median)}`` seconds per call of several calls timed taking turns: each in
+    batches of >= ``batch_time`` (its own count of calls per batch), one batch of each per round
+    (``benchdoc.interleaved``), so that a slow spell of the machine weighs on every side of a ratio
+    alike instead of on whichever ran in it."""
+    counts = {}
+    for name, fn in fns.items():
+        fn()
+        number = 1
+        while True:
+            t = _timed(fn, number)
+            if t >= batch_time:
+                break
+            number = max(number * 2, int(number * batch_time / max(t, 1e-9) * 1.2))
+        counts[name] = number
+    batches = {name: (lambda f=fn, k=counts[name]: _timed(f, k)) for name, fn in fns.items()}
+    out = interleaved(batches, repeat)
+    return {name: (out[name][0] / counts[name], out[name][1] / counts[name]) for name in fns}
 
 
 def whole_run(fn, repeat: int, budget: float) -> tuple[float, float, int, object]:
@@ -283,8 +292,8 @@ def measure_calls(sizes, repeat, peers, log) -> list[dict]:
         mm_ms = ms.dynamics.mass_matrix(m, q)
         # like Pinocchio (which returns its data.ddq), write into a kept array: no allocation per call
         out = np.empty(m.nu)
-        row["mechsys_aba"] = per_call(lambda: ms.dynamics.forward_dynamics(m, q, u, out=out), repeat)
-        row["mechsys_crba"] = per_call(lambda: ms.dynamics.mass_matrix(m, q), repeat)
+        calls = {"mechsys_aba": lambda: ms.dynamics.forward_dynamics(m, q, u, out=out),
+                 "mechsys_crba": lambda: ms.dynamics.mass_matrix(m, q)}
         if "pinocchio" in peers:
             import pinocchio as pin
 
@@ -298,8 +307,10 @@ def measure_calls(sizes, repeat, peers, log) -> list[dict]:
             if row["check_aba_pin"] > REL_TOL or row["check_crba_pin"] > REL_TOL:
                 row["mismatch"] = True
                 log(f"  MISMATCH N={n}: aba rel {row['check_aba_pin']:.2e}, crba rel {row['check_crba_pin']:.2e}")
-            row["pin_aba"] = per_call(lambda: pin.aba(pm, pd, q, u, tau), repeat)
-            row["pin_crba"] = per_call(lambda: pin.crba(pm, pd, q), repeat)
+            calls["pin_aba"] = lambda: pin.aba(pm, pd, q, u, tau)
+            calls["pin_crba"] = lambda: pin.crba(pm, pd, q)
+        # every call's batches taken in turns with the others' (one batch of each per round)
+        row.update(per_call_turns(calls, repeat))
         if "mujoco" in peers:
             import mujoco
 
@@ -464,7 +475,8 @@ def report(calls, sims, notes, peers, missing, mach, vers, rust, argv) -> str:
     L.append("")
     L.append("Command: `.venv/bin/python benches/peers.py " + " ".join(argv) + "`")
     L.append("")
-    L.append("Cells: min (median) over the repeats; ratios use the minimum.")
+    L.append("Cells: min (median) over the repeats; ratios use the minimum. Per-call timings: batches of "
+             ">= 20 ms, one batch of each call per round, mechsys's and Pinocchio's taking turns.")
     L.append("")
 
     if calls:
