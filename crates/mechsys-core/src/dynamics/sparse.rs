@@ -31,6 +31,10 @@ pub struct Saddle {
     m_off: Vec<f64>,
     /// Diagonal of M, then D.
     m_diag: Vec<f64>,
+    /// Velocities starting a dense block of six without ancestors outside it (a free joint on
+    /// the ground): each velocity's ancestors are the block's earlier ones, and the factor and
+    /// solves run on it with fixed sizes (see [`Saddle::factor_mass`]).
+    block6: Vec<bool>,
     // ---- rows of G: velocities row_idx[row_ptr[r]..row_ptr[r+1]], ascending
     row_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -78,6 +82,29 @@ pub(crate) fn velocity_ancestors(model: &Model) -> (Vec<usize>, Vec<usize>, Vec<
         depth[k] = anc_ptr[k + 1] - anc_ptr[k];
     }
     (parent, depth, anc_ptr, anc_idx)
+}
+
+/// Offsets of the ancestors of the j-th velocity of a block of six among its 15 factor entries
+/// (`j (j - 1) / 2`: velocity j has the j before it).
+const TRI6: [usize; 6] = [0, 0, 1, 3, 6, 10];
+
+/// Per velocity: whether it starts a block of six in which velocity `k0 + j` has exactly the
+/// ancestors `k0 + j - 1, …, k0` (nearest first), as the six velocities of a free joint on the
+/// ground have. Blocks do not overlap; what hangs below a block may be anything.
+fn dense_blocks6(nu: usize, depth: &[usize], anc_ptr: &[usize], anc_idx: &[usize]) -> Vec<bool> {
+    let mut out = vec![false; nu];
+    let mut k0 = 0;
+    while k0 + 6 <= nu {
+        let dense =
+            (0..6).all(|j| depth[k0 + j] == j && (0..j).all(|p| anc_idx[anc_ptr[k0 + j] + p] == k0 + j - 1 - p));
+        if dense {
+            out[k0] = true;
+            k0 += 6;
+        } else {
+            k0 += 1;
+        }
+    }
+    out
 }
 
 impl Saddle {
@@ -191,9 +218,11 @@ impl Saddle {
                 }
             }
         }
+        let block6 = dense_blocks6(nu, &depth, &anc_ptr, &anc_idx);
         Saddle {
             nu,
             nc,
+            block6,
             depth,
             anc_ptr,
             m_off: vec![0.0; anc_idx.len()],
@@ -233,7 +262,18 @@ impl Saddle {
     /// Factors `M = Lᵀ D L` in place; false if a pivot is not positive (M singular).
     pub fn factor_mass(&mut self) -> bool {
         let scale = self.m_diag.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
-        for k in (0..self.nu).rev() {
+        let mut k = self.nu;
+        while k > 0 {
+            k -= 1;
+            if k >= 5 && self.block6[k - 5] {
+                // the same steps as below, in the same order, on fixed-size views: a free body's
+                // 21 entries without index lists
+                k -= 5;
+                if !self.factor_block6(k, scale) {
+                    return false;
+                }
+                continue;
+            }
             let d = self.m_diag[k];
             if !(d > 1e-14 * scale) {
                 return false;
@@ -255,6 +295,38 @@ impl Saddle {
         true
     }
 
+    /// The block of six starting at velocity `k0` (see `block6`) factored as [`Saddle::factor_mass`]
+    /// factors any velocity: velocity `k0 + j` keeps its ancestors `k0 + j - 1, …, k0` at
+    /// `m_off[base + TRI6[j]..]`.
+    fn factor_block6(&mut self, k0: usize, scale: f64) -> bool {
+        let base = self.anc_ptr[k0];
+        let (Ok(off), Ok(diag)) = (
+            <&mut [f64; 15]>::try_from(&mut self.m_off[base..base + 15]),
+            <&mut [f64; 6]>::try_from(&mut self.m_diag[k0..k0 + 6]),
+        ) else {
+            return false;
+        };
+        for j in (0..6).rev() {
+            let d = diag[j];
+            if !(d > 1e-14 * scale) {
+                return false;
+            }
+            let s = TRI6[j];
+            for p in 0..j {
+                let i = j - 1 - p;
+                let mk = off[s + p];
+                let a = mk / d;
+                diag[i] -= a * mk;
+                let si = TRI6[i];
+                for q in p + 1..j {
+                    off[si + q - p - 1] -= a * off[s + q];
+                }
+                off[s + p] = a;
+            }
+        }
+        true
+    }
+
     /// The factor of M after [`Saddle::factor_mass`]: `L` below the diagonal (per velocity, its
     /// ancestors nearest first, as [`velocity_ancestors`] lists them) and `D`.
     pub(crate) fn mass_factor(&self) -> (&[f64], &[f64]) {
@@ -263,7 +335,22 @@ impl Saddle {
 
     /// `x ← Lᵀ⁻¹ x` (leaves to root).
     fn solve_lt(&self, x: &mut [f64]) {
-        for k in (0..self.nu).rev() {
+        let mut k = self.nu;
+        while k > 0 {
+            k -= 1;
+            if k >= 5 && self.block6[k - 5] {
+                k -= 5;
+                let (off, xb) = self.block6_views(k, x);
+                for j in (0..6).rev() {
+                    let xk = xb[j];
+                    if xk != 0.0 {
+                        for p in 0..j {
+                            xb[j - 1 - p] -= off[TRI6[j] + p] * xk;
+                        }
+                    }
+                }
+                continue;
+            }
             let xk = x[k];
             if xk != 0.0 {
                 for p in self.anc_ptr[k]..self.anc_ptr[k + 1] {
@@ -276,13 +363,37 @@ impl Saddle {
     /// `x ← M⁻¹ x` with the factor of [`Saddle::factor_mass`].
     pub fn solve_mass(&self, x: &mut [f64]) {
         self.solve_lt(x);
-        for k in 0..self.nu {
+        let mut k = 0;
+        while k < self.nu {
+            if self.block6[k] {
+                let diag = &self.m_diag[k..k + 6];
+                let (off, xb) = self.block6_views(k, x);
+                for j in 0..6 {
+                    let mut s = xb[j] / diag[j];
+                    for p in 0..j {
+                        s -= off[TRI6[j] + p] * xb[j - 1 - p];
+                    }
+                    xb[j] = s;
+                }
+                k += 6;
+                continue;
+            }
             let mut s = x[k] / self.m_diag[k];
             for p in self.anc_ptr[k]..self.anc_ptr[k + 1] {
                 s -= self.m_off[p] * x[self.anc_idx[p]];
             }
             x[k] = s;
+            k += 1;
         }
+    }
+
+    /// The factor entries and the unknowns of the block of six starting at `k0`.
+    #[inline]
+    fn block6_views<'a>(&'a self, k0: usize, x: &'a mut [f64]) -> (&'a [f64; 15], &'a mut [f64; 6]) {
+        let base = self.anc_ptr[k0];
+        let off = <&[f64; 15]>::try_from(&self.m_off[base..base + 15]).expect("a block of six has 15 factor entries");
+        let xb = <&mut [f64; 6]>::try_from(&mut x[k0..k0 + 6]).expect("a block of six has six unknowns");
+        (off, xb)
     }
 
     /// Copies the rows of the dense `G` (nc × nu) onto the row pattern.
@@ -507,6 +618,67 @@ mod tests {
             dist("d3", "link1", "link4", [0.2, 0.0, 0.1]),
         ];
         Model::from_description(d).unwrap()
+    }
+
+    /// The mass matrix of `m` at q0 put into a fresh plan.
+    fn planned(m: &Model) -> (Saddle, nalgebra::DMatrix<f64>) {
+        let mut d = Data::new(m);
+        let q = m.q0().to_vec();
+        crate::dynamics::crba::mass_matrix(m, &mut d, 0.0, &q);
+        let mut sp = Saddle::new(m);
+        for r in 0..m.nu {
+            for c in 0..m.nu {
+                if d.mass_matrix[(r, c)] != 0.0 {
+                    sp.put_mass(r, c, d.mass_matrix[(r, c)]);
+                }
+            }
+        }
+        (sp, d.mass_matrix.clone())
+    }
+
+    #[test]
+    fn blocks_of_six_factor_and_solve_bit_for_bit_as_the_index_lists_do() {
+        // free bodies on the ground (one with a revolute and a spherical joint below it), and a
+        // chain of eight revolutes whose first six velocities form the same dense pattern
+        let mut tree = crate::fixtures::chain_description(5, "revolute");
+        for (k, (kind, parent)) in
+            [("free", "ground"), ("revolute", "link1"), ("free", "ground"), ("spherical", "link3"), ("free", "ground")]
+                .into_iter()
+                .enumerate()
+        {
+            let j = &mut tree.joints[k];
+            j.kind = kind.into();
+            j.parent = parent.into();
+            j.q0 = match kind {
+                "free" => Some(vec![0.1 * k as f64, 0.2, -0.3, 0.9, 0.1 * k as f64, -0.3, 0.2]),
+                "spherical" => Some(vec![0.8, 0.36, 0.0, 0.48]),
+                _ => Some(vec![0.4]),
+            };
+            if kind != "revolute" {
+                j.axis = None;
+            }
+        }
+        let tree = Model::from_description(tree).unwrap();
+        for (m, blocks) in [(tree, vec![0, 7, 16]), (crate::fixtures::chain(8, "revolute"), vec![0])] {
+            let (mut fast, dense) = planned(&m);
+            let starts: Vec<usize> = (0..m.nu).filter(|&k| fast.block6[k]).collect();
+            assert_eq!(starts, blocks, "{}: blocks of six found", m.name);
+            let mut slow = fast.clone();
+            slow.block6.fill(false);
+            assert!(fast.factor_mass() && slow.factor_mass());
+            assert_eq!(fast.m_diag, slow.m_diag, "{}", m.name);
+            assert_eq!(fast.m_off, slow.m_off, "{}", m.name);
+            let b: Vec<f64> = (0..m.nu).map(|i| (i as f64 * 0.9).cos() - 0.3).collect();
+            let (mut x_fast, mut x_slow) = (b.clone(), b.clone());
+            fast.solve_mass(&mut x_fast);
+            slow.solve_mass(&mut x_slow);
+            assert_eq!(x_fast, x_slow, "{}", m.name);
+            // and both are M⁻¹ b: against nalgebra's dense Cholesky
+            let x = dense.clone().cholesky().unwrap().solve(&nalgebra::DVector::from_column_slice(&b));
+            for i in 0..m.nu {
+                assert!((x_fast[i] - x[i]).abs() < 1e-10 * x.amax(), "{} row {i}: {} vs {}", m.name, x_fast[i], x[i]);
+            }
+        }
     }
 
     #[test]
