@@ -218,10 +218,20 @@ def simulate_batch(
         if first is not None:
             raise first
 
+    metas: dict = {}
+
+    def metadata(c) -> tuple:
+        # the description and joint table of the engine model that ran, made once per model
+        # (the cases of one model share them) and only for the results that are asked for
+        got = metas.get(id(c))
+        if got is None:
+            got = metas[id(c)] = (c.description_json(), c.joints())
+        return got
+
     def make(i: int, raw: dict) -> Results:
         m = models[i] if values is not None else model
         c = cores[i] if values is not None else core
-        description, joints = m.run_metadata()
+        description, joints = metadata(c)
         raw = dict(raw)
         raw.pop("warnings", None)
         attrs = {

@@ -140,6 +140,8 @@ def simulate(
     if not isinstance(model, Model):
         raise SettingsError(f"simulate: expected a mechsys.Model, got {type(model).__name__}")
     core = model.build()
+    # taken with the build that runs (the model could change before the results are made)
+    description, joints = model.run_metadata()
     if core.nc:
         _warn_redundant(model, q0, t0)
     if keep:
@@ -183,7 +185,6 @@ def simulate(
 
     for note in raw.pop("warnings", []):
         warnings.warn(f"model '{model.name}': {note}", UserWarning, stacklevel=2)
-    description, joints = model.run_metadata()
     attrs = {
         "model": description,
         "settings": text,
