@@ -174,3 +174,17 @@ def test_cancelling_stops_every_case_at_its_next_sample():
     assert len(out) == 3
     for raw, err in out:
         assert err is None and "cancelled" in raw["cancelled"] and len(raw["t"]) <= 1
+
+
+def test_results_made_after_the_model_changed_carry_the_model_that_ran():
+    # a batch's Results are made on first use, possibly after the caller changed the model: they
+    # must still name the joints and columns of the model that ran, not of the changed one
+    m = pendulum_chain()
+    batch = ms.simulate_batch(m, t_end=0.05, integrator=ms.RK4(1e-3), output_dt=0.01, initial_states=states(2), threads=1)
+    b = m.add_body("l3", mass=1.0, inertia=ms.inertia.rod(1.0, 0.5), com=(0.25, 0.0, 0.0))
+    m.add_joint(ms.joints.Revolute("j3", parent="l2", child=b, parent_frame=(0.5, 0.0, 0.0), axis=(0, 0, 1)))
+    assert '"j3"' in m.run_metadata()[0]
+    for res in batch.results:
+        assert '"j3"' not in res.attrs["model"] and '"j2"' in res.attrs["model"]
+        assert res["q"].shape[1] == 3 and "joint/j3/q" not in res.names()
+        np.testing.assert_array_equal(res["joint/j2/q"], res["q"][:, 2])

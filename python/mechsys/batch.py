@@ -124,6 +124,10 @@ def simulate_batch(
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
         raise SettingsError(f"threads: must be a whole number >= 1, got {threads!r}")
     core = model.build()
+    # the description and joint table the results carry (`Model.run_metadata`): the caller's
+    # model's now, with the build that runs (it may change before results are made); the
+    # parameter sets' copies are this function's own, so theirs when their results are made
+    shared = model.run_metadata() if values is None else None
     n: int | None = None
     if initial_states is not None:
         states = np.asarray(initial_states, dtype=float)
@@ -218,20 +222,10 @@ def simulate_batch(
         if first is not None:
             raise first
 
-    metas: dict = {}
-
-    def metadata(c) -> tuple:
-        # the description and joint table of the engine model that ran, made once per model
-        # (the cases of one model share them) and only for the results that are asked for
-        got = metas.get(id(c))
-        if got is None:
-            got = metas[id(c)] = (c.description_json(), c.joints())
-        return got
-
     def make(i: int, raw: dict) -> Results:
         m = models[i] if values is not None else model
         c = cores[i] if values is not None else core
-        description, joints = metadata(c)
+        description, joints = shared if shared is not None else m.run_metadata()
         raw = dict(raw)
         raw.pop("warnings", None)
         attrs = {

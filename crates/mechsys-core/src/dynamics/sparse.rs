@@ -86,7 +86,7 @@ pub(crate) fn velocity_ancestors(model: &Model) -> (Vec<usize>, Vec<usize>, Vec<
 
 /// Offsets of the ancestors of the j-th velocity of a block of six among its 15 factor entries
 /// (`j (j - 1) / 2`: velocity j has the j before it).
-const TRI6: [usize; 6] = [0, 0, 1, 3, 6, 10];
+pub(crate) const TRI6: [usize; 6] = [0, 0, 1, 3, 6, 10];
 
 /// Per velocity: whether it starts a block of six in which velocity `k0 + j` has exactly the
 /// ancestors `k0 + j - 1, …, k0` (nearest first), as the six velocities of a free joint on the
@@ -300,12 +300,10 @@ impl Saddle {
     /// `m_off[base + TRI6[j]..]`.
     fn factor_block6(&mut self, k0: usize, scale: f64) -> bool {
         let base = self.anc_ptr[k0];
-        let (Ok(off), Ok(diag)) = (
-            <&mut [f64; 15]>::try_from(&mut self.m_off[base..base + 15]),
-            <&mut [f64; 6]>::try_from(&mut self.m_diag[k0..k0 + 6]),
-        ) else {
-            return false;
-        };
+        // (the lengths follow from the block's pattern; not a singular M)
+        let off =
+            <&mut [f64; 15]>::try_from(&mut self.m_off[base..base + 15]).expect("a block of six has 15 factor entries");
+        let diag = <&mut [f64; 6]>::try_from(&mut self.m_diag[k0..k0 + 6]).expect("a block of six has six pivots");
         for j in (0..6).rev() {
             let d = diag[j];
             if !(d > 1e-14 * scale) {

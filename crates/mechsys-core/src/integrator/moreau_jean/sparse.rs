@@ -402,11 +402,12 @@ impl SparseRows {
                     wk[r] = 0.0 + dirs[r].dot(&v);
                 }
             }
-            // y = D^{-1/2} L⁻ᵀ w, leaves first; L(iu + j, iu + j - 1 - p) at off[j(j-1)/2 + p]
+            // y = D^{-1/2} L⁻ᵀ w, leaves first; L(iu + j, iu + j - 1 - p) at off[TRI6[j] + p]
+            // (the layout of a free joint's block in the mass factor, `Saddle`'s blocks of six)
             let mut y = w;
             for j in (1..6).rev() {
                 let v = y[j];
-                let lj = j * (j - 1) / 2;
+                let lj = crate::dynamics::sparse::TRI6[j];
                 for p in 0..j {
                     let l = off[lj + p];
                     for r in 0..D {
