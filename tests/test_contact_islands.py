@@ -42,6 +42,35 @@ def test_two_stacks_are_two_islands_and_each_carries_its_weight():
             np.testing.assert_allclose(res[f"contact/on{s}_{k}/lambda_n"][1:].sum(axis=1), (5 - k) * G, rtol=0, atol=1e-8)
 
 
+def test_a_dominant_island_above_newtons_size_is_swept_whole_and_carries_its_weights():
+    """Auto sweeps the whole problem on the factored operator (no islands, no Delassus blocks)
+    when its largest island is above Newton's size and holds most contacts: a stack of 5 boxes
+    (20 points, 60 unknowns) beside a single box (4 points), Newton's size set to 30 unknowns.
+    Each box still rests on what is below it with the weight above it, as in the split solve."""
+    m = ms.Model("stack and box", gravity=(0.0, 0.0, -G))
+    shape = ms.contours.Box(half_extents=HALF)
+    floor = m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)))
+    below = None
+    for k in range(6):
+        b = m.add_body(f"b{k}", 1.0, ms.inertia.box(1.0, tuple(2 * h for h in HALF)))
+        x, z = (0.0, HALF[2] * (2 * k + 1)) if k < 5 else (0.5, HALF[2])
+        m.add_joint(ms.joints.Free(f"f{k}", m.ground, b, q0=[x, 0.0, z, 1, 0, 0, 0]))
+        other = floor if k in (0, 5) else below.contour(shape)
+        m.add_contact(ms.Contact(f"c{k}", b.contour(shape), other, friction=ms.laws.Coulomb(0.5)))
+        below = b
+    weights = {f"c{k}": (5 - k) * G for k in range(5)} | {"c5": G}
+    for newton_max in (30, 480):  # swept whole; split into two islands, Newton on each
+        res = ms.simulate(m, 0.2, ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-10, newton_max_unknowns=newton_max)),
+                          output_dt=1e-3)
+        assert res["solver/converged"][1:].all()
+        assert (res["solver/contacts"][1:] == 24).all()
+        for name, w in weights.items():
+            np.testing.assert_allclose(res[f"contact/{name}/lambda_n"][1:].sum(axis=1), w, rtol=0, atol=1e-6,
+                                       err_msg=f"{name}, newton_max_unknowns={newton_max}")
+        # the top box does not drift off its support
+        assert abs(res["body/b4/position"][-1, 2] - HALF[2] * 9) < 1e-9
+
+
 def test_islands_give_the_same_result_serial_and_parallel_bit_for_bit():
     """A falling, tumbling pile-up of several stacks (impacts, slip and stick; above the size
     from which islands go to threads): serial and threaded runs agree exactly."""

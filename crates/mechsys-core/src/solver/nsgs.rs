@@ -246,12 +246,84 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
     if bn >= 0.0 {
         return [0.0; 3];
     }
-    let ann = a[0];
     if mu == 0.0 {
-        return [-bn / ann, 0.0, 0.0];
+        return [-bn / a[0], 0.0, 0.0];
     }
-    // stick
     let stick = solve3(a, &[-b[0], -b[1], -b[2]]);
+    slip_or_stick_3d(a, isotropic(a), mu, b, prev, stick)
+}
+
+/// A contact's 3-D diagonal block with what the local solve derives from the block alone, made
+/// once per solve instead of once per sweep ([`LocalBlock3::solve`]): its inverse for the stick
+/// candidate and whether it is isotropic (explicit slip).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LocalBlock3 {
+    a: [f64; 9],
+    /// `A⁻¹` (row-major), `None` where [`solve3`] would find `A` nearly singular.
+    inv: Option<[f64; 9]>,
+    iso: bool,
+}
+
+impl LocalBlock3 {
+    /// From the row-major 3 × 3 block `a` (`A_NN > 0`).
+    pub(crate) fn new(a: &[f64; 9]) -> Self {
+        LocalBlock3 { a: *a, inv: inverse3(a), iso: isotropic(a) }
+    }
+
+    /// [`local_solve`] for `d = 3` on this block: the same cases in the same order, the stick
+    /// candidate `−A⁻¹ b` from the kept inverse (equal to Cramer's rule up to round-off).
+    #[inline]
+    pub(crate) fn solve(&self, mu: f64, b: &[f64; 3], r: &mut [f64; 3]) {
+        let bn = b[0];
+        *r = if bn >= 0.0 {
+            [0.0; 3]
+        } else if mu == 0.0 {
+            [-bn / self.a[0], 0.0, 0.0]
+        } else {
+            let stick = self.inv.map(|m| {
+                [
+                    -(m[0] * b[0] + m[1] * b[1] + m[2] * b[2]),
+                    -(m[3] * b[0] + m[4] * b[1] + m[5] * b[2]),
+                    -(m[6] * b[0] + m[7] * b[1] + m[8] * b[2]),
+                ]
+            });
+            if let Some(x) = stick {
+                // the common case inline: a sticking contact
+                if x[0] > 0.0 && (x[1] * x[1] + x[2] * x[2]).sqrt() <= mu * x[0] * (1.0 + SLACK) {
+                    *r = x;
+                    return;
+                }
+            }
+            slip_or_stick_3d(&self.a, self.iso, mu, b, r, stick)
+        };
+    }
+}
+
+/// Whether `W_NT = W_TN = 0` and `W_TT = c I` (to round-off), e.g. any contact of spheres with
+/// uniform inertia: the sliding velocity then stays parallel to `b_T`.
+fn isotropic(a: &[f64; 9]) -> bool {
+    let tiny = 1e-13 * (a[0] + a[4] + a[8]);
+    a[1].abs() <= tiny
+        && a[2].abs() <= tiny
+        && a[3].abs() <= tiny
+        && a[6].abs() <= tiny
+        && a[5].abs() <= tiny
+        && a[7].abs() <= tiny
+        && (a[4] - a[8]).abs() <= tiny
+        && a[4] > 0.0
+}
+
+/// The 3-D local solve after the open and frictionless cases (`b_N < 0`, `μ > 0`), given the
+/// stick candidate `−A⁻¹ b` (`None`: `A` nearly singular) and whether `A` is isotropic.
+fn slip_or_stick_3d(
+    a: &[f64; 9],
+    iso: bool,
+    mu: f64,
+    b: &[f64; 3],
+    prev: &[f64; 3],
+    stick: Option<[f64; 3]>,
+) -> [f64; 3] {
+    let (bn, ann) = (b[0], a[0]);
     let guess_dir = match stick {
         Some(x) => {
             if x[0] > 0.0 && (x[1] * x[1] + x[2] * x[2]).sqrt() <= mu * x[0] * (1.0 + SLACK) {
@@ -268,20 +340,9 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
             ut
         }
     };
-    // an isotropic block (W_NT = W_TN = 0, W_TT = c I, e.g. any contact of spheres with uniform
-    // inertia): the sliding velocity stays parallel to b_T, so the slip solution is explicit
-    let tiny = 1e-13 * (a[0] + a[4] + a[8]);
+    // an isotropic block: the slip solution is explicit
     let btn = (b[1] * b[1] + b[2] * b[2]).sqrt();
-    if btn > 0.0
-        && a[1].abs() <= tiny
-        && a[2].abs() <= tiny
-        && a[3].abs() <= tiny
-        && a[6].abs() <= tiny
-        && a[5].abs() <= tiny
-        && a[7].abs() <= tiny
-        && (a[4] - a[8]).abs() <= tiny
-        && a[4] > 0.0
-    {
+    if btn > 0.0 && iso {
         let rn = -bn / ann;
         // stick failed: |b_T| / c > μ r_N, so u_T = b_T (1 − c μ r_N / |b_T|) points along b_T
         if btn > a[4] * mu * rn {
@@ -300,16 +361,38 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
     }
 }
 
-/// `A x = y` for a 3×3 row-major `A` by Cramer's rule; `None` if nearly singular.
-fn solve3(a: &[f64; 9], y: &[f64; 3]) -> Option<[f64; 3]> {
+/// The first row's cofactors `c` and the determinant of a 3×3 row-major `A`; `None` if `A` is
+/// nearly singular (`|det| ≤ 1e-13 |A_00 A_11 A_22|`).
+fn cofactors3(a: &[f64; 9]) -> Option<([f64; 3], f64)> {
     let c0 = a[4] * a[8] - a[5] * a[7];
     let c1 = a[5] * a[6] - a[3] * a[8];
     let c2 = a[3] * a[7] - a[4] * a[6];
     let det = a[0] * c0 + a[1] * c1 + a[2] * c2;
     let scale = (a[0] * a[4] * a[8]).abs();
-    if !(det.abs() > 1e-13 * scale) {
-        return None;
-    }
+    (det.abs() > 1e-13 * scale).then_some(([c0, c1, c2], det))
+}
+
+/// `A⁻¹` of a 3×3 row-major `A` (adjugate over determinant); `None` where [`solve3`] finds `A`
+/// nearly singular.
+fn inverse3(a: &[f64; 9]) -> Option<[f64; 9]> {
+    let ([c0, c1, c2], det) = cofactors3(a)?;
+    let adj = [
+        c0,
+        a[2] * a[7] - a[1] * a[8],
+        a[1] * a[5] - a[2] * a[4],
+        c1,
+        a[0] * a[8] - a[2] * a[6],
+        a[2] * a[3] - a[0] * a[5],
+        c2,
+        a[1] * a[6] - a[0] * a[7],
+        a[0] * a[4] - a[1] * a[3],
+    ];
+    Some(adj.map(|v| v / det))
+}
+
+/// `A x = y` for a 3×3 row-major `A` by Cramer's rule; `None` if nearly singular.
+fn solve3(a: &[f64; 9], y: &[f64; 3]) -> Option<[f64; 3]> {
+    let ([c0, c1, c2], det) = cofactors3(a)?;
     let x0 = (y[0] * c0 + a[1] * (a[5] * y[2] - y[1] * a[8]) + a[2] * (y[1] * a[7] - a[4] * y[2])) / det;
     let x1 = (a[0] * (y[1] * a[8] - a[5] * y[2]) + y[0] * c1 + a[2] * (a[3] * y[2] - y[1] * a[6])) / det;
     let x2 = (a[0] * (a[4] * y[2] - y[1] * a[7]) + a[1] * (y[1] * a[6] - a[3] * y[2]) + y[0] * c2) / det;

@@ -378,6 +378,46 @@ fn local_solver_covers_all_cases_exactly() {
         assert!(res < 1e-11, "a {a:?} b {b:?} mu {mu}: r {r:?} residual {res}");
         let p = FrictionContact::new(3, Delassus::Dense(a.to_vec()), b.to_vec(), vec![mu]).unwrap();
         counts[p.contact_state(0, &r, 1e-9).unwrap() as usize] += 1;
+        // the block prepared once (kept inverse) solves it too, to round-off
+        assert_prepared_block_agrees(&a, mu, &b, &r);
+    }
+    assert!(counts.iter().all(|&c| c > 100), "open/stick/slip counts {counts:?}");
+}
+
+/// `LocalBlock3` (inverse and isotropy kept per solve) against `local_solve` on one problem:
+/// a solution of its own (residual) and the same one.
+fn assert_prepared_block_agrees(a: &[f64; 9], mu: f64, b: &[f64; 3], r: &[f64; 3]) {
+    let mut r2 = [0.3, -0.1, 0.2];
+    super::nsgs::LocalBlock3::new(a).solve(mu, b, &mut r2);
+    let u: Vec<f64> = (0..3).map(|i| b[i] + (0..3).map(|j| a[i * 3 + j] * r2[j]).sum::<f64>()).collect();
+    let res = super::problem::contact_residual_sq(3, mu, a[0], &r2, &u).sqrt();
+    assert!(res < 1e-11, "prepared block, a {a:?} b {b:?} mu {mu}: r {r2:?} residual {res}");
+    let scale = 1.0 + r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!((0..3).all(|i| (r2[i] - r[i]).abs() <= 1e-12 * scale), "prepared block {r2:?} against {r:?}");
+}
+
+#[test]
+fn prepared_isotropic_blocks_slip_explicitly_as_the_local_solve_does() {
+    // sphere-like blocks (W_NT = 0, W_TT = c I): open, stick and the explicit slip, with the
+    // slip impulse opposing the sliding velocity (closed form r_T = −μ r_N b_T/|b_T|)
+    let mut rng = Rng::new(7);
+    let mut counts = [0usize; 3];
+    for _ in 0..1000 {
+        let (ann, c) = (rng.uniform(0.5, 2.0), rng.uniform(0.5, 4.0));
+        let a = [ann, 0.0, 0.0, 0.0, c, 0.0, 0.0, 0.0, c];
+        let b = [rng.uniform(-1.0, 0.3), rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0)];
+        let mu = rng.uniform(0.2, 2.0);
+        let mut r = [0.0; 3];
+        local_solve(3, &a, mu, &b, &mut r);
+        assert_prepared_block_agrees(&a, mu, &b, &r);
+        let p = FrictionContact::new(3, Delassus::Dense(a.to_vec()), b.to_vec(), vec![mu]).unwrap();
+        let state = p.contact_state(0, &r, 1e-9).unwrap();
+        if state == ContactState::Slip {
+            let (rn, bt) = (-b[0] / ann, b[1].hypot(b[2]));
+            assert!((r[0] - rn).abs() < 1e-14 * (1.0 + rn));
+            assert!((r[1] + mu * rn * b[1] / bt).abs() < 1e-14 && (r[2] + mu * rn * b[2] / bt).abs() < 1e-14);
+        }
+        counts[state as usize] += 1;
     }
     assert!(counts.iter().all(|&c| c > 100), "open/stick/slip counts {counts:?}");
 }

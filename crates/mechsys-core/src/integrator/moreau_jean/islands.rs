@@ -56,6 +56,15 @@ impl Islands {
         self.count
     }
 
+    /// Contacts in the largest island of the last [`Islands::partition`] (0 if none).
+    pub(super) fn largest(&self) -> usize {
+        if self.count <= 1 {
+            // (one island or none: the members were not sorted)
+            return if self.count == 1 { self.of.len() } else { 0 };
+        }
+        (0..self.count).map(|k| self.start[k + 1] - self.start[k]).max().unwrap_or(0)
+    }
+
     /// One island of `n` contacts (the dense assembly couples every contact through `M̃⁻¹`), or
     /// none if `n` is 0.
     pub(super) fn single(&mut self, n: usize) {

@@ -135,6 +135,8 @@ pub(super) struct SparseRows {
     /// The reduced rows packed for the factored sweeps when every contact is on free bodies
     /// and the ground (see `factored`).
     packed: Vec<factored::Packed>,
+    /// The 3-D diagonal blocks prepared for the local solves of one Gauss–Seidel solve.
+    local3: Vec<crate::solver::nsgs::LocalBlock3>,
     /// Anderson acceleration of the factored sweeps.
     aa: crate::solver::anderson::Anderson,
     /// The body-space Newton method's scratch and held factorization.
@@ -210,6 +212,7 @@ impl SparseRows {
             f: vec![0.0; model.nu],
             z: vec![0.0; model.nu],
             packed: Vec::new(),
+            local3: Vec::new(),
             aa: Default::default(),
             newton: Default::default(),
         }

@@ -24,7 +24,7 @@ pub(super) struct Packed {
     bodies: usize,
     y: [[[f64; 6]; 3]; 2],
 }
-use crate::solver::nsgs::{local_solve, CheckSchedule};
+use crate::solver::nsgs::{local_solve, CheckSchedule, LocalBlock3};
 use crate::solver::{contact_residual_sq, project_onto_cone, NsgsOptions, Report};
 
 /// Sweeps after which a convergence check recomputes `z = Y r` instead of trusting the updated one.
@@ -69,6 +69,14 @@ impl SparseRows {
         let mut residual = f64::INFINITY;
         let (mut omega, mut last_change) = (opts.relaxation, f64::INFINITY);
         let packed = self.pack::<D>();
+        // (3-D: each block's inverse and isotropy once per solve, not once per sweep)
+        self.local3.clear();
+        if D == 3 {
+            for a in 0..n {
+                let blk: &[f64; 9] = self.diag[a * 9..(a + 1) * 9].try_into().expect("3 × 3 block");
+                self.local3.push(LocalBlock3::new(blk));
+            }
+        }
         self.factored_product::<D>(r);
         if opts.anderson > 0 {
             // (room for every contact point since the integrator's construction; beyond that,
@@ -96,7 +104,11 @@ impl SparseRows {
                     b[c] += q[a * D + c] - own;
                 }
                 let mut new = old;
-                local_solve(D, &blk, mu[a], &b, &mut new);
+                if D == 3 {
+                    self.local3[a].solve(mu[a], &b, &mut new);
+                } else {
+                    local_solve(D, &blk, mu[a], &b, &mut new);
+                }
                 if omega != 1.0 {
                     // over- or under-relaxed as in nsgs::sweep (back onto the cone if extrapolated)
                     let mut v = [0.0; 3];
