@@ -254,24 +254,24 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
 }
 
 /// A contact's 3-D diagonal block with what the local solve derives from the block alone, made
-/// once per solve instead of once per sweep ([`LocalBlock3::solve`]): its inverse for the stick
-/// candidate and whether it is isotropic (explicit slip).
+/// once per solve instead of once per sweep ([`LocalBlock3::solve`]): the cofactors and
+/// determinant of Cramer's rule for the stick candidate, and whether it is isotropic. The
+/// solution is the one of [`local_solve`] bit for bit.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LocalBlock3 {
     a: [f64; 9],
-    /// `A⁻¹` (row-major), `None` where [`solve3`] would find `A` nearly singular.
-    inv: Option<[f64; 9]>,
+    /// First-row cofactors and determinant; `None` where `A` is nearly singular.
+    cramer: Option<([f64; 3], f64)>,
     iso: bool,
 }
 
 impl LocalBlock3 {
     /// From the row-major 3 × 3 block `a` (`A_NN > 0`).
     pub(crate) fn new(a: &[f64; 9]) -> Self {
-        LocalBlock3 { a: *a, inv: inverse3(a), iso: isotropic(a) }
+        LocalBlock3 { a: *a, cramer: cofactors3(a), iso: isotropic(a) }
     }
 
-    /// [`local_solve`] for `d = 3` on this block: the same cases in the same order, the stick
-    /// candidate `−A⁻¹ b` from the kept inverse (equal to Cramer's rule up to round-off).
+    /// [`local_solve`] for `d = 3` on this block.
     #[inline]
     pub(crate) fn solve(&self, mu: f64, b: &[f64; 3], r: &mut [f64; 3]) {
         let bn = b[0];
@@ -280,20 +280,7 @@ impl LocalBlock3 {
         } else if mu == 0.0 {
             [-bn / self.a[0], 0.0, 0.0]
         } else {
-            let stick = self.inv.map(|m| {
-                [
-                    -(m[0] * b[0] + m[1] * b[1] + m[2] * b[2]),
-                    -(m[3] * b[0] + m[4] * b[1] + m[5] * b[2]),
-                    -(m[6] * b[0] + m[7] * b[1] + m[8] * b[2]),
-                ]
-            });
-            if let Some(x) = stick {
-                // the common case inline: a sticking contact
-                if x[0] > 0.0 && (x[1] * x[1] + x[2] * x[2]).sqrt() <= mu * x[0] * (1.0 + SLACK) {
-                    *r = x;
-                    return;
-                }
-            }
+            let stick = self.cramer.map(|(c, det)| cramer3(&self.a, c, det, &[-b[0], -b[1], -b[2]]));
             slip_or_stick_3d(&self.a, self.iso, mu, b, r, stick)
         };
     }
@@ -361,7 +348,7 @@ fn slip_or_stick_3d(
     }
 }
 
-/// The first row's cofactors `c` and the determinant of a 3×3 row-major `A`; `None` if `A` is
+/// The first row's cofactors and the determinant of a 3×3 row-major `A`; `None` if `A` is
 /// nearly singular (`|det| ≤ 1e-13 |A_00 A_11 A_22|`).
 fn cofactors3(a: &[f64; 9]) -> Option<([f64; 3], f64)> {
     let c0 = a[4] * a[8] - a[5] * a[7];
@@ -372,31 +359,19 @@ fn cofactors3(a: &[f64; 9]) -> Option<([f64; 3], f64)> {
     (det.abs() > 1e-13 * scale).then_some(([c0, c1, c2], det))
 }
 
-/// `A⁻¹` of a 3×3 row-major `A` (adjugate over determinant); `None` where [`solve3`] finds `A`
-/// nearly singular.
-fn inverse3(a: &[f64; 9]) -> Option<[f64; 9]> {
-    let ([c0, c1, c2], det) = cofactors3(a)?;
-    let adj = [
-        c0,
-        a[2] * a[7] - a[1] * a[8],
-        a[1] * a[5] - a[2] * a[4],
-        c1,
-        a[0] * a[8] - a[2] * a[6],
-        a[2] * a[3] - a[0] * a[5],
-        c2,
-        a[1] * a[6] - a[0] * a[7],
-        a[0] * a[4] - a[1] * a[3],
-    ];
-    Some(adj.map(|v| v / det))
-}
-
 /// `A x = y` for a 3×3 row-major `A` by Cramer's rule; `None` if nearly singular.
 fn solve3(a: &[f64; 9], y: &[f64; 3]) -> Option<[f64; 3]> {
-    let ([c0, c1, c2], det) = cofactors3(a)?;
+    let (c, det) = cofactors3(a)?;
+    Some(cramer3(a, c, det, y))
+}
+
+/// Cramer's rule for `A x = y` given `A`'s first-row cofactors `c` and determinant.
+#[inline(always)]
+fn cramer3(a: &[f64; 9], [c0, c1, c2]: [f64; 3], det: f64, y: &[f64; 3]) -> [f64; 3] {
     let x0 = (y[0] * c0 + a[1] * (a[5] * y[2] - y[1] * a[8]) + a[2] * (y[1] * a[7] - a[4] * y[2])) / det;
     let x1 = (a[0] * (y[1] * a[8] - a[5] * y[2]) + y[0] * c1 + a[2] * (a[3] * y[2] - y[1] * a[6])) / det;
     let x2 = (a[0] * (a[4] * y[2] - y[1] * a[7]) + a[1] * (y[1] * a[6] - a[3] * y[2]) + y[0] * c2) / det;
-    Some([x0, x1, x2])
+    [x0, x1, x2]
 }
 
 /// Sliding solution of the 3-D local problem (see the module documentation), `b_N < 0`, `μ > 0`.

@@ -378,22 +378,21 @@ fn local_solver_covers_all_cases_exactly() {
         assert!(res < 1e-11, "a {a:?} b {b:?} mu {mu}: r {r:?} residual {res}");
         let p = FrictionContact::new(3, Delassus::Dense(a.to_vec()), b.to_vec(), vec![mu]).unwrap();
         counts[p.contact_state(0, &r, 1e-9).unwrap() as usize] += 1;
-        // the block prepared once (kept inverse) solves it too, to round-off
+        // the block prepared once solves it too, bit for bit
         assert_prepared_block_agrees(&a, mu, &b, &r);
     }
     assert!(counts.iter().all(|&c| c > 100), "open/stick/slip counts {counts:?}");
 }
 
-/// `LocalBlock3` (inverse and isotropy kept per solve) against `local_solve` on one problem:
-/// a solution of its own (residual) and the same one.
+/// `LocalBlock3` (Cramer's cofactors and isotropy kept per solve) against `local_solve` on one
+/// problem: a solution of its own (residual), and the same one bit for bit.
 fn assert_prepared_block_agrees(a: &[f64; 9], mu: f64, b: &[f64; 3], r: &[f64; 3]) {
-    let mut r2 = [0.3, -0.1, 0.2];
+    let mut r2 = [0.0; 3]; // (the same first guess as the local_solve call)
     super::nsgs::LocalBlock3::new(a).solve(mu, b, &mut r2);
     let u: Vec<f64> = (0..3).map(|i| b[i] + (0..3).map(|j| a[i * 3 + j] * r2[j]).sum::<f64>()).collect();
     let res = super::problem::contact_residual_sq(3, mu, a[0], &r2, &u).sqrt();
     assert!(res < 1e-11, "prepared block, a {a:?} b {b:?} mu {mu}: r {r2:?} residual {res}");
-    let scale = 1.0 + r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!((0..3).all(|i| (r2[i] - r[i]).abs() <= 1e-12 * scale), "prepared block {r2:?} against {r:?}");
+    assert_eq!(r2.map(f64::to_bits), r.map(f64::to_bits), "prepared block {r2:?} against {r:?}");
 }
 
 #[test]

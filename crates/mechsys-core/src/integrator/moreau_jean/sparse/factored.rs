@@ -69,7 +69,7 @@ impl SparseRows {
         let mut residual = f64::INFINITY;
         let (mut omega, mut last_change) = (opts.relaxation, f64::INFINITY);
         let packed = self.pack::<D>();
-        // (3-D: each block's inverse and isotropy once per solve, not once per sweep)
+        // (3-D: each block's Cramer cofactors and isotropy once per solve, not once per sweep)
         self.local3.clear();
         if D == 3 {
             for a in 0..n {
