@@ -250,7 +250,7 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
         return [-bn / a[0], 0.0, 0.0];
     }
     let stick = solve3(a, &[-b[0], -b[1], -b[2]]);
-    slip_or_stick_3d(a, isotropic(a), mu, b, prev, stick)
+    slip_or_stick_3d(a, None, mu, b, prev, stick)
 }
 
 /// A contact's 3-D diagonal block with what the local solve derives from the block alone, made
@@ -281,7 +281,7 @@ impl LocalBlock3 {
             [-bn / self.a[0], 0.0, 0.0]
         } else {
             let stick = self.cramer.map(|(c, det)| cramer3(&self.a, c, det, &[-b[0], -b[1], -b[2]]));
-            slip_or_stick_3d(&self.a, self.iso, mu, b, r, stick)
+            slip_or_stick_3d(&self.a, Some(self.iso), mu, b, r, stick)
         };
     }
 }
@@ -301,10 +301,11 @@ fn isotropic(a: &[f64; 9]) -> bool {
 }
 
 /// The 3-D local solve after the open and frictionless cases (`b_N < 0`, `μ > 0`), given the
-/// stick candidate `−A⁻¹ b` (`None`: `A` nearly singular) and whether `A` is isotropic.
+/// stick candidate `−A⁻¹ b` (`None`: `A` nearly singular) and whether `A` is isotropic (`None`:
+/// tested here, only once the contact does not stick).
 fn slip_or_stick_3d(
     a: &[f64; 9],
-    iso: bool,
+    iso: Option<bool>,
     mu: f64,
     b: &[f64; 3],
     prev: &[f64; 3],
@@ -329,7 +330,7 @@ fn slip_or_stick_3d(
     };
     // an isotropic block: the slip solution is explicit
     let btn = (b[1] * b[1] + b[2] * b[2]).sqrt();
-    if btn > 0.0 && iso {
+    if btn > 0.0 && iso.unwrap_or_else(|| isotropic(a)) {
         let rn = -bn / ann;
         // stick failed: |b_T| / c > μ r_N, so u_T = b_T (1 − c μ r_N / |b_T|) points along b_T
         if btn > a[4] * mu * rn {
