@@ -46,7 +46,9 @@ def test_a_dominant_island_above_newtons_size_is_swept_whole_and_carries_its_wei
     """Auto sweeps the whole problem on the factored operator (no islands, no Delassus blocks)
     when its largest island is above Newton's size and holds most contacts: a stack of 5 boxes
     (20 points, 60 unknowns) beside a single box (4 points), Newton's size set to 30 unknowns.
-    Each box still rests on what is below it with the weight above it, as in the split solve."""
+    Each box still rests on what is below it with the weight above it, as in the split solve (to
+    1e-8 N at tol 1e-12, as the split stacks above). The signals do not tell which path ran: this
+    checks the whole path's answer; `Islands::largest`, which picks it, has its own Rust test."""
     m = ms.Model("stack and box", gravity=(0.0, 0.0, -G))
     shape = ms.contours.Box(half_extents=HALF)
     floor = m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)))
@@ -60,12 +62,12 @@ def test_a_dominant_island_above_newtons_size_is_swept_whole_and_carries_its_wei
         below = b
     weights = {f"c{k}": (5 - k) * G for k in range(5)} | {"c5": G}
     for newton_max in (30, 480):  # swept whole; split into two islands, Newton on each
-        res = ms.simulate(m, 0.2, ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-10, newton_max_unknowns=newton_max)),
+        res = ms.simulate(m, 0.2, ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-12, newton_max_unknowns=newton_max)),
                           output_dt=1e-3)
         assert res["solver/converged"][1:].all()
         assert (res["solver/contacts"][1:] == 24).all()
         for name, w in weights.items():
-            np.testing.assert_allclose(res[f"contact/{name}/lambda_n"][1:].sum(axis=1), w, rtol=0, atol=1e-6,
+            np.testing.assert_allclose(res[f"contact/{name}/lambda_n"][1:].sum(axis=1), w, rtol=0, atol=1e-8,
                                        err_msg=f"{name}, newton_max_unknowns={newton_max}")
         # the top box does not drift off its support
         assert abs(res["body/b4/position"][-1, 2] - HALF[2] * 9) < 1e-9

@@ -257,6 +257,19 @@ mod tests {
         assert_eq!(isl.count(), 0);
     }
 
+    #[test]
+    fn largest_counts_the_contacts_of_the_biggest_island() {
+        // islands {0, 3, 5}, {1, 2}, {4}: the largest holds 3 (counted by hand)
+        let mut isl = Islands::default();
+        isl.partition(6, &[(3, 5), (1, 2), (0, 3)]);
+        assert_eq!(isl.largest(), 3);
+        // one island: every contact (its members are not sorted then); none: 0
+        isl.partition(4, &[(0, 1), (1, 2), (2, 3)]);
+        assert_eq!((isl.count(), isl.largest()), (1, 4));
+        isl.partition(0, &[]);
+        assert_eq!(isl.largest(), 0);
+    }
+
     /// Two random problems of 5 and 4 contacts, interleaved into one block-diagonal problem.
     fn two_problems() -> (FrictionContact, Vec<f64>, Vec<(usize, usize)>, Vec<f64>) {
         let (a, b) = (random_friction_contact(3, 5, 0.4, 11).unwrap(), random_friction_contact(3, 4, 0.4, 12).unwrap());
