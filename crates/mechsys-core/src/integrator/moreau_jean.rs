@@ -972,6 +972,7 @@ impl MoreauJean {
                         // (capacity for every contact point since construction: no allocation)
                         self.local_u.resize(m, 0.0);
                         let sp = self.sparse.as_mut().expect("sparse assembly");
+                        sp.parallel = self.parallel;
                         let problem = (&self.problem.q[..], &self.problem.mu[..]);
                         Ok(sp.gauss_seidel(problem, &self.ws.order, &mut self.r, o, &mut self.local_u))
                     }

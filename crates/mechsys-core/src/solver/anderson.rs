@@ -86,6 +86,12 @@ impl Anderson {
         self.f[i] = f;
     }
 
+    /// The residual terms of the current sweep (what [`Anderson::set_residual`] writes), to be
+    /// filled in place.
+    pub(crate) fn residuals(&mut self) -> &mut [f64] {
+        &mut self.f[..self.n]
+    }
+
     /// Forgets the history.
     pub(crate) fn restart(&mut self) {
         self.cols = 0;

@@ -271,6 +271,12 @@ impl LocalBlock3 {
         LocalBlock3 { a: *a, cramer: cofactors3(a), iso: isotropic(a) }
     }
 
+    /// The block (row-major 3 × 3).
+    #[inline(always)]
+    pub(crate) fn block(&self) -> &[f64; 9] {
+        &self.a
+    }
+
     /// [`local_solve`] for `d = 3` on this block.
     #[inline]
     pub(crate) fn solve(&self, mu: f64, b: &[f64; 3], r: &mut [f64; 3]) {

@@ -17,6 +17,7 @@
 //! O(N). All storage grows to the largest problem seen and is reused: no allocation afterwards.
 
 mod body_newton;
+mod domains;
 mod factored;
 
 use crate::math::Vec3;
@@ -139,6 +140,11 @@ pub(super) struct SparseRows {
     local3: Vec<crate::solver::nsgs::LocalBlock3>,
     /// Anderson acceleration of the factored sweeps.
     aa: crate::solver::anderson::Anderson,
+    /// The two domains of a large factored Gauss–Seidel solve.
+    dom: domains::Domains,
+    /// Whether the two domains are swept on two of rayon's threads (the impulses do not depend
+    /// on it).
+    pub(in crate::integrator::moreau_jean) parallel: bool,
     /// The body-space Newton method's scratch and held factorization.
     pub(super) newton: body_newton::BodyNewton,
 }
@@ -214,6 +220,8 @@ impl SparseRows {
             packed: Vec::new(),
             local3: Vec::new(),
             aa: Default::default(),
+            dom: Default::default(),
+            parallel: true,
             newton: Default::default(),
         }
     }
@@ -673,6 +681,7 @@ mod tests {
     use crate::data::Data;
     use crate::dynamics::sparse::Saddle;
     use crate::model::ModelDescription;
+    const SPLIT_MIN_CONTACTS_FOR_TESTS: usize = domains::SPLIT_MIN_CONTACTS;
 
     /// Two free bodies (off-centre mass) and an arm on a revolute joint.
     fn model() -> Model {
@@ -800,6 +809,161 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// A row of `n` free spheres (r = 5 cm, touching) on the ground at their initial state:
+    /// kinematics done, mass matrix factored.
+    fn row_of_spheres(n: usize) -> (Model, Data, Saddle) {
+        let bodies: Vec<String> =
+            (0..n).map(|i| format!(r#"{{"name": "s{i}", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4]}}"#)).collect();
+        let joints: Vec<String> = (0..n)
+            .map(|i| {
+                format!(
+                    r#"{{"name": "f{i}", "type": "free", "parent": "ground", "child": "s{i}", "q0": [{}, 0, 0.05, 1, 0, 0, 0]}}"#,
+                    0.1 * i as f64
+                )
+            })
+            .collect();
+        let json = format!(
+            r#"{{"name": "row", "gravity": [0, 0, -9.81], "bodies": [{}], "joints": [{}]}}"#,
+            bodies.join(","),
+            joints.join(",")
+        );
+        let model = Model::from_description(ModelDescription::from_json(&json).unwrap()).unwrap();
+        let mut data = Data::new(&model);
+        crate::kinematics::forward_pass(&model, &mut data, 0.0, &model.q0(), &model.u0());
+        let mut saddle = Saddle::new(&model);
+        {
+            let Data { inertia, s, ic, elastic, .. } = &mut data;
+            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| {
+                saddle.put_mass(r, c, v)
+            });
+        }
+        assert!(saddle.factor_mass());
+        (model, data, saddle)
+    }
+
+    /// A large problem on free bodies is swept in two domains: the halves share no body, the
+    /// interface holds the contacts between them, every part keeps the caller's order, and the
+    /// solve is Gauss–Seidel in that order (the block solver visiting the contacts in it gives the
+    /// same sweeps to round-off), with impulses that do not depend on the threads, bit for bit.
+    #[test]
+    fn two_domain_sweeps_are_gauss_seidel_in_their_order_on_any_threads() {
+        use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
+        let ns = 60;
+        let (model, data, saddle) = row_of_spheres(ns);
+        let mut sp = SparseRows::new(&model, 3);
+        sp.factor.copy_from(&saddle);
+        let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+        let z = Vec3::z();
+        // each sphere on the ground, each pair of neighbours side by side (119 contacts; the normal
+        // points from the second body to the first)
+        for i in 0..ns {
+            let c = Vec3::new(0.1 * i as f64, 0.0, 0.0);
+            sp.add_contact(&model, &data.s, el, i + 1, &c, 0, &c, &[z, Vec3::x(), Vec3::y()]);
+        }
+        for i in 0..ns - 1 {
+            let c = Vec3::new(0.1 * i as f64 + 0.05, 0.0, 0.05);
+            sp.add_contact(&model, &data.s, el, i + 2, &c, i + 1, &c, &[Vec3::x(), Vec3::y(), z]);
+        }
+        sp.delassus();
+        let nc = sp.len();
+        assert!(nc >= SPLIT_MIN_CONTACTS_FOR_TESTS);
+        // pressed onto the ground and together, pushed sideways by varying amounts: sliding and
+        // sticking contacts
+        let qv: Vec<f64> = (0..3 * nc)
+            .map(|k| match k % 3 {
+                // (neighbours mostly parting: short pressed runs, a problem swept in tens of sweeps)
+                0 if k / 3 >= ns && (k / 3) % 4 != 0 => 0.002,
+                0 => -0.01 - 0.002 * ((k / 3) % 5) as f64,
+                1 => 0.004 * (((k / 3) * 7 % 11) as f64 - 5.0),
+                _ => 0.001 * (((k / 3) * 3 % 7) as f64 - 3.0),
+            })
+            .collect();
+        let mu: Vec<f64> = (0..nc).map(|a| 0.3 + 0.05 * (a % 4) as f64).collect();
+        // visiting order: descending index (any permutation the caller gives is kept per part)
+        let order: Vec<usize> = (0..nc).rev().collect();
+        let o = NsgsOptions { tol: 1e-14, max_iter: 40, relaxation: 1.0, anderson: 0 };
+        assert!(sp.pack::<3>());
+        assert!(sp.dom.plan(&sp.packed, &order, sp.z.len()));
+        let (na, nb, perm) = (sp.dom.na, sp.dom.nb, sp.dom.perm.clone());
+        sp.dom.finish();
+        // the parts: a permutation; A and B on disjoint bodies; the interface across them
+        let mut seen = perm.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..nc).collect::<Vec<_>>());
+        let bodies = |a: usize| {
+            let p = &sp.packed[a];
+            p.iu()[..p.bodies()].to_vec()
+        };
+        let side_a: std::collections::BTreeSet<usize> = perm[..na].iter().flat_map(|&a| bodies(a)).collect();
+        let side_b: std::collections::BTreeSet<usize> = perm[na..na + nb].iter().flat_map(|&a| bodies(a)).collect();
+        assert!(side_a.is_disjoint(&side_b), "the halves share a body");
+        for &a in &perm[na + nb..] {
+            let b = bodies(a);
+            assert!(
+                b.iter().any(|x| !side_b.contains(x)) && b.iter().any(|x| !side_a.contains(x)),
+                "interface contact {a}"
+            );
+        }
+        // a row cut in the middle: two halves of about 60 contacts, one contact between them
+        assert!(na.abs_diff(nb) <= 2 && nc - na - nb == 1, "{na} {nb} {nc}");
+        for part in [&perm[..na], &perm[na..na + nb], &perm[na + nb..]] {
+            assert!(part.windows(2).all(|w| w[0] > w[1]), "the caller's order within a part");
+        }
+        // Gauss–Seidel in the order A, B, interface: the block solver's sweeps to round-off
+        let mut bw = BlockDelassus::default();
+        bw.refill(3, nc, &sp.diag, &sp.upper, &sp.upper_val);
+        let p = FrictionContact::new(3, Delassus::Blocks(bw), qv.clone(), mu.clone()).unwrap();
+        for sweeps in [8, 60] {
+            let o = NsgsOptions { max_iter: sweeps, ..o };
+            let method = Method::Nsgs(o);
+            let mut ws = Workspace::default();
+            ws.reserve(&p, &method).unwrap();
+            ws.order = perm.clone();
+            let mut r_blocks = vec![0.0; 3 * nc];
+            let rep = solver::solve(&p, &method, &mut r_blocks, false, &mut ws).unwrap();
+            let mut runs = Vec::new();
+            for (threads, parallel) in [(1, false), (2, true), (1, true)] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                let (mut r, mut u) = (vec![0.0; 3 * nc], vec![0.0; 3 * nc]);
+                sp.parallel = parallel;
+                let fact = pool.install(|| sp.gauss_seidel((&qv, &mu), &order, &mut r, &o, &mut u));
+                runs.push((fact, r, u));
+            }
+            let (fact, r, _) = &runs[0];
+            assert_eq!(fact.iterations, rep.iterations, "{sweeps} sweeps");
+            let big = r_blocks.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(big > 1e-3, "a problem with impulses");
+            for k in 0..3 * nc {
+                assert!((r[k] - r_blocks[k]).abs() <= 1e-12 * big, "r[{k}]: {} vs {}", r[k], r_blocks[k]);
+            }
+            for (f, r2, u2) in &runs[1..] {
+                assert_eq!(f.iterations, runs[0].0.iterations);
+                assert_eq!(f.residual.to_bits(), runs[0].0.residual.to_bits());
+                assert!(r2.iter().zip(&runs[0].1).all(|(a, b)| a.to_bits() == b.to_bits()), "r on other threads");
+                assert!(u2.iter().zip(&runs[0].2).all(|(a, b)| a.to_bits() == b.to_bits()), "u on other threads");
+            }
+        }
+        // Anderson-accelerated to convergence (sliding spheres rolling against each other take
+        // thousands of plain sweeps): the tolerance met on any threads, bit for bit
+        let oa = NsgsOptions { anderson: 4, max_iter: 20_000, tol: 1e-10, ..o };
+        let mut out = Vec::new();
+        for (threads, parallel) in [(1, false), (2, true)] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (mut r, mut u) = (vec![0.0; 3 * nc], vec![0.0; 3 * nc]);
+            sp.parallel = parallel;
+            let rep = pool.install(|| sp.gauss_seidel((&qv, &mu), &order, &mut r, &oa, &mut u));
+            assert!(rep.converged && p.residual(&r).unwrap() <= 2e-10, "{rep:?}");
+            out.push((rep, r));
+        }
+        assert_eq!(out[0].0.iterations, out[1].0.iterations);
+        assert!(out[0].1.iter().zip(&out[1].1).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // with sliding and sticking contacts among them
+        let states: Vec<_> = (0..nc).map(|i| p.contact_state(i, &out[0].1, 1e-9).unwrap()).collect();
+        for s in [solver::ContactState::Stick, solver::ContactState::Slip, solver::ContactState::Open] {
+            assert!(states.contains(&s), "{states:?}");
         }
     }
 

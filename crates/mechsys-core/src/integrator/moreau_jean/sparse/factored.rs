@@ -14,6 +14,7 @@
 //! residual are those of `nsgs::solve_fc`; the numbers differ from the block form by round-off
 //! only (`W r` is summed in another order).
 
+use super::domains::{SPLIT_MIN_CONTACTS, SPLIT_MIN_SWEEPS};
 use super::SparseRows;
 
 /// One contact's reduced rows on one or two free bodies, transposed for contiguous products:
@@ -78,6 +79,15 @@ impl SparseRows {
             }
         }
         self.factored_product::<D>(r);
+        if D == 3
+            && packed
+            && omega == 1.0
+            && n >= SPLIT_MIN_CONTACTS
+            && max_sweeps >= SPLIT_MIN_SWEEPS
+            && self.dom.plan(&self.packed, order, self.z.len())
+        {
+            return self.gauss_seidel_split(q, mu, r, opts, u, qn);
+        }
         if opts.anderson > 0 {
             // (room for every contact point since the integrator's construction; beyond that,
             // e.g. points of contact groups, it grows once)
@@ -160,6 +170,60 @@ impl SparseRows {
             }
         }
         Report { iterations: max_sweeps, residual, converged: false }
+    }
+
+    /// [`SparseRows::gauss_seidel`] in two domains ([`super::domains`]) after a successful
+    /// [`Domains::plan`](super::domains::Domains::plan): the same stopping test and acceleration
+    /// on the problem copied into the split's order (3-D, no relaxation, packed rows).
+    fn gauss_seidel_split(
+        &mut self,
+        q: &[f64],
+        mu: &[f64],
+        r: &mut [f64],
+        opts: &NsgsOptions,
+        u: &mut [f64],
+        qn: f64,
+    ) -> Report {
+        if self.parallel && rayon::current_thread_index().is_none() {
+            // the whole solve on one of rayon's threads: a sweep's half then goes to the other
+            // one through its queue (from outside the pool, each sweep would wait for a thread
+            // to wake up: slower than one thread sweeping alone)
+            return rayon::scope(|_| self.gauss_seidel_split(q, mu, r, opts, u, qn));
+        }
+        let (tol, max_sweeps) = (opts.tol, opts.max_iter);
+        let n = self.len();
+        let mut check = CheckSchedule::new();
+        let mut residual = f64::INFINITY;
+        self.dom.gather(&self.packed, &self.local3, q, mu, r, &self.z);
+        let nz = self.dom.z.len();
+        if opts.anderson > 0 {
+            self.aa.reserve(n * 3, nz);
+            self.aa.begin(n * 3, nz, opts.anderson);
+        }
+        let mut report = Report { iterations: max_sweeps, residual, converged: false };
+        for it in 1..=max_sweeps {
+            let f = (opts.anderson > 0).then(|| self.aa.residuals());
+            let change = self.dom.sweep(f, self.parallel);
+            if check.due(it, change.sqrt() / qn <= tol) || it == max_sweeps {
+                self.dom.scatter(r, &mut self.z);
+                if it > FRESH_Z_AFTER {
+                    self.factored_product::<3>(r);
+                    self.dom.gather_z(&self.z);
+                }
+                residual = self.factored_residual::<3>(q, mu, r, u) / qn;
+                if residual <= tol {
+                    report = Report { iterations: it, residual, converged: true };
+                    break;
+                }
+                report.residual = residual;
+            }
+            if opts.anderson > 0 && it < max_sweeps {
+                self.aa.step(&mut self.dom.r, &mut self.dom.z, change);
+            }
+        }
+        self.dom.scatter(r, &mut self.z);
+        self.dom.finish();
+        report
     }
 
     /// Room for the Anderson acceleration of problems of up to `unknowns` unknowns.
@@ -312,6 +376,12 @@ impl Packed {
         self.y[k][c][j]
     }
 
+    /// The same rows on the bodies whose velocities start at `iu` instead.
+    #[inline(always)]
+    pub(super) fn moved(&self, iu: [usize; 2]) -> Packed {
+        Packed { iu, ..*self }
+    }
+
     /// `Y_aᵀ z` (zero beyond `D`).
     #[inline(always)]
     pub(super) fn times<const D: usize>(&self, z: &[f64]) -> [f64; 3] {
@@ -329,7 +399,7 @@ impl Packed {
 
     /// `z += Y_a v`.
     #[inline(always)]
-    fn add_to<const D: usize>(&self, z: &mut [f64], v: &[f64; 3]) {
+    pub(super) fn add_to<const D: usize>(&self, z: &mut [f64], v: &[f64; 3]) {
         for k in 0..self.bodies {
             let zs: &mut [f64; 6] = (&mut z[self.iu[k]..self.iu[k] + 6]).try_into().expect("six velocities");
             for j in 0..6 {
