@@ -68,13 +68,13 @@ def test_group_equals_the_explicit_pairwise_contacts():
     assert 0 < rg["contact/pile/pairs"][-1] < 66
 
 
-def square_pyramid(gap=1e-3, mu=0.5):
-    """14 spheres stacked 3×3, 2×2, 1 in a box that holds the base layer exactly, each layer
-    dropped from `gap` above its resting height."""
+def square_pyramid(gap=1e-3, mu=0.5, base=3):
+    """14 spheres stacked 3×3, 2×2, 1 (``base`` = 3; else ``base``², ..., 1) in a box that holds
+    the base layer exactly, each layer dropped from `gap` above its resting height."""
     m = ms.Model("pyramid", gravity=(0, 0, -G))
     members = []
     k = 0
-    for layer, size in enumerate((3, 2, 1)):
+    for layer, size in enumerate(range(base, 0, -1)):
         z = R + layer * np.sqrt(2) * R + gap * (layer + 1)
         for i in range(size):
             for j in range(size):
@@ -87,7 +87,7 @@ def square_pyramid(gap=1e-3, mu=0.5):
     for ax in range(2):
         for sgn in (1, -1):
             nrm, pt = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-            nrm[ax], pt[ax] = sgn, -sgn * 3 * R
+            nrm[ax], pt[ax] = sgn, -sgn * base * R
             against.append(m.ground.contour(ms.contours.Plane(point=pt, normal=nrm)))
     m.add_contact(ms.ContactGroup("pile", members=members, against=against, friction=ms.laws.Coulomb(mu=mu)))
     return m, k

@@ -223,7 +223,8 @@ class MoreauJean:
     #: track); positions move without a force, so the energy balance carries that small work
     project: bool = False
     #: solve independent contact islands (groups of contacts that share no moving body) on
-    #: several threads; the results are the same bit for bit either way
+    #: several threads, and sweep the two halves of a large problem on free bodies on two; the
+    #: results are the same bit for bit either way
     parallel: bool = True
 
     def __post_init__(self):
