@@ -705,7 +705,11 @@ mod tests {
 
     /// The test model at its initial state: kinematics done, mass matrix factored.
     fn factored_mass() -> (Model, Data, Saddle) {
-        let model = model();
+        at_initial_state(model())
+    }
+
+    /// `model` at its initial state: kinematics done, mass matrix factored.
+    fn at_initial_state(model: Model) -> (Model, Data, Saddle) {
         let mut data = Data::new(&model);
         let mut q = model.q0();
         model.normalize(&mut q);
@@ -830,18 +834,7 @@ mod tests {
             bodies.join(","),
             joints.join(",")
         );
-        let model = Model::from_description(ModelDescription::from_json(&json).unwrap()).unwrap();
-        let mut data = Data::new(&model);
-        crate::kinematics::forward_pass(&model, &mut data, 0.0, &model.q0(), &model.u0());
-        let mut saddle = Saddle::new(&model);
-        {
-            let Data { inertia, s, ic, elastic, .. } = &mut data;
-            crate::dynamics::crba::composite_inertias(&model, inertia, s, ic, elastic, |r, c, v| {
-                saddle.put_mass(r, c, v)
-            });
-        }
-        assert!(saddle.factor_mass());
-        (model, data, saddle)
+        at_initial_state(Model::from_description(ModelDescription::from_json(&json).unwrap()).unwrap())
     }
 
     /// A large problem on free bodies is swept in two domains: the halves share no body, the
