@@ -171,8 +171,7 @@ impl Domains {
             }
             self.z.clear();
             self.z.resize(next, 0.0);
-        }
-        if !ok {
+        } else {
             self.finish();
         }
         ok
