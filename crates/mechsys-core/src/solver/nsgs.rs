@@ -15,6 +15,10 @@
 //!   solved by Newton from the previous sliding direction, or by bracketing all its roots if that
 //!   fails; a root counts if `r_N > 0` and `t · u_T ≥ 0` (the friction force opposes sliding).
 //!
+//! An isotropic block (`W_NT = 0`, `W_TT = c I`: contacts of spheres, or of bodies with uniform
+//! inertia) needs no cases: `r_N = max(0, −b_N/W_NN)` and `r_T` is the stick impulse `−b_T/c`
+//! scaled back onto the disk of radius `μ r_N`.
+//!
 //! Over-relaxation `ω ∈ (1, 2)` extrapolates each local solution (`r_i ← ω r_i,local + (1 − ω)
 //! r_i`, projected back onto the cone); the solve drops to `ω = 1` at the first sweep that
 //! changes the impulses more than the previous one (the safeguard against overshooting).
@@ -242,6 +246,9 @@ fn local_2d(a: &[f64; 9], mu: f64, b: &[f64; 3]) -> [f64; 3] {
 }
 
 fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
+    if isotropic(a) {
+        return isotropic_3d(1.0 / a[0], 1.0 / a[4], mu, b);
+    }
     let bn = b[0];
     if bn >= 0.0 {
         return [0.0; 3];
@@ -250,25 +257,43 @@ fn local_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3]) -> [f64; 3] {
         return [-bn / a[0], 0.0, 0.0];
     }
     let stick = solve3(a, &[-b[0], -b[1], -b[2]]);
-    slip_or_stick_3d(a, None, mu, b, prev, stick)
+    slip_or_stick_3d(a, mu, b, prev, stick)
+}
+
+/// The local solve on an isotropic block (`W_NT = 0`, `W_TT = c I`, see [`isotropic`]) from
+/// `1/W_NN` and `1/c`: the normal impulse decouples, `r_N = max(0, −b_N/W_NN)`, and the
+/// tangential one is the stick impulse `−b_T/c` scaled back onto the disk `|r_T| ≤ μ r_N` (sliding
+/// then opposes `b_T`: `u_T = b_T (1 − c μ r_N/|b_T|)`). No branch on the contact's state, which
+/// a Gauss–Seidel sweep over a pile cannot predict; open (`b_N ≥ 0`) and frictionless contacts
+/// come out of the same formula.
+#[inline(always)]
+fn isotropic_3d(inv_nn: f64, inv_c: f64, mu: f64, b: &[f64; 3]) -> [f64; 3] {
+    let x = -b[0] * inv_nn;
+    // (NaN stays NaN for the caller's finiteness check)
+    let rn = if x < 0.0 { 0.0 } else { x };
+    let (t1, t2) = (-b[1] * inv_c, -b[2] * inv_c);
+    let (limit, t_sq) = (mu * rn, t1 * t1 + t2 * t2);
+    let scale = if t_sq > limit * limit { limit / t_sq.sqrt() } else { 1.0 };
+    [rn, scale * t1, scale * t2]
 }
 
 /// A contact's 3-D diagonal block with what the local solve derives from the block alone, made
 /// once per solve instead of once per sweep ([`LocalBlock3::solve`]): the cofactors and
-/// determinant of Cramer's rule for the stick candidate, and whether it is isotropic. The
+/// determinant of Cramer's rule for the stick candidate, or an isotropic block's inverses. The
 /// solution is the one of [`local_solve`] bit for bit.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LocalBlock3 {
     a: [f64; 9],
     /// First-row cofactors and determinant; `None` where `A` is nearly singular.
     cramer: Option<([f64; 3], f64)>,
-    iso: bool,
+    /// `1/W_NN` and `1/c` of an isotropic block ([`isotropic_3d`]), else `None`.
+    iso: Option<[f64; 2]>,
 }
 
 impl LocalBlock3 {
     /// From the row-major 3 × 3 block `a` (`A_NN > 0`).
     pub(crate) fn new(a: &[f64; 9]) -> Self {
-        LocalBlock3 { a: *a, cramer: cofactors3(a), iso: isotropic(a) }
+        LocalBlock3 { a: *a, cramer: cofactors3(a), iso: isotropic(a).then(|| [1.0 / a[0], 1.0 / a[4]]) }
     }
 
     /// The block (row-major 3 × 3).
@@ -281,13 +306,15 @@ impl LocalBlock3 {
     #[inline]
     pub(crate) fn solve(&self, mu: f64, b: &[f64; 3], r: &mut [f64; 3]) {
         let bn = b[0];
-        *r = if bn >= 0.0 {
+        *r = if let Some([inv_nn, inv_c]) = self.iso {
+            isotropic_3d(inv_nn, inv_c, mu, b)
+        } else if bn >= 0.0 {
             [0.0; 3]
         } else if mu == 0.0 {
             [-bn / self.a[0], 0.0, 0.0]
         } else {
             let stick = self.cramer.map(|(c, det)| cramer3(&self.a, c, det, &[-b[0], -b[1], -b[2]]));
-            slip_or_stick_3d(&self.a, Some(self.iso), mu, b, r, stick)
+            slip_or_stick_3d(&self.a, mu, b, r, stick)
         };
     }
 }
@@ -307,11 +334,9 @@ fn isotropic(a: &[f64; 9]) -> bool {
 }
 
 /// The 3-D local solve after the open and frictionless cases (`b_N < 0`, `μ > 0`), given the
-/// stick candidate `−A⁻¹ b` (`None`: `A` nearly singular) and whether `A` is isotropic (`None`:
-/// tested here, only once the contact does not stick).
+/// stick candidate `−A⁻¹ b` (`None`: `A` nearly singular), on a block that is not isotropic.
 fn slip_or_stick_3d(
     a: &[f64; 9],
-    iso: Option<bool>,
     mu: f64,
     b: &[f64; 3],
     prev: &[f64; 3],
@@ -334,15 +359,6 @@ fn slip_or_stick_3d(
             ut
         }
     };
-    // an isotropic block: the slip solution is explicit
-    let btn = (b[1] * b[1] + b[2] * b[2]).sqrt();
-    if btn > 0.0 && iso.unwrap_or_else(|| isotropic(a)) {
-        let rn = -bn / ann;
-        // stick failed: |b_T| / c > μ r_N, so u_T = b_T (1 − c μ r_N / |b_T|) points along b_T
-        if btn > a[4] * mu * rn {
-            return [rn, -mu * rn * b[1] / btn, -mu * rn * b[2] / btn];
-        }
-    }
     // the previous sliding direction is the better guess inside a Gauss–Seidel loop
     let theta0 = if prev[0] > 0.0 && prev[1].hypot(prev[2]) > 0.0 {
         (-prev[2]).atan2(-prev[1])

@@ -1211,24 +1211,30 @@ fn auto_rescues_a_stalled_newton_with_sweeps() {
 
 /// Anderson-accelerated Gauss–Seidel solves the same problems (the returned impulses satisfy
 /// the contact conditions to the tolerance, checked by an independent residual evaluation) in
-/// fewer sweeps on piles, where plain sweeps crawl; a depth above the limit is refused.
+/// fewer sweeps on piles, where plain sweeps crawl; a depth above the limit is refused. The
+/// gain varies from pile to pile (on a few the history keeps restarting until the stall guard
+/// turns it off, and the count is then near the plain one), so the test takes fifteen piles
+/// and holds the median and the worst case.
 #[test]
 fn anderson_sweeps_converge_in_fewer_sweeps_on_piles() {
     let mut ratios = Vec::new();
-    for (n, seed) in [(60, 3), (150, 5), (300, 7)] {
-        let p = sphere_pile(n, 0.5, seed).unwrap();
-        let plain = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 100_000, ..Default::default() });
-        let fast = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 100_000, anderson: 4, ..Default::default() });
-        let (_, rp) = run_fc(&p, plain).unwrap();
-        let (r, ra) = run_fc(&p, fast).unwrap();
-        assert!(rp.converged && ra.converged, "{n}: {rp:?} {ra:?}");
-        // the residual recomputed from the returned impulses alone
-        let again = p.residual(&r).unwrap();
-        assert!(again <= 1e-8 && (again - ra.residual).abs() <= 1e-12, "{n}: {again} vs {ra:?}");
-        ratios.push(ra.iterations as f64 / rp.iterations as f64);
+    for n in [100, 150, 200] {
+        for seed in 1..=5 {
+            let p = sphere_pile(n, 0.5, seed).unwrap();
+            let plain = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 100_000, ..Default::default() });
+            let fast = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 100_000, anderson: 4, ..Default::default() });
+            let (_, rp) = run_fc(&p, plain).unwrap();
+            let (r, ra) = run_fc(&p, fast).unwrap();
+            assert!(rp.converged && ra.converged, "{n}/{seed}: {rp:?} {ra:?}");
+            // the residual recomputed from the returned impulses alone
+            let again = p.residual(&r).unwrap();
+            assert!(again <= 1e-8 && (again - ra.residual).abs() <= 1e-12, "{n}/{seed}: {again} vs {ra:?}");
+            ratios.push(ra.iterations as f64 / rp.iterations as f64);
+        }
     }
-    // (measured: 0.21, 0.09, 0.13)
-    assert!(ratios.iter().all(|x| *x < 0.5), "sweep ratios (accelerated / plain) {ratios:?}");
+    ratios.sort_by(f64::total_cmp);
+    // (measured: median 0.15, worst 0.66, plain sweeps 286–7504)
+    assert!(ratios[7] < 0.3 && ratios[14] < 1.0, "sweep ratios (accelerated / plain) {ratios:?}");
     let bad = Method::Nsgs(NsgsOptions { anderson: anderson::MAX_DEPTH + 1, ..Default::default() });
     let e = run_fc(&sphere_pile(10, 0.5, 1).unwrap(), bad).unwrap_err().to_string();
     assert!(e.contains("anderson") && e.contains("0..=8"), "{e}");
@@ -1253,3 +1259,4 @@ fn a_tolerance_that_is_not_finite_and_positive_is_refused() {
     }
     assert!(Method::Auto(AutoOptions { tol: 1e300, ..Default::default() }).validate().is_ok());
 }
+
