@@ -302,20 +302,31 @@ impl LocalBlock3 {
         &self.a
     }
 
-    /// [`local_solve`] for `d = 3` on this block.
-    #[inline]
+    /// [`local_solve`] for `d = 3` on this block. (Inlined into the sweeps, with the general
+    /// case behind a call that takes and returns values, so that the isotropic case's impulses
+    /// stay in registers: a call that wrote them through `r` kept them on the stack, and reading
+    /// them back as one 16-byte load from separate 8-byte stores stalled the sweep's chain of
+    /// dependent contacts.)
+    #[inline(always)]
     pub(crate) fn solve(&self, mu: f64, b: &[f64; 3], r: &mut [f64; 3]) {
+        *r = match self.iso {
+            Some([inv_nn, inv_c]) => isotropic_3d(inv_nn, inv_c, mu, b),
+            None => self.general(mu, *b, *r),
+        };
+    }
+
+    /// The local solve on a block that is not isotropic, from the previous impulse `prev`.
+    #[inline(never)]
+    fn general(&self, mu: f64, b: [f64; 3], prev: [f64; 3]) -> [f64; 3] {
         let bn = b[0];
-        *r = if let Some([inv_nn, inv_c]) = self.iso {
-            isotropic_3d(inv_nn, inv_c, mu, b)
-        } else if bn >= 0.0 {
+        if bn >= 0.0 {
             [0.0; 3]
         } else if mu == 0.0 {
             [-bn / self.a[0], 0.0, 0.0]
         } else {
             let stick = self.cramer.map(|(c, det)| cramer3(&self.a, c, det, &[-b[0], -b[1], -b[2]]));
-            slip_or_stick_3d(&self.a, mu, b, r, stick)
-        };
+            slip_or_stick_3d(&self.a, mu, &b, &prev, stick)
+        }
     }
 }
 
