@@ -19,19 +19,24 @@ def _run(above, t_end=0.3):
 def test_body_space_newton_moves_the_pyramid_as_the_dense_newton_does():
     body, n = _run(0)
     dense, _ = _run(10**9)
-    # every step converged in body space; the dense method (plain Newton, up to 200 iterations)
-    # ends one step just above the tolerance
-    assert body["solver/converged"][1:].all()
-    assert (dense["solver/converged"][1:] == 0).sum() <= 1 and dense["solver/residual"].max() < 2e-9
-    # about as many Newton iterations (a wrong direction fails the line search and falls back to
-    # one sweep per iteration: many more)
-    it_body, it_dense = body["solver/iterations"].sum(), dense["solver/iterations"].sum()
-    assert it_body <= 1.2 * it_dense + 20, (it_body, it_dense)
+    # every step converged, but for at most one that ends at Newton's cap (200 iterations) just
+    # above the tolerance, in either method: the settled pyramid's forces are statically
+    # indeterminate, and which step stalls there changes with round-off
+    for res in (body, dense):
+        assert (res["solver/converged"][1:] == 0).sum() <= 1 and res["solver/residual"].max() < 2e-9
+    # in most steps as many Newton iterations (a wrong direction would fail the line search in
+    # every step and fall back to one sweep per iteration): the same median, and at most two more
+    # in three steps of four (measured 80-90 %; the totals swing with the one or two steps that
+    # stall near the tolerance, 1274 against 1575 and 1707 against 710 in two builds)
+    it_body, it_dense = body["solver/iterations"][1:], dense["solver/iterations"][1:]
+    assert np.median(it_body) <= np.median(it_dense), (np.median(it_body), np.median(it_dense))
+    assert np.mean(it_body <= it_dense + 2) >= 0.75, np.mean(it_body <= it_dense + 2)
     # (6e-11 m measured: round-off of the two factorizations over 300 steps)
     assert np.abs(np.asarray(body["q"]) - np.asarray(dense["q"])).max() < 1e-9
-    # settled: the container carries the weight of the 14 spheres (momentum balance)
+    # settled: the container carries the weight of the 14 spheres (momentum balance), to the
+    # residual the steps end at (below 2e-9)
     f = body["contact/pile/force_against"][-20:, 2]
-    np.testing.assert_allclose(f, n * MASS * G, rtol=1e-9)
+    np.testing.assert_allclose(f, n * MASS * G, rtol=2e-9)
 
 
 @pytest.mark.parametrize("bad", [-1, 2.5, float("nan")])

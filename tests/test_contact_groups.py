@@ -68,28 +68,31 @@ def test_group_equals_the_explicit_pairwise_contacts():
     assert 0 < rg["contact/pile/pairs"][-1] < 66
 
 
-def square_pyramid(gap=1e-3, mu=0.5, base=3):
+def square_pyramid(gap=1e-3, mu=0.5, base=3, at=(0.0,)):
     """14 spheres stacked 3×3, 2×2, 1 (``base`` = 3; else ``base``², ..., 1) in a box that holds
-    the base layer exactly, each layer dropped from `gap` above its resting height."""
+    the base layer exactly, each layer dropped from `gap` above its resting height; one such
+    pyramid and box at each x of `at` (one contact group each, ``pile``, ``pile1``, ...)."""
     m = ms.Model("pyramid", gravity=(0, 0, -G))
-    members = []
     k = 0
-    for layer, size in enumerate(range(base, 0, -1)):
-        z = R + layer * np.sqrt(2) * R + gap * (layer + 1)
-        for i in range(size):
-            for j in range(size):
-                x, y = (2 * i - (size - 1)) * R, (2 * j - (size - 1)) * R
-                b = m.add_body(f"s{k}", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
-                m.add_joint(ms.joints.Free(f"f{k}", m.ground, b, q0=[x, y, z, 1, 0, 0, 0]))
-                members.append(b.contour(ms.contours.Sphere(radius=R)))
-                k += 1
-    against = [m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)))]
-    for ax in range(2):
-        for sgn in (1, -1):
-            nrm, pt = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-            nrm[ax], pt[ax] = sgn, -sgn * base * R
-            against.append(m.ground.contour(ms.contours.Plane(point=pt, normal=nrm)))
-    m.add_contact(ms.ContactGroup("pile", members=members, against=against, friction=ms.laws.Coulomb(mu=mu)))
+    for p, x0 in enumerate(at):
+        members = []
+        for layer, size in enumerate(range(base, 0, -1)):
+            z = R + layer * np.sqrt(2) * R + gap * (layer + 1)
+            for i in range(size):
+                for j in range(size):
+                    x, y = x0 + (2 * i - (size - 1)) * R, (2 * j - (size - 1)) * R
+                    b = m.add_body(f"s{k}", mass=MASS, inertia=ms.inertia.sphere(MASS, R))
+                    m.add_joint(ms.joints.Free(f"f{k}", m.ground, b, q0=[x, y, z, 1, 0, 0, 0]))
+                    members.append(b.contour(ms.contours.Sphere(radius=R)))
+                    k += 1
+        against = [m.ground.contour(ms.contours.Plane(point=(x0, 0, 0), normal=(0, 0, 1)))]
+        for ax in range(2):
+            for sgn in (1, -1):
+                nrm, pt = [0.0, 0.0, 0.0], [x0, 0.0, 0.0]
+                nrm[ax], pt[ax] = sgn, pt[ax] - sgn * base * R
+                against.append(m.ground.contour(ms.contours.Plane(point=pt, normal=nrm)))
+        m.add_contact(ms.ContactGroup("pile" if p == 0 else f"pile{p}", members=members, against=against,
+                                      friction=ms.laws.Coulomb(mu=mu)))
     return m, k
 
 

@@ -74,40 +74,36 @@ def test_a_dominant_island_above_newtons_size_is_swept_whole_and_carries_its_wei
 
 
 def test_islands_give_the_same_result_serial_and_parallel_bit_for_bit():
-    """A falling, tumbling pile-up of several stacks (impacts, slip and stick; above the size
-    from which islands go to threads): serial and threaded runs agree exactly."""
-    m = stacks(4, 5, gap=0.21)
-    q0 = {}
-    rng = np.random.default_rng(3)
-    for s in range(4):
-        for k in range(5):
-            a = rng.uniform(-0.3, 0.3, 3)
-            w = np.sqrt(max(0.0, 1 - (a ** 2).sum() * 0.01))
-            q0[f"f{s}_{k}"] = [s * 0.21 + rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02),
-                               0.12 * k + 0.06, w, *(0.1 * a)]
+    """Two pyramids of 55 spheres, each in its own box, dropped onto their floors (impacts, then
+    slip and stick while they settle): two islands, together above the size from which islands
+    go to threads (400 contact points). Serial and threaded runs agree exactly."""
+    from test_contact_groups import square_pyramid
+
+    m, _ = square_pyramid(gap=3e-3, mu=0.3, base=5, at=(0.0, 1.0))
     runs = []
     for parallel in (False, True):
-        integ = ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-8), parallel=parallel)
-        runs.append(ms.simulate(m, 0.4, integ, q0=q0, output_dt=1e-2))
+        integ = ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-6), parallel=parallel)
+        runs.append(ms.simulate(m, 0.1, integ, output_dt=1e-3, progress=False))
     serial, threaded = runs
     assert serial["solver/islands"].max() >= 2
-    assert serial["solver/contacts"].max() >= 64  # PARALLEL_MIN_CONTACTS: the threads were used
-    for name in ("q", "u", "solver/residual", "solver/iterations"):
+    assert serial["solver/contacts"].max() >= 400  # PARALLEL_MIN_CONTACTS: the threads were used
+    for name in ("q", "u", "solver/residual", "solver/iterations", "contact/pile/force_against",
+                 "contact/pile1/force_against"):
         assert np.array_equal(serial[name], threaded[name]), name
-    for s in range(4):
-        assert np.array_equal(serial[f"contact/floor{s}/lambda_n"], threaded[f"contact/floor{s}/lambda_n"])
 
 
 def test_a_large_pile_swept_in_two_domains_on_two_threads_is_the_serial_run_bit_for_bit():
-    """A square pyramid of 55 spheres (5×5 ... 1) settling in a box that holds its base: one
-    island of about 240 contact points, swept whole (Newton's size set below it), so that each
-    Gauss–Seidel sweep runs in two domains of the contact graph on two threads
-    (``MoreauJean(parallel=True)``) and then over the contacts between them. Serial and threaded
-    runs agree exactly, every step converges, and once settled the container carries the weight
-    (momentum balance, to the solver's tolerance)."""
+    """A square pyramid of 91 spheres (6×6 ... 1) settling in a box that holds its base: one
+    island of over 400 contact points, swept whole (Newton's size set below it), so that each
+    Gauss–Seidel sweep runs in two domains of the contact graph, on two threads
+    (``MoreauJean(parallel=True)``) after a solve's first 16 sweeps, and then over the contacts
+    between them. Serial and threaded runs agree exactly and once settled the container carries
+    the weight (momentum balance, to the solver's tolerance). (Gauss–Seidel crawls on a resting
+    pyramid, whose forces are statically indeterminate: a step or two while it settles may end at
+    the sweep budget; the settled steps converge.)"""
     from test_contact_groups import MASS, square_pyramid
 
-    m, n = square_pyramid(base=5)
+    m, n = square_pyramid(base=6)
     runs = []
     for parallel in (False, True):
         solver = ms.Auto(tol=1e-5, newton_max_unknowns=30)
@@ -116,8 +112,9 @@ def test_a_large_pile_swept_in_two_domains_on_two_threads_is_the_serial_run_bit_
     serial, threaded = runs
     for name in ("q", "u", "contact/pile/force_against", "solver/iterations", "solver/residual"):
         assert np.array_equal(serial[name], threaded[name]), name
-    assert serial["solver/converged"][1:].all()
-    # one island above the size from which a solve is split (96 contact points)
-    assert (serial["solver/islands"][-50:] == 1).all() and serial["solver/contacts"][-50:].min() >= 200
+    assert serial["solver/converged"][-50:].all() and serial["solver/converged"][1:].mean() >= 0.98
+    # one island above the size from which the halves go to threads, solves beyond the serial sweeps
+    assert (serial["solver/islands"][-50:] == 1).all() and serial["solver/contacts"][-50:].min() >= 400
+    assert serial["solver/iterations"][-50:].max() > 16
     f = serial["contact/pile/force_against"][-30:, 2]
-    np.testing.assert_allclose(f, n * MASS * G, rtol=2e-6)
+    np.testing.assert_allclose(f, n * MASS * G, rtol=1e-5)
