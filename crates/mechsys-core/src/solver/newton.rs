@@ -41,7 +41,7 @@
 //! solution, and sweeps do better from there. Cost per iteration `O((d n)³)`, so this is the
 //! method for accuracy on moderate sizes; NSGS is the one for large ones.
 
-use super::nsgs::{cache_diagonal, sweep};
+use super::nsgs::{prepare_diagonal, sweep};
 use super::problem::{fc_residual, Delassus, FrictionContact};
 use super::{NewtonOptions, Report, Workspace};
 use crate::error::Result;
@@ -300,9 +300,9 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
     let d = p.dim;
     let n = p.contacts();
     let m = d * n;
-    let diag = &mut ws.diag[..n];
-    cache_diagonal(p, diag);
+    prepare_diagonal(p, &mut ws.diag[..n], &mut ws.local3[..n]);
     let diag = &ws.diag[..n];
+    let local3 = &ws.local3[..n];
     let order = &ws.order;
     let u = &mut ws.u[..m];
     let nw = &mut ws.newton;
@@ -371,7 +371,7 @@ pub(crate) fn solve(p: &FrictionContact, o: &NewtonOptions, r: &mut [f64], ws: &
             fresh = true;
         }
         if !accepted {
-            sweep(p, diag, order, r, 1.0, None);
+            sweep(p, (diag, local3), order, r, 1.0, None);
         }
     }
 }

@@ -73,7 +73,7 @@ pub(crate) fn solve_lcp(p: &Lcp, o: &NsgsOptions, z: &mut [f64], ws: &mut Worksp
 pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: &mut Workspace) -> Result<Report> {
     let n = p.contacts();
     let m = p.dim * n;
-    cache_diagonal(p, &mut ws.diag[..n]);
+    prepare_diagonal(p, &mut ws.diag[..n], &mut ws.local3[..n]);
     let qn = 1.0 + norm(&p.q);
     let mut residual = f64::INFINITY;
     let mut check = CheckSchedule::new();
@@ -87,7 +87,7 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
     for it in 1..=o.max_iter {
         let accelerate = o.anderson > 0 && omega == 1.0;
         let steps = if accelerate { Some(&mut ws.anderson) } else { None };
-        let change = sweep(p, &ws.diag[..n], &ws.order, r, omega, steps);
+        let change = sweep(p, (&ws.diag[..n], &ws.local3[..n]), &ws.order, r, omega, steps);
         if omega > 1.0 && change > last_change {
             omega = 1.0;
         }
@@ -139,12 +139,23 @@ pub(crate) fn cache_diagonal(p: &FrictionContact, diag: &mut [[f64; 9]]) {
     }
 }
 
+/// [`cache_diagonal`], and for a 3-D problem each block prepared for the sweeps' local solves.
+pub(crate) fn prepare_diagonal(p: &FrictionContact, diag: &mut [[f64; 9]], local3: &mut [LocalBlock3]) {
+    cache_diagonal(p, diag);
+    if p.dim == 3 {
+        for (l, blk) in local3.iter_mut().zip(diag.iter()) {
+            *l = LocalBlock3::new(blk);
+        }
+    }
+}
+
 /// One Gauss–Seidel sweep over the contacts, in `order` if it holds a permutation of them
 /// ([`Workspace::set_order`]), else by index; returns `Σ_i ‖W_NN,i Δr_i‖²` and gives each
-/// unknown's term `W_NN,i Δr_i` to the Anderson acceleration `aa` if there is one.
+/// unknown's term `W_NN,i Δr_i` to the Anderson acceleration `aa` if there is one. The diagonal
+/// blocks as [`prepare_diagonal`] left them.
 pub(crate) fn sweep(
     p: &FrictionContact,
-    diag: &[[f64; 9]],
+    (diag, local3): (&[[f64; 9]], &[LocalBlock3]),
     order: &[usize],
     r: &mut [f64],
     relaxation: f64,
@@ -165,7 +176,11 @@ pub(crate) fn sweep(
             old[a] = r[i * d + a];
         }
         let mut new = old;
-        local_solve(d, &diag[i], p.mu[i], &b, &mut new);
+        if d == 3 {
+            local3[i].solve(p.mu[i], &b, &mut new);
+        } else {
+            local_solve(d, &diag[i], p.mu[i], &b, &mut new);
+        }
         let mut v = [0.0; 3];
         for a in 0..d {
             v[a] = relaxation * new[a] + (1.0 - relaxation) * old[a];
@@ -296,7 +311,7 @@ fn isotropic_3d(inv_nn: f64, inv_c: f64, mu: f64, b: &[f64; 3]) -> [f64; 3] {
 /// once per solve instead of once per sweep ([`LocalBlock3::solve`]): the cofactors and
 /// determinant of Cramer's rule for the stick candidate, or an isotropic block's inverses. The
 /// solution is the one of [`local_solve`] bit for bit.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct LocalBlock3 {
     a: [f64; 9],
     /// First-row cofactors and determinant; `None` where `A` is nearly singular.

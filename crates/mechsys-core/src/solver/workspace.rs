@@ -56,6 +56,8 @@ pub struct Workspace {
     cap: Needs,
     pub(crate) u: Vec<f64>,
     pub(crate) diag: Vec<[f64; 9]>,
+    /// The 3-D diagonal blocks prepared for the local solves of the sweeps.
+    pub(crate) local3: Vec<super::nsgs::LocalBlock3>,
     pub(crate) lemke: LemkeWork,
     /// Friction LCP: `M` (row-major), `q`, `z`.
     pub(crate) lcp_m: Vec<f64>,
@@ -94,6 +96,7 @@ impl Workspace {
         grow(&mut self.u, cap.u);
         if self.diag.len() < cap.diag {
             self.diag.resize(cap.diag, [0.0; 9]);
+            self.local3.resize(cap.diag, super::nsgs::LocalBlock3::default());
         }
         self.lemke.reserve(cap.lemke);
         grow(&mut self.lcp_m, cap.lcp * cap.lcp);
