@@ -506,7 +506,8 @@ def main(argv=None) -> int:
                   "cheaper part of the pour: this errs in the peer's favour) and its penetration and mean height are "
                   "those of that part. Threads: mechsys solves independent contact islands, and the two halves of "
                   "a large problem on free bodies, on up to two threads (`MoreauJean(parallel=True)`, the default; "
-                  "the impulses are the same bit for bit on one); MuJoCo and PyBullet step on one. Load average "
+                  "from 400 contact points, so the 100-sphere pile runs on one; the impulses are the same bit for "
+                  "bit on one); MuJoCo and PyBullet step on one. Load average "
                   f"{load_before:.2f} before the run, {load_after:.2f} after the piles (2 cores shared with other work: "
                   "times above ≈ 1 per core are slowed)."]
             L += ["", "Targets (issue 4): the 100-sphere pile at least 4× faster than MuJoCo's default at the same step; "
