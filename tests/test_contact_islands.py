@@ -4,6 +4,7 @@ threads. The split changes nothing physical: two stacks side by side carry their
 runs with and without threads give the same numbers bit for bit."""
 
 import numpy as np
+import pytest
 
 import mechsys as ms
 
@@ -42,35 +43,40 @@ def test_two_stacks_are_two_islands_and_each_carries_its_weight():
             np.testing.assert_allclose(res[f"contact/on{s}_{k}/lambda_n"][1:].sum(axis=1), (5 - k) * G, rtol=0, atol=1e-8)
 
 
-def test_a_dominant_island_above_newtons_size_is_swept_whole_and_carries_its_weights():
+@pytest.mark.parametrize("heights", [(5,), (5, 4)])
+def test_islands_above_newtons_size_are_swept_whole_and_carry_their_weights(heights):
     """Auto sweeps the whole problem on the factored operator (no islands, no Delassus blocks)
-    when its largest island is above Newton's size and holds most contacts: a stack of 5 boxes
-    (20 points, 60 unknowns) beside a single box (4 points), Newton's size set to 30 unknowns.
-    Each box still rests on what is below it with the weight above it, as in the split solve (to
-    1e-8 N at tol 1e-12, as the split stacks above). The signals do not tell which path ran: this
-    checks the whole path's answer; `Islands::largest`, which picks it, has its own Rust test."""
-    m = ms.Model("stack and box", gravity=(0.0, 0.0, -G))
+    when the islands above Newton's size hold most contacts: a stack of 5 boxes (20 points, 60
+    unknowns), or stacks of 5 and 4 boxes (neither alone holding three quarters of the points),
+    beside a single box (4 points), Newton's size set to 30 unknowns. Each box still rests on what
+    is below it with the weight above it, as in the split solve (to 1e-8 N at tol 1e-12, as the
+    split stacks above). The signals do not tell which path ran: this checks the whole path's
+    answer; `Islands::in_islands_above`, which picks it, has its own Rust test."""
+    m = ms.Model("stacks and box", gravity=(0.0, 0.0, -G))
     shape = ms.contours.Box(half_extents=HALF)
     floor = m.ground.contour(ms.contours.Plane(normal=(0, 0, 1)))
-    below = None
-    for k in range(6):
-        b = m.add_body(f"b{k}", 1.0, ms.inertia.box(1.0, tuple(2 * h for h in HALF)))
-        x, z = (0.0, HALF[2] * (2 * k + 1)) if k < 5 else (0.5, HALF[2])
-        m.add_joint(ms.joints.Free(f"f{k}", m.ground, b, q0=[x, 0.0, z, 1, 0, 0, 0]))
-        other = floor if k in (0, 5) else below.contour(shape)
-        m.add_contact(ms.Contact(f"c{k}", b.contour(shape), other, friction=ms.laws.Coulomb(0.5)))
-        below = b
-    weights = {f"c{k}": (5 - k) * G for k in range(5)} | {"c5": G}
-    for newton_max in (30, 480):  # swept whole; split into two islands, Newton on each
+    weights = {}
+    for s, n in enumerate((*heights, 1)):
+        below = None
+        for k in range(n):
+            b = m.add_body(f"b{s}_{k}", 1.0, ms.inertia.box(1.0, tuple(2 * h for h in HALF)))
+            m.add_joint(ms.joints.Free(f"f{s}_{k}", m.ground, b, q0=[0.5 * s, 0.0, HALF[2] * (2 * k + 1), 1, 0, 0, 0]))
+            other = floor if k == 0 else below.contour(shape)
+            m.add_contact(ms.Contact(f"c{s}_{k}", b.contour(shape), other, friction=ms.laws.Coulomb(0.5)))
+            weights[f"c{s}_{k}"] = (n - k) * G
+            below = b
+    points = 4 * (sum(heights) + 1)
+    for newton_max in (30, 480):  # swept whole; split into islands, Newton on each
         res = ms.simulate(m, 0.2, ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-12, newton_max_unknowns=newton_max)),
                           output_dt=1e-3)
         assert res["solver/converged"][1:].all()
-        assert (res["solver/contacts"][1:] == 24).all()
+        assert (res["solver/contacts"][1:] == points).all()
         for name, w in weights.items():
             np.testing.assert_allclose(res[f"contact/{name}/lambda_n"][1:].sum(axis=1), w, rtol=0, atol=1e-8,
                                        err_msg=f"{name}, newton_max_unknowns={newton_max}")
-        # the top box does not drift off its support
-        assert abs(res["body/b4/position"][-1, 2] - HALF[2] * 9) < 1e-9
+        # the top boxes do not drift off their supports
+        for s, n in enumerate(heights):
+            assert abs(res[f"body/b{s}_{n - 1}/position"][-1, 2] - HALF[2] * (2 * n - 1)) < 1e-9
 
 
 def test_islands_give_the_same_result_serial_and_parallel_bit_for_bit():
@@ -82,7 +88,8 @@ def test_islands_give_the_same_result_serial_and_parallel_bit_for_bit():
     m, _ = square_pyramid(gap=3e-3, mu=0.3, base=5, at=(0.0, 1.0))
     runs = []
     for parallel in (False, True):
-        integ = ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-6), parallel=parallel)
+        # (NSGS: `auto` would sweep two islands of this size whole)
+        integ = ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-6, max_iter=3000, anderson=4), parallel=parallel)
         runs.append(ms.simulate(m, 0.1, integ, output_dt=1e-3, progress=False))
     serial, threaded = runs
     assert serial["solver/islands"].max() >= 2

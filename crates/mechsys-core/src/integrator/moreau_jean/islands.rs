@@ -56,13 +56,13 @@ impl Islands {
         self.count
     }
 
-    /// Contacts in the largest island of the last [`Islands::partition`] (0 if none).
-    pub(super) fn largest(&self) -> usize {
+    /// Contacts in the islands of more than `above` contacts (after [`Islands::partition`]).
+    pub(super) fn in_islands_above(&self, above: usize) -> usize {
         if self.count <= 1 {
-            // (one island or none: the members were not sorted)
-            return if self.count == 1 { self.of.len() } else { 0 };
+            let n = if self.count == 1 { self.of.len() } else { 0 };
+            return if n > above { n } else { 0 };
         }
-        (0..self.count).map(|k| self.start[k + 1] - self.start[k]).max().unwrap_or(0)
+        (0..self.count).map(|k| self.start[k + 1] - self.start[k]).filter(|&c| c > above).sum()
     }
 
     /// One island of `n` contacts (the dense assembly couples every contact through `M̃⁻¹`), or
@@ -258,16 +258,18 @@ mod tests {
     }
 
     #[test]
-    fn largest_counts_the_contacts_of_the_biggest_island() {
-        // islands {0, 3, 5}, {1, 2}, {4}: the largest holds 3 (counted by hand)
+    fn in_islands_above_counts_the_contacts_of_the_islands_above_a_size() {
+        // islands {0, 3, 5}, {1, 2}, {4} (counted by hand): above 0 all six, above 1 five, above
+        // 2 three, above 3 none
         let mut isl = Islands::default();
         isl.partition(6, &[(3, 5), (1, 2), (0, 3)]);
-        assert_eq!(isl.largest(), 3);
-        // one island: every contact (its members are not sorted then); none: 0
+        let counts: Vec<usize> = (0..4).map(|a| isl.in_islands_above(a)).collect();
+        assert_eq!(counts, [6, 5, 3, 0]);
+        // one island: every contact if above the size (its members are not sorted then); none: 0
         isl.partition(4, &[(0, 1), (1, 2), (2, 3)]);
-        assert_eq!((isl.count(), isl.largest()), (1, 4));
+        assert_eq!((isl.count(), isl.in_islands_above(3), isl.in_islands_above(4)), (1, 4, 0));
         isl.partition(0, &[]);
-        assert_eq!(isl.largest(), 0);
+        assert_eq!(isl.in_islands_above(0), 0);
     }
 
     /// Two random problems of 5 and 4 contacts, interleaved into one block-diagonal problem.
