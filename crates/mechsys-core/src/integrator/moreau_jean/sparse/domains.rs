@@ -20,8 +20,10 @@
 use super::factored::Packed;
 use crate::solver::nsgs::LocalBlock3;
 
-/// Contacts from which a factored Gauss–Seidel solve is split (below, one thread's sweep is a few
-/// microseconds, about the cost of handing half of it to another thread).
+/// Contacts from which a factored Gauss–Seidel solve is split, i.e. swept in the domains' order
+/// (the integrator lets the halves go to two threads only from
+/// [`PARALLEL_MIN_CONTACTS`](crate::integrator::moreau_jean::PARALLEL_MIN_CONTACTS) on; the order,
+/// and so the impulses, do not depend on it).
 pub(super) const SPLIT_MIN_CONTACTS: usize = 96;
 
 /// Sweeps a solve allows at least to be split (a single sweep, e.g. the fallback of a Newton
