@@ -100,8 +100,8 @@ def test_islands_give_the_same_result_serial_and_parallel_bit_for_bit():
 
 
 def test_a_large_pile_swept_in_two_domains_on_two_threads_is_the_serial_run_bit_for_bit():
-    """A square pyramid of 91 spheres (6×6 ... 1) settling in a box that holds its base: one
-    island of over 400 contact points, swept whole (Newton's size set below it), so that each
+    """A square pyramid of 140 spheres (7×7 ... 1) settling in a box that holds its base: one
+    island of about 640 contact points, swept whole (Newton's size set below it), so that each
     Gauss–Seidel sweep runs in two domains of the contact graph, on two threads
     (``MoreauJean(parallel=True)``) after a solve's first 16 sweeps, and then over the contacts
     between them. Serial and threaded runs agree exactly and once settled the container carries
@@ -110,7 +110,7 @@ def test_a_large_pile_swept_in_two_domains_on_two_threads_is_the_serial_run_bit_
     the sweep budget; the settled steps converge.)"""
     from test_contact_groups import MASS, square_pyramid
 
-    m, n = square_pyramid(base=6)
+    m, n = square_pyramid(base=7)
     runs = []
     for parallel in (False, True):
         solver = ms.Auto(tol=1e-5, newton_max_unknowns=30)

@@ -843,13 +843,13 @@ mod tests {
     #[test]
     fn two_domain_sweeps_are_gauss_seidel_in_their_order_on_any_threads() {
         use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
-        let ns = 60;
+        let ns = 201;
         let (model, data, saddle) = row_of_spheres(ns);
         let mut sp = SparseRows::new(&model, 3);
         sp.factor.copy_from(&saddle);
         let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
         let z = Vec3::z();
-        // each sphere on the ground, each pair of neighbours side by side (119 contacts; the normal
+        // each sphere on the ground, each pair of neighbours side by side (401 contacts; the normal
         // points from the second body to the first)
         for i in 0..ns {
             let c = Vec3::new(0.1 * i as f64, 0.0, 0.0);
@@ -899,7 +899,7 @@ mod tests {
                 "interface contact {a}"
             );
         }
-        // a row cut in the middle: two halves of about 60 contacts, one contact between them
+        // a row cut in the middle: two halves of about 200 contacts, one contact between them
         assert!(na.abs_diff(nb) <= 2 && nc - na - nb == 1, "{na} {nb} {nc}");
         for part in [&perm[..na], &perm[na..na + nb], &perm[na + nb..]] {
             assert!(part.windows(2).all(|w| w[0] > w[1]), "the caller's order within a part");
