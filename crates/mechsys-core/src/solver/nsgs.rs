@@ -211,10 +211,10 @@ pub(crate) fn local_solve(d: usize, a: &[f64; 9], mu: f64, b: &[f64; 3], r: &mut
 
 /// Largest off-diagonal entry of a block, and difference of its two tangential diagonal entries,
 /// relative to its trace, for the block to be solved as isotropic. The blocks of sphere
-/// contacts come out of the assembly isotropic only to about 1e-12 (the contact point and frame
-/// carried from the last step, the lever arms' round-off: in a pile of spheres most blocks
-/// missed a test at 1e-13, and each miss cost the iterative slip solve); the closed form then
-/// solves a block within 1e-10 of the assembled one, well inside the tolerances sweeps stop at.
+/// contacts come out of the assembly isotropic only to about 1e-13–1e-12 of their trace
+/// (measured in a pile of spheres, where most blocks missed a test at 1e-13 and each miss cost
+/// the iterative slip solve); the closed form then solves a block within 1e-12 of its trace of
+/// the assembled one, inside the tolerances sweeps stop at.
 const ISOTROPY_TOL: f64 = 1e-12;
 
 /// Relative slack of the stick and slip sign tests, so that a solution on the cone's edge is
