@@ -79,7 +79,8 @@ fn margin(last_state: f64, first_step: bool) -> f64 {
 /// this many active contact points on; the impulses are the same either way. Below, handing work
 /// to a second thread costs more than it saves: on the pour of 100 spheres (up to about 250
 /// contact points) one thread was 10–20 % faster than two over eight starts; four such pours
-/// side by side (800 points in several islands) ran 1.35 times faster on two.
+/// side by side (800 points in several islands, solved island by island) ran 1.35 times faster
+/// on two.
 pub const PARALLEL_MIN_CONTACTS: usize = 400;
 
 /// Contact state code in the recorded signal `contact/<c>/state`.
@@ -974,7 +975,9 @@ impl MoreauJean {
                         // (capacity for every contact point since construction: no allocation)
                         self.local_u.resize(m, 0.0);
                         let sp = self.sparse.as_mut().expect("sparse assembly");
-                        sp.parallel = self.parallel && m / self.problem.dim >= PARALLEL_MIN_CONTACTS;
+                        // (a solve is split, and its halves go to threads, only from
+                        // PARALLEL_MIN_CONTACTS points: `domains::SPLIT_MIN_CONTACTS`)
+                        sp.parallel = self.parallel;
                         let problem = (&self.problem.q[..], &self.problem.mu[..]);
                         Ok(sp.gauss_seidel(problem, &self.ws.order, &mut self.r, o, &mut self.local_u))
                     }

@@ -1293,4 +1293,3 @@ fn a_tolerance_that_is_not_finite_and_positive_is_refused() {
     }
     assert!(Method::Auto(AutoOptions { tol: 1e300, ..Default::default() }).validate().is_ok());
 }
-
