@@ -32,7 +32,7 @@ fn group_steps_do_not_allocate_after_warm_up() {
 /// Gauss–Seidel above its Newton size).
 #[test]
 fn group_steps_with_anderson_do_not_allocate_after_warm_up() {
-    let nsgs = NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0, anderson: 4 };
+    let nsgs = NsgsOptions { tol: 1e-8, max_iter: 500, relaxation: 1.0, anderson: 4, stall: 0 };
     pile_steps_do_not_allocate_after_warm_up(Method::Nsgs(nsgs));
     let auto = AutoOptions { tol: 1e-8, newton_max_unknowns: 0, nsgs_max_iter: 500, ..Default::default() };
     pile_steps_do_not_allocate_after_warm_up(Method::Auto(auto));
@@ -96,7 +96,7 @@ fn projected_steps_do_not_allocate() {
     }"#;
     let model = Model::from_description(ModelDescription::from_json(json).unwrap()).unwrap();
     let h = 1e-3;
-    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0, anderson: 0 });
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0, anderson: 0, stall: 0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();
     st.project = true;
     let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));
@@ -120,7 +120,7 @@ fn projected_steps_do_not_allocate() {
 fn curve_contact_steps_do_not_allocate_after_warm_up() {
     let model = mechsys_core::fixtures::ellipse_cam(20.0, 0.061);
     let h = 1e-4;
-    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0, anderson: 0 });
+    let method = Method::Nsgs(NsgsOptions { tol: 1e-10, max_iter: 500, relaxation: 1.0, anderson: 0, stall: 0 });
     let mut st = MoreauJean::new(&model, h, method).unwrap();
     assert!(st.warm_search);
     let (mut data, mut ws) = (Data::new(&model), Workspace::new(&model));

@@ -153,11 +153,18 @@ pub struct NsgsOptions {
     /// the change stalls. On the pour of 100 spheres (tol 1e-4) the sweeps per step
     /// fell from 107 to 37–45 (mean over the run; the pour is chaotic).
     pub anderson: usize,
+    /// Stall test (friction contact): the length of its first window of sweeps, 0 for none.
+    /// When the smallest change of a sweep stops halving from one window to the next (windows of
+    /// `stall`, `stall`, `2 stall`, `4 stall`, … sweeps; `nsgs::StallWatch`), the sweeps are
+    /// cycling rather than converging, and from then on they are under-relaxed: `ω ← 0.9 ω` at
+    /// each stall, down to 0.5, without Anderson acceleration. Set by [`Method::Auto`]
+    /// ([`AUTO_SWEEP_STALL`]).
+    pub stall: usize,
 }
 
 impl Default for NsgsOptions {
     fn default() -> Self {
-        Self { tol: 1e-10, max_iter: 10_000, relaxation: 1.0, anderson: 0 }
+        Self { tol: 1e-10, max_iter: 10_000, relaxation: 1.0, anderson: 0, stall: 0 }
     }
 }
 
@@ -211,6 +218,13 @@ impl Default for NewtonOptions {
 /// up to 30 before converging; the 42 that never converged had stalled by their 20th and then
 /// ran to the cap of 200, each with fresh factorizations.
 pub const AUTO_NEWTON_STALL: usize = 30;
+
+/// The first window of [`Method::Auto`]'s stall test on its Gauss–Seidel sweeps (problems above
+/// Newton's size, and the rescue of a Newton solve): see [`NsgsOptions::stall`]. Over eight starts
+/// of the 100-sphere pour, 256 and 1024 both left no step unconverged (one before), but 256 also
+/// damped slowly converging steps of the 1000-sphere pour and slowed them; 1024 passes any steady
+/// rate of at least 2000× in 10 000 sweeps.
+pub const AUTO_SWEEP_STALL: usize = 1024;
 
 /// Accelerated projected gradient ([`apgd`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -380,7 +394,8 @@ impl AutoOptions {
 
     /// Its Gauss–Seidel settings (problems above Newton's size, and the rescue of a Newton solve).
     fn sweeps(&self) -> NsgsOptions {
-        NsgsOptions { tol: self.tol, max_iter: self.nsgs_max_iter, anderson: self.nsgs_anderson, ..Default::default() }
+        let (tol, max_iter, anderson) = (self.tol, self.nsgs_max_iter, self.nsgs_anderson);
+        NsgsOptions { tol, max_iter, anderson, stall: AUTO_SWEEP_STALL, ..Default::default() }
     }
 
     /// The method it takes for a friction-contact problem of `unknowns` unknowns.

@@ -84,6 +84,7 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
     if o.anderson > 0 {
         ws.anderson.begin(m, 0, o.anderson);
     }
+    let mut stall = StallWatch::new(o.stall);
     for it in 1..=o.max_iter {
         let accelerate = o.anderson > 0 && omega == 1.0;
         let steps = if accelerate { Some(&mut ws.anderson) } else { None };
@@ -92,6 +93,9 @@ pub(crate) fn solve_fc(p: &FrictionContact, o: &NsgsOptions, r: &mut [f64], ws: 
             omega = 1.0;
         }
         last_change = change;
+        if stall.stalled(it, change) {
+            omega = StallWatch::damped(omega);
+        }
         if check.due(it, change.sqrt() / qn <= o.tol) || it == o.max_iter {
             let u = &mut ws.u[..m];
             p.w.velocity(p.dim, r, &p.q, u);
@@ -129,6 +133,62 @@ impl CheckSchedule {
         } else {
             false
         }
+    }
+}
+
+/// Whether Gauss–Seidel has stopped converging. The sweeps are cut into windows ending at sweep
+/// `stall`, `2 stall`, `4 stall`, … after the start (or the last stall); at the end of a window
+/// the smallest change of a sweep in it (the measure of the stopping test) must be at most half
+/// that of the window before. Sweeps that converge at any steady rate pass (each window is at
+/// least as long as the one before, so it gains at least as much). Some problems of a settling
+/// pile make plain sweeps cycle: the residual wanders between 1e-4 and 1e-3 for 20 000 sweeps,
+/// where sweeps under-relaxed to ω = 0.9 converge in 2 000. At a stall the solvers therefore
+/// damp the sweeps ([`STALL_DAMPING`]).
+pub(crate) struct StallWatch {
+    stall: usize,
+    start: usize,
+    next: usize,
+    window: f64,
+    before: f64,
+}
+
+/// The factor on the relaxation `ω` at each stall of [`StallWatch`] (down to [`STALL_MIN_OMEGA`]).
+pub(crate) const STALL_DAMPING: f64 = 0.9;
+/// The smallest relaxation the stalls lead to.
+pub(crate) const STALL_MIN_OMEGA: f64 = 0.5;
+
+impl StallWatch {
+    /// `stall = 0`: never stalls.
+    pub(crate) fn new(stall: usize) -> Self {
+        Self { stall, start: 0, next: stall, window: f64::INFINITY, before: f64::INFINITY }
+    }
+
+    /// After sweep `it` with change `change`: whether the sweeps stalled (the windows then start
+    /// again from `it`).
+    #[inline]
+    pub(crate) fn stalled(&mut self, it: usize, change: f64) -> bool {
+        if self.stall == 0 {
+            return false;
+        }
+        self.window = self.window.min(change);
+        if it < self.next {
+            return false;
+        }
+        let stalled = self.window > 0.5 * self.before;
+        if stalled {
+            (self.start, self.before) = (it, f64::INFINITY);
+        } else {
+            self.before = self.window;
+        }
+        self.window = f64::INFINITY;
+        // windows of stall, stall, 2 stall, 4 stall, … after the start
+        self.next = it + (it - self.start).max(self.stall);
+        stalled
+    }
+
+    /// The relaxation after a stall at relaxation `omega`.
+    pub(crate) fn damped(omega: f64) -> f64 {
+        (STALL_DAMPING * omega.min(1.0)).max(STALL_MIN_OMEGA)
     }
 }
 
@@ -376,13 +436,7 @@ fn isotropic(a: &[f64; 9]) -> bool {
 
 /// The 3-D local solve after the open and frictionless cases (`b_N < 0`, `μ > 0`), given the
 /// stick candidate `−A⁻¹ b` (`None`: `A` nearly singular), on a block that is not isotropic.
-fn slip_or_stick_3d(
-    a: &[f64; 9],
-    mu: f64,
-    b: &[f64; 3],
-    prev: &[f64; 3],
-    stick: Option<[f64; 3]>,
-) -> [f64; 3] {
+fn slip_or_stick_3d(a: &[f64; 9], mu: f64, b: &[f64; 3], prev: &[f64; 3], stick: Option<[f64; 3]>) -> [f64; 3] {
     let (bn, ann) = (b[0], a[0]);
     let guess_dir = match stick {
         Some(x) => {

@@ -685,7 +685,7 @@ fn workspace_must_fit_and_reserving_again_is_free() {
 
 #[test]
 fn method_options_round_trip_through_json() {
-    let m = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 50, relaxation: 0.9, anderson: 0 });
+    let m = Method::Nsgs(NsgsOptions { tol: 1e-8, max_iter: 50, relaxation: 0.9, anderson: 0, stall: 0 });
     let s = serde_json::to_string(&m).unwrap();
     assert_eq!(serde_json::from_str::<Method>(&s).unwrap(), m);
     let m: Method = serde_json::from_str(r#"{"type": "lemke", "facets": 16}"#).unwrap();
@@ -1292,4 +1292,49 @@ fn a_tolerance_that_is_not_finite_and_positive_is_refused() {
         }
     }
     assert!(Method::Auto(AutoOptions { tol: 1e300, ..Default::default() }).validate().is_ok());
+}
+
+#[test]
+fn stall_watch_passes_steady_convergence_and_catches_cycling() {
+    use super::nsgs::StallWatch;
+    // sweeps converging at a steady rate, however slow within reason (a factor 2.2 per window of
+    // 1024 sweeps: 2000x in 10 000 sweeps, the slowest steps of the 1000-sphere pour), never stall
+    let rate = (1.0f64 / 2000.0).powf(1.0 / 10_000.0);
+    let mut w = StallWatch::new(1024);
+    let mut change = 1.0;
+    for it in 1..=50_000 {
+        // (Anderson-like noise: every third sweep jumps up)
+        let noisy = if it % 3 == 0 { 5.0 * change } else { change };
+        assert!(!w.stalled(it, noisy), "steady convergence flagged as a stall at sweep {it}");
+        change *= rate;
+    }
+    // a change that wanders without trend stalls at the end of the second window (2 × 1024),
+    // then the windows start again from there: the next at 2048 + 2 × 1024
+    let mut w = StallWatch::new(1024);
+    let mut rng = Rng::new(7);
+    let mut stalls = Vec::new();
+    for it in 1..=10_000 {
+        if w.stalled(it, rng.uniform(1e-3, 1e-2)) {
+            stalls.push(it);
+        }
+    }
+    assert_eq!(&stalls[..2], &[2048, 4096], "{stalls:?}");
+    // after a stall, a change that then halves per window passes again
+    let mut w = StallWatch::new(100);
+    for it in 1..=200 {
+        w.stalled(it, 1.0);
+    }
+    let mut change = 1.0;
+    for it in 201..=5000 {
+        change *= 0.99;
+        assert!(!w.stalled(it, change), "sweep {it}");
+    }
+    // 0: never
+    let mut w = StallWatch::new(0);
+    assert!((1..=100_000).all(|it| !w.stalled(it, 1.0)));
+    // the damping: 0.9 per stall, down to 0.5; over-relaxation drops to it at once
+    assert_eq!(StallWatch::damped(1.0), 0.9);
+    assert!((StallWatch::damped(0.9) - 0.81).abs() < 1e-15);
+    assert_eq!(StallWatch::damped(0.52), 0.5);
+    assert_eq!(StallWatch::damped(1.5), 0.9);
 }

@@ -306,7 +306,8 @@ mod tests {
     #[test]
     fn islands_solve_like_the_whole_problem_and_the_same_on_threads() {
         let (whole, diag, upper, upper_val) = two_problems();
-        let method = Method::Nsgs(NsgsOptions { tol: 1e-13, max_iter: 100_000, relaxation: 1.0, anderson: 0 });
+        let method =
+            Method::Nsgs(NsgsOptions { tol: 1e-13, max_iter: 100_000, relaxation: 1.0, anderson: 0, stall: 0 });
         let mut ws = Workspace::for_problem(&whole, &method).unwrap();
         let mut r_whole = vec![0.0; 27];
         assert!(solver::solve(&whole, &method, &mut r_whole, false, &mut ws).unwrap().converged);

@@ -759,7 +759,7 @@ mod tests {
             mu[0] = 3.0;
             let p = FrictionContact::new(dim, Delassus::Blocks(bw), qv.clone(), mu.clone()).unwrap();
             for (sweeps, relaxation) in [(1, 1.0), (3, 1.0), (200, 1.0), (3, 1.3), (200, 1.3), (200, 0.8)] {
-                let o = NsgsOptions { tol: 1e-14, max_iter: sweeps, relaxation, anderson: 0 };
+                let o = NsgsOptions { tol: 1e-14, max_iter: sweeps, relaxation, anderson: 0, stall: 0 };
                 let method = Method::Nsgs(o);
                 let mut ws = Workspace::default();
                 ws.reserve(&p, &method).unwrap();
@@ -876,7 +876,7 @@ mod tests {
         let mu: Vec<f64> = (0..nc).map(|a| 0.3 + 0.05 * (a % 4) as f64).collect();
         // visiting order: descending index (any permutation the caller gives is kept per part)
         let order: Vec<usize> = (0..nc).rev().collect();
-        let o = NsgsOptions { tol: 1e-14, max_iter: 40, relaxation: 1.0, anderson: 0 };
+        let o = NsgsOptions { tol: 1e-14, max_iter: 40, relaxation: 1.0, anderson: 0, stall: 0 };
         assert!(sp.pack::<3>());
         assert!(sp.dom.plan(&sp.packed, &order, sp.z.len()));
         let (na, nb, perm) = (sp.dom.na, sp.dom.nb, sp.dom.perm.clone());

@@ -8,7 +8,7 @@ use crate::model::{Model, ModelDescription};
 use crate::solver::{Method, NsgsOptions};
 
 fn nsgs_tight() -> Method {
-    Method::Nsgs(NsgsOptions { tol: 1e-14, max_iter: 100_000, relaxation: 1.0, anderson: 0 })
+    Method::Nsgs(NsgsOptions { tol: 1e-14, max_iter: 100_000, relaxation: 1.0, anderson: 0, stall: 0 })
 }
 
 /// A two-link arm (revolute, then spherical: trees with multi-velocity joints and child-frame

@@ -217,7 +217,7 @@ impl Domains {
     /// One sweep: both halves (on two threads if `parallel`), then the interface. Each contact's
     /// term `W_NN Δr` goes to `f` (the split order's, for the Anderson acceleration) if
     /// `accelerate`, else to scratch; returns their sum of squares.
-    pub(super) fn sweep(&mut self, f: Option<&mut [f64]>, parallel: bool) -> f64 {
+    pub(super) fn sweep(&mut self, f: Option<&mut [f64]>, omega: f64, parallel: bool) -> f64 {
         let (na, nb) = (self.na, self.nb);
         let accelerate = f.is_some();
         let f = f.unwrap_or(&mut self.f[..]);
@@ -235,15 +235,15 @@ impl Domains {
         let (fb, fi) = rest.split_at_mut(3 * nb);
         let (ca, cb) = {
             let (za, zb) = self.z.split_at_mut(self.nza);
-            let mut half_a = || sweep_part(pa, la, qa, ma, ra, za, fa, accelerate);
-            let mut half_b = || sweep_part(pb, lb, qb, mb, rb, zb, fb, accelerate);
+            let mut half_a = || sweep_part(pa, la, (qa, ma), ra, za, fa, (omega, accelerate));
+            let mut half_b = || sweep_part(pb, lb, (qb, mb), rb, zb, fb, (omega, accelerate));
             if parallel {
                 rayon::join(half_a, half_b)
             } else {
                 (half_a(), half_b())
             }
         };
-        let ci = sweep_part(pi, li, qi, mi, ri, &mut self.z, fi, accelerate);
+        let ci = sweep_part(pi, li, (qi, mi), ri, &mut self.z, fi, (omega, accelerate));
         (ca + cb) + ci
     }
 
@@ -306,20 +306,18 @@ impl Domains {
     }
 }
 
-/// One Gauss–Seidel sweep (3-D, no relaxation) over `rows` in order, on their impulses `r` and
+/// One Gauss–Seidel sweep (3-D; relaxed by `omega ≤ 1`, 1 until a stall) over `rows` in order, on their impulses `r` and
 /// their bodies' entries of `z`: the loop of the factored sweeps (`factored.rs`), the same
 /// arithmetic. Writes each contact's `W_NN Δr` into `f` if `accelerate`; returns their sum of
 /// squares.
-#[allow(clippy::too_many_arguments)]
 fn sweep_part(
     rows: &[Packed],
     local: &[LocalBlock3],
-    q: &[f64],
-    mu: &[f64],
+    (q, mu): (&[f64], &[f64]),
     r: &mut [f64],
     z: &mut [f64],
     f: &mut [f64],
-    accelerate: bool,
+    (omega, accelerate): (f64, bool),
 ) -> f64 {
     let mut change = 0.0;
     for (a, (p, blk)) in rows.iter().zip(local).enumerate() {
@@ -336,6 +334,13 @@ fn sweep_part(
         }
         let mut new = old;
         blk.solve(mu[a], &b, &mut new);
+        if omega != 1.0 {
+            // under-relaxed after a stall (inside the cone: a convex combination), as in the
+            // serial factored sweeps
+            for c in 0..3 {
+                new[c] = omega * new[c] + (1.0 - omega) * old[c];
+            }
+        }
         let mut delta = [0.0; 3];
         for c in 0..3 {
             delta[c] = new[c] - old[c];

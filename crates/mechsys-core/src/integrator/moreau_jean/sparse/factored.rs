@@ -25,7 +25,7 @@ pub(super) struct Packed {
     bodies: usize,
     y: [[[f64; 6]; 3]; 2],
 }
-use crate::solver::nsgs::{local_solve, CheckSchedule, LocalBlock3};
+use crate::solver::nsgs::{local_solve, CheckSchedule, LocalBlock3, StallWatch};
 use crate::solver::{contact_residual_sq, project_onto_cone, NsgsOptions, Report};
 
 /// Sweeps after which a convergence check recomputes `z = Y r` instead of trusting the updated one.
@@ -43,6 +43,9 @@ const SERIAL_SWEEPS: usize = 16;
 struct SplitRun {
     it: usize,
     check: CheckSchedule,
+    stall: StallWatch,
+    /// The relaxation (1 until the sweeps stall).
+    omega: f64,
     report: Report,
 }
 
@@ -109,6 +112,7 @@ impl SparseRows {
             self.aa.reserve(n * D, self.z.len());
             self.aa.begin(n * D, self.z.len(), opts.anderson);
         }
+        let mut stall = StallWatch::new(opts.stall);
         for it in 1..=max_sweeps {
             // Anderson's combination of past sweeps (z = Y r is linear in r: it takes the same)
             let accelerate = opts.anderson > 0 && omega == 1.0;
@@ -168,6 +172,9 @@ impl SparseRows {
                 omega = 1.0;
             }
             last_change = change;
+            if stall.stalled(it, change) {
+                omega = StallWatch::damped(omega);
+            }
             if check.due(it, change.sqrt() / qn <= tol) || it == max_sweeps {
                 // a fresh z once many sweeps' updates could have accumulated round-off into it
                 // (after a warm step's one or two sweeps the updated z is as good, and the
@@ -211,6 +218,8 @@ impl SparseRows {
         let mut run = SplitRun {
             it: 0,
             check: CheckSchedule::new(),
+            stall: StallWatch::new(opts.stall),
+            omega: 1.0,
             report: Report { iterations: opts.max_iter, residual: f64::INFINITY, converged: false },
         };
         let serial = if self.parallel { SERIAL_SWEEPS.min(opts.max_iter) } else { opts.max_iter };
@@ -243,8 +252,12 @@ impl SparseRows {
         while run.it < until {
             run.it += 1;
             let it = run.it;
-            let f = (opts.anderson > 0).then(|| self.aa.residuals());
-            let change = self.dom.sweep(f, threads);
+            let accelerate = opts.anderson > 0 && run.omega == 1.0;
+            let f = accelerate.then(|| self.aa.residuals());
+            let change = self.dom.sweep(f, run.omega, threads);
+            if run.stall.stalled(it, change) {
+                run.omega = StallWatch::damped(run.omega);
+            }
             if run.check.due(it, change.sqrt() / qn <= tol) || it == max_sweeps {
                 self.dom.scatter(r, &mut self.z);
                 if it > FRESH_Z_AFTER {
@@ -258,7 +271,7 @@ impl SparseRows {
                     return;
                 }
             }
-            if opts.anderson > 0 && it < max_sweeps {
+            if accelerate && it < max_sweeps {
                 self.aa.step(&mut self.dom.r, &mut self.dom.z, change);
             }
         }

@@ -1,0 +1,82 @@
+"""Gauss-Seidel sweeps that cycle instead of converging, and ``Auto``'s remedy.
+
+The state in ``data/pile100_cycling.npz`` is one step of the 100-sphere pour of
+``benches/contacts.py`` (start seed 1, t = 0.979 s, 206 contact points). From it, the step's
+friction-contact problem is one plain sweeps never settle: the residual wanders between 1e-4 and
+1e-3 however many sweeps are made, with or without Anderson acceleration. Sweeps under-relaxed to
+ω = 0.9 converge. ``Auto`` notices the stall (its smallest sweep change stops halving from one
+window of sweeps to the next, see ``solver::nsgs::StallWatch``) and damps its sweeps, so the step
+converges instead of spending its 10 000-sweep budget."""
+
+import pathlib
+import warnings
+
+import numpy as np
+import pytest
+
+import mechsys as ms
+
+R, M, MU, HALF = 0.05, 0.1, 0.5, 0.275
+STATE = pathlib.Path(__file__).parent / "data" / "pile100_cycling.npz"
+TOL = 1e-4
+
+
+def pile100():
+    """The benchmark's 100-sphere pile (its initial positions are replaced by the saved state)."""
+    m = ms.Model("pile-100", gravity=(0, 0, -9.81))
+    members = []
+    for i in range(100):
+        b = m.add_body(f"s{i}", M, ms.inertia.sphere(M, R))
+        m.add_joint(ms.joints.Free(f"f{i}", m.ground, b, q0=[0.0, 0.0, R + 2.2 * R * i, 1, 0, 0, 0]))
+        members.append(b.contour(ms.contours.Sphere(radius=R)))
+    walls = [((0, 0, 0), (0, 0, 1))] + [(tuple(-s * HALF * (k == ax) for k in range(3)), tuple(s * (k == ax) * 1.0 for k in range(3)))
+                                        for ax in range(2) for s in (1, -1)]
+    against = [m.ground.contour(ms.contours.Plane(point=p, normal=nrm)) for p, nrm in walls]
+    m.add_contact(ms.ContactGroup("pile", members=members, against=against, friction=ms.laws.Coulomb(MU),
+                                  impact=ms.laws.Newton(0.0)))
+    m.build()
+    return m
+
+
+@pytest.fixture(scope="module")
+def model():
+    return pile100()
+
+
+def one_step(model, solver):
+    d = np.load(STATE)
+    t0 = float(d["t"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the unconverged runs warn; their report is checked
+        res = ms.simulate(model, t0 + 1e-3, ms.MoreauJean(1e-3, solver=solver), q0=d["q"], u0=d["u"], t0=t0,
+                          output_dt=1e-3, progress=False)
+    assert res.t[-1] == pytest.approx(t0 + 1e-3)
+    return int(res["solver/iterations"][-1]), float(res["solver/residual"][-1]), bool(res["solver/converged"][-1])
+
+
+def test_the_state_holds_a_crowded_pile(model):
+    d = np.load(STATE)
+    z = d["q"].reshape(100, 7)[:, 2]
+    assert z.min() == pytest.approx(R, abs=1e-3)  # spheres on the floor
+    assert 0.15 < z.mean() < 0.25
+
+
+@pytest.mark.parametrize("anderson", [0, 4])
+def test_plain_sweeps_cycle_on_it(model, anderson):
+    # 6000 sweeps, far beyond what this pour's converging steps need (at most about 1000)
+    it, residual, converged = one_step(model, ms.NSGS(tol=TOL, max_iter=6000, anderson=anderson))
+    assert not converged and it == 6000
+    assert residual > 1.2 * TOL
+
+
+def test_under_relaxed_sweeps_converge_on_it(model):
+    it, residual, converged = one_step(model, ms.NSGS(tol=TOL, max_iter=10_000, relaxation=0.9))
+    assert converged and residual <= TOL
+    assert it < 4000
+
+
+def test_auto_damps_the_stall_and_converges(model):
+    it, residual, converged = one_step(model, ms.Auto(tol=TOL))
+    assert converged and residual <= TOL
+    # the stall shows after two windows of 1024 sweeps; damped sweeps finish in about 2000 more
+    assert 2048 <= it < 6000
