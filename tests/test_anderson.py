@@ -9,30 +9,20 @@ import numpy as np
 import pytest
 
 import mechsys as ms
+from piles import M, R, box_pile
 from mechsys.errors import SettingsError
 
-R, M, MU = 0.05, 0.1, 0.5
 
 
 def pile(n=36, half=0.16):
-    m = ms.Model(f"pile-{n}", gravity=(0, 0, -9.81))
     rng = np.random.default_rng(1)
     per = 3
-    members = []
+    centres = []
     for i in range(n):
         ix, iy, iz = i % per, (i // per) % per, i // (per * per)
-        x = (-half + 1.1 * R + 2.2 * R * ix + rng.uniform(-0.02, 0.02) * R,
-             -half + 1.1 * R + 2.2 * R * iy + rng.uniform(-0.02, 0.02) * R, R + 0.01 + 2.2 * R * iz)
-        b = m.add_body(f"s{i}", M, ms.inertia.sphere(M, R))
-        m.add_joint(ms.joints.Free(f"f{i}", m.ground, b, q0=[*x, 1, 0, 0, 0]))
-        members.append(b.contour(ms.contours.Sphere(radius=R)))
-    walls = [((0, 0, 0), (0, 0, 1))] + [(tuple(-s * half * (k == ax) for k in range(3)), tuple(s * (k == ax) * 1.0 for k in range(3)))
-                                        for ax in range(2) for s in (1, -1)]
-    against = [m.ground.contour(ms.contours.Plane(point=p, normal=nrm)) for p, nrm in walls]
-    m.add_contact(ms.ContactGroup("pile", members=members, against=against, friction=ms.laws.Coulomb(MU),
-                                  impact=ms.laws.Newton(0.0)))
-    m.build()
-    return m
+        centres.append((-half + 1.1 * R + 2.2 * R * ix + rng.uniform(-0.02, 0.02) * R,
+                        -half + 1.1 * R + 2.2 * R * iy + rng.uniform(-0.02, 0.02) * R, R + 0.01 + 2.2 * R * iz))
+    return box_pile(centres, half)
 
 
 def run(solver, t_end=1.2):

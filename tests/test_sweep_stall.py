@@ -15,27 +15,16 @@ import numpy as np
 import pytest
 
 import mechsys as ms
+from piles import R, box_pile
 
-R, M, MU, HALF = 0.05, 0.1, 0.5, 0.275
+HALF = 0.275
 STATE = pathlib.Path(__file__).parent / "data" / "pile100_cycling.npz"
 TOL = 1e-4
 
 
 def pile100():
     """The benchmark's 100-sphere pile (its initial positions are replaced by the saved state)."""
-    m = ms.Model("pile-100", gravity=(0, 0, -9.81))
-    members = []
-    for i in range(100):
-        b = m.add_body(f"s{i}", M, ms.inertia.sphere(M, R))
-        m.add_joint(ms.joints.Free(f"f{i}", m.ground, b, q0=[0.0, 0.0, R + 2.2 * R * i, 1, 0, 0, 0]))
-        members.append(b.contour(ms.contours.Sphere(radius=R)))
-    walls = [((0, 0, 0), (0, 0, 1))] + [(tuple(-s * HALF * (k == ax) for k in range(3)), tuple(s * (k == ax) * 1.0 for k in range(3)))
-                                        for ax in range(2) for s in (1, -1)]
-    against = [m.ground.contour(ms.contours.Plane(point=p, normal=nrm)) for p, nrm in walls]
-    m.add_contact(ms.ContactGroup("pile", members=members, against=against, friction=ms.laws.Coulomb(MU),
-                                  impact=ms.laws.Newton(0.0)))
-    m.build()
-    return m
+    return box_pile([(0.0, 0.0, R + 2.2 * R * i) for i in range(100)], HALF, name="pile-100")
 
 
 @pytest.fixture(scope="module")
@@ -80,3 +69,16 @@ def test_auto_damps_the_stall_and_converges(model):
     assert converged and residual <= TOL
     # the stall shows after two windows of 1024 sweeps; damped sweeps finish in about 2000 more
     assert 2048 <= it < 6000
+
+
+def test_nsgs_takes_the_stall_test_when_asked(model):
+    it, residual, converged = one_step(model, ms.NSGS(tol=TOL, max_iter=10_000, anderson=4, stall=1024))
+    assert converged and residual <= TOL and 2048 <= it < 6000
+
+
+@pytest.mark.parametrize("bad", [-1, 1.5, float("nan")])
+def test_a_bad_stall_window_is_refused_by_name(model, bad):
+    from mechsys.errors import SettingsError
+
+    with pytest.raises(SettingsError, match=r"NSGS\.stall"):
+        one_step(model, ms.NSGS(stall=bad))

@@ -127,10 +127,16 @@ class NSGS:
     #: Anderson acceleration: the number of past sweeps combined (0 = off, at most 8); with
     #: ``relaxation = 1``. Piles converge in several times fewer sweeps.
     anderson: int = 0
+    #: Stall test: the first window of sweeps (0 = none). When the smallest change of a sweep stops
+    #: halving from one window to the next (windows of ``stall``, ``stall``, ``2 stall``, ...), the
+    #: sweeps are cycling, and from then on they are under-relaxed (``ω ← 0.9 ω`` per stall, down to
+    #: 0.5). ``Auto`` uses 1024.
+    stall: int = 0
 
     def describe(self) -> dict:
         return {"type": "nsgs", "tol": _number(self, "tol", self.tol), "max_iter": _whole(self, "max_iter", self.max_iter),
-                "relaxation": _number(self, "relaxation", self.relaxation), "anderson": _whole(self, "anderson", self.anderson)}
+                "relaxation": _number(self, "relaxation", self.relaxation), "anderson": _whole(self, "anderson", self.anderson),
+                "stall": _whole(self, "stall", self.stall)}
 
 
 @dataclass(frozen=True)
