@@ -25,6 +25,7 @@ fn group_steps_do_not_allocate_after_warm_up() {
         max_iter: 500,
         relaxation: 1.0,
         anderson: 0,
+        stall: 0,
     }));
 }
 
