@@ -48,7 +48,9 @@ def test_islands_above_newtons_size_are_swept_whole_and_carry_their_weights(heig
     """Auto sweeps the whole problem on the factored operator (no islands, no Delassus blocks)
     when the islands above Newton's size hold most contacts: a stack of 5 boxes (20 points, 60
     unknowns), or stacks of 5 and 4 boxes (neither alone holding three quarters of the points),
-    beside a single box (4 points), Newton's size set to 30 unknowns. Each box still rests on what
+    beside a single box (4 points), Newton's size set to 30 unknowns. NSGS does so when its
+    largest island holds three quarters of the points (the stack of 5 beside the box), and goes
+    island by island otherwise. Each box still rests on what
     is below it with the weight above it, as in the split solve (to 1e-8 N at tol 1e-12, as the
     split stacks above). The signals do not tell which path ran: this checks the whole path's
     answer; `Islands::in_islands_above`, which picks it, has its own Rust test."""
@@ -66,14 +68,17 @@ def test_islands_above_newtons_size_are_swept_whole_and_carry_their_weights(heig
             weights[f"c{s}_{k}"] = (n - k) * G
             below = b
     points = 4 * (sum(heights) + 1)
-    for newton_max in (30, 480):  # swept whole; split into islands, Newton on each
-        res = ms.simulate(m, 0.2, ms.MoreauJean(1e-3, solver=ms.Auto(tol=1e-12, newton_max_unknowns=newton_max)),
-                          output_dt=1e-3)
+    # Auto swept whole, Auto split into islands with Newton on each; NSGS swept whole where one
+    # island holds three quarters of the points (the stack of 5 beside the box), else by islands
+    solvers = [ms.Auto(tol=1e-12, newton_max_unknowns=30), ms.Auto(tol=1e-12, newton_max_unknowns=480),
+               ms.NSGS(tol=1e-12, max_iter=100_000)]
+    for newton_max, solver in zip((30, 480, None), solvers):
+        res = ms.simulate(m, 0.2, ms.MoreauJean(1e-3, solver=solver), output_dt=1e-3)
         assert res["solver/converged"][1:].all()
         assert (res["solver/contacts"][1:] == points).all()
         for name, w in weights.items():
             np.testing.assert_allclose(res[f"contact/{name}/lambda_n"][1:].sum(axis=1), w, rtol=0, atol=1e-8,
-                                       err_msg=f"{name}, newton_max_unknowns={newton_max}")
+                                       err_msg=f"{name}, {solver}")
         # the top boxes do not drift off their supports
         for s, n in enumerate(heights):
             assert abs(res[f"body/b{s}_{n - 1}/position"][-1, 2] - HALF[2] * (2 * n - 1)) < 1e-9

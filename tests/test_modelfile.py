@@ -318,13 +318,19 @@ def test_toml_contact_integrator_tables(tmp_path):
                                  '{ type = "moreau_jean", dt = 1e-3, solver = { type = "nsgs", tol = 1e-8, max_iter = 50 } }')
     _, sim = load_model(write(tmp_path, text))
     assert sim["integrator"] == {"type": "moreau_jean", "dt": 1e-3,
-                                 "solver": {"type": "nsgs", "tol": 1e-8, "max_iter": 50, "relaxation": 1.0, "anderson": 0}}
+                                 "solver": {"type": "nsgs", "tol": 1e-8, "max_iter": 50, "relaxation": 1.0, "anderson": 0,
+                                            "stall": 0}}
     assert simulation_kwargs(sim)["integrator"] == ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-8, max_iter=50))
     text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }',
                                  '{ type = "moreau_jean", dt = 1e-3, solver = { type = "nsgs", tol = 1e-6, anderson = 4 } }')
     _, sim = load_model(write(tmp_path, text))
     assert simulation_kwargs(sim)["integrator"] == ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-6, anderson=4))
-    for table, key in (('{ type = "nsgs", anderson = -1 }', "anderson"), ('{ type = "auto", nsgs_anderson = 2.5 }', "nsgs_anderson")):
+    text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }',
+                                 '{ type = "moreau_jean", dt = 1e-3, solver = { type = "nsgs", tol = 1e-6, stall = 1024 } }')
+    _, sim = load_model(write(tmp_path, text))
+    assert simulation_kwargs(sim)["integrator"] == ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-6, stall=1024))
+    for table, key in (('{ type = "nsgs", anderson = -1 }', "anderson"), ('{ type = "auto", nsgs_anderson = 2.5 }', "nsgs_anderson"),
+                       ('{ type = "nsgs", stall = -1 }', "stall")):
         text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }', f'{{ type = "moreau_jean", dt = 1e-3, solver = {table} }}')
         with pytest.raises(ModelError, match=rf"simulation\.integrator\.solver\.{key}: expected an integer >= 0"):
             load_model(write(tmp_path, text))

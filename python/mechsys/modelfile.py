@@ -74,11 +74,11 @@ _INTEGRATOR_OBJECTS = "mechsys.RK4, DOPRI5, Radau5, MoreauJean or EventDriven"
 #: Parameters of integrators and solvers: integers (with their least value), booleans, and numbers
 #: that must be > 0; all other parameters are numbers >= 0.
 _INTEGER_KEYS = {"max_events": 1, "max_iter": 1, "facets": 3, "newton_max_unknowns": 0, "newton_max_iter": 1,
-                 "nsgs_max_iter": 1, "anderson": 0, "nsgs_anderson": 0, "body_space_above": 0}
+                 "nsgs_max_iter": 1, "anderson": 0, "nsgs_anderson": 0, "body_space_above": 0, "stall": 0}
 _BOOLEAN_KEYS = ("continue_on_painleve", "project", "parallel")
 _POSITIVE_KEYS = ("dt", "rtol", "newton_tol", "tol", "pivot_tol", "relaxation")
 #: Keys of a solver table, per solver type (besides ``type``).
-SOLVER_KEYS: dict[str, tuple[str, ...]] = {"nsgs": ("tol", "max_iter", "relaxation", "anderson"),
+SOLVER_KEYS: dict[str, tuple[str, ...]] = {"nsgs": ("tol", "max_iter", "relaxation", "anderson", "stall"),
                                            "newton": ("tol", "max_iter", "regularization", "body_space_above"),
                                            "lemke": ("facets", "pivot_tol"),
                                            "apgd": ("tol", "max_iter"),

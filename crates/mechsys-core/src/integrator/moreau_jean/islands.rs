@@ -65,6 +65,14 @@ impl Islands {
         (0..self.count).map(|k| self.start[k + 1] - self.start[k]).filter(|&c| c > above).sum()
     }
 
+    /// Contacts in the largest island (after [`Islands::partition`]).
+    pub(super) fn largest(&self) -> usize {
+        if self.count <= 1 {
+            return if self.count == 1 { self.of.len() } else { 0 };
+        }
+        (0..self.count).map(|k| self.start[k + 1] - self.start[k]).max().unwrap_or(0)
+    }
+
     /// One island of `n` contacts (the dense assembly couples every contact through `M̃⁻¹`), or
     /// none if `n` is 0.
     pub(super) fn single(&mut self, n: usize) {
@@ -270,6 +278,9 @@ mod tests {
         assert_eq!((isl.count(), isl.in_islands_above(3), isl.in_islands_above(4)), (1, 4, 0));
         isl.partition(0, &[]);
         assert_eq!(isl.in_islands_above(0), 0);
+        assert_eq!(isl.largest(), 0);
+        isl.partition(6, &[(3, 5), (1, 2), (0, 3)]);
+        assert_eq!(isl.largest(), 3);
     }
 
     /// Two random problems of 5 and 4 contacts, interleaved into one block-diagonal problem.
