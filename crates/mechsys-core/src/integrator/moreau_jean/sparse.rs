@@ -960,6 +960,41 @@ mod tests {
         for s in [solver::ContactState::Stick, solver::ContactState::Slip, solver::ContactState::Open] {
             assert!(states.contains(&s), "{states:?}");
         }
+        // a stall test with a short first window (4 sweeps) finds these slow plain sweeps stalled
+        // and damps them: still the block solver's sweeps in the split's order, on any threads
+        let od = NsgsOptions { stall: 4, max_iter: 200, ..o };
+        let block = |opts: NsgsOptions| {
+            let method = Method::Nsgs(opts);
+            let mut ws = Workspace::default();
+            ws.reserve(&p, &method).unwrap();
+            ws.order = perm.clone();
+            let mut r = vec![0.0; 3 * nc];
+            let rep = solver::solve(&p, &method, &mut r, false, &mut ws).unwrap();
+            (rep, r)
+        };
+        let (rep_d, r_damped) = block(od);
+        let (_, r_plain) = block(NsgsOptions { stall: 0, ..od });
+        let big = r_plain.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let moved = r_damped.iter().zip(&r_plain).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(moved > 1e-6 * big, "the damping changed nothing ({moved})");
+        let mut first: Option<(crate::solver::Report, Vec<f64>)> = None;
+        for (threads, parallel) in [(1, false), (2, true)] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (mut r, mut u) = (vec![0.0; 3 * nc], vec![0.0; 3 * nc]);
+            sp.parallel = parallel;
+            let rep = pool.install(|| sp.gauss_seidel((&qv, &mu), &order, &mut r, &od, &mut u));
+            assert_eq!(rep.iterations, rep_d.iterations);
+            for k in 0..3 * nc {
+                assert!((r[k] - r_damped[k]).abs() <= 1e-12 * big, "r[{k}]: {} vs {}", r[k], r_damped[k]);
+            }
+            match &first {
+                None => first = Some((rep, r)),
+                Some((f, r0)) => {
+                    assert_eq!(f.residual.to_bits(), rep.residual.to_bits());
+                    assert!(r.iter().zip(r0).all(|(a, b)| a.to_bits() == b.to_bits()), "damped r on two threads");
+                }
+            }
+        }
     }
 
     /// The free-body rows and their reduction are the general path's bit for bit (any sign or

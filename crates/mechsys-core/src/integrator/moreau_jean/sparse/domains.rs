@@ -306,10 +306,10 @@ impl Domains {
     }
 }
 
-/// One Gauss–Seidel sweep (3-D; relaxed by `omega ≤ 1`, 1 until a stall) over `rows` in order, on their impulses `r` and
-/// their bodies' entries of `z`: the loop of the factored sweeps (`factored.rs`), the same
-/// arithmetic. Writes each contact's `W_NN Δr` into `f` if `accelerate`; returns their sum of
-/// squares.
+/// One Gauss–Seidel sweep (3-D, relaxed by `omega ≤ 1`: 1 until the sweeps stall) over `rows` in
+/// order, on their impulses `r` and their bodies' entries of `z`: the loop of the factored sweeps
+/// (`factored.rs`), the same arithmetic. Writes each contact's `W_NN Δr` into `f` if
+/// `accelerate`; returns their sum of squares.
 fn sweep_part(
     rows: &[Packed],
     local: &[LocalBlock3],
