@@ -863,7 +863,7 @@ impl MoreauJean {
                             if pts.len() < pts.capacity() {
                                 let p = &self.act[ai].point;
                                 let f = (p.n * imp[0] + p.t1 * imp[1] + p.t2 * imp[2]) / h;
-                                pts.push([p.p1.x, p.p1.y, p.p1.z, f.x, f.y, f.z, code as f64]);
+                                pts.push([p.p1.x, p.p1.y, p.p1.z, f.x, f.y, f.z, code]);
                             }
                         }
                     }

@@ -39,6 +39,10 @@ const FRESH_Z_AFTER: usize = 4;
 /// 1000-sphere pour, thousands of sweeps of 2000 contacts, they make it 1.5 times faster.)
 const SERIAL_SWEEPS: usize = 16;
 
+/// The problem, options and outputs a two-domain solve's sweeps work on: `q`, `mu`, the impulses,
+/// the options, the velocities and the residual's scale `1 + ‖q‖`.
+type SplitProblem<'a> = (&'a [f64], &'a [f64], &'a mut [f64], &'a NsgsOptions, &'a mut [f64], f64);
+
 /// Where a two-domain solve stands between its serial and its threaded sweeps.
 struct SplitRun {
     it: usize,
@@ -246,7 +250,7 @@ impl SparseRows {
         run: &mut SplitRun,
         until: usize,
         threads: bool,
-        (q, mu, r, opts, u, qn): (&[f64], &[f64], &mut [f64], &NsgsOptions, &mut [f64], f64),
+        (q, mu, r, opts, u, qn): SplitProblem<'_>,
     ) {
         let (tol, max_sweeps) = (opts.tol, opts.max_iter);
         while run.it < until {
