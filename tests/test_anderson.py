@@ -9,9 +9,8 @@ import numpy as np
 import pytest
 
 import mechsys as ms
-from piles import M, R, box_pile
 from mechsys.errors import SettingsError
-
+from piles import M, R, box_pile
 
 
 def pile(n=36, half=0.16):

@@ -340,6 +340,11 @@ def test_toml_contact_integrator_tables(tmp_path):
     text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }', '{ type = "event_driven", max_events = 1.5 }')
     with pytest.raises(ModelError, match=r"simulation\.integrator\.max_events: expected an integer >= 1, got 1\.5"):
         load_model(write(tmp_path, text))
+    # a count beyond what the engine's unsigned integers take, named (it had reached the engine)
+    text = PENDULUM_TOML.replace('{ type = "rk4", dt = 1e-3 }',
+                                 '{ type = "moreau_jean", dt = 1e-3, solver = { type = "nsgs", stall = 1e30 } }')
+    with pytest.raises(ModelError, match=r"simulation\.integrator\.solver\.stall: expected an integer at most 2\*\*53"):
+        load_model(write(tmp_path, text))
 
 
 def test_simulation_kwargs_overrides_an_integrator_object():

@@ -76,8 +76,10 @@ def test_nsgs_takes_the_stall_test_when_asked(model):
     assert converged and residual <= TOL and 2048 <= it < 6000
 
 
-@pytest.mark.parametrize("bad", [-1, 1.5, float("nan")])
+@pytest.mark.parametrize("bad", [-1, 1.5, float("nan"), 10**30, 2**64 - 1])
 def test_a_bad_stall_window_is_refused_by_name(model, bad):
+    # (a window beyond 2**53 had reached the engine as a float and was refused naming only
+    # "settings.integrator")
     from mechsys.errors import SettingsError
 
     with pytest.raises(SettingsError, match=r"NSGS\.stall"):

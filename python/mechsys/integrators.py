@@ -39,7 +39,15 @@ def _whole(owner: object, key: str, value) -> int:
     x = _as_float(value)
     if not math.isfinite(x) or x != int(x) or x < 0:
         raise SettingsError(f"{type(owner).__name__}.{key}: expected a whole number >= 0, got {value!r}")
+    if x > MAX_COUNT:
+        # (beyond, the engine's unsigned counts refused it as a float, naming only the integrator)
+        raise SettingsError(f"{type(owner).__name__}.{key}: expected a whole number at most 2**53, got {value!r}")
     return int(x)
+
+
+#: The largest count a setting takes (the largest whole number a float holds exactly; every
+#: count, e.g. sweeps or a stall window, is far below it in practice).
+MAX_COUNT = 2**53
 
 
 def _number(owner: object, key: str, value) -> float:

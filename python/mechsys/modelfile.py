@@ -51,7 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import MechsysError, ModelError, SettingsError
-from .integrators import APGD, DOPRI5, NSGS, RK4, Auto, EventDriven, Lemke, MoreauJean, Newton, Radau5
+from .integrators import APGD, DOPRI5, MAX_COUNT, NSGS, RK4, Auto, EventDriven, Lemke, MoreauJean, Newton, Radau5
 from .model import Model
 
 #: Keys of the ``[simulation]`` table.
@@ -127,6 +127,8 @@ def _parameter(value: Any, key: str, allowed: tuple[str, ...], kind: str, where:
     if key in _INTEGER_KEYS:
         if x != int(x) or x < _INTEGER_KEYS[key]:
             raise error(f"{where}: expected an integer >= {_INTEGER_KEYS[key]}, got {value!r}")
+        if x > MAX_COUNT:
+            raise error(f"{where}: expected an integer at most 2**53, got {value!r}")
         return int(x)
     if x < 0 or (x == 0 and key in _POSITIVE_KEYS):
         raise error(f"{where}: must be {'>' if key in _POSITIVE_KEYS else '>='} 0, got {x:g}")

@@ -908,14 +908,19 @@ mod tests {
         let mut bw = BlockDelassus::default();
         bw.refill(3, nc, &sp.diag, &sp.upper, &sp.upper_val);
         let p = FrictionContact::new(3, Delassus::Blocks(bw), qv.clone(), mu.clone()).unwrap();
-        for sweeps in [8, 60] {
-            let o = NsgsOptions { max_iter: sweeps, ..o };
-            let method = Method::Nsgs(o);
+        // the block solver from a cold start, visiting the contacts in the split's order
+        let block = |opts: NsgsOptions| {
+            let method = Method::Nsgs(opts);
             let mut ws = Workspace::default();
             ws.reserve(&p, &method).unwrap();
             ws.order = perm.clone();
-            let mut r_blocks = vec![0.0; 3 * nc];
-            let rep = solver::solve(&p, &method, &mut r_blocks, false, &mut ws).unwrap();
+            let mut r = vec![0.0; 3 * nc];
+            let rep = solver::solve(&p, &method, &mut r, false, &mut ws).unwrap();
+            (rep, r)
+        };
+        for sweeps in [8, 60] {
+            let o = NsgsOptions { max_iter: sweeps, ..o };
+            let (rep, r_blocks) = block(o);
             let mut runs = Vec::new();
             for (threads, parallel) in [(1, false), (2, true), (1, true)] {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -963,15 +968,6 @@ mod tests {
         // a stall test with a short first window (4 sweeps) finds these slow plain sweeps stalled
         // and damps them: still the block solver's sweeps in the split's order, on any threads
         let od = NsgsOptions { stall: 4, max_iter: 200, ..o };
-        let block = |opts: NsgsOptions| {
-            let method = Method::Nsgs(opts);
-            let mut ws = Workspace::default();
-            ws.reserve(&p, &method).unwrap();
-            ws.order = perm.clone();
-            let mut r = vec![0.0; 3 * nc];
-            let rep = solver::solve(&p, &method, &mut r, false, &mut ws).unwrap();
-            (rep, r)
-        };
         let (rep_d, r_damped) = block(od);
         let (_, r_plain) = block(NsgsOptions { stall: 0, ..od });
         let big = r_plain.iter().fold(0.0f64, |a, v| a.max(v.abs()));
