@@ -1274,6 +1274,50 @@ fn anderson_sweeps_converge_in_fewer_sweeps_on_piles() {
     assert!(e.contains("anderson") && e.contains("0..=8"), "{e}");
 }
 
+/// Anderson's guard pauses the acceleration at a stall and then starts it again: after
+/// `STALL` sweeps whose change does not beat the best one it stops extrapolating, and after
+/// `RETRY` plain sweeps it extrapolates again from a fresh history (off for the rest of a solve,
+/// the late steps of the 1000-sphere pour ran mostly plain; see `tests/test_anderson_retry.py`).
+#[test]
+fn anderson_pauses_at_a_stall_and_starts_again() {
+    use super::anderson::{Anderson, RETRY};
+    let n = 4;
+    let mut aa = Anderson::default();
+    aa.reserve(n, n);
+    aa.begin(n, n, 4);
+    let (mut g, mut z) = (vec![0.0; n], vec![0.0; n]);
+    // sweeps whose change never falls below the first one (the same squared norm every time,
+    // scattered residual terms so that the least-squares problems stay regular): a stall
+    let mut seed = 12345u64;
+    let mut sweep = |aa: &mut Anderson, g: &mut Vec<f64>, z: &mut Vec<f64>| {
+        for i in 0..n {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let f = 0.2 + 0.1 * (seed >> 11) as f64 / (1u64 << 53) as f64;
+            aa.set_residual(i, f);
+            g[i] += f;
+            z[i] = g[i];
+        }
+        aa.step(g, z, 1.0)
+    };
+    let mut extrapolated = Vec::new();
+    for _ in 0..(128 + RETRY + 10) {
+        extrapolated.push(sweep(&mut aa, &mut g, &mut z));
+    }
+    // extrapolating from the second sweep on (the first has no difference yet) ...
+    assert!(!extrapolated[0] && extrapolated[1..100].iter().all(|e| *e), "{extrapolated:?}");
+    // ... then paused for RETRY plain sweeps once the best change has stood for 128 sweeps ...
+    let first_off = (1..extrapolated.len()).find(|&k| k > 100 && !extrapolated[k..k + RETRY].iter().any(|e| *e));
+    let first_off = first_off.expect("the guard never paused the acceleration");
+    assert!((128..=140).contains(&first_off), "paused at sweep {first_off}");
+    // ... and extrapolating again after the pause (a fresh history needs two sweeps)
+    let back = first_off + RETRY;
+    assert!(
+        extrapolated[back..back + 4].iter().any(|e| *e),
+        "not resumed after {RETRY} plain sweeps: {:?}",
+        &extrapolated[back..]
+    );
+}
+
 /// A tolerance that is not a finite number > 0 is refused before a solve, naming the solver: an
 /// infinite one (`tol = inf` in a model file) passed the old `> 0` test and ended every solve at
 /// its warm start, reported converged.
