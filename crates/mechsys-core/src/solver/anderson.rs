@@ -87,6 +87,11 @@ impl Anderson {
     pub(crate) fn begin(&mut self, n: usize, nz: usize, depth: usize) {
         debug_assert!(self.f.len() >= n && self.z_prev.len() >= nz && (1..=MAX_DEPTH).contains(&depth));
         (self.n, self.nz, self.depth) = (n, nz, depth);
+        self.fresh();
+    }
+
+    /// On, with no history and no best change yet (a solve's start, and the end of a pause).
+    fn fresh(&mut self) {
         (self.best, self.since_best, self.off, self.plain) = (f64::INFINITY, 0, false, 0);
         self.restart();
     }
@@ -119,9 +124,8 @@ impl Anderson {
         if self.off {
             self.plain += 1;
             if self.plain >= RETRY {
-                // a fresh start: the history and the best change are the stalled phase's
-                (self.best, self.since_best, self.off, self.plain) = (f64::INFINITY, 0, false, 0);
-                self.restart();
+                // (the history and the best change were the stalled phase's)
+                self.fresh();
             }
             return false;
         }
