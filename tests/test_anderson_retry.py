@@ -59,4 +59,3 @@ def test_accelerated_sweeps_converge_on_the_settling_pile(model, solver):
     # paused and resumed: 4520 sweeps for the three steps (stopped for the rest of each step
     # instead: 11 422)
     assert it.sum() < 7000, it
-

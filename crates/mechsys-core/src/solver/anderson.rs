@@ -49,7 +49,7 @@ pub(crate) struct Anderson {
 /// The acceleration pauses when the smallest change of a sweep has not fallen for this many
 /// sweeps (on a settling pile one solve thrashed for 10 000 sweeps, four in five restarting, at
 /// a change that stayed put; plain sweeps took 1300).
-const STALL: usize = 128;
+pub(crate) const STALL: usize = 128;
 
 /// Plain sweeps after a stall before the acceleration starts again with a fresh history. Off
 /// for the rest of a solve instead, the late steps of the 1000-sphere pour ran mostly plain. One

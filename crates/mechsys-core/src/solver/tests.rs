@@ -1280,7 +1280,7 @@ fn anderson_sweeps_converge_in_fewer_sweeps_on_piles() {
 /// the late steps of the 1000-sphere pour ran mostly plain; see `tests/test_anderson_retry.py`).
 #[test]
 fn anderson_pauses_at_a_stall_and_starts_again() {
-    use super::anderson::{Anderson, RETRY};
+    use super::anderson::{Anderson, RETRY, STALL};
     let n = 4;
     let mut aa = Anderson::default();
     aa.reserve(n, n);
@@ -1300,15 +1300,15 @@ fn anderson_pauses_at_a_stall_and_starts_again() {
         aa.step(g, z, 1.0)
     };
     let mut extrapolated = Vec::new();
-    for _ in 0..(128 + RETRY + 10) {
+    for _ in 0..(STALL + RETRY + 10) {
         extrapolated.push(sweep(&mut aa, &mut g, &mut z));
     }
     // extrapolating from the second sweep on (the first has no difference yet) ...
-    assert!(!extrapolated[0] && extrapolated[1..100].iter().all(|e| *e), "{extrapolated:?}");
-    // ... then paused for RETRY plain sweeps once the best change has stood for 128 sweeps ...
-    let first_off = (1..extrapolated.len()).find(|&k| k > 100 && !extrapolated[k..k + RETRY].iter().any(|e| *e));
+    assert!(!extrapolated[0] && extrapolated[1..STALL - 28].iter().all(|e| *e), "{extrapolated:?}");
+    // ... then paused for RETRY plain sweeps once the best change has stood for STALL sweeps ...
+    let first_off = (1..extrapolated.len()).find(|&k| k > STALL - 28 && !extrapolated[k..k + RETRY].iter().any(|e| *e));
     let first_off = first_off.expect("the guard never paused the acceleration");
-    assert!((128..=140).contains(&first_off), "paused at sweep {first_off}");
+    assert!((STALL..=STALL + 12).contains(&first_off), "paused at sweep {first_off}");
     // ... and extrapolating again after the pause (a fresh history needs two sweeps)
     let back = first_off + RETRY;
     assert!(
