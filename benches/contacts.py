@@ -245,7 +245,8 @@ def _walls(half):
     return out
 
 
-def ms_pile(n):
+def ms_pile(n, compliance=0.0):
+    """The pile of `n` spheres; with `compliance` (m/N) its contacts are compliant Signorini ones."""
     import mechsys as ms
 
     half, pos = pile_layout(n)
@@ -257,7 +258,7 @@ def ms_pile(n):
         members.append(b.contour(ms.contours.Sphere(radius=PILE_R)))
     against = [m.ground.contour(ms.contours.Plane(point=p, normal=nrm)) for p, nrm in _walls(half)]
     m.add_contact(ms.ContactGroup("pile", members=members, against=against, friction=ms.laws.Coulomb(PILE_MU),
-                                  impact=ms.laws.Newton(0.0)))
+                                  impact=ms.laws.Newton(0.0), normal=ms.laws.Signorini(compliance=compliance)))
     m.build()
     return m
 

@@ -100,7 +100,7 @@ def _normal_law(what: str, normal, friction, impact) -> dict | None:
         raise ModelError(f"{what}.normal: expected mechsys.laws.Signorini(), Bilateral() or a compliant law (KelvinVoigt, Hertz, "
                          f"HuntCrossley, LankaraniNikravesh, Flores, UserLaw), got {type(normal).__name__}")
     if isinstance(normal, laws.Signorini):
-        return None
+        return normal.describe(f"{what}.normal")
     for key, law in (("friction", friction), ("impact", impact)):
         if law is not None:
             raise ModelError(f"{what}.{key}: a bilateral contact is held closed and takes no {key} law "
@@ -211,6 +211,10 @@ class ContactGroup:
                 if not isinstance(self.material, laws.Material):
                     raise ModelError(f"{what}.material: expected mechsys.Material(E, nu, density), got {type(self.material).__name__}")
                 out["material"] = self.material.describe(f"{what}.material")
+        elif isinstance(self.normal, laws.Signorini):
+            signorini = self.normal.describe(f"{what}.normal")
+            if signorini is not None:
+                out["normal"] = signorini
         out.update(_law_fields(what, self.friction, self.impact))
         return out
 

@@ -2,7 +2,8 @@
 :class:`mechsys.Contact`.
 
 - :class:`Signorini`: the normal corner law g_N >= 0, lambda_N >= 0, g_N lambda_N = 0 (rigid and
-  unilateral: the default).
+  unilateral: the default); with ``compliance`` c a compliant layer in series, g_N + c lambda_N >= 0
+  (time-stepping).
 - :class:`Bilateral`: the contact is held closed, g_N = 0, by a bilateral constraint whose force
   may pull (MBSim's bilateral constraint law); ``rolling=True`` also holds the tangential relative
   velocity at zero (rolling without slip). The contact is then a constraint: its force is the
@@ -45,6 +46,7 @@ plays no part), or :class:`LuGre` bristles, which hold a sticking contact withou
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -60,10 +62,36 @@ def _num(x, what: str) -> float:
 
 @dataclass
 class Signorini:
-    """Signorini's law for the normal direction (Fig. 2.33)."""
+    """Signorini's law for the normal direction (Fig. 2.33): rigid by default.
 
-    def describe(self, what: str) -> None:
-        return None
+    ``compliance`` c > 0 (m/N, the inverse of a contact stiffness k = 1/c) puts a linear compliant
+    layer in series with the rigid contact: ``g_N + c lambda_N >= 0``, ``lambda_N >= 0``, their
+    product zero. At rest a pressed contact then overlaps by ``c lambda_N`` instead of drifting,
+    and in :class:`mechsys.MoreauJean` the contact problem is regularized by ``c/h^2`` on its
+    normal diagonal: its solution is unique, so the sweeps of a dense pile converge in tens
+    instead of thousands (see "Compliant Signorini contacts" in docs/usage.md). ``damping`` d
+    (N s/m) damps the layer, ``lambda_N = k delta + d delta'``; undamped, a stiff layer is damped
+    only by the scheme (an implicit Euler step of the layer: little where ``sqrt(k/m) h`` is well
+    below 1, so a ball then bounces off it). Time-stepping only: the event-driven scheme refuses
+    it."""
+
+    compliance: float = 0.0
+    damping: float = 0.0
+
+    def describe(self, what: str) -> dict | None:
+        c, d = self.compliance, self.damping
+        for key, v, unit in (("compliance", c, "m/N; 0 for a rigid contact"), ("damping", d, "N s/m")):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise ModelError(f"{what}.{key}: expected a finite number >= 0 ({unit}), got {v!r}")
+        if d > 0 and c == 0:
+            raise ModelError(f"{what}.damping: damps a compliant layer; give a compliance > 0 too (a rigid contact's "
+                             "impacts take an impact law)")
+        if c == 0:
+            return None
+        out = {"type": "signorini", "compliance": float(c)}
+        if d > 0:
+            out["damping"] = float(d)
+        return out
 
 
 @dataclass

@@ -46,7 +46,10 @@ for k points; tangential ones (n, [k,] 2) in 3-D): ``contact/<c>/g_n`` (m), ``gd
 ``impulse_t`` (N s), ``point`` (m, where the contact is on the first contour's surface, inertial
 components, (n, [k,] 3)), ``normal`` (from the second contour towards the first), ``state`` (int8 levels open 0, stick 1, slip 2: ``res.levels(name)``; an
 HDF5 enum in files), ``friction_reserve`` (mu0 lambda_N -
-|lambda_T|, N), and ``energy/dissipated_impact``, ``energy/dissipated_friction`` (J).
+|lambda_T|, N), and ``energy/dissipated_impact``, ``energy/dissipated_friction`` (J), and
+``energy/contact_elastic`` (J, the energy held by compliant Signorini layers, ``½ c lambda_N²``
+summed; zero for rigid contacts: kinetic + potential + contact_elastic + dissipated - external
+work stays at its start).
 
 ``constraint/<c>/velocity_violation`` (the violation's unit per second, same shape as
 ``violation``) is ``G u - b`` for every row, the velocity-only (non-holonomic) rows included.
@@ -356,6 +359,8 @@ class Results:
         if engine is not None and "dissipated_impact" in raw:
             put("energy/dissipated_impact", raw["dissipated_impact"], "J")
             put("energy/dissipated_friction", raw["dissipated_friction"], "J")
+            if "contact_elastic" in raw:
+                put("energy/contact_elastic", raw["contact_elastic"], "J")
             if "solver" in raw:
                 # the contact solver over the steps since the previous sample
                 sv = raw["solver"]
@@ -909,7 +914,7 @@ def signal_universe(engine) -> list[str]:
             names += [f"marker/{n}/{mk[0]}/{x}" for x in ("position", "velocity", "acceleration", "orientation")]
     names += ["com/position", "com/velocity", "com/acceleration"]
     names += [f"energy/{x}" for x in ("kinetic", "potential", "total", "dissipated", "external_work", "dissipated_impact",
-                                      "dissipated_friction")]
+                                      "dissipated_friction", "contact_elastic")]
     names += ["momentum/linear", "momentum/angular"]
     names += [f"solver/{x}" for x in ("residual", "iterations", "converged", "contacts", "islands")]
     for c in engine.constraints():

@@ -278,6 +278,8 @@ pub struct Recording {
     pub dissipated_impact: Vec<f64>,
     /// Energy dissipated by friction since t0 (n_out), J.
     pub dissipated_friction: Vec<f64>,
+    /// Elastic energy held by compliant Signorini layers (n_out), J (Moreau–Jean; 0 otherwise).
+    pub contact_elastic: Vec<f64>,
     /// Moreau–Jean's contact solver over the steps since the previous sample (n_out × 5): the
     /// worst residual (of [`crate::solver::Report::residual`], 1), the most iterations of a step,
     /// 1 if every step converged (else 0), the unknowns' contacts of the last step and its
@@ -373,6 +375,7 @@ impl Recording {
         }
         self.dissipated_impact.reserve(samples);
         self.dissipated_friction.reserve(samples);
+        self.contact_elastic.reserve(samples);
         self.solver.reserve(5 * samples);
     }
 
@@ -1310,6 +1313,16 @@ pub fn simulate(
         model.contact_groups.first().map_or("", |g| g.name.as_str())
     );
     if let IntegratorKind::EventDriven(opts) = settings.integrator {
+        // its contacts close and open at located events, rigidly: a compliant layer's overlap
+        // is the time-stepping scheme's regularized law
+        if let Some(c) = model.contacts.iter().find(|c| c.compliance > 0.0) {
+            return Err(Error::Settings(format!(
+                "integrator: contact '{}' has a compliant Signorini law (normal.compliance = {} m/N), which the \
+                 event-driven scheme does not take; use MoreauJean (time-stepping), or a compliant force law \
+                 (laws.KelvinVoigt, laws.Hertz) in any scheme",
+                c.name, c.compliance
+            )));
+        }
         return event_driven(model, settings, cb, progress, &t_out, y0, opts, rec);
     }
     crate::ensure!(
@@ -1642,6 +1655,7 @@ fn time_stepping(
         acc_t.fill([0.0; 2]);
         rec.dissipated_impact.push(stepper.dissipated_impact);
         rec.dissipated_friction.push(stepper.dissipated_friction);
+        rec.contact_elastic.push(stepper.contact_elastic);
         let (contacts, islands) = stepper.problem_shape();
         rec.solver.extend_from_slice(&[
             solver_acc.0,
@@ -1760,6 +1774,7 @@ fn event_driven(
         }
         rec.dissipated_impact.push(e_impact);
         rec.dissipated_friction.push(y[e + 2] + e_impulsive_friction);
+        rec.contact_elastic.push(0.0);
         budget.wall(t)?;
         report_progress(progress, rec.t.len(), t)
     };

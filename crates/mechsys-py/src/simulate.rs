@@ -369,6 +369,7 @@ fn recording_dict<'py>(
     if !m.contacts.is_empty() || !m.contact_groups.is_empty() {
         put("dissipated_impact", rec.dissipated_impact, &[n])?;
         put("dissipated_friction", rec.dissipated_friction, &[n])?;
+        put("contact_elastic", rec.contact_elastic, &[n])?;
         if !rec.solver.is_empty() {
             put("solver", rec.solver, &[n, 5])?;
         }

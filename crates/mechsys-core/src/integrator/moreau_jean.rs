@@ -194,6 +194,12 @@ pub struct MoreauJean {
     /// Per active point: it took the static coefficient µ0 (it was not sliding) while its law
     /// slides with less; a break-away in the step is solved again with the sliding coefficient.
     static_mu: Vec<bool>,
+    /// Each active point's normal regularization `c/(h (h + τ))` (compliant Signorini laws,
+    /// `τ = c d`); emptied after assembly where every point is rigid.
+    reg: Vec<f64>,
+    /// Each active point's compliance c and time constant τ = c d (with `reg`, for the layer's
+    /// energy).
+    layer_c: Vec<[f64; 2]>,
     /// Painlevé situations of the last step: (point, µ, critical µ, non-unique) for each
     /// explicit point that slid into the step with a non-positive normal velocity change per
     /// unit normal impulse under its sliding friction; non-unique if its free motion separates
@@ -203,6 +209,9 @@ pub struct MoreauJean {
     pub dissipated_impact: f64,
     /// Energy dissipated so far by tangential impulses (J).
     pub dissipated_friction: f64,
+    /// Elastic energy held by the compliant Signorini layers at the end of the last step,
+    /// `Σ ½ c λ_N²` (J); the impact share of the contacts' work leaves its changes out.
+    pub contact_elastic: f64,
     /// Work done on the system by moving surfaces (conveyor belts) through friction (J).
     pub surface_work: f64,
     /// Bilateral constraint impulse of the last step (nc), N s.
@@ -315,9 +324,12 @@ impl MoreauJean {
             tmp_u: vec![0.0; nu],
             gd_before: vec![0.0; dim * np],
             static_mu: Vec::with_capacity(np),
+            reg: Vec::with_capacity(np),
+            layer_c: Vec::with_capacity(np),
             painleve: Vec::with_capacity(np),
             dissipated_impact: 0.0,
             dissipated_friction: 0.0,
+            contact_elastic: 0.0,
             surface_work: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
             unconverged: (0, 0.0),
@@ -525,7 +537,7 @@ impl MoreauJean {
             self.group_stats[gi].pairs = ph.live.len();
         }
         let m = self.act.len();
-        let (mut dw_n, mut dw_t) = (0.0, 0.0);
+        let (mut dw_n, mut dw_t, mut stored) = (0.0, 0.0, 0.0);
         if m > 0 {
             let dm = d * m;
             // local velocities before (u_k) and without (u_free) the impulses: ġ⁻, ġ_free
@@ -619,22 +631,24 @@ impl MoreauJean {
             self.problem.dim = d;
             self.problem.mu.clear();
             self.static_mu.clear();
+            self.reg.clear();
+            self.layer_c.clear();
             self.painleve.clear();
             self.r.clear();
             for (ai, a) in self.act.iter().enumerate() {
-                let (friction, impact, gd_t, prev, prev_state) = match a.source {
+                let (friction, impact, compliance, gd_t, prev, prev_state) = match a.source {
                     Source::Point(pt) => {
                         let con = &model.contacts[a.contact];
                         let r = &self.results[pt];
                         let prev = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
-                        (&con.friction, &con.impact, self.kin[pt].gd_t, prev, r.state)
+                        (&con.friction, &con.impact, (con.compliance, con.damping), self.kin[pt].gd_t, prev, r.state)
                     }
                     Source::Group { group, slot, k } => {
                         let g = &model.contact_groups[group];
                         let sl = &self.groups[group].slots[slot];
                         let fresh = sl.stamp == self.steps.wrapping_sub(1);
                         let (prev, st) = if fresh { sl.last[k] } else { ([0.0; 3], OPEN) };
-                        (&g.friction, &g.impact, sl.kin[k].gd_t, prev, st)
+                        (&g.friction, &g.impact, (g.compliance, g.damping), sl.kin[k].gd_t, prev, st)
                     }
                 };
                 // a point slides into the step if it slid in the last one, or if it took no
@@ -671,8 +685,15 @@ impl MoreauJean {
                         }
                     }
                 }
-                // a point still open by less than the margin may close within the step, not beyond
-                let gap_allowance = a.point.g_n.max(0.0) / h;
+                // a point still open by less than the margin may close within the step, not
+                // beyond. A compliant point's layer (k = 1/c, d) holds the overlap −g_N: with
+                // F = k δ + d δ̇ at the step's end, g_N + (h + τ) ġ_N⁺ + c F ≥ 0 (τ = c d, F = Λ_N/h),
+                // i.e. ġ_N⁺ + g_N/(h + τ) + c/(h (h + τ)) Λ_N ≥ 0: the regularization of W_NN
+                // (added below) and a gap term, as an implicit Euler step of the layer
+                let (c, damping) = compliance;
+                let gap_allowance = if c > 0.0 { a.point.g_n / (h + c * damping) } else { a.point.g_n.max(0.0) / h };
+                self.reg.push(c / (h * (h + c * damping)));
+                self.layer_c.push([c, c * damping]);
                 self.problem.q[ai * d] += impact.eps() * self.gd_before[ai * d].min(0.0) + gap_allowance;
                 let mu = match friction {
                     FrictionLaw::None => 0.0,
@@ -689,6 +710,27 @@ impl MoreauJean {
                 } else {
                     self.r.extend_from_slice(&prev[..d]);
                 }
+            }
+            // the compliant layers' regularization on the normal diagonal (all solvers see W + R)
+            if self.reg.iter().any(|v| *v > 0.0) {
+                match self.sparse.as_mut() {
+                    Some(sp) => {
+                        for (ai, reg) in self.reg.iter().enumerate() {
+                            sp.diag[ai * d * d] += reg;
+                        }
+                        sp.reg.clear();
+                        sp.reg.extend_from_slice(&self.reg);
+                    }
+                    None => {
+                        let Delassus::Dense(w) = &mut self.problem.w else { unreachable!("dense Delassus") };
+                        for (ai, reg) in self.reg.iter().enumerate() {
+                            w[(ai * d) * (d * m) + ai * d] += reg;
+                        }
+                    }
+                }
+            } else {
+                self.reg.clear();
+                self.layer_c.clear();
             }
             // sweeps from the bottom up along gravity: each contact then sees the newest support
             // below it, and a warm-started pile settles in fewer sweeps than in pair order
@@ -732,7 +774,11 @@ impl MoreauJean {
             // Newton on a large problem of free bodies: solved whole, its direction in body space
             self.body_space = match (&self.method, self.sparse.as_ref()) {
                 (Method::Newton(o), Some(sp)) => {
-                    m * d > o.body_space_above && !self.static_mu.iter().any(|s| *s) && sp.all_free()
+                    // (its direction in body space carries no regularization)
+                    m * d > o.body_space_above
+                        && !self.static_mu.iter().any(|s| *s)
+                        && sp.all_free()
+                        && self.reg.is_empty()
                 }
                 _ => false,
             };
@@ -897,6 +943,15 @@ impl MoreauJean {
                         dw_t += -self.r[a] * after[row];
                     }
                 }
+                if let Some(&[c, tau]) = self.layer_c.get(ai) {
+                    // ½ k δ² of the layer pressed by λ_N = Λ_N / h = k δ + d δ̇ (δ̇ = −ġ_N⁺), so
+                    // δ = c λ_N + τ ġ_N⁺ (undamped: ½ c λ_N²); a layer without force holds none
+                    let f = self.r[ai * d] / h;
+                    if f > 0.0 {
+                        let delta = (c * f + tau * after[0]).max(0.0);
+                        stored += 0.5 * delta * delta / c;
+                    }
+                }
                 if let Source::Point(pt) = self.act[ai].source {
                     self.results[pt].energy = e_point;
                 }
@@ -924,7 +979,9 @@ impl MoreauJean {
             }
         }
         self.steps += 1;
-        self.dissipated_impact += dw_n - dw_t;
+        // (what a compliant layer takes in, it holds; what it gives back, it had held)
+        self.dissipated_impact += dw_n - dw_t - (stored - self.contact_elastic);
+        self.contact_elastic = stored;
         self.dissipated_friction += dw_t;
         // ---- positions at the end of the step, and u in the end's joint frames
         model.integrate(&self.q_mid, u, 0.5 * h, q);
@@ -934,7 +991,10 @@ impl MoreauJean {
         // too, so a symmetric resting configuration stays symmetric)
         if self.project {
             let (proj, in_step) = (&mut self.projection, &self.in_step);
-            proj.project(model, data, ws, t + h, q, u, cb, |pt| in_step[pt])?;
+            // (a compliant point's overlap is its layer's deflection, held on purpose)
+            proj.project(model, data, ws, t + h, q, u, cb, |pt| {
+                in_step[pt] && model.contact_of_point(pt).compliance == 0.0
+            })?;
         }
         if nc > 0 {
             crate::dynamics::constrained::project(model, data, ws, t + h, q, u, cb)?;

@@ -125,6 +125,11 @@ pub struct Contact {
     pub friction: FrictionLaw,
     /// Impact law.
     pub impact: ImpactLaw,
+    /// Compliance of its Signorini law (m/N): 0 rigid; else `g_N + c λ_N ≥ 0` in the
+    /// time-stepping scheme.
+    pub compliance: f64,
+    /// Damping of the compliant layer (N s/m; 0 where rigid).
+    pub damping: f64,
     /// Index of its first candidate point among all contact points of the model.
     pub first: usize,
 }
@@ -154,6 +159,10 @@ pub struct ContactGroup {
     pub friction: FrictionLaw,
     /// Impact law of every pair.
     pub impact: ImpactLaw,
+    /// Compliance of every pair's Signorini law (m/N), as [`Contact::compliance`].
+    pub compliance: f64,
+    /// Damping of their compliant layers (N s/m), as [`Contact::damping`].
+    pub damping: f64,
     /// Whether the group is planar (every contour in the x-y planes of its bodies).
     pub planar: bool,
 }
@@ -553,7 +562,9 @@ pub(super) fn compliant_law(
             };
             (ElasticSpec::Hertz { stiffness: h.stiffness, length: h.length }, dissipation, h.v_reg)
         }
-        N::Signorini | N::Bilateral { .. } => return Err(Error::Model(format!("{what}.normal: not a compliant law"))),
+        N::Signorini { .. } | N::Bilateral { .. } => {
+            return Err(Error::Model(format!("{what}.normal: not a compliant law")))
+        }
     };
     let tangential = match friction {
         FrictionDescription::None => Tangential::None,
@@ -650,6 +661,31 @@ fn impact_law(impact: &ImpactDescription, what: &str) -> Result<ImpactLaw> {
     Ok(impact)
 }
 
+/// The compliance and damping of a Signorini law (0 for a bilateral one), checked: finite and
+/// `≥ 0`, damping only with a compliance.
+fn compliance(normal: &super::contact_description::NormalDescription, what: &str) -> Result<(f64, f64)> {
+    let (c, d) = match normal {
+        super::contact_description::NormalDescription::Signorini { compliance, damping } => (*compliance, *damping),
+        _ => (0.0, 0.0),
+    };
+    crate::ensure!(
+        c.is_finite() && c >= 0.0,
+        Model,
+        "{what}.normal.compliance: must be a finite number >= 0 (m/N; 0 for a rigid contact), got {c}"
+    );
+    crate::ensure!(
+        d.is_finite() && d >= 0.0,
+        Model,
+        "{what}.normal.damping: must be a finite number >= 0 (N s/m), got {d}"
+    );
+    crate::ensure!(
+        d == 0.0 || c > 0.0,
+        Model,
+        "{what}.normal.damping: damps a compliant layer; give a compliance > 0 too (a rigid contact's impacts take an impact law)"
+    );
+    Ok((c, d))
+}
+
 /// Validates one contact description (body indices resolved by `body`).
 pub(super) fn validate(
     d: &ContactDescription,
@@ -686,7 +722,8 @@ pub(super) fn validate(
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
     let geometry = ContactGeometry::Contours { pair, contours };
-    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, geometry, friction, impact, first })
+    let (compliance, damping) = compliance(&d.normal, &what)?;
+    Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, geometry, friction, impact, compliance, damping, first })
 }
 
 /// Validates one gap contact (`index` among the gap contacts, `first` its point index): its
@@ -773,7 +810,8 @@ pub(super) fn validate_gap(
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
     let geometry = ContactGeometry::Gap { function: GapFunction::new(terms, coordinates), slot: index };
-    Ok(Contact { name: d.name.clone(), body1: 0, body2: 0, geometry, friction, impact, first })
+    let (compliance, damping) = compliance(&d.normal, &what)?;
+    Ok(Contact { name: d.name.clone(), body1: 0, body2: 0, geometry, friction, impact, compliance, damping, first })
 }
 
 /// Validates one contact group (body indices resolved by `body`): names, contours, that every
@@ -909,7 +947,17 @@ pub(super) fn validate_group(
     }
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
-    Ok(ContactGroup { name: d.name.clone(), members, against, friction, impact, planar: any_planar })
+    let (compliance, damping) = compliance(&d.normal, &what)?;
+    Ok(ContactGroup {
+        name: d.name.clone(),
+        members,
+        against,
+        friction,
+        impact,
+        compliance,
+        damping,
+        planar: any_planar,
+    })
 }
 
 /// Validates a contact group whose normal law is compliant (`slot` its place among the compliant
@@ -940,7 +988,7 @@ pub(super) fn validate_compliant_group(
     }
     let mut rigid = d.clone();
     rigid.friction = FrictionDescription::None;
-    rigid.normal = super::contact_description::NormalDescription::Signorini;
+    rigid.normal = super::contact_description::NormalDescription::default();
     let geometry = validate_group(&rigid, index, body, rotation)?;
     let (elastic, dissipation, tangential) = compliant_law(&d.normal, &d.friction, &what, n_callbacks)?;
     let mut materials = Vec::with_capacity(d.members.len() + d.against.len());

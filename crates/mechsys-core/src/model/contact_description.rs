@@ -387,12 +387,21 @@ pub enum GapTermDescription {
 }
 
 /// Normal contact law.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum NormalDescription {
-    /// Signorini's corner law: g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0 (a unilateral contact).
-    #[default]
-    Signorini,
+    /// Signorini's corner law: g_N ≥ 0, λ_N ≥ 0, g_N λ_N = 0 (a unilateral contact); with a
+    /// `compliance` c > 0 (m/N) a linear compliant layer in series, `g_N + c λ_N ≥ 0`, damped by
+    /// `damping` d (the time-stepping scheme's regularized Signorini law; see
+    /// `integrator::moreau_jean`).
+    Signorini {
+        /// Compliance c = 1/k of the contact layer (m/N), ≥ 0; 0 for a rigid contact.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        compliance: f64,
+        /// Damping d of the layer (N s/m), ≥ 0 (with a compliance only): `k δ + d δ̇ = λ_N`.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        damping: f64,
+    },
     /// The contact is held closed, g_N = 0, by a bilateral constraint whose force may pull (a
     /// follower that never lifts off, a wheel held on its rail); with `rolling`, it also rolls
     /// without slipping (ġ_T = 0). No friction or impact law applies.
@@ -430,10 +439,26 @@ pub enum NormalDescription {
     },
 }
 
+impl Default for NormalDescription {
+    fn default() -> Self {
+        NormalDescription::Signorini { compliance: 0.0, damping: 0.0 }
+    }
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
 impl NormalDescription {
-    /// Whether this is Signorini's law (the default, left out when written).
+    /// Whether this is Signorini's law, rigid or with a compliant layer (a unilateral contact of
+    /// the time-stepping scheme, not a force element).
     pub fn is_signorini(&self) -> bool {
-        matches!(self, NormalDescription::Signorini)
+        matches!(self, NormalDescription::Signorini { .. })
+    }
+
+    /// Whether this is the default, rigid Signorini law (left out when written).
+    pub fn is_rigid_signorini(&self) -> bool {
+        matches!(self, NormalDescription::Signorini { compliance, damping } if *compliance == 0.0 && *damping == 0.0)
     }
 }
 
@@ -565,7 +590,7 @@ pub struct ContactGroupDescription {
     /// Normal law of every pair: Signorini's (rigid, Moreau–Jean) if absent, or a compliant law
     /// (Kelvin–Voigt, Hertz and its dissipative forms, a user law): the group's pairs are then
     /// force elements found by the broad phase at every evaluation, in the smooth schemes too.
-    #[serde(default, skip_serializing_if = "NormalDescription::is_signorini")]
+    #[serde(default, skip_serializing_if = "NormalDescription::is_rigid_signorini")]
     pub normal: NormalDescription,
     /// Material of every contour that gives none of its own (compliant groups).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -1232,7 +1232,7 @@ impl Model {
                 "contacts[{i}] '{}': duplicate contact name",
                 d.name
             );
-            if !matches!(d.normal, NormalDescription::Signorini | NormalDescription::Bilateral { .. }) {
+            if !matches!(d.normal, NormalDescription::Signorini { .. } | NormalDescription::Bilateral { .. }) {
                 // compliant: a force element on the contact's geometry, not a unilateral contact
                 let c = super::contact::validate_compliant(d, i, n_compliant_points, body, rotation, &mut n_callbacks)?;
                 n_compliant_points += c.points();

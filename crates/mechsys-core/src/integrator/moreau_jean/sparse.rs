@@ -147,6 +147,10 @@ pub(super) struct SparseRows {
     pub(in crate::integrator::moreau_jean) parallel: bool,
     /// The body-space Newton method's scratch and held factorization.
     pub(super) newton: body_newton::BodyNewton,
+    /// The regularization `c/h²` of each contact's normal direction (compliant Signorini
+    /// laws), already added to its diagonal block: the sweeps, whose `Y r` products carry only
+    /// `W r`, add `c/h² r_N` back. Empty where every contact is rigid.
+    pub(super) reg: Vec<f64>,
 }
 
 impl SparseRows {
@@ -223,6 +227,7 @@ impl SparseRows {
             dom: Default::default(),
             parallel: true,
             newton: Default::default(),
+            reg: Vec::new(),
         }
     }
 
@@ -235,6 +240,7 @@ impl SparseRows {
         self.w.clear();
         self.y.clear();
         self.roots.clear();
+        self.reg.clear();
     }
 
     /// Number of contacts added since [`SparseRows::clear`].
@@ -813,6 +819,119 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Compliant layers regularize each normal diagonal by `R_a` (in `diag`, and in `reg` for the
+    /// sweeps, whose `z = Y r` carries `W r` only): the factored sweeps, on general and on packed
+    /// rows, and the two-domain sweeps of a large problem, solve the block problem with `W + R`,
+    /// sweep for sweep to round-off; its regularized velocities `(W + R) r + q` come back in `u`.
+    #[test]
+    fn regularized_sweeps_solve_the_regularized_block_problem() {
+        use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
+        fn regularize(sp: &mut SparseRows, dim: usize) {
+            let nc = sp.len();
+            sp.reg = (0..nc).map(|a| 0.05 * (1 + a % 3) as f64 * sp.diag[a * dim * dim]).collect();
+            for a in 0..nc {
+                sp.diag[a * dim * dim] += sp.reg[a];
+            }
+        }
+        // the block solver on W + R in `order` against the factored sweeps; returns the sweeps
+        fn compare(
+            sp: &mut SparseRows,
+            dim: usize,
+            qv: &[f64],
+            mu: &[f64],
+            order: &[usize],
+            perm: &[usize],
+            o: NsgsOptions,
+        ) -> usize {
+            let nc = sp.len();
+            let mut bw = BlockDelassus::default();
+            bw.refill(dim, nc, &sp.diag, &sp.upper, &sp.upper_val);
+            let p = FrictionContact::new(dim, Delassus::Blocks(bw), qv.to_vec(), mu.to_vec()).unwrap();
+            let method = Method::Nsgs(o);
+            let mut ws = Workspace::default();
+            ws.reserve(&p, &method).unwrap();
+            ws.order = perm.to_vec();
+            let mut r_blocks = vec![0.0; dim * nc];
+            let rep = solver::solve(&p, &method, &mut r_blocks, false, &mut ws).unwrap();
+            let (mut r, mut u) = (vec![0.0; dim * nc], vec![0.0; dim * nc]);
+            let fact = sp.gauss_seidel((qv, mu), order, &mut r, &o, &mut u);
+            assert_eq!(fact.iterations, rep.iterations, "dim {dim}");
+            assert!(rep.converged && fact.converged, "{rep:?} {fact:?}");
+            let mut u_blocks = vec![0.0; dim * nc];
+            p.velocity(&r_blocks, &mut u_blocks).unwrap();
+            let big = r_blocks.iter().chain(&u_blocks).fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(big > 1e-3, "a problem with impulses");
+            for k in 0..dim * nc {
+                assert!((r[k] - r_blocks[k]).abs() <= 1e-11 * big, "r[{k}]: {} vs {}", r[k], r_blocks[k]);
+                assert!((u[k] - u_blocks[k]).abs() <= 1e-11 * big, "u[{k}]: {} vs {}", u[k], u_blocks[k]);
+            }
+            // the regularization is in the problem: a normal velocity R r_N below the rigid one
+            let pressed = (0..nc).filter(|&a| r[a * dim] > 1e-9).count();
+            assert!(pressed > 0, "pressed contacts");
+            fact.iterations
+        }
+        let (model, data, saddle) = factored_mass();
+        for dim in [3, 2] {
+            let mut sp = SparseRows::new(&model, dim);
+            sp.factor.copy_from(&saddle);
+            for (k, &(b1, b2)) in [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0), (3, 1), (0, 3)].iter().enumerate() {
+                let n = Vec3::new(0.3 - 0.1 * k as f64, -0.5, 0.8).normalize();
+                let t1 = n.cross(&Vec3::x()).normalize();
+                let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
+                let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+                sp.add_contact(&model, &data.s, el, b1, &p1, b2, &(p1 - 1e-3 * n), &[n, t1, n.cross(&t1)]);
+            }
+            sp.delassus();
+            regularize(&mut sp, dim);
+            let nc = sp.len();
+            let qv: Vec<f64> = (0..dim * nc).map(|i| ((i * 7 % 11) as f64 - 6.0) * 0.1).collect();
+            let mu: Vec<f64> = (0..nc).map(|i| 0.2 + 0.1 * i as f64).collect();
+            let o = NsgsOptions { tol: 1e-13, max_iter: 5000, relaxation: 1.0, anderson: 0, stall: 0 };
+            compare(&mut sp, dim, &qv, &mu, &[], &[], o);
+        }
+        // 401 contacts on free bodies: two domains
+        let ns = 201;
+        let (model, data, saddle) = row_of_spheres(ns);
+        let mut sp = SparseRows::new(&model, 3);
+        sp.factor.copy_from(&saddle);
+        let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+        let z = Vec3::z();
+        for i in 0..ns {
+            let c = Vec3::new(0.1 * i as f64, 0.0, 0.0);
+            sp.add_contact(&model, &data.s, el, i + 1, &c, 0, &c, &[z, Vec3::x(), Vec3::y()]);
+        }
+        for i in 0..ns - 1 {
+            let c = Vec3::new(0.1 * i as f64 + 0.05, 0.0, 0.05);
+            sp.add_contact(&model, &data.s, el, i + 2, &c, i + 1, &c, &[Vec3::x(), Vec3::y(), z]);
+        }
+        sp.delassus();
+        regularize(&mut sp, 3);
+        let nc = sp.len();
+        let qv: Vec<f64> = (0..3 * nc)
+            .map(|k| match k % 3 {
+                0 => -0.01 - 0.002 * ((k / 3) % 5) as f64,
+                1 => 0.004 * (((k / 3) * 7 % 11) as f64 - 5.0),
+                _ => 0.001 * (((k / 3) * 3 % 7) as f64 - 3.0),
+            })
+            .collect();
+        let mu: Vec<f64> = (0..nc).map(|a| 0.3 + 0.05 * (a % 4) as f64).collect();
+        let order: Vec<usize> = (0..nc).rev().collect();
+        assert!(sp.pack::<3>());
+        assert!(sp.dom.plan(&sp.packed, &order, sp.z.len()), "split in two domains");
+        let perm = sp.dom.perm.clone();
+        sp.dom.finish();
+        let o = NsgsOptions { tol: 1e-10, max_iter: 20_000, relaxation: 1.0, anderson: 0, stall: 0 };
+        let split = compare(&mut sp, 3, &qv, &mu, &order, &perm, o);
+        // the same problem rigid takes more sweeps than regularized (a pressed row of spheres)
+        for a in 0..nc {
+            sp.diag[a * 9] -= sp.reg[a];
+        }
+        sp.reg.clear();
+        let (mut r, mut u) = (vec![0.0; 3 * nc], vec![0.0; 3 * nc]);
+        let rigid = sp.gauss_seidel((&qv, &mu), &order, &mut r, &o, &mut u);
+        assert!(rigid.iterations > split, "rigid {} sweeps, regularized {split}", rigid.iterations);
     }
 
     /// A row of `n` free spheres (r = 5 cm, touching) on the ground at their initial state:

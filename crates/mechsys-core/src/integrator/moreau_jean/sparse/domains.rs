@@ -58,6 +58,8 @@ pub(super) struct Domains {
     /// The problem in sweep order; each half's rows point into its own slice of `z`.
     pub(super) packed: Vec<Packed>,
     pub(super) local: Vec<LocalBlock3>,
+    /// The normal regularization of each contact (compliant laws; empty if all are rigid).
+    pub(super) reg: Vec<f64>,
     pub(super) q: Vec<f64>,
     pub(super) mu: Vec<f64>,
     pub(super) r: Vec<f64>,
@@ -184,7 +186,7 @@ impl Domains {
     pub(super) fn gather(
         &mut self,
         packed: &[Packed],
-        local: &[LocalBlock3],
+        (local, reg): (&[LocalBlock3], &[f64]),
         q: &[f64],
         mu: &[f64],
         r: &[f64],
@@ -192,6 +194,7 @@ impl Domains {
     ) {
         self.packed.clear();
         self.local.clear();
+        self.reg.clear();
         self.q.clear();
         self.mu.clear();
         self.r.clear();
@@ -205,6 +208,9 @@ impl Domains {
             }
             self.packed.push(p.moved(iu));
             self.local.push(local[a]);
+            if !reg.is_empty() {
+                self.reg.push(reg[a]);
+            }
             self.q.extend_from_slice(&q[a * 3..a * 3 + 3]);
             self.mu.push(mu[a]);
             self.r.extend_from_slice(&r[a * 3..a * 3 + 3]);
@@ -225,6 +231,14 @@ impl Domains {
         let (pb, pi) = rest.split_at(nb);
         let (la, rest) = self.local.split_at(na);
         let (lb, li) = rest.split_at(nb);
+        // (no regularization: empty slices)
+        let (ga, gb, gi) = if self.reg.is_empty() {
+            (&[][..], &[][..], &[][..])
+        } else {
+            let (ga, rest) = self.reg.split_at(na);
+            let (gb, gi) = rest.split_at(nb);
+            (ga, gb, gi)
+        };
         let (ma, rest) = self.mu.split_at(na);
         let (mb, mi) = rest.split_at(nb);
         let (qa, rest) = self.q.split_at(3 * na);
@@ -235,15 +249,15 @@ impl Domains {
         let (fb, fi) = rest.split_at_mut(3 * nb);
         let (ca, cb) = {
             let (za, zb) = self.z.split_at_mut(self.nza);
-            let mut half_a = || sweep_part(pa, la, (qa, ma), ra, za, fa, (omega, accelerate));
-            let mut half_b = || sweep_part(pb, lb, (qb, mb), rb, zb, fb, (omega, accelerate));
+            let mut half_a = || sweep_part(pa, (la, ga), (qa, ma), ra, za, fa, (omega, accelerate));
+            let mut half_b = || sweep_part(pb, (lb, gb), (qb, mb), rb, zb, fb, (omega, accelerate));
             if parallel {
                 rayon::join(half_a, half_b)
             } else {
                 (half_a(), half_b())
             }
         };
-        let ci = sweep_part(pi, li, (qi, mi), ri, &mut self.z, fi, (omega, accelerate));
+        let ci = sweep_part(pi, (li, gi), (qi, mi), ri, &mut self.z, fi, (omega, accelerate));
         (ca + cb) + ci
     }
 
@@ -312,7 +326,7 @@ impl Domains {
 /// `accelerate`; returns their sum of squares.
 fn sweep_part(
     rows: &[Packed],
-    local: &[LocalBlock3],
+    (local, reg): (&[LocalBlock3], &[f64]),
     (q, mu): (&[f64], &[f64]),
     r: &mut [f64],
     z: &mut [f64],
@@ -331,6 +345,10 @@ fn sweep_part(
                 own += w[c * 3 + k] * old[k];
             }
             b[c] += q[a * 3 + c] - own;
+        }
+        if let Some(g) = reg.get(a) {
+            // (the block holds W_aa + c/h² e_N e_Nᵀ; z only W r)
+            b[0] += g * old[0];
         }
         let mut new = old;
         blk.solve(mu[a], &b, &mut new);

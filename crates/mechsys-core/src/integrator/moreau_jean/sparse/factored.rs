@@ -117,6 +117,7 @@ impl SparseRows {
             self.aa.begin(n * D, self.z.len(), opts.anderson);
         }
         let mut stall = StallWatch::new(opts.stall);
+        let compliant = !self.reg.is_empty();
         for it in 1..=max_sweeps {
             // Anderson's combination of past sweeps (z = Y r is linear in r: it takes the same)
             let accelerate = opts.anderson > 0 && omega == 1.0;
@@ -135,6 +136,10 @@ impl SparseRows {
                         own += blk[c * D + k] * old[k];
                     }
                     b[c] += q[a * D + c] - own;
+                }
+                if compliant {
+                    // (the block holds W_aa + c/h² e_N e_Nᵀ; z only W r)
+                    b[0] += self.reg[a] * old[0];
                 }
                 let mut new = old;
                 if D == 3 {
@@ -213,7 +218,7 @@ impl SparseRows {
         qn: f64,
     ) -> Report {
         let n = self.len();
-        self.dom.gather(&self.packed, &self.local3, q, mu, r, &self.z);
+        self.dom.gather(&self.packed, (&self.local3, &self.reg), q, mu, r, &self.z);
         let nz = self.dom.z.len();
         if opts.anderson > 0 {
             self.aa.reserve(n * 3, nz);
@@ -378,6 +383,9 @@ impl SparseRows {
             // `couplings` gives it adds nothing to its velocity in the block form either)
             for c in 0..D {
                 u[a * D + c] = ua[c] + q[a * D + c];
+            }
+            if let Some(reg) = self.reg.get(a) {
+                u[a * D] += reg * r[a * D];
             }
             let wnn = self.diag[a * D * D];
             sum += contact_residual_sq(D, mu[a], wnn, &r[a * D..(a + 1) * D], &u[a * D..(a + 1) * D]);
