@@ -30,8 +30,10 @@ import mechsys as ms
 R, MASS, MU, G = 0.05, 0.1, 0.5, 9.81
 
 
-def build(n: int = 100, seed: int = 0) -> ms.Model:
-    """The pile of `n` spheres in a box just wide enough for 5 (n ≤ 100) or 10 spheres a row."""
+def build(n: int = 100, seed: int = 0, compliance: float = 0.0) -> ms.Model:
+    """The pile of `n` spheres in a box just wide enough for 5 (n ≤ 100) or 10 spheres a row; its
+    contacts rigid, or on compliant Signorini layers of `compliance` m/N
+    (`examples/compliant_layer_pile.py`)."""
     half = 0.275 if n <= 100 else 0.55
     per = int(round(2 * half / (2.2 * R)))
     rng = np.random.default_rng(seed)
@@ -50,7 +52,8 @@ def build(n: int = 100, seed: int = 0) -> ms.Model:
                                                 normal=(s * (ax == 0), s * (ax == 1), 0)))
              for ax in (0, 1) for s in (1, -1)]
     m.add_contact(ms.ContactGroup("pile", members=members, against=[floor, *walls],
-                                  friction=ms.laws.Coulomb(mu=MU), impact=ms.laws.Newton(eps=0.0)))
+                                  friction=ms.laws.Coulomb(mu=MU), impact=ms.laws.Newton(eps=0.0),
+                                  normal=ms.laws.Signorini(compliance=compliance)))
     return m
 
 

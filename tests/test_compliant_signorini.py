@@ -162,6 +162,20 @@ def test_equal_layers_share_each_boxs_load_equally_among_its_corners(solver):
         np.testing.assert_allclose(g[closed], -c * quarter, rtol=1e-6, err_msg=name)
 
 
+def test_auto_sweeps_a_well_regularized_problem_and_takes_newton_on_a_stiff_one():
+    """`auto` on a stack whose layers regularize every normal diagonal by more than 1 % (c/h^2 =
+    1 against W_NN of a few 1/kg) is its Gauss-Seidel setting, bit for bit; with layers 1e4 times
+    stiffer it keeps Newton (fewer iterations than the sweeps need)."""
+    auto, tol = ms.Auto(tol=1e-10), 1e-10
+    sweeps = ms.NSGS(tol=tol, max_iter=auto.nsgs_max_iter, anderson=auto.nsgs_anderson, stall=1024)
+    soft = [ms.simulate(stack(3, 1e-6), 0.2, ms.MoreauJean(1e-3, solver=s), output_dt=1e-3) for s in (auto, sweeps)]
+    for name in ("q", "u", "solver/iterations", "solver/residual"):
+        assert np.array_equal(soft[0][name], soft[1][name]), name
+    stiff = [ms.simulate(stack(3, 1e-10), 0.2, ms.MoreauJean(1e-3, solver=s), output_dt=1e-3) for s in (auto, sweeps)]
+    assert stiff[0]["solver/converged"][1:].all()
+    assert stiff[0]["solver/iterations"][1:].sum() < stiff[1]["solver/iterations"][1:].sum()
+
+
 @pytest.fixture(scope="module")
 def pile1000():
     return box_pile([(0.0, 0.0, PILE_R + 2.2 * PILE_R * i) for i in range(1000)], 0.55, name="pile-1000")

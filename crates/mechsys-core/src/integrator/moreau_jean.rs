@@ -732,6 +732,14 @@ impl MoreauJean {
                 self.reg.clear();
                 self.layer_c.clear();
             }
+            // `auto` sweeps a problem regularized well on every contact, at any size (its sweeps
+            // converge fast; Newton's factorizations cost more than they save there)
+            let chosen = self.method;
+            if let Method::Auto(o) = chosen {
+                if !self.reg.is_empty() && self.well_regularized(d) {
+                    self.method = Method::Nsgs(o.sweeps());
+                }
+            }
             // sweeps from the bottom up along gravity: each contact then sees the newest support
             // below it, and a warm-started pile settles in fewer sweeps than in pair order
             self.height.clear();
@@ -830,6 +838,7 @@ impl MoreauJean {
                     })?;
                 }
             }
+            self.method = chosen;
             if !report.converged {
                 self.unconverged.0 += 1;
                 self.unconverged.1 = self.unconverged.1.max(report.residual);
@@ -1076,6 +1085,21 @@ impl MoreauJean {
         self.ws.reserve(&self.problem, &self.method)?;
         let warm = again || self.r.iter().any(|v| *v != 0.0);
         solver::solve(&self.problem, &self.method, &mut self.r, warm, &mut self.ws)
+    }
+
+    /// Whether every active point's normal regularization is at least [`solver::AUTO_SOFT`] of
+    /// its rigid `W_NN` (after the regularization was added to the diagonal).
+    fn well_regularized(&self, d: usize) -> bool {
+        let m = self.reg.len();
+        (0..m).all(|ai| {
+            let wnn = match (self.sparse.as_ref(), &self.problem.w) {
+                (Some(sp), _) => sp.diag[ai * d * d],
+                (None, Delassus::Dense(w)) => w[(ai * d) * (d * m) + ai * d],
+                (None, _) => return false,
+            };
+            let reg = self.reg[ai];
+            reg >= solver::AUTO_SOFT * (wnn - reg)
+        })
     }
 
     /// Puts the sparse assembly's Delassus blocks into the step's problem (once per step).
