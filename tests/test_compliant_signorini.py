@@ -107,10 +107,10 @@ def test_free_vibration_on_the_layer_converges_at_first_order_with_an_exact_ener
 def test_a_damped_layer_takes_the_bounce_out_of_a_drop_and_the_balance_closes():
     """Dropped from 0.2 m onto an undamped stiff layer (omega h = 0.22) the ball bounces back to
     about half its height: the layer gives back what it stored (less the scheme's numerical
-    damping), whatever the plastic impact law. Damped critically (d = 2 sqrt(k m)) the ball hops
-    by under 2 mm (a Kelvin-Voigt layer lets go while it still moves up); damped at four times
-    that it never leaves the floor. All come to rest at the static overlap, and the energy balance
-    (kinetic, potential, the layer's, dissipated) closes to round-off."""
+    damping), whatever the plastic impact law. Damped critically (d = 2 sqrt(k m)) or at four
+    times that, the ball hops by under a millimetre (a Kelvin-Voigt layer lets go while the ball
+    still moves up: 0.08 and 0.2 mm measured). All come to rest at the static overlap, and the
+    energy balance (kinetic, potential, the layer's, dissipated) closes to round-off."""
     c, mass = 1e-5, 2.0
     crit = 2.0 * np.sqrt(mass / c)
     hops = []
@@ -123,8 +123,7 @@ def test_a_damped_layer_takes_the_bounce_out_of_a_drop_and_the_balance_closes():
         if d > 0:
             np.testing.assert_allclose(res["contact/floor/g_n"][-1], -c * mass * G, rtol=1e-6)
     assert 0.05 < hops[0] < 0.2
-    assert 0.0 < hops[1] < 2e-3
-    assert hops[2] < 0.0
+    assert hops[1] < 1e-3 and hops[2] < 1e-3
 
 
 def stack(n, compliance, mass=1.0, half=(0.1, 0.1, 0.05)):
@@ -207,6 +206,19 @@ def test_a_settling_pile_on_compliant_layers_converges_in_tens_of_sweeps(pile100
     it_rigid, it_soft = rigid["solver/iterations"][1:].sum(), soft["solver/iterations"][1:].sum()
     assert it_rigid > 3000, it_rigid
     assert it_soft < 600, it_soft
+
+
+def test_a_layer_takes_no_restitution_on_top_of_its_own():
+    with pytest.raises(ms.ModelError, match=r"'floor'\.impact: a compliant Signorini layer rebounds"):
+        m = ms.Model("bad", gravity=(0, 0, -G))
+        b = m.add_body("ball", 1.0, ms.inertia.sphere(1.0, 0.1))
+        m.add_joint(ms.joints.Free("f", m.ground, b))
+        m.add_contact(ms.Contact("floor", b.contour(ms.contours.Sphere(radius=0.1)),
+                                 m.ground.contour(ms.contours.Plane(normal=(0, 0, 1))), normal=ms.laws.Signorini(compliance=1e-6),
+                                 impact=ms.laws.Newton(eps=0.5)))
+        m.build()
+    # a plastic Newton law goes with it (the pile's groups)
+    assert box_pile([(0.0, 0.0, PILE_R)], 0.3, compliance=1e-6) is not None
 
 
 @pytest.mark.parametrize("kwargs, key", [({"compliance": -1.0}, "compliance"), ({"compliance": float("nan")}, "compliance"),

@@ -65,6 +65,15 @@ pub const CONTACT_MARGIN: f64 = 1e-9;
 /// point takes an impulse only where it would otherwise end the step inside its contact.
 pub const HOLD_MARGIN: f64 = 1e-7;
 
+/// How far (m) beyond the activation margin a compliant point is taken into the step's problem
+/// while it approaches at `gd_n` (twice the step's approach at the start velocity): its gap
+/// allowance lets it close, not pass. A compliant layer must not be entered by a whole step's
+/// motion the way a rigid point is (its velocity-level penetration stays as drift): the gap term
+/// would then push that penetration out within a step, an elastic pop at any stiffness.
+fn speculative(h: f64, gd_n: f64) -> f64 {
+    2.0 * h * (-gd_n).max(0.0)
+}
+
 /// The activation margin of a point by its state in the last step (the run's first step holds
 /// every point that touches at the start, so that a state given as closed is treated as closed).
 fn margin(last_state: f64, first_step: bool) -> f64 {
@@ -507,7 +516,8 @@ impl MoreauJean {
                 .map_err(|e| at_contact(e, &con.name, tm))?;
             for (j, kk) in k.iter().enumerate() {
                 let pt = con.first + j;
-                if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) {
+                let reach = if con.compliance > 0.0 { speculative(h, kk.gd_n) } else { 0.0 };
+                if kk.point.g_n <= margin(self.results[pt].state, self.steps == 0) + reach {
                     self.act.push(Active {
                         b1: con.body1,
                         b2: con.body2,
@@ -527,7 +537,8 @@ impl MoreauJean {
                 let fresh = sl.stamp == self.steps.wrapping_sub(1);
                 for (k, kk) in sl.kin.iter().enumerate() {
                     pen = pen.max(-kk.point.g_n);
-                    if kk.point.g_n <= margin(if fresh { sl.last[k].1 } else { OPEN }, self.steps == 0) {
+                    let reach = if group.compliance > 0.0 { speculative(h, kk.gd_n) } else { 0.0 };
+                    if kk.point.g_n <= margin(if fresh { sl.last[k].1 } else { OPEN }, self.steps == 0) + reach {
                         let source = Source::Group { group: gi, slot, k };
                         self.act.push(Active { b1: sl.body1, b2: sl.body2, contact: 0, point: kk.point, source });
                     }
@@ -691,7 +702,8 @@ impl MoreauJean {
                 // i.e. ġ_N⁺ + g_N/(h + τ) + c/(h (h + τ)) Λ_N ≥ 0: the regularization of W_NN
                 // (added below) and a gap term, as an implicit Euler step of the layer
                 let (c, damping) = compliance;
-                let gap_allowance = if c > 0.0 { a.point.g_n / (h + c * damping) } else { a.point.g_n.max(0.0) / h };
+                let g = a.point.g_n;
+                let gap_allowance = if c > 0.0 && g < 0.0 { g / (h + c * damping) } else { g.max(0.0) / h };
                 self.reg.push(c / (h * (h + c * damping)));
                 self.layer_c.push([c, c * damping]);
                 self.problem.q[ai * d] += impact.eps() * self.gd_before[ai * d].min(0.0) + gap_allowance;
@@ -954,10 +966,13 @@ impl MoreauJean {
                 }
                 if let Some(&[c, tau]) = self.layer_c.get(ai) {
                     // ½ k δ² of the layer pressed by λ_N = Λ_N / h = k δ + d δ̇ (δ̇ = −ġ_N⁺), so
-                    // δ = c λ_N + τ ġ_N⁺ (undamped: ½ c λ_N²); a layer without force holds none
+                    // δ = c λ_N + τ ġ_N⁺ (undamped: ½ c λ_N², exact); a layer without force holds
+                    // none. Damped and extending (ġ_N⁺ > 0), δ is taken at most c λ_N: an overlap
+                    // the step let in before the point took part (an impact's) is no deflection
+                    // of the layer, and a layer pushing it out gives back no more than it holds
                     let f = self.r[ai * d] / h;
                     if f > 0.0 {
-                        let delta = (c * f + tau * after[0]).max(0.0);
+                        let delta = (c * f + tau * after[0]).clamp(0.0, c * f);
                         stored += 0.5 * delta * delta / c;
                     }
                 }

@@ -686,6 +686,18 @@ fn compliance(normal: &super::contact_description::NormalDescription, what: &str
     Ok((c, d))
 }
 
+/// A compliant layer's rebound comes from its stiffness and damping: a restitution on top of it
+/// is refused (a plastic Newton law, ε = 0, the default, is accepted).
+fn layer_takes_no_restitution(impact: &ImpactLaw, compliance: f64, what: &str) -> Result<()> {
+    crate::ensure!(
+        compliance == 0.0 || (matches!(impact, ImpactLaw::Newton { .. }) && impact.eps() == 0.0),
+        Model,
+        "{what}.impact: a compliant Signorini layer rebounds by its own stiffness and damping (normal.compliance, \
+         normal.damping); give no impact law or Newton(eps=0)"
+    );
+    Ok(())
+}
+
 /// Validates one contact description (body indices resolved by `body`).
 pub(super) fn validate(
     d: &ContactDescription,
@@ -723,6 +735,7 @@ pub(super) fn validate(
     let impact = impact_law(&d.impact, &what)?;
     let geometry = ContactGeometry::Contours { pair, contours };
     let (compliance, damping) = compliance(&d.normal, &what)?;
+    layer_takes_no_restitution(&impact, compliance, &what)?;
     Ok(Contact { name: d.name.clone(), body1: b1, body2: b2, geometry, friction, impact, compliance, damping, first })
 }
 
@@ -811,6 +824,7 @@ pub(super) fn validate_gap(
     let impact = impact_law(&d.impact, &what)?;
     let geometry = ContactGeometry::Gap { function: GapFunction::new(terms, coordinates), slot: index };
     let (compliance, damping) = compliance(&d.normal, &what)?;
+    layer_takes_no_restitution(&impact, compliance, &what)?;
     Ok(Contact { name: d.name.clone(), body1: 0, body2: 0, geometry, friction, impact, compliance, damping, first })
 }
 
@@ -948,6 +962,7 @@ pub(super) fn validate_group(
     let friction = friction_law(&d.friction, &what)?;
     let impact = impact_law(&d.impact, &what)?;
     let (compliance, damping) = compliance(&d.normal, &what)?;
+    layer_takes_no_restitution(&impact, compliance, &what)?;
     Ok(ContactGroup {
         name: d.name.clone(),
         members,
