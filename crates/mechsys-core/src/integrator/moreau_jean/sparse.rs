@@ -741,16 +741,7 @@ mod tests {
         let with_arm = [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0), (3, 1), (0, 3)];
         let free_only = [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0)];
         for (dim, pairs) in [(3, &with_arm[..]), (2, &with_arm[..]), (3, &free_only[..]), (2, &free_only[..])] {
-            let mut sp = SparseRows::new(&model, dim);
-            sp.factor.copy_from(&saddle);
-            for (k, &(b1, b2)) in pairs.iter().enumerate() {
-                let n = Vec3::new(0.3 - 0.1 * k as f64, -0.5, 0.8).normalize();
-                let t1 = n.cross(&Vec3::x()).normalize();
-                let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
-                let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
-                sp.add_contact(&model, &data.s, el, b1, &p1, b2, &(p1 - 1e-3 * n), &[n, t1, n.cross(&t1)]);
-            }
-            sp.delassus();
+            let mut sp = contact_rows((&model, &data, &saddle), dim, pairs);
             let nc = sp.len();
             let packs = if dim == 3 { sp.pack::<3>() } else { sp.pack::<2>() };
             assert_eq!(packs, pairs.len() == free_only.len(), "packed rows on free bodies only");
@@ -874,16 +865,8 @@ mod tests {
         }
         let (model, data, saddle) = factored_mass();
         for dim in [3, 2] {
-            let mut sp = SparseRows::new(&model, dim);
-            sp.factor.copy_from(&saddle);
-            for (k, &(b1, b2)) in [(1, 0), (0, 2), (1, 2), (2, 1), (2, 0), (3, 1), (0, 3)].iter().enumerate() {
-                let n = Vec3::new(0.3 - 0.1 * k as f64, -0.5, 0.8).normalize();
-                let t1 = n.cross(&Vec3::x()).normalize();
-                let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
-                let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
-                sp.add_contact(&model, &data.s, el, b1, &p1, b2, &(p1 - 1e-3 * n), &[n, t1, n.cross(&t1)]);
-            }
-            sp.delassus();
+            let mut sp =
+                contact_rows((&model, &data, &saddle), dim, &[(1, 0), (0, 2), (1, 2), (2, 1), (2, 0), (3, 1), (0, 3)]);
             regularize(&mut sp, dim);
             let nc = sp.len();
             let qv: Vec<f64> = (0..dim * nc).map(|i| ((i * 7 % 11) as f64 - 6.0) * 0.1).collect();
@@ -892,31 +875,10 @@ mod tests {
             compare(&mut sp, dim, &qv, &mu, &[], &[], o);
         }
         // 401 contacts on free bodies: two domains
-        let ns = 201;
-        let (model, data, saddle) = row_of_spheres(ns);
-        let mut sp = SparseRows::new(&model, 3);
-        sp.factor.copy_from(&saddle);
-        let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
-        let z = Vec3::z();
-        for i in 0..ns {
-            let c = Vec3::new(0.1 * i as f64, 0.0, 0.0);
-            sp.add_contact(&model, &data.s, el, i + 1, &c, 0, &c, &[z, Vec3::x(), Vec3::y()]);
-        }
-        for i in 0..ns - 1 {
-            let c = Vec3::new(0.1 * i as f64 + 0.05, 0.0, 0.05);
-            sp.add_contact(&model, &data.s, el, i + 2, &c, i + 1, &c, &[Vec3::x(), Vec3::y(), z]);
-        }
-        sp.delassus();
+        let mut sp = sphere_row_rows(201);
         regularize(&mut sp, 3);
         let nc = sp.len();
-        let qv: Vec<f64> = (0..3 * nc)
-            .map(|k| match k % 3 {
-                0 => -0.01 - 0.002 * ((k / 3) % 5) as f64,
-                1 => 0.004 * (((k / 3) * 7 % 11) as f64 - 5.0),
-                _ => 0.001 * (((k / 3) * 3 % 7) as f64 - 3.0),
-            })
-            .collect();
-        let mu: Vec<f64> = (0..nc).map(|a| 0.3 + 0.05 * (a % 4) as f64).collect();
+        let (qv, mu) = sphere_row_load(201, false);
         let order: Vec<usize> = (0..nc).rev().collect();
         assert!(sp.pack::<3>());
         assert!(sp.dom.plan(&sp.packed, &order, sp.z.len()), "split in two domains");
@@ -932,6 +894,64 @@ mod tests {
         let (mut r, mut u) = (vec![0.0; 3 * nc], vec![0.0; 3 * nc]);
         let rigid = sp.gauss_seidel((&qv, &mu), &order, &mut r, &o, &mut u);
         assert!(rigid.iterations > split, "rigid {} sweeps, regularized {split}", rigid.iterations);
+    }
+
+    /// The rows of `pairs` of bodies of [`factored_mass`]'s model in contact (dimension `dim`),
+    /// with their Delassus blocks.
+    fn contact_rows(
+        (model, data, saddle): (&Model, &Data, &Saddle),
+        dim: usize,
+        pairs: &[(usize, usize)],
+    ) -> SparseRows {
+        let mut sp = SparseRows::new(model, dim);
+        sp.factor.copy_from(saddle);
+        for (k, &(b1, b2)) in pairs.iter().enumerate() {
+            let n = Vec3::new(0.3 - 0.1 * k as f64, -0.5, 0.8).normalize();
+            let t1 = n.cross(&Vec3::x()).normalize();
+            let p1 = Vec3::new(0.1 * k as f64, -0.2, 0.3 + 0.05 * k as f64);
+            let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+            sp.add_contact(model, &data.s, el, b1, &p1, b2, &(p1 - 1e-3 * n), &[n, t1, n.cross(&t1)]);
+        }
+        sp.delassus();
+        sp
+    }
+
+    /// The rows of [`row_of_spheres`]: each sphere on the ground, each pair of neighbours side by
+    /// side (2 ns − 1 contacts; the normal points from the second body to the first), with their
+    /// Delassus blocks.
+    fn sphere_row_rows(ns: usize) -> SparseRows {
+        let (model, data, saddle) = row_of_spheres(ns);
+        let mut sp = SparseRows::new(&model, 3);
+        sp.factor.copy_from(&saddle);
+        let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
+        let z = Vec3::z();
+        for i in 0..ns {
+            let c = Vec3::new(0.1 * i as f64, 0.0, 0.0);
+            sp.add_contact(&model, &data.s, el, i + 1, &c, 0, &c, &[z, Vec3::x(), Vec3::y()]);
+        }
+        for i in 0..ns - 1 {
+            let c = Vec3::new(0.1 * i as f64 + 0.05, 0.0, 0.05);
+            sp.add_contact(&model, &data.s, el, i + 2, &c, i + 1, &c, &[Vec3::x(), Vec3::y(), z]);
+        }
+        sp.delassus();
+        sp
+    }
+
+    /// The free velocities and friction coefficients of [`sphere_row_rows`]' contacts: pressed
+    /// onto the ground and together, pushed sideways by varying amounts (sliding and sticking
+    /// contacts); with `parting`, neighbours mostly parting (short pressed runs, a problem swept
+    /// in tens of sweeps).
+    fn sphere_row_load(ns: usize, parting: bool) -> (Vec<f64>, Vec<f64>) {
+        let nc = 2 * ns - 1;
+        let qv = (0..3 * nc)
+            .map(|k| match k % 3 {
+                0 if parting && k / 3 >= ns && (k / 3) % 4 != 0 => 0.002,
+                0 => -0.01 - 0.002 * ((k / 3) % 5) as f64,
+                1 => 0.004 * (((k / 3) * 7 % 11) as f64 - 5.0),
+                _ => 0.001 * (((k / 3) * 3 % 7) as f64 - 3.0),
+            })
+            .collect();
+        (qv, (0..nc).map(|a| 0.3 + 0.05 * (a % 4) as f64).collect())
     }
 
     /// A row of `n` free spheres (r = 5 cm, touching) on the ground at their initial state:
@@ -963,36 +983,10 @@ mod tests {
     fn two_domain_sweeps_are_gauss_seidel_in_their_order_on_any_threads() {
         use crate::solver::{self, BlockDelassus, Delassus, FrictionContact, Method, NsgsOptions, Workspace};
         let ns = 201;
-        let (model, data, saddle) = row_of_spheres(ns);
-        let mut sp = SparseRows::new(&model, 3);
-        sp.factor.copy_from(&saddle);
-        let el = (&data.x_abs[..], &data.elastic[..], &data.body_elastic[..]);
-        let z = Vec3::z();
-        // each sphere on the ground, each pair of neighbours side by side (401 contacts; the normal
-        // points from the second body to the first)
-        for i in 0..ns {
-            let c = Vec3::new(0.1 * i as f64, 0.0, 0.0);
-            sp.add_contact(&model, &data.s, el, i + 1, &c, 0, &c, &[z, Vec3::x(), Vec3::y()]);
-        }
-        for i in 0..ns - 1 {
-            let c = Vec3::new(0.1 * i as f64 + 0.05, 0.0, 0.05);
-            sp.add_contact(&model, &data.s, el, i + 2, &c, i + 1, &c, &[Vec3::x(), Vec3::y(), z]);
-        }
-        sp.delassus();
+        let mut sp = sphere_row_rows(ns);
         let nc = sp.len();
         assert!(nc >= domains::SPLIT_MIN_CONTACTS);
-        // pressed onto the ground and together, pushed sideways by varying amounts: sliding and
-        // sticking contacts
-        let qv: Vec<f64> = (0..3 * nc)
-            .map(|k| match k % 3 {
-                // (neighbours mostly parting: short pressed runs, a problem swept in tens of sweeps)
-                0 if k / 3 >= ns && (k / 3) % 4 != 0 => 0.002,
-                0 => -0.01 - 0.002 * ((k / 3) % 5) as f64,
-                1 => 0.004 * (((k / 3) * 7 % 11) as f64 - 5.0),
-                _ => 0.001 * (((k / 3) * 3 % 7) as f64 - 3.0),
-            })
-            .collect();
-        let mu: Vec<f64> = (0..nc).map(|a| 0.3 + 0.05 * (a % 4) as f64).collect();
+        let (qv, mu) = sphere_row_load(ns, true);
         // visiting order: descending index (any permutation the caller gives is kept per part)
         let order: Vec<usize> = (0..nc).rev().collect();
         let o = NsgsOptions { tol: 1e-14, max_iter: 40, relaxation: 1.0, anderson: 0, stall: 0 };
