@@ -261,3 +261,25 @@ def test_a_model_file_carries_the_layer(tmp_path):
     bad.write_text(text.replace("compliance = 1e-06", "compliance = -1e-06"))
     with pytest.raises(ms.ModelError, match=r"bad\.toml.*normal\.compliance"):
         load_model(bad)
+
+
+def test_linearized_with_the_contact_held_a_layer_is_its_spring_and_damper():
+    """At rest on its layer (overlap c m g), `linearize(contacts="hold")` holds the contact as the
+    layer: the bounce mode's natural frequency is sqrt(k/m) and its damping ratio d/(2 sqrt(k m))
+    (the four other rigid-body directions free, frequency 0)."""
+    c, mass = 1e-5, 2.0
+    k = 1.0 / c
+    for d in (0.0, 150.0):
+        m = ball_on_floor(c, mass, damping=d)
+        res = ms.simulate(m, 1.0, ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-13)), output_dt=1e-2)
+        lin = ms.linear.linearize(m, q=res["q"][-1], u=np.zeros(6), contacts="hold")
+        modes = lin.modes()
+        bounce = int(np.argmax(modes.natural_frequency))
+        np.testing.assert_allclose(modes.natural_frequency[bounce], np.sqrt(k / mass) / (2 * np.pi), rtol=1e-9)
+        np.testing.assert_allclose(modes.damping_ratio[bounce], d / (2 * np.sqrt(k * mass)), rtol=1e-9, atol=1e-12)
+        assert np.sort(modes.natural_frequency)[-2] < 1e-3
+    # rolling on a layer is not offered, and a layer touched without load has a kink: refused by name
+    with pytest.raises(ms.SettingsError, match=r"contact 'floor' has a compliant Signorini layer.*contacts='hold'"):
+        ms.linear.linearize(m, q=res["q"][-1], u=np.zeros(6), contacts="roll")
+    with pytest.raises(ms.SettingsError, match=r"contact 'floor' touches without pressing its compliant layer"):
+        ms.linear.linearize(ball_on_floor(c, mass), contacts="hold")

@@ -532,7 +532,10 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
     without slip: ġ_T = 0 too). A held contact must press at the point (normal force > 0, from
     the constrained dynamics there), and a rolling one must stay inside its static friction cone;
     otherwise a SettingsError names it and its force. Open contacts exert nothing and are left
-    out. ``lin.model`` is then the model with the held contacts (``laws.Bilateral``).
+    out. ``lin.model`` is then the model with the held contacts (``laws.Bilateral``). A contact on
+    a compliant Signorini layer (``laws.Signorini(compliance=c, damping=d)``) pressed at the point
+    is held as its layer instead, a spring 1/c and damper d along the normal sliding
+    frictionlessly (``laws.KelvinVoigt`` in ``lin.model``; ``"hold"`` only).
 
     ``at`` chooses the point instead of ``q``/``u``: ``None`` or ``"q0"`` (the model's q0, u0),
     ``"equilibrium"`` (:func:`mechsys.analysis.static_equilibrium` from ``q``, at rest unless
@@ -700,9 +703,11 @@ def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str)
     cm = contact_matrices(model, q, u, t)
     scale = 1e-9 * (1.0 + float(np.abs(q).max(initial=0.0)))
     closed: dict[str, int] = {}
+    closed_gap: dict[str, float] = {}
     for name, g in zip(cm["contact"], cm["gap"]):
         if g <= scale:
             closed[name] = closed.get(name, 0) + 1
+            closed_gap[name] = min(closed_gap.get(name, np.inf), float(g))
     if not closed:
         return model, {}
     desc, callbacks = model.describe()
@@ -716,6 +721,22 @@ def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str)
         if c.get("points", 1) != 1:
             raise SettingsError(f"{what} looks for {c['points']} contact points; only a single-point contact "
                                 "(points=1) can be held closed")
+        layer = c.get("normal") or {}
+        if layer.get("type") == "signorini" and layer.get("compliance", 0.0) > 0.0:
+            # a compliant Signorini layer held closed is its spring (and damper) along the normal,
+            # sliding frictionlessly: a Kelvin-Voigt force, smooth where the layer is pressed
+            if mode == "roll":
+                raise SettingsError(f"{what} has a compliant Signorini layer: held, it is its spring along the normal and "
+                                    "slides frictionlessly; rolling without slip on a layer is not supported (use contacts='hold')")
+            if closed_gap[c["name"]] >= 0.0:
+                raise SettingsError(f"{what} touches without pressing its compliant layer at the point (gap "
+                                    f"{closed_gap[c['name']]:.3g} m): the layer's force has a kink there; linearize where "
+                                    "it is pressed (at rest under load) or open")
+            c["normal"] = {"type": "kelvin_voigt", "k": 1.0 / float(layer["compliance"]),
+                           "d": float(layer.get("damping", 0.0))}
+            c.pop("friction", None)
+            c.pop("impact", None)
+            continue
         mu = _static_mu(c.get("friction"))
         if mode == "roll" and mu is None:
             raise SettingsError(f"{what} is frictionless, so it cannot roll without slip; use contacts='hold'")
