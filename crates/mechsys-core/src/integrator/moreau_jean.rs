@@ -219,7 +219,8 @@ pub struct MoreauJean {
     /// Energy dissipated so far by tangential impulses (J).
     pub dissipated_friction: f64,
     /// Elastic energy held by the compliant Signorini layers at the end of the last step,
-    /// `Σ ½ c λ_N²` (J); the impact share of the contacts' work leaves its changes out.
+    /// `Σ ½ k δ²` (J; `½ c λ_N²` undamped); the impact share of the contacts' work leaves its
+    /// changes out.
     pub contact_elastic: f64,
     /// Work done on the system by moving surfaces (conveyor belts) through friction (J).
     pub surface_work: f64,
