@@ -257,6 +257,14 @@ def test_a_model_file_carries_the_layer(tmp_path):
     back, _ = load_model(path)
     res = ms.simulate(back, 0.3, ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-12)), output_dt=1e-2)
     np.testing.assert_allclose(res["contact/floor/g_n"][-1], -1e-6 * 2.0 * G, rtol=1e-9)
+    # `mechsys info` names the layer and the one scheme that takes it
+    from click.testing import CliRunner
+    from mechsys.cli import cli
+
+    shown = CliRunner().invoke(cli, ["info", str(path)])
+    assert shown.exit_code == 0, shown.output
+    assert "compliant layer k = 1e+06 N/m, d = 30 N s/m" in shown.output
+    assert "moreau_jean (compliant layers: time-stepping only)" in shown.output
     bad = tmp_path / "bad.toml"
     bad.write_text(text.replace("compliance = 1e-06", "compliance = -1e-06"))
     with pytest.raises(ms.ModelError, match=r"bad\.toml.*normal\.compliance"):

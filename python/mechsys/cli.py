@@ -80,6 +80,15 @@ def cli() -> None:
 # ---- helpers -------------------------------------------------------------------------------------
 
 
+def _layer(c: dict) -> str:
+    """", compliant layer k = ... N/m[, d = ... N s/m]" for a contact on a compliant Signorini layer."""
+    comp = c.get("compliance", 0.0)
+    if not comp:
+        return ""
+    damp = c.get("damping", 0.0)
+    return f", compliant layer k = {1.0 / comp:.3g} N/m" + (f", d = {damp:.3g} N s/m" if damp else "")
+
+
 def _table(headers: Sequence[str], rows: Sequence[Sequence[Any]], indent: str = "  ") -> str:
     """A plain-text table with left-aligned columns."""
     cells = [[str(h) for h in headers]] + [[str(c) for c in r] for r in rows]
@@ -471,9 +480,11 @@ def info(model_file: Path) -> None:
     contacts = core.contacts()
     if contacts:
         click.echo("")
-        click.echo(f"contacts ({len(contacts)}; simulate with --integrator moreau_jean or event_driven):")
+        layered = any(c.get("compliance", 0.0) > 0 for c in contacts)
+        schemes = "moreau_jean (compliant layers: time-stepping only)" if layered else "moreau_jean or event_driven"
+        click.echo(f"contacts ({len(contacts)}; simulate with --integrator {schemes}):")
         rows = [(c["name"], "gap function" if c.get("kind") == "gap" else f"{c['body1']} / {c['body2']}", str(c["points"]),
-                 "planar" if c["tangents"] == 1 else "spatial")
+                 ("planar" if c["tangents"] == 1 else "spatial") + _layer(c))
                 for c in contacts]
         click.echo(_table(["name", "bodies", "points", "kind"], rows))
     groups = core.contact_groups() if hasattr(core, "contact_groups") else []
@@ -481,7 +492,7 @@ def info(model_file: Path) -> None:
         click.echo("")
         click.echo(f"contact groups ({len(groups)}; pairs found by a broad phase at every step; simulate with --integrator moreau_jean):")
         rows = [(g["name"], str(g["members"]), ", ".join(g["member_kinds"]), str(g["against"]),
-                 ", ".join(g["against_kinds"]) or "-", "planar" if g["planar"] else "spatial") for g in groups]
+                 ", ".join(g["against_kinds"]) or "-", ("planar" if g["planar"] else "spatial") + _layer(g)) for g in groups]
         click.echo(_table(["name", "members", "member contours", "against", "against contours", "kind"], rows))
     if sim:
         click.echo("")

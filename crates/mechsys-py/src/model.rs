@@ -152,7 +152,8 @@ impl PyModel {
         self.model.nc
     }
     /// One dict per constraint: name, type, row, rows, unit (of λ), violation_unit.
-    /// Contacts: name, bodies, first candidate point, number of points, tangent directions.
+    /// Contacts: name, bodies, first candidate point, number of points, tangent directions, the
+    /// compliance and damping of a compliant Signorini layer (0 rigid).
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mut out = vec![];
         for c in &self.model.contacts {
@@ -164,13 +165,16 @@ impl PyModel {
             d.set_item("points", c.points())?;
             d.set_item("tangents", c.tangent_dim())?;
             d.set_item("kind", if c.gap().is_some() { "gap" } else { "contours" })?;
+            d.set_item("compliance", c.compliance)?;
+            d.set_item("damping", c.damping)?;
             out.push(d);
         }
         Ok(out)
     }
 
     /// One dict per contact group: name, members, against (counts), kinds (contour kinds of the
-    /// members, then of `against`), planar.
+    /// members, then of `against`), planar, compliance and damping (of a compliant Signorini
+    /// layer; 0 rigid).
     fn contact_groups<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mut out = vec![];
         for g in &self.model.contact_groups {
@@ -191,6 +195,8 @@ impl PyModel {
             d.set_item("member_kinds", kinds(&g.members))?;
             d.set_item("against_kinds", kinds(&g.against))?;
             d.set_item("planar", g.planar)?;
+            d.set_item("compliance", g.compliance)?;
+            d.set_item("damping", g.damping)?;
             out.push(d);
         }
         Ok(out)
