@@ -9,9 +9,10 @@ regularized by c/h^2 on each normal diagonal, its solution unique, and every ste
 tens. The price is an overlap of c times each contact's force (micrometres here), which the layer
 holds at rest instead of letting it drift like the rigid scheme's penetration.
 
-Printed: sweeps per step (mean, largest), wall time, the vertical force of the box on the spheres
-(N m g once the pile rests), the largest overlap at the end against c times the largest contact
-force, and the energy balance with the layers' energy (``energy/contact_elastic``).
+Printed for both pours: sweeps per step (mean, largest), unconverged steps, wall time, the vertical
+force of the box on the spheres (N m g once the pile rests) and the largest penetration at the
+end; for the layers also the energy they hold (``energy/contact_elastic``), the energy balance
+with it and the summed normal force of the group's points.
 
 ``python examples/compliant_layer_pile.py [N]`` (default 100 spheres, 1 s; a few seconds);
 ``mechsys run examples/compliant_layer_pile.py`` runs the compliant pour alone.

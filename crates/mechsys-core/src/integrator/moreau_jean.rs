@@ -806,7 +806,12 @@ impl MoreauJean {
             let split = self.sparse.is_some() && self.islands.count() > 1 && !self.body_space && !sweep_whole;
             self.local_u.clear();
             let factored = !split && !self.static_mu.iter().any(|s| *s);
-            let report = self.solve_contacts(split, false, factored).map_err(|e| {
+            let solved = self.solve_contacts(split, false, factored);
+            if solved.is_err() {
+                // (the integrator's own method back before the error leaves the step)
+                self.method = chosen;
+            }
+            let report = solved.map_err(|e| {
                 let names = self.active_names(model);
                 Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
             })?;
@@ -845,7 +850,11 @@ impl MoreauJean {
                     }
                 }
                 if again {
-                    report = self.solve_contacts(split, true, false).map_err(|e| {
+                    let solved = self.solve_contacts(split, true, false);
+                    if solved.is_err() {
+                        self.method = chosen;
+                    }
+                    report = solved.map_err(|e| {
                         let names = self.active_names(model);
                         Error::Solver(format!("contacts {names:?} at t = {tm:.6} s: {e}"))
                     })?;
