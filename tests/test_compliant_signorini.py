@@ -180,13 +180,17 @@ def pile1000():
     return box_pile([(0.0, 0.0, PILE_R + 2.2 * PILE_R * i) for i in range(1000)], 0.55, name="pile-1000")
 
 
-def pile_steps(model, n=3):
-    d = np.load(pathlib.Path(__file__).parent / "data" / "pile1000_settling.npz")
+def pile_steps(model, n=5):
+    """`n` steps of the 1000-sphere pour on layers of k = 1e6 N/m from its own state at t = 0.8 s
+    (``data/pile1000_layer_settling.npz``: ``benches/contacts.py``'s pile, seed 0, ``Auto(tol=1e-4)``,
+    dt 1e-3, saved from the compliant pour, so its overlaps are the layers' own and nothing pops)."""
+    d = np.load(pathlib.Path(__file__).parent / "data" / "pile1000_layer_settling.npz")
     t0 = float(d["t"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # an unconverged step warns; the report is checked
         return ms.simulate(model, t0 + n * 1e-3, ms.MoreauJean(1e-3, solver=ms.NSGS(tol=1e-4, max_iter=10_000, anderson=4)),
-                           q0=d["q"], u0=d["u"], t0=t0, output_dt=1e-3, progress=False, sensors=["solver/*"])
+                           q0=d["q"], u0=d["u"], t0=t0, output_dt=1e-3, progress=False,
+                           sensors=["solver/*", "energy/kinetic"])
 
 
 def compliant_pile(c):
@@ -194,17 +198,22 @@ def compliant_pile(c):
 
 
 def test_a_settling_pile_on_compliant_layers_converges_in_tens_of_sweeps(pile1000):
-    """The 1000-sphere pour at t = 0.8 s (about 2000 contact points, two-domain sweeps): rigid,
-    its three steps take thousands of sweeps (1401 + 2015 + 1104); with layers of k = 1e6 N/m
-    (overlap at most tens of micrometres under the pile's weight) every step converges within a
-    few hundred."""
+    """The same settling state of the 1000-sphere pour (about 2040 contact points, two-domain
+    sweeps) stepped on rigid contacts and on its layers of k = 1e6 N/m: rigid, five steps take
+    thousands of sweeps (1155, 610, 685, 1640, 1416 measured); on the layers tens (66, 41, 41, 41,
+    45). The pile stays as it was on both (its contacts within 3 %, its kinetic energy within
+    20 %): a state whose overlaps the layers did not make would be pushed apart instead, and its
+    few remaining contacts would converge fast for the wrong reason."""
     rigid = pile_steps(pile1000)
     soft = pile_steps(compliant_pile(1e-6))
     for res in (rigid, soft):
         assert res["solver/converged"][1:].all()
-        assert (res["solver/contacts"][1:] > 1500).all()
+        contacts = res["solver/contacts"][1:]
+        assert contacts.min() > 1900 and contacts.min() > 0.97 * contacts.max(), contacts
+        ke = res["energy/kinetic"]
+        assert ke.max() < 1.2 * ke[0] and ke.min() > 0.8 * ke[0], ke
     it_rigid, it_soft = rigid["solver/iterations"][1:].sum(), soft["solver/iterations"][1:].sum()
-    assert it_rigid > 3000, it_rigid
+    assert it_rigid > 2500, it_rigid
     assert it_soft < 600, it_soft
 
 
