@@ -12,7 +12,8 @@ holds at rest instead of letting it drift like the rigid scheme's penetration.
 Printed for both pours: sweeps per step (mean, largest), unconverged steps, wall time, the vertical
 force of the box on the spheres (N m g once the pile rests) and the largest penetration at the
 end; for the layers also the energy they hold (``energy/contact_elastic``), the energy balance
-with it and the summed normal force of the group's points.
+with it, the summed normal force of the group's points, what the impacts took and what points
+that joined a step already overlapped gave (``energy/dissipated_drift``).
 
 ``python examples/compliant_layer_pile.py [N]`` (default 100 spheres, 1 s; a few seconds);
 ``mechsys run examples/compliant_layer_pile.py`` runs the compliant pour alone.
@@ -66,9 +67,10 @@ if __name__ == "__main__":
          - res["energy/external_work"])
     lam = res["contact/pile/lambda_n"][-1]
     print(f"compliant layers: energy held {res['energy/contact_elastic'][-1]:.3e} J; balance drift {np.ptp(e):.1e} J; "
-          f"summed normal force {lam:.3f} N")
+          f"summed normal force {lam:.3f} N; taken by impacts {res['energy/dissipated_impact'][-1]:.3f} J, "
+          f"given by points joining overlapped {-res['energy/dissipated_drift'][-1]:.3e} J")
     Path("results").mkdir(exist_ok=True)
     res.save("results/compliant_layer_pile.h5")
     ms.plot(res, ["solver/iterations", "contact/pile/max_penetration", "energy/contact_elastic", "energy/kinetic",
-                  "energy/dissipated"], out="results/compliant_layer_pile.png")
+                  "energy/dissipated", "energy/dissipated_drift"], out="results/compliant_layer_pile.png")
     print("wrote results/compliant_layer_pile.h5, results/compliant_layer_pile.png")

@@ -47,9 +47,12 @@ for k points; tangential ones (n, [k,] 2) in 3-D): ``contact/<c>/g_n`` (m), ``gd
 components, (n, [k,] 3)), ``normal`` (from the second contour towards the first), ``state`` (int8 levels open 0, stick 1, slip 2: ``res.levels(name)``; an
 HDF5 enum in files), ``friction_reserve`` (mu0 lambda_N -
 |lambda_T|, N), and ``energy/dissipated_impact``, ``energy/dissipated_friction`` (J), and
-``energy/contact_elastic`` (J, the energy held by compliant Signorini layers, ``½ c lambda_N²``
-summed; zero for rigid contacts: kinetic + potential + contact_elastic + dissipated - external
-work stays at its start).
+``energy/contact_elastic`` (J, the energy held by compliant Signorini layers, ``½ k δ²`` summed
+over their deflections δ, ``½ c lambda_N²`` undamped; zero for rigid contacts: kinetic + potential
++ contact_elastic + dissipated - external work stays at its start), and
+``energy/dissipated_drift`` (J, part of ``energy/dissipated``: what the steps' geometry took from
+the layers between steps, overlaps that changed without work, negative where it gave; zero for
+rigid contacts).
 
 ``constraint/<c>/velocity_violation`` (the violation's unit per second, same shape as
 ``violation``) is ``G u - b`` for every row, the velocity-only (non-holonomic) rows included.
@@ -252,6 +255,8 @@ class Results:
         put("energy/total", raw["kinetic"] + raw["potential"], "J")
         # with contacts, what the impulses dissipate counts too (its parts are signals of their own)
         contact_loss = raw["dissipated_impact"] + raw["dissipated_friction"] if "dissipated_impact" in raw else 0.0
+        if "contact_drift" in raw:
+            contact_loss = contact_loss + raw["contact_drift"]
         put("energy/dissipated", raw["dissipated"] + contact_loss, "J")
         put("energy/external_work", raw["external_work"], "J")
         put("momentum/linear", raw["momentum_linear"], "N s", xyz)
@@ -361,6 +366,8 @@ class Results:
             put("energy/dissipated_friction", raw["dissipated_friction"], "J")
             if "contact_elastic" in raw:
                 put("energy/contact_elastic", raw["contact_elastic"], "J")
+            if "contact_drift" in raw:
+                put("energy/dissipated_drift", raw["contact_drift"], "J")
             if "solver" in raw:
                 # the contact solver over the steps since the previous sample
                 sv = raw["solver"]
@@ -914,7 +921,7 @@ def signal_universe(engine) -> list[str]:
             names += [f"marker/{n}/{mk[0]}/{x}" for x in ("position", "velocity", "acceleration", "orientation")]
     names += ["com/position", "com/velocity", "com/acceleration"]
     names += [f"energy/{x}" for x in ("kinetic", "potential", "total", "dissipated", "external_work", "dissipated_impact",
-                                      "dissipated_friction", "contact_elastic")]
+                                      "dissipated_friction", "dissipated_drift", "contact_elastic")]
     names += ["momentum/linear", "momentum/angular"]
     names += [f"solver/{x}" for x in ("residual", "iterations", "converged", "contacts", "islands")]
     for c in engine.constraints():

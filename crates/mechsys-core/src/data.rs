@@ -46,6 +46,13 @@ pub struct Data {
     pub f_ext: Vec<Force>,
     /// forces: applied generalized forces from joint springs, dampers and joint forces (nu).
     pub tau_applied: Vec<f64>,
+    /// forces: the external loads' share of `f_ext` (body forces, thrust), world components
+    /// about the origin (nbody): with `tau_load`, what [`crate::forces::Powers::external`] is the
+    /// power of, for a scheme that needs their work at other velocities than the forces' own.
+    pub f_load: Vec<Force>,
+    /// forces: the external loads' share of `tau_applied` (joint forces, servos, callbacks and the
+    /// elastic coordinates' share of loads at nodes) (nu).
+    pub tau_load: Vec<f64>,
     /// dynamics: spatial force transmitted by the joint into body i, body frame (nbody).
     pub f: Vec<Force>,
     /// crba: composite rigid-body inertias (nbody).
@@ -158,6 +165,8 @@ impl Data {
             inertia: vec![RigidInertia::default(); nb],
             f_ext: vec![Force::ZERO; nb],
             tau_applied: vec![0.0; nu],
+            f_load: vec![Force::ZERO; nb],
+            tau_load: vec![0.0; nu],
             f: vec![Force::ZERO; nb],
             ic: vec![RigidInertia::default(); nb],
             mass_matrix: DMatrix::zeros(nu, nu),

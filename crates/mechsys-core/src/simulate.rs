@@ -280,6 +280,9 @@ pub struct Recording {
     pub dissipated_friction: Vec<f64>,
     /// Elastic energy held by compliant Signorini layers (n_out), J (Moreau–Jean; 0 otherwise).
     pub contact_elastic: Vec<f64>,
+    /// Energy the steps' geometry took from the compliant layers between steps since t0
+    /// (n_out), J ([`crate::integrator::moreau_jean::MoreauJean::contact_drift`]; 0 otherwise).
+    pub contact_drift: Vec<f64>,
     /// Moreau–Jean's contact solver over the steps since the previous sample (n_out × 5): the
     /// worst residual (of [`crate::solver::Report::residual`], 1), the most iterations of a step,
     /// 1 if every step converged (else 0), the unknowns' contacts of the last step and its
@@ -376,6 +379,7 @@ impl Recording {
         self.dissipated_impact.reserve(samples);
         self.dissipated_friction.reserve(samples);
         self.contact_elastic.reserve(samples);
+        self.contact_drift.reserve(samples);
         self.solver.reserve(5 * samples);
     }
 
@@ -1656,6 +1660,7 @@ fn time_stepping(
         rec.dissipated_impact.push(stepper.dissipated_impact);
         rec.dissipated_friction.push(stepper.dissipated_friction);
         rec.contact_elastic.push(stepper.contact_elastic);
+        rec.contact_drift.push(stepper.contact_drift);
         let (contacts, islands) = stepper.problem_shape();
         rec.solver.extend_from_slice(&[
             solver_acc.0,
@@ -1775,6 +1780,7 @@ fn event_driven(
         rec.dissipated_impact.push(e_impact);
         rec.dissipated_friction.push(y[e + 2] + e_impulsive_friction);
         rec.contact_elastic.push(0.0);
+        rec.contact_drift.push(0.0);
         budget.wall(t)?;
         report_progress(progress, rec.t.len(), t)
     };

@@ -370,6 +370,7 @@ fn recording_dict<'py>(
         put("dissipated_impact", rec.dissipated_impact, &[n])?;
         put("dissipated_friction", rec.dissipated_friction, &[n])?;
         put("contact_elastic", rec.contact_elastic, &[n])?;
+        put("contact_drift", rec.contact_drift, &[n])?;
         if !rec.solver.is_empty() {
             put("solver", rec.solver, &[n, 5])?;
         }

@@ -67,6 +67,9 @@ pub struct PairSlot {
     pub last: Vec<([f64; 3], f64)>,
     /// The step in which `last` was written.
     pub stamp: u64,
+    /// Each candidate's compliant-layer deflection at the end of that step (m; valid with
+    /// `last`, on compliant groups).
+    pub layer: Vec<f64>,
 }
 
 /// Broad phase, pair cache and narrow phase of one contact group.
@@ -164,6 +167,7 @@ impl GroupPhase {
                         kin: vec![ContactKinematics::default(); m],
                         last: vec![([0.0; 3], 0.0); m],
                         stamp: u64::MAX,
+                        layer: vec![0.0; m],
                     });
                     self.cache.insert(key, self.slots.len() - 1);
                     self.slots.len() - 1

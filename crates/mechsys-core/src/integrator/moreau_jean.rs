@@ -44,7 +44,7 @@ use crate::model::joint::quat_matrix;
 use crate::model::JointKind;
 use crate::model::Model;
 use crate::solver::{self, BlockDelassus, ContactState, Delassus, FrictionContact, Method, Workspace};
-use crate::spatial::Motion;
+use crate::spatial::{Force, Motion};
 
 mod islands;
 mod projection;
@@ -70,6 +70,17 @@ pub const HOLD_MARGIN: f64 = 1e-7;
 /// allowance lets it close, not pass. A compliant layer must not be entered by a whole step's
 /// motion the way a rigid point is (its velocity-level penetration stays as drift): the gap term
 /// would then push that penetration out within a step, an elastic pop at any stiffness.
+/// The share `τ/(h + τ)` of a compliant layer's deflection that is left after a step of `h`
+/// without force (implicit Euler of `k δ + d δ̇ = 0`, `τ = c d`): 0 undamped, 1 infinitely damped.
+#[inline]
+fn relaxed(h: f64, tau: f64) -> f64 {
+    if tau.is_finite() {
+        tau / (h + tau)
+    } else {
+        1.0
+    }
+}
+
 fn speculative(h: f64, gd_n: f64) -> f64 {
     2.0 * h * (-gd_n).max(0.0)
 }
@@ -112,6 +123,10 @@ pub struct PointResult {
     pub gd_n_before: f64,
     /// Kinetic energy the point's impulses took in the step (J).
     pub energy: f64,
+    /// Deflection δ of its compliant Signorini layer at the step's end (m): the layer's state,
+    /// carried into the next step while the point stays in the problem. `None` for a rigid
+    /// point or one not in the step (a layer left is taken as relaxed).
+    pub layer: Option<f64>,
 }
 
 /// How the local contact problem is assembled.
@@ -193,6 +208,11 @@ pub struct MoreauJean {
     pub results: Vec<PointResult>,
     u_free: Vec<f64>,
     u_prev: Vec<f64>,
+    /// The external loads' generalized forces at the midpoint (nu): their work over the step is
+    /// `h Q_extᵀ (u_k + u_{k+1})/2`, the velocities the impulses leave included.
+    q_ext: Vec<f64>,
+    /// Scratch for `q_ext`: the loads' wrenches summed up the tree (nbody).
+    load_acc: Vec<Force>,
     q_mid: Vec<f64>,
     q_pred: Vec<f64>,
     /// Joints whose velocities are components in their moving child frame (free: v and ω,
@@ -206,9 +226,9 @@ pub struct MoreauJean {
     /// Each active point's normal regularization `c/(h (h + τ))` (compliant Signorini laws,
     /// `τ = c d`); emptied after assembly where every point is rigid.
     reg: Vec<f64>,
-    /// Each active point's compliance c and time constant τ = c d (with `reg`, for the layer's
-    /// energy).
-    layer_c: Vec<[f64; 2]>,
+    /// Each active point's compliance c, time constant τ = c d and layer deflection δ at the
+    /// step's start (with `reg`; for the layer's law, state and energy).
+    layer_c: Vec<[f64; 3]>,
     /// Painlevé situations of the last step: (point, µ, critical µ, non-unique) for each
     /// explicit point that slid into the step with a non-positive normal velocity change per
     /// unit normal impulse under its sliding friction; non-unique if its free motion separates
@@ -222,6 +242,12 @@ pub struct MoreauJean {
     /// `Σ ½ k δ²` (J; `½ c λ_N²` undamped); the impact share of the contacts' work leaves its
     /// changes out.
     pub contact_elastic: f64,
+    /// Energy the steps' geometry has given the compliant Signorini layers, as a negative
+    /// dissipation (J, never positive): the held energy `½ k g_N²` of each point that joined a
+    /// step already overlapped (the velocity-level step let it in within a step, so no work
+    /// deflected its layer), which the layer then gives back. Zero for rigid contacts; part of the
+    /// dissipated energy, so the balance is unchanged.
+    pub contact_drift: f64,
     /// Work done on the system by moving surfaces (conveyor belts) through friction (J).
     pub surface_work: f64,
     /// Bilateral constraint impulse of the last step (nc), N s.
@@ -320,6 +346,8 @@ impl MoreauJean {
             results: vec![PointResult::default(); np],
             u_free: vec![0.0; nu],
             u_prev: vec![0.0; nu],
+            q_ext: vec![0.0; nu],
+            load_acc: vec![Force::ZERO; model.nbodies()],
             q_mid: vec![0.0; model.nq],
             q_pred: vec![0.0; model.nq],
             rotating: model
@@ -340,6 +368,7 @@ impl MoreauJean {
             dissipated_impact: 0.0,
             dissipated_friction: 0.0,
             contact_elastic: 0.0,
+            contact_drift: 0.0,
             surface_work: 0.0,
             bilateral_impulse: vec![0.0; model.nc],
             unconverged: (0, 0.0),
@@ -444,7 +473,9 @@ impl MoreauJean {
                 crate::dynamics::prepare(model, data, ws, tm, &self.q_mid, u, cb)?
             } else {
                 // (the same midpoint positions: only the velocities and forces are redone)
-                crate::dynamics::prepare_rates(model, data, ws, tm, &self.q_mid, &self.u_free, cb)?
+                let p = crate::dynamics::prepare_rates(model, data, ws, tm, &self.q_mid, &self.u_free, cb)?;
+                self.external_loads(model, data);
+                p
             };
             data.a[0] = Motion::ZERO;
             let zero = std::mem::take(&mut data.zero_u);
@@ -549,7 +580,10 @@ impl MoreauJean {
             self.group_stats[gi].pairs = ph.live.len();
         }
         let m = self.act.len();
-        let (mut dw_n, mut dw_t, mut stored) = (0.0, 0.0, 0.0);
+        // (stored: the layers' energy at the step's end; start: at the overlaps it starts from)
+        // the layers' energy at the step's end (stored), at the start of the points that carry
+        // their layer's state from the last step (kept) and of those that join overlapped (new)
+        let (mut dw_n, mut dw_t, mut stored, mut kept, mut new) = (0.0, 0.0, 0.0, 0.0, 0.0);
         if m > 0 {
             let dm = d * m;
             // local velocities before (u_k) and without (u_free) the impulses: ġ⁻, ġ_free
@@ -648,19 +682,28 @@ impl MoreauJean {
             self.painleve.clear();
             self.r.clear();
             for (ai, a) in self.act.iter().enumerate() {
-                let (friction, impact, compliance, gd_t, prev, prev_state) = match a.source {
+                let (friction, impact, compliance, gd_t, prev, prev_state, prev_layer) = match a.source {
                     Source::Point(pt) => {
                         let con = &model.contacts[a.contact];
                         let r = &self.results[pt];
                         let prev = [r.impulse_n, r.impulse_t[0], r.impulse_t[1]];
-                        (&con.friction, &con.impact, (con.compliance, con.damping), self.kin[pt].gd_t, prev, r.state)
+                        (
+                            &con.friction,
+                            &con.impact,
+                            (con.compliance, con.damping),
+                            self.kin[pt].gd_t,
+                            prev,
+                            r.state,
+                            r.layer,
+                        )
                     }
                     Source::Group { group, slot, k } => {
                         let g = &model.contact_groups[group];
                         let sl = &self.groups[group].slots[slot];
                         let fresh = sl.stamp == self.steps.wrapping_sub(1);
                         let (prev, st) = if fresh { sl.last[k] } else { ([0.0; 3], OPEN) };
-                        (&g.friction, &g.impact, (g.compliance, g.damping), sl.kin[k].gd_t, prev, st)
+                        let layer = (fresh && g.compliance > 0.0).then(|| sl.layer[k]);
+                        (&g.friction, &g.impact, (g.compliance, g.damping), sl.kin[k].gd_t, prev, st, layer)
                     }
                 };
                 // a point slides into the step if it slid in the last one, or if it took no
@@ -698,15 +741,27 @@ impl MoreauJean {
                     }
                 }
                 // a point still open by less than the margin may close within the step, not
-                // beyond. A compliant point's layer (k = 1/c, d) holds the overlap −g_N: with
-                // F = k δ + d δ̇ at the step's end, g_N + (h + τ) ġ_N⁺ + c F ≥ 0 (τ = c d, F = Λ_N/h),
-                // i.e. ġ_N⁺ + g_N/(h + τ) + c/(h (h + τ)) Λ_N ≥ 0: the regularization of W_NN
-                // (added below) and a gap term, as an implicit Euler step of the layer
+                // beyond. A compliant point's layer (k = 1/c, d, τ = c d) is deflected by δ₀ at the
+                // step's start: its state from the last step, or the overlap −g_N of a point that
+                // joins overlapped. Pressed, it ends the step at the body, δ = −(g_N + h ġ_N⁺), with
+                // F = Λ_N/h = k δ + d (δ − δ₀)/h, i.e. ġ_N⁺ + (g_N + τ δ₀/(h + τ))/h
+                // + c/(h (h + τ)) Λ_N ≥ 0: the regularization of W_NN (added below) and a gap
+                // term, an implicit Euler step of the layer. Without force the layer relaxes to
+                // τ δ₀/(h + τ) on its own, and the body cannot pass its surface there (a layer
+                // let go while still deflected is not pressed again at the body's overlap)
                 let (c, damping) = compliance;
                 let g = a.point.g_n;
-                let gap_allowance = if c > 0.0 && g < 0.0 { g / (h + c * damping) } else { g.max(0.0) / h };
-                self.reg.push(c / (h * (h + c * damping)));
-                self.layer_c.push([c, c * damping]);
+                let tau = c * damping;
+                let d0 = if c > 0.0 { prev_layer.unwrap_or((-g).max(0.0)) } else { 0.0 };
+                if c > 0.0 {
+                    match prev_layer {
+                        Some(_) => kept += 0.5 * d0 * d0 / c,
+                        None => new += 0.5 * d0 * d0 / c,
+                    }
+                }
+                let gap_allowance = if c > 0.0 { (g + relaxed(h, tau) * d0) / h } else { g.max(0.0) / h };
+                self.reg.push(c / (h * (h + tau)));
+                self.layer_c.push([c, tau, d0]);
                 self.problem.q[ai * d] += impact.eps() * self.gd_before[ai * d].min(0.0) + gap_allowance;
                 let mu = match friction {
                     FrictionLaw::None => 0.0,
@@ -918,6 +973,7 @@ impl MoreauJean {
                             state: code,
                             gd_n_before: self.gd_before[ai * d],
                             energy: 0.0,
+                            layer: None,
                         };
                     }
                     Source::Group { group, slot, k } => {
@@ -974,16 +1030,21 @@ impl MoreauJean {
                         dw_t += -self.r[a] * after[row];
                     }
                 }
-                if let Some(&[c, tau]) = self.layer_c.get(ai) {
-                    // ½ k δ² of the layer pressed by λ_N = Λ_N / h = k δ + d δ̇ (δ̇ = −ġ_N⁺), so
-                    // δ = c λ_N + τ ġ_N⁺ (undamped: ½ c λ_N², exact); a layer without force holds
-                    // none. Damped and extending (ġ_N⁺ > 0), δ is taken at most c λ_N: an overlap
-                    // the step let in before the point took part (an impact's) is no deflection
-                    // of the layer, and a layer pushing it out gives back no more than it holds
-                    let f = self.r[ai * d] / h;
-                    if f > 0.0 {
-                        let delta = (c * f + tau * after[0]).clamp(0.0, c * f);
+                if let Some(&[c, tau, d0]) = self.layer_c.get(ai) {
+                    // the layer's state at the step's end: pressed, at the body (by the step's law
+                    // δ = (h c λ_N + τ δ₀)/(h + τ) = −(g_N + h ġ_N⁺)); without force, relaxed on its
+                    // own to τ δ₀/(h + τ). It holds ½ k δ²; from δ₀ the layer takes in
+                    // λ_N (δ − δ₀) and stores ½ k (δ² − δ₀²), the rest (½ k + d/h) (δ − δ₀)² is its
+                    // damper's and the step's dissipation: never negative
+                    if c > 0.0 {
+                        let f = self.r[ai * d] / h;
+                        let w = relaxed(h, tau);
+                        let delta = if f > 0.0 { (1.0 - w) * c * f + w * d0 } else { w * d0 };
                         stored += 0.5 * delta * delta / c;
+                        match self.act[ai].source {
+                            Source::Point(pt) => self.results[pt].layer = Some(delta),
+                            Source::Group { group, slot, k } => self.groups[group].slots[slot].layer[k] = delta,
+                        }
                     }
                 }
                 if let Source::Point(pt) = self.act[ai].source {
@@ -1013,10 +1074,19 @@ impl MoreauJean {
             }
         }
         self.steps += 1;
-        // (what a compliant layer takes in, it holds; what it gives back, it had held)
-        self.dissipated_impact += dw_n - dw_t - (stored - self.contact_elastic);
+        // (what a compliant layer takes in within the step, it holds, from the deflection it
+        // starts from; a layer whose point left the step relaxes, its damper dissipating what it
+        // held (the last step's store less what the points kept carry on); a point that joins
+        // overlapped brings a deflection no work made: the step's geometry put that energy in)
+        self.dissipated_impact += dw_n - dw_t - (stored - kept - new) + (self.contact_elastic - kept);
+        self.contact_drift -= new;
         self.contact_elastic = stored;
         self.dissipated_friction += dw_t;
+        // the external loads' work over the step at the velocities the step gives them, u_k and
+        // u_{k+1} (both in the midpoint's joint frames here): at the force stage's own (u_k +
+        // u_free)/2 it missed the impulses' share, e.g. counted work on a body pressed at rest
+        let external =
+            h * self.q_ext.iter().zip(&self.u_prev).zip(u.iter()).map(|((f, a), b)| f * 0.5 * (a + b)).sum::<f64>();
         // ---- positions at the end of the step, and u in the end's joint frames
         model.integrate(&self.q_mid, u, 0.5 * h, q);
         self.reframe(&self.q_mid, q, u);
@@ -1033,7 +1103,25 @@ impl MoreauJean {
         if nc > 0 {
             crate::dynamics::constrained::project(model, data, ws, t + h, q, u, cb)?;
         }
-        Ok((p.external * h, p.dissipated * h))
+        Ok((external, p.dissipated * h))
+    }
+
+    /// `q_ext`: the generalized forces of the external loads of the force stage just evaluated
+    /// (`Data::f_load`, `Data::tau_load`), the wrenches summed from the leaves (world components,
+    /// so a parent adds its children's as they are) and projected on each joint's motion.
+    fn external_loads(&mut self, model: &Model, data: &Data) {
+        self.q_ext.copy_from_slice(&data.tau_load);
+        self.load_acc.copy_from_slice(&data.f_load);
+        for (ji, j) in model.joints.iter().enumerate().rev() {
+            let i = ji + 1;
+            let f = self.load_acc[i];
+            for k in 0..j.nu() {
+                self.q_ext[j.iu + k] += data.s[i][k].dot(&f);
+            }
+            if j.parent != 0 {
+                self.load_acc[j.parent] += f;
+            }
+        }
     }
 
     /// Solves the step's friction-contact problem into `self.r` (warm-started from it): whole,
