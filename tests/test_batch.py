@@ -124,6 +124,26 @@ def test_a_failing_case_is_kept_apart():
         ms.simulate_batch(m, t_end=0.2, integrator=ms.RK4(1e-3), q0=q0, u0=u0)
 
 
+def test_a_case_is_its_results_by_number_and_bad_keys_are_named():
+    """``batch[i]`` is case i's Results (negative from the end); a failed case, a number out of
+    range or a key of another type are errors that say so (an integer had reached the signal
+    lookup's spelling hints and crashed there with a TypeError)."""
+    m = free_body()
+    q0 = np.array([[0, 0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 0, 0], [0, 0, 0, 0.6, 0.8, 0, 0]], dtype=float)
+    u0 = np.tile([0.1, 0.0, 0.0, 1.0, 2.0, 3.0], (3, 1))
+    batch = ms.simulate_batch(m, t_end=0.1, integrator=ms.RK4(1e-3), output_dt=0.01, q0=q0, u0=u0, on_error="keep")
+    assert np.array_equal(batch[2]["q"], batch.q[2]) and np.array_equal(batch[-1]["u"], batch.u[2])
+    assert np.array_equal(batch[np.int64(0)]["q"], batch.q[0])
+    with pytest.raises(ms.ResultsError, match="batch case 1 failed: .*'free'"):
+        batch[1]
+    with pytest.raises(ms.ResultsError, match=r"batch case 3: the batch has 3 cases \(0 \.\. 2\)"):
+        batch[3]
+    with pytest.raises(ms.ResultsError, match="signal name or a case number, got 1.5"):
+        batch[1.5]
+    with pytest.raises(ms.ResultsError, match="named by a string such as 'joint/j1/q', got 0 \\(int\\)"):
+        batch[0][0]
+
+
 def test_cli_batch_writes_stacked_states(tmp_path):
     x0 = states(4)
     np.save(tmp_path / "states.npy", x0)

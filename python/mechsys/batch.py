@@ -15,7 +15,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from . import _core
-from .errors import SettingsError
+from .errors import ResultsError, SettingsError
 from .model import Model
 from .results import Results
 from .simulate import _settings
@@ -57,8 +57,20 @@ class BatchResults:
             self._results = [None if r is None else self._make(i, r) for i, r in enumerate(self._raws)]
         return self._results
 
-    def __getitem__(self, name: str) -> np.ndarray:
+    def __getitem__(self, name: str | int) -> np.ndarray | Results:
+        """A signal stacked over the cases (``batch["q"]``: (cases, samples, ...)), or by an
+        integer the one case's :class:`mechsys.Results` (``batch[3]``; negative from the end)."""
         res = self.results
+        if isinstance(name, (int, np.integer)) and not isinstance(name, bool):
+            i = int(name)
+            if not -len(res) <= i < len(res):
+                raise ResultsError(f"batch case {i}: the batch has {len(res)} cases (0 .. {len(res) - 1})")
+            if res[i] is None:
+                raise ResultsError(f"batch case {i} failed: {self.errors[i]}")
+            return res[i]
+        if not isinstance(name, str):
+            raise ResultsError(f"a batch is indexed by a signal name or a case number, got {name!r} "
+                               f"({type(name).__name__})")
         ok = next((r for r in res if r is not None), None)
         if ok is None:
             raise KeyError(f"{name}: no case ran")

@@ -478,6 +478,9 @@ class Results:
 
     # ---- access --------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> np.ndarray:
+        if not isinstance(name, str):
+            raise ResultsError(f"a signal is named by a string such as 'joint/j1/q', got {name!r} "
+                               f"({type(name).__name__}); res.names() lists them")
         try:
             return self._signals[name]
         except KeyError:
