@@ -496,3 +496,29 @@ def test_rk4_on_the_rotation_group_splits_its_steps_at_the_onsets_too():
     close, opened = contact_times(rk)
     assert close[0] == pytest.approx(gap, rel=1e-9)
     assert opened[0] - close[0] == pytest.approx(T, rel=1e-6)
+
+
+@pytest.mark.parametrize("law", ["hertz", "kelvin_voigt"])
+def test_linearized_at_rest_a_stiff_contact_has_its_tangent_stiffness(law):
+    """A 1 cm steel ball at rest on a steel plane under gravity overlaps by delta = (m g / K)^(2/3)
+    = 0.08 micrometre (Hertz, K = 4/3 E* sqrt(R)); linearized there, its bounce mode has the
+    tangent stiffness 1.5 K sqrt(delta). On a Kelvin-Voigt contact of k = 1e9 N/m (overlap
+    0.3 nm) it is k. The central differences' position step (1e-5 m) reached across the force
+    law's kink at delta = 0 and gave about half of either: the step is now a quarter of the
+    smallest overlap."""
+    g = 9.81
+    if law == "hertz":
+        k_h = 4.0 / 3.0 * E_STAR * math.sqrt(R)
+        delta = (MASS * g / k_h) ** (2.0 / 3.0)
+        stiffness = 1.5 * k_h * math.sqrt(delta)
+        normal = ms.laws.Hertz()
+    else:
+        stiffness = 1e9
+        delta = MASS * g / stiffness
+        normal = ms.laws.KelvinVoigt(k=stiffness)
+    m = ball_on_plane(normal, v0=0.0, gap=-delta, gravity=g)
+    m.build()
+    lin = ms.linear.linearize(m)
+    assert lin.method == "fd"
+    np.testing.assert_allclose(lin.K[0, 0], stiffness, rtol=1e-6)
+    np.testing.assert_allclose(lin.modes().natural_frequency[-1], math.sqrt(stiffness / MASS) / (2 * math.pi), rtol=1e-6)

@@ -369,8 +369,85 @@ def test_linearized_with_the_contact_held_a_layer_is_its_spring_and_damper():
         np.testing.assert_allclose(modes.natural_frequency[bounce], np.sqrt(k / mass) / (2 * np.pi), rtol=1e-9)
         np.testing.assert_allclose(modes.damping_ratio[bounce], d / (2 * np.sqrt(k * mass)), rtol=1e-9, atol=1e-12)
         assert np.sort(modes.natural_frequency)[-2] < 1e-3
-    # rolling on a layer is not offered, and a layer touched without load has a kink: refused by name
-    with pytest.raises(ms.SettingsError, match=r"contact 'floor' has a compliant Signorini layer.*contacts='hold'"):
-        ms.linear.linearize(m, q=res["q"][-1], u=np.zeros(6), contacts="roll")
+    # a layer touched without load has a kink: refused by name
     with pytest.raises(ms.SettingsError, match=r"contact 'floor' touches without pressing its compliant layer"):
         ms.linear.linearize(ball_on_floor(c, mass), contacts="hold")
+
+
+def ball_in_bowl(c, mass=1.0, r=0.05, radius=0.5, friction=True):
+    m = ms.Model("bowl", gravity=(0, 0, -G))
+    b = m.add_body("ball", mass, ms.inertia.sphere(mass, r))
+    m.add_joint(ms.joints.Free("f", m.ground, b, q0=[0, 0, -(radius - r), 1, 0, 0, 0]))
+    m.add_contact(ms.Contact("bowl", b.contour(ms.contours.Sphere(radius=r)), m.ground.contour(ms.contours.Bowl(radius=radius)),
+                             normal=ms.laws.Signorini(compliance=c), friction=ms.laws.Coulomb(0.8) if friction else None))
+    m.build()
+    return m
+
+
+def test_a_ball_rolling_in_a_bowl_on_its_layer_rocks_at_the_rolling_frequency():
+    """A ball (radius r) at rest at the bottom of a spherical bowl (radius R) on a layer of
+    k = 1e9 N/m, linearized with the contact held: sliding ("hold") it rocks at
+    sqrt(g/(R - r)), rolling without slip ("roll": the layer carries the normal force, a
+    tangents-only bilateral contact the friction) at sqrt(5 g / (7 (R - r))), the classical
+    rolling ball in a bowl; in both its bounce on the layer is sqrt(k/m), and the spin about the
+    normal is free. (Before, "roll" on a layer was refused.)"""
+    c, mass, r, radius = 1e-9, 1.0, 0.05, 0.5
+    m = ball_in_bowl(c, mass, r, radius)
+    q = np.array([0.0, 0.0, -(radius - r) - c * mass * G, 1.0, 0.0, 0.0, 0.0])
+    bounce = np.sqrt(1.0 / (c * mass)) / (2 * np.pi)
+    # (central differences, the layer's force being no exact-derivative law: 2.4e-7 and 2.5e-6
+    # measured; the same ball on a rigid bowl's held contact comes out to 1e-11)
+    for mode, rock, tol in (("hold", np.sqrt(G / (radius - r)), 1e-6), ("roll", np.sqrt(5 * G / (7 * (radius - r))), 5e-6)):
+        lin = ms.linear.linearize(m, q=q, u=np.zeros(6), contacts=mode)
+        f = np.sort(lin.modes().natural_frequency)
+        np.testing.assert_allclose(f[-1], bounce, rtol=1e-6, err_msg=mode)
+        np.testing.assert_allclose(f[-3:-1], rock / (2 * np.pi), rtol=tol, err_msg=mode)
+        assert np.abs(f[:-3]).max() < 1e-6 * rock, (mode, f)
+    held = ms.linear.linearize(m, q=q, u=np.zeros(6), contacts="roll").model
+    assert {c["name"] for c in held.engine()[0].constraints()} == {"bowl_rolling"}
+    # a frictionless layer cannot roll; a gap contact's layer rolls in no tangent plane of its own
+    with pytest.raises(ms.SettingsError, match=r"contact 'bowl' has a frictionless compliant Signorini layer.*contacts='hold'"):
+        ms.linear.linearize(ball_in_bowl(c, mass, r, radius, friction=False), q=q, u=np.zeros(6), contacts="roll")
+
+
+def test_rolling_on_a_layer_that_would_slip_is_refused_by_name():
+    """The same ball held by its layer on a bowl's flank under a sideways pull larger than
+    mu0 times the layer's normal force would have to slip: refused naming the contact."""
+    c, mass, r, radius = 1e-9, 1.0, 0.05, 0.5
+    m2 = ms.Model("bowl-pulled", gravity=(0, 0, -G))
+    b = m2.add_body("ball", mass, ms.inertia.sphere(mass, r))
+    m2.add_joint(ms.joints.Free("f", m2.ground, b, q0=[0, 0, -(radius - r), 1, 0, 0, 0]))
+    m2.add_contact(ms.Contact("bowl", b.contour(ms.contours.Sphere(radius=r)), m2.ground.contour(ms.contours.Bowl(radius=radius)),
+                              normal=ms.laws.Signorini(compliance=c), friction=ms.laws.Coulomb(0.1)))
+    m2.add_force(ms.forces.BodyForce("pull", b, force=(0.5 * mass * G, 0.0, 0.0), point=(0.0, 0.0, r)))
+    m2.build()
+    q = np.array([0.0, 0.0, -(radius - r) - c * mass * G, 1.0, 0.0, 0.0, 0.0])
+    with pytest.raises(ms.SettingsError, match=r"contact 'bowl' cannot roll on its compliant layer at the point"):
+        ms.linear.linearize(m2, q=q, u=np.zeros(6), contacts="roll", operating_point=True)
+
+
+def test_a_tangents_only_bilateral_contact_and_the_static_equilibrium_on_a_layer():
+    """laws.Bilateral(rolling=True, hold_normal=False) holds only the tangents (the constraint's
+    columns are t1, t2); without rolling it holds nothing and is refused by name. The static
+    equilibrium of the ball in the bowl with its layer held rolling sinks it by c m g and leaves
+    no friction force."""
+    with pytest.raises(ms.ModelError, match=r"hold_normal: False holds only the tangents, so it needs rolling=True"):
+        ms.laws.Bilateral(hold_normal=False).describe("contact 'x'.normal")
+    c, mass, r, radius = 1e-6, 1.0, 0.05, 0.5
+    m = ball_in_bowl(c, mass, r, radius)
+    eq = ms.analysis.static_equilibrium(m, q=[0.0, 0.0, -(radius - r), 1.0, 0.0, 0.0, 0.0], contacts="roll")
+    np.testing.assert_allclose(eq["q"][2], -(radius - r) - c * mass * G, rtol=0, atol=1e-12)
+    assert set(eq["lambda"]) == {"bowl_rolling"} and np.abs(eq["lambda"]["bowl_rolling"]).max() < 1e-9
+    held = ms.linear.linearize(m, q=eq["q"], u=np.zeros(6), contacts="roll").model
+    (info,) = held.engine()[0].constraints()
+    assert info["columns"] == ["t1", "t2"] and info["holonomic_rows"] == 0
+    # the model file carries the key, and a gap contact refuses it by name
+    desc, _ = held.describe()
+    roller = next(d for d in desc["contacts"] if d["name"] == "bowl_rolling")
+    assert roller["normal"] == {"type": "bilateral", "rolling": True, "hold_normal": False}
+    g = ms.Model("gap", gravity=(0, 0, -G))
+    b = g.add_body("slider", 1.0, ms.inertia.box(1.0, (0.1, 0.1, 0.1)))
+    g.add_joint(ms.joints.Prismatic("z", g.ground, b, axis=(0, 0, 1)))
+    g.add_contact(ms.GapContact("stop", gap="z", tangents=["z"], normal=ms.laws.Bilateral(rolling=True, hold_normal=False)))
+    with pytest.raises(ms.ModelError, match=r"gap_contacts\[0\] 'stop'\.normal: hold_normal = false .* is for contour contacts"):
+        g.build()

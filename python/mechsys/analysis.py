@@ -169,6 +169,17 @@ def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10,
     names = {c["name"]: lam[c["row"] : c["row"] + c["rows"]].copy() for c in core.constraints()}
     for name, mu in held.items():
         lam_c = names[name]
+        if isinstance(mu, tuple):
+            # rolling on a compliant layer: the layer carries the normal force, the rows are the
+            # tangential forces
+            from .linear import _layer_force
+
+            lam_n = _layer_force(mu, qk, zero, t)
+            if np.linalg.norm(lam_c) > mu[0] * lam_n * (1 + 1e-12):
+                raise SolverError(f"static equilibrium: contact '{mu[2]}' would need a friction force "
+                                  f"{np.linalg.norm(lam_c):.4g} N, more than mu0 x its layer's normal force "
+                                  f"({mu[0]:.3g} x {lam_n:.4g} N): it slips")
+            continue
         if lam_c[0] <= 0.0:
             raise SolverError(f"static equilibrium: contact '{name}' would have to pull (normal force {lam_c[0]:.4g} N) "
                               "in the equilibrium found: it opens there")

@@ -97,14 +97,25 @@ class Signorini:
 @dataclass
 class Bilateral:
     """The contact stays closed (g_N = 0, the normal force may be negative: pulling); with
-    ``rolling``, it also rolls without slipping. No friction or impact law goes with it."""
+    ``rolling``, it also rolls without slipping. No friction or impact law goes with it. With
+    ``hold_normal=False`` (and ``rolling``) only the tangents are held: the contact rolls without
+    slip while another contact of the same pair carries its normal force (a compliant one: a
+    wheel on an elastic layer, as ``linearize(contacts="roll")`` holds a compliant Signorini
+    layer)."""
 
     rolling: bool = False
+    hold_normal: bool = True
 
     def describe(self, what: str) -> dict:
-        if not isinstance(self.rolling, (bool,)):
-            raise ModelError(f"{what}.rolling: expected True or False, got {self.rolling!r}")
-        return {"type": "bilateral", "rolling": bool(self.rolling)}
+        for key in ("rolling", "hold_normal"):
+            if not isinstance(getattr(self, key), (bool,)):
+                raise ModelError(f"{what}.{key}: expected True or False, got {getattr(self, key)!r}")
+        if not self.hold_normal and not self.rolling:
+            raise ModelError(f"{what}.hold_normal: False holds only the tangents, so it needs rolling=True")
+        d = {"type": "bilateral", "rolling": bool(self.rolling)}
+        if not self.hold_normal:
+            d["hold_normal"] = False
+        return d
 
 
 @dataclass

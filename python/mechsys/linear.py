@@ -534,8 +534,10 @@ def linearize(model: Model, q=None, u=None, t: float = 0.0, operating_point: boo
     otherwise a SettingsError names it and its force. Open contacts exert nothing and are left
     out. ``lin.model`` is then the model with the held contacts (``laws.Bilateral``). A contact on
     a compliant Signorini layer (``laws.Signorini(compliance=c, damping=d)``) pressed at the point
-    is held as its layer instead, a spring 1/c and damper d along the normal sliding
-    frictionlessly (``laws.KelvinVoigt`` in ``lin.model``; ``"hold"`` only).
+    is held as its layer instead, a spring 1/c and damper d along the normal (``laws.KelvinVoigt``
+    in ``lin.model``), sliding frictionlessly with ``"hold"``; with ``"roll"`` a second contact
+    of the pair, ``<name>_rolling`` (``laws.Bilateral(rolling=True, hold_normal=False)``), holds
+    its tangents, and must stay inside mu0 times the layer's force.
 
     ``at`` chooses the point instead of ``q``/``u``: ``None`` or ``"q0"`` (the model's q0, u0),
     ``"equilibrium"`` (:func:`mechsys.analysis.static_equilibrium` from ``q``, at rest unless
@@ -712,6 +714,7 @@ def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str)
         return model, {}
     desc, callbacks = model.describe()
     held = {}
+    rollers = []
     for c in desc.get("contacts", []) + desc.get("gap_contacts", []):
         if c["name"] not in closed:
             continue
@@ -724,10 +727,22 @@ def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str)
         layer = c.get("normal") or {}
         if layer.get("type") == "signorini" and layer.get("compliance", 0.0) > 0.0:
             # a compliant Signorini layer held closed is its spring (and damper) along the normal,
-            # sliding frictionlessly: a Kelvin-Voigt force, smooth where the layer is pressed
+            # sliding frictionlessly: a Kelvin-Voigt force, smooth where the layer is pressed;
+            # rolling, a second contact of the pair holds its tangents (laws.Bilateral with
+            # hold_normal=False) while the layer carries the normal force
             if mode == "roll":
-                raise SettingsError(f"{what} has a compliant Signorini layer: held, it is its spring along the normal and "
-                                    "slides frictionlessly; rolling without slip on a layer is not supported (use contacts='hold')")
+                if "gap" in c:
+                    raise SettingsError(f"{what} is a gap contact on a compliant Signorini layer: rolling on a layer is "
+                                        "held for contour contacts only; use contacts='hold'")
+                mu = _static_mu(c.get("friction"))
+                if mu is None:
+                    raise SettingsError(f"{what} has a frictionless compliant Signorini layer, so it cannot roll without "
+                                        "slip; use contacts='hold'")
+                roller = {k: v for k, v in c.items() if k not in ("friction", "impact", "normal")}
+                roller["name"] = f"{c['name']}_rolling"
+                roller["normal"] = {"type": "bilateral", "rolling": True, "hold_normal": False}
+                rollers.append(roller)
+                held[roller["name"]] = (mu, model, c["name"], 1.0 / float(layer["compliance"]))
             if closed_gap[c["name"]] >= 0.0:
                 raise SettingsError(f"{what} touches without pressing its compliant layer at the point (gap "
                                     f"{closed_gap[c['name']]:.3g} m): the layer's force has a kink there; linearize where "
@@ -744,7 +759,19 @@ def _held_model(model: Model, q: np.ndarray, u: np.ndarray, t: float, mode: str)
         c["normal"] = {"type": "bilateral", "rolling": mode == "roll"}
         c.pop("friction", None)
         c.pop("impact", None)
+    desc.setdefault("contacts", []).extend(rollers)
     return Model.from_dict(desc, callbacks), held
+
+
+def _layer_force(entry: tuple, q: np.ndarray, u: np.ndarray, t: float) -> float:
+    """The normal force k max(0, -g_N) of a contact held rolling on its compliant layer (a
+    ``held`` entry (mu, model, contact, k)), from its gap in the model it was derived from."""
+    from .dynamics import contact_matrices
+
+    _, original, name, k = entry
+    cm = contact_matrices(original, q, u, t)
+    gaps = [float(g) for c, g in zip(cm["contact"], cm["gap"]) if c == name]
+    return k * max(0.0, -min(gaps)) if gaps else 0.0
 
 
 def _check_held(derived: Model, held: dict, q: np.ndarray, u: np.ndarray, t: float, mode: str) -> None:
@@ -761,6 +788,17 @@ def _check_held(derived: Model, held: dict, q: np.ndarray, u: np.ndarray, t: flo
     lam = np.linalg.lstsq(g_mat @ m_inv_h[:, 1:], gamma - g_mat @ m_inv_h[:, 0], rcond=None)[0]
     for info in derived.engine()[0].constraints():
         if info["name"] not in held:
+            continue
+        if isinstance(held[info["name"]], tuple):
+            # rolling on a compliant layer: the layer's spring carries the normal force, the
+            # constraint's rows are the tangential (friction) forces
+            entry = held[info["name"]]
+            lam_n = _layer_force(entry, q, u, t)
+            lam_t = float(np.linalg.norm(lam[info["row"]:info["row"] + info["rows"]]))
+            if lam_t > entry[0] * lam_n * (1.0 + 1e-12):
+                raise SettingsError(f"linearize: contact '{entry[2]}' cannot roll on its compliant layer at the point: it "
+                                    f"needs a friction force {lam_t:.4g} N, more than mu0 times the layer's normal force "
+                                    f"({entry[0]:.3g} x {lam_n:.4g} N); it slips (use contacts='hold' for frictionless sliding)")
             continue
         r0, lam_n = info["row"], float(lam[info["row"]])
         if lam_n <= 0.0:

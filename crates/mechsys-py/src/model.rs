@@ -264,9 +264,11 @@ impl PyModel {
                 d.set_item("column_units", units.iter().map(|u| u.0).collect::<Vec<_>>())?;
                 d.set_item("column_violation_units", units.iter().map(|u| u.1).collect::<Vec<_>>())?;
             }
-            if let K::Contact { .. } = &c.kind {
-                // a held contact: its normal force, then the rolling rows' tangential forces
-                d.set_item("columns", ["normal", "t1", "t2"][..c.rows()].to_vec())?;
+            if let K::Contact { normal, .. } = &c.kind {
+                // a held contact: its normal force, then the rolling rows' tangential forces (the
+                // tangents alone where another law carries the normal)
+                let skip = usize::from(!*normal);
+                d.set_item("columns", ["normal", "t1", "t2"][skip..skip + c.rows()].to_vec())?;
                 d.set_item("column_units", vec!["N"; c.rows()])?;
                 d.set_item("column_violation_units", vec!["m"; c.rows()])?;
             }

@@ -756,12 +756,14 @@ pub fn positions(model: &Model, data: &mut Data, t: f64, q: &[f64], cb: &dyn Cal
                     r,
                 );
             }
-            ConstraintKind::Contact { body1, body2, pair, .. } => {
-                // g_N = 0 (holonomic), then ġ_T = 0 along each friction direction (rolling)
+            ConstraintKind::Contact { body1, body2, pair, normal, .. } => {
+                // g_N = 0 (holonomic), then ġ_T = 0 along each friction direction (rolling);
+                // without the normal row the tangents alone
                 let (k, tg) = held_contact(c, data, t, *body1, *body2, pair)?;
                 let rows = c.kind.rows();
-                for (j, e) in std::iter::once(&k.n).chain(tg.iter()).take(rows).enumerate() {
-                    data.phi[r + j] = if j == 0 { k.g } else { 0.0 };
+                let skip = usize::from(!*normal);
+                for (j, e) in std::iter::once(&k.n).chain(tg.iter()).skip(skip).take(rows).enumerate() {
+                    data.phi[r + j] = if j == 0 && *normal { k.g } else { 0.0 };
                     data.b[r + j] = 0.0;
                     add_relative_rows(
                         model,
@@ -883,7 +885,7 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64
                 // d²|d|/dt² = e·a + (|v|² - (e·v)²)/|d|
                 data.gamma[r] = -(e.dot(&a) + (v.norm_squared() - e.dot(&v).powi(2)) / l);
             }
-            ConstraintKind::Contact { body1, body2, pair, .. } => {
+            ConstraintKind::Contact { body1, body2, pair, normal, .. } => {
                 // the velocity-product parts w̄_N, w̄_T of the contact kinematics (eqs. 2.114,
                 // 2.115): data.a holds the tree's accelerations at u̇ = 0 here
                 use crate::contact::{contact_kinematics, BodyMotion, ContactKinematics};
@@ -892,9 +894,10 @@ pub fn accelerations(model: &Model, data: &mut Data, t: f64, q: &[f64], u: &[f64
                 contact_kinematics(pair, &b1, &b2, &mut k)
                     .map_err(|e| Error::Solver(format!("constraint '{}' (bilateral contact): {e}", c.name)))?;
                 let rows = c.kind.rows();
-                data.gamma[r] = -k[0].wbar_n;
-                for j in 1..rows {
-                    data.gamma[r + j] = -k[0].wbar_t[j - 1];
+                let skip = usize::from(!*normal);
+                for j in 0..rows {
+                    let a = j + skip;
+                    data.gamma[r + j] = if a == 0 { -k[0].wbar_n } else { -k[0].wbar_t[a - 1] };
                 }
             }
             ConstraintKind::Gap { function, slot, .. } => {
@@ -970,11 +973,13 @@ fn apply_forces_checked(model: &Model, data: &mut Data) -> Result<()> {
                 add_point_force(data, *body1, p1, &f);
                 add_point_force(data, *body2, p2, &(-f));
             }
-            ConstraintKind::Contact { body1, body2, pair, .. } => {
+            ConstraintKind::Contact { body1, body2, pair, normal, .. } => {
                 let (k, tg) = held_contact(c, data, f64::NAN, *body1, *body2, pair)?;
-                let mut f = k.n * data.lambda[r];
-                for j in 1..c.kind.rows() {
-                    f += tg[j - 1] * data.lambda[r + j];
+                let skip = usize::from(!*normal);
+                let mut f = Vec3::zeros();
+                for j in 0..c.kind.rows() {
+                    let a = j + skip;
+                    f += if a == 0 { k.n } else { tg[a - 1] } * data.lambda[r + j];
                 }
                 if *body1 != 0 {
                     data.f_ext[*body1] += Force::new(k.p1.cross(&f), f);

@@ -781,20 +781,25 @@ fn model_with_held_contacts() -> Model {
     let base = model_with_new_kinds();
     let mut desc = base.description.clone();
     desc.constraints.clear();
-    let held =
-        |name: &str, b1: &str, c1: ContourDescription, b2: &str, c2: ContourDescription, rolling| ContactDescription {
-            name: name.into(),
-            body1: b1.into(),
-            contour1: c1,
-            body2: b2.into(),
-            contour2: c2,
-            normal: NormalDescription::Bilateral { rolling },
-            friction: FrictionDescription::None,
-            impact: ImpactDescription::default(),
-            points: None,
-            material1: None,
-            material2: None,
+    let held_as =
+        |name: &str, b1: &str, c1: ContourDescription, b2: &str, c2: ContourDescription, rolling, hold_normal| {
+            ContactDescription {
+                name: name.into(),
+                body1: b1.into(),
+                contour1: c1,
+                body2: b2.into(),
+                contour2: c2,
+                normal: NormalDescription::Bilateral { rolling, hold_normal },
+                friction: FrictionDescription::None,
+                impact: ImpactDescription::default(),
+                points: None,
+                material1: None,
+                material2: None,
+            }
         };
+    let held = |name: &str, b1: &str, c1: ContourDescription, b2: &str, c2: ContourDescription, rolling| {
+        held_as(name, b1, c1, b2, c2, rolling, true)
+    };
     let sphere = |c: [f64; 3], r| ContourDescription::Sphere { center: c, radius: r };
     desc.contacts = vec![
         held(
@@ -814,6 +819,8 @@ fn model_with_held_contacts() -> Model {
             true,
         ),
         held("balls", "d", sphere([0.0, 0.1, 0.0], 0.1), "c", sphere([0.1, 0.0, 0.05], 0.15), false),
+        // the tangents alone (another law of the pair carrying the normal)
+        held_as("rolling_only", "d", sphere([0.02, -0.1, 0.03], 0.12), "b", sphere([0.0, 0.05, 0.1], 0.2), true, false),
     ];
     Model::from_description(desc).unwrap()
 }
@@ -824,7 +831,7 @@ fn held_contacts_have_their_row_counts() {
     assert!(model.contacts.is_empty(), "held contacts are constraints");
     let rows: Vec<(usize, usize)> =
         model.constraints.iter().map(|c| (c.kind.rows(), c.kind.holonomic_rows())).collect();
-    assert_eq!(rows, [(3, 1), (3, 1), (1, 1)]);
+    assert_eq!(rows, [(3, 1), (3, 1), (1, 1), (2, 0)]);
 }
 
 #[test]

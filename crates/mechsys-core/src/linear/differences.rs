@@ -5,7 +5,12 @@
 //! Step `1e-5` for positions and `1e-5 · max(1, |u|∞)` for velocities: truncation `h²/6 |u̇'''|`
 //! and round-off `ε |u̇| / h` meet near 1e-10 relative for smooth force laws (exact for linear
 //! ones). Used by `Derivatives::CentralDifferences` and wherever the exact path cannot go
-//! (callback forces).
+//! (callback forces, compliant contacts). A compliant contact's force has a kink where its
+//! overlap δ is zero; a stiff contact at rest overlaps by less than the step (a micrometre at
+//! 1e7 N/m), and a difference across the kink halves its stiffness. The position step is
+//! therefore shortened along each direction that moves a compliant contact's point: to a
+//! thousandth of its overlap over its rate along the direction, and so that the overlap's
+//! curvature along it changes the overlap by less than a millionth.
 
 use nalgebra::DMatrix;
 
@@ -17,6 +22,44 @@ use crate::model::Model;
 
 /// Step of the central differences (positions absolute, velocities relative to `max(1, |u|∞)`).
 pub(super) const STEP: f64 = 1e-5;
+
+/// Where the overlaps δ of the explicit compliant contacts' points are recorded
+/// (`Data::element_deflection`), for [`acceleration_derivatives`]' step.
+fn overlap_slots(model: &Model) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut next = 0;
+    for fe in &model.forces {
+        let o = next;
+        next += fe.outputs(model.nu);
+        if let crate::model::ForceElement::Contact(c) = fe {
+            out.extend((0..c.points()).map(|k| o + crate::model::compliant::OUTPUTS_PER_POINT * k));
+        }
+    }
+    out
+}
+
+/// The position step along a direction from the overlaps at the point (`at`) and at ±`h`: `h`,
+/// or less where a compliant point's overlap changes along it, so that the difference stays a
+/// thousandth of the overlap away from the force law's kink at δ = 0 and the overlap's own
+/// curvature along the direction (a ball rocking in a bowl) moves it by less than a millionth
+/// (either gives about 1e-6 relative in the stiffness); not below 1e-13 m.
+fn step_along(at: &[f64], plus: &[f64], minus: &[f64], h: f64) -> f64 {
+    let mut step = h;
+    for ((d0, dp), dm) in at.iter().zip(plus).zip(minus) {
+        if !(d0.is_finite() && *d0 != 0.0) {
+            continue;
+        }
+        let rate = (dp - dm).abs() / (2.0 * h);
+        if rate > 0.0 {
+            step = step.min(1e-3 * d0.abs() / rate);
+        }
+        let curvature = (dp + dm - 2.0 * d0).abs() / (h * h);
+        if curvature > 0.0 {
+            step = step.min((1e-6 * d0.abs() / curvature).sqrt());
+        }
+    }
+    step.max(1e-13)
+}
 
 /// `(∂u̇/∂q V, ∂u̇/∂u V)`, each nu × n, by central differences of `dynamics::forward_dynamics`.
 #[allow(clippy::too_many_arguments)]
@@ -36,6 +79,12 @@ pub(super) fn acceleration_derivatives(
         Ok(data.udot.clone())
     };
     let (mut qp, mut up, mut dir) = (vec![0.0; nq], u.to_vec(), vec![0.0; nu]);
+    // the compliant contacts' overlaps at the point, and at each difference's ends
+    let slots = overlap_slots(model);
+    let overlaps = |data: &Data| -> Vec<f64> { slots.iter().map(|&i| data.element_deflection[i]).collect() };
+    accel(data, q, u)?;
+    let at = overlaps(data);
+    let mut ends: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
     let mut dq = DMatrix::zeros(nu, n);
     let mut du = DMatrix::zeros(nu, n);
     // the velocity step scales with the state so that fast operating points keep their digits
@@ -46,13 +95,24 @@ pub(super) fn acceleration_derivatives(
         }
         // positions: q* ⊕ ±h V_j
         let mut col = [vec![0.0; nu], vec![0.0; nu]];
-        for (s, sign) in [1.0, -1.0].iter().enumerate() {
-            model.integrate(q, &dir, sign * STEP, &mut qp);
-            model.normalize(&mut qp);
-            col[s] = accel(data, &qp, u)?;
+        let mut h = STEP;
+        for pass in 0..2 {
+            for (s, sign) in [1.0, -1.0].iter().enumerate() {
+                model.integrate(q, &dir, sign * h, &mut qp);
+                model.normalize(&mut qp);
+                col[s] = accel(data, &qp, u)?;
+                ends[s] = overlaps(data);
+            }
+            // a stiff contact at rest overlaps by less than STEP (a micrometre at 1e7 N/m): a
+            // difference across its kink at δ = 0 halves its stiffness, so step again, shorter
+            let shorter = step_along(&at, &ends[0], &ends[1], h);
+            if pass == 1 || shorter >= h {
+                break;
+            }
+            h = shorter;
         }
         for i in 0..nu {
-            dq[(i, j)] = (col[0][i] - col[1][i]) / (2.0 * STEP);
+            dq[(i, j)] = (col[0][i] - col[1][i]) / (2.0 * h);
         }
         for (s, sign) in [1.0, -1.0].iter().enumerate() {
             for i in 0..nu {

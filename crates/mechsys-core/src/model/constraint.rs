@@ -170,6 +170,8 @@ pub enum ConstraintKind {
         pair: Box<ContactPair>,
         /// Whether the contact also rolls without slipping.
         rolling: bool,
+        /// Whether g_N = 0 is held (row 0); without it the rows are the tangents alone.
+        normal: bool,
     },
     /// A gap contact held closed: its gap function `g_N(q, t) = 0` (1 holonomic row, λ the
     /// generalized force along `∂g/∂q`) and, when `rolling`, the rates of its tangential
@@ -271,8 +273,8 @@ impl ConstraintKind {
             ConstraintKind::PointOnLine { .. } => 2,
             ConstraintKind::PrescribedBody { orientation, .. } => 3 + 3 * usize::from(orientation.is_some()),
             ConstraintKind::Velocity { rows, .. } => *rows,
-            ConstraintKind::Contact { pair, rolling, .. } => {
-                1 + usize::from(*rolling) * if pair.is_planar() { 1 } else { 2 }
+            ConstraintKind::Contact { pair, rolling, normal, .. } => {
+                usize::from(*normal) + usize::from(*rolling) * if pair.is_planar() { 1 } else { 2 }
             }
             ConstraintKind::Gap { function, rolling, .. } => 1 + usize::from(*rolling) * function.tangents(),
             ConstraintKind::Loop { joint, .. } => match joint {
@@ -306,7 +308,8 @@ impl ConstraintKind {
     pub fn holonomic_rows(&self) -> usize {
         match self {
             ConstraintKind::KnifeEdge { .. } | ConstraintKind::Velocity { .. } => 0,
-            ConstraintKind::RollingDisc { .. } | ConstraintKind::Contact { .. } | ConstraintKind::Gap { .. } => 1,
+            ConstraintKind::Contact { normal, .. } => usize::from(*normal),
+            ConstraintKind::RollingDisc { .. } | ConstraintKind::Gap { .. } => 1,
             k => k.rows(),
         }
     }

@@ -409,6 +409,11 @@ pub enum NormalDescription {
         /// Whether the tangential relative velocity is held at zero too.
         #[serde(default)]
         rolling: bool,
+        /// Whether g_N = 0 is held (the default). `false` with `rolling`: only the tangents are
+        /// held (rolling without slip) while another law of the same pair carries the normal
+        /// force, e.g. a contact held on its compliant layer for a linearization.
+        #[serde(default = "yes", skip_serializing_if = "is_true")]
+        hold_normal: bool,
     },
     /// Compliant, Kelvin–Voigt: F = max(0, k δ + d δ̇) with δ = −g_N the overlap.
     KelvinVoigt {
@@ -443,6 +448,14 @@ impl Default for NormalDescription {
     fn default() -> Self {
         NormalDescription::Signorini { compliance: 0.0, damping: 0.0 }
     }
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(v: &bool) -> bool {
+    *v
 }
 
 fn is_zero(v: &f64) -> bool {

@@ -1240,9 +1240,14 @@ impl Model {
                 continue;
             }
             let c = super::contact::validate(d, i, n_contact_points, body, rotation)?;
-            if let NormalDescription::Bilateral { rolling } = d.normal {
+            if let NormalDescription::Bilateral { rolling, hold_normal } = d.normal {
                 // held closed: a constraint, not a unilateral contact
                 let what = format!("contacts[{i}] '{}'", d.name);
+                crate::ensure!(
+                    hold_normal || rolling,
+                    Model,
+                    "{what}.normal: hold_normal = false holds only the tangents, so it needs rolling = true"
+                );
                 crate::ensure!(
                     matches!(d.friction, FrictionDescription::None),
                     Model,
@@ -1260,7 +1265,13 @@ impl Model {
                     Model,
                     "{what}: a bilateral contact on a moving surface is not supported; use the unilateral law"
                 );
-                let kind = ConstraintKind::Contact { body1: c.body1, body2: c.body2, pair: Box::new(pair), rolling };
+                let kind = ConstraintKind::Contact {
+                    body1: c.body1,
+                    body2: c.body2,
+                    pair: Box::new(pair),
+                    rolling,
+                    normal: hold_normal,
+                };
                 hold(&what, &d.name, kind, &mut constraint_names, &mut constraints, &mut row)?;
                 continue;
             }
@@ -1277,8 +1288,13 @@ impl Model {
                 d.name
             );
             let c = super::contact::validate_gap(d, i, n_contact_points, &joints, &mut n_callbacks)?;
-            if let NormalDescription::Bilateral { rolling } = d.normal {
+            if let NormalDescription::Bilateral { rolling, hold_normal } = d.normal {
                 let what = format!("gap_contacts[{i}] '{}'", d.name);
+                crate::ensure!(
+                    hold_normal,
+                    Model,
+                    "{what}.normal: hold_normal = false (the tangents alone) is for contour contacts; a gap contact holds its gap"
+                );
                 crate::ensure!(
                     matches!(d.friction, FrictionDescription::None),
                     Model,
