@@ -67,9 +67,9 @@ pub struct PairSlot {
     pub last: Vec<([f64; 3], f64)>,
     /// The step in which `last` was written.
     pub stamp: u64,
-    /// Each candidate's compliant-layer deflection at the end of that step (m; valid with
-    /// `last`, on compliant groups).
-    pub layer: Vec<f64>,
+    /// Each candidate's compliant-layer deflection (m) and the step that wrote it (on compliant
+    /// groups; a candidate's own step, since the others of its pair may have taken part without it).
+    pub layer: Vec<(f64, u64)>,
 }
 
 /// Broad phase, pair cache and narrow phase of one contact group.
@@ -167,7 +167,7 @@ impl GroupPhase {
                         kin: vec![ContactKinematics::default(); m],
                         last: vec![([0.0; 3], 0.0); m],
                         stamp: u64::MAX,
-                        layer: vec![0.0; m],
+                        layer: vec![(0.0, u64::MAX); m],
                     });
                     self.cache.insert(key, self.slots.len() - 1);
                     self.slots.len() - 1

@@ -702,7 +702,8 @@ impl MoreauJean {
                         let sl = &self.groups[group].slots[slot];
                         let fresh = sl.stamp == self.steps.wrapping_sub(1);
                         let (prev, st) = if fresh { sl.last[k] } else { ([0.0; 3], OPEN) };
-                        let layer = (fresh && g.compliance > 0.0).then(|| sl.layer[k]);
+                        let (delta, written) = sl.layer[k];
+                        let layer = (g.compliance > 0.0 && written == self.steps.wrapping_sub(1)).then_some(delta);
                         (&g.friction, &g.impact, (g.compliance, g.damping), sl.kin[k].gd_t, prev, st, layer)
                     }
                 };
@@ -1043,7 +1044,9 @@ impl MoreauJean {
                         stored += 0.5 * delta * delta / c;
                         match self.act[ai].source {
                             Source::Point(pt) => self.results[pt].layer = Some(delta),
-                            Source::Group { group, slot, k } => self.groups[group].slots[slot].layer[k] = delta,
+                            Source::Group { group, slot, k } => {
+                                self.groups[group].slots[slot].layer[k] = (delta, self.steps)
+                            }
                         }
                     }
                 }
