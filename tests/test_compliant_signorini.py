@@ -467,3 +467,17 @@ def test_released_aside_the_ball_rolls_in_the_bowl_at_the_linearized_rolling_fre
     f = 1.0 / ms.analysis.period(res.t, res["body/ball/position"][:, 0])
     np.testing.assert_allclose(f, rolling, rtol=1e-3)
     assert np.abs(res["contact/bowl/gd_t"]).max() < 1e-9
+
+
+@pytest.mark.parametrize("c", [1e-6, 1e-8, 1e-10])
+@pytest.mark.parametrize("mode", ["hold", "roll"])
+def test_the_static_equilibrium_on_a_stiff_layer_from_the_touching_point(c, mode):
+    """From the ball just touching the bowl, the equilibrium with the layer held sinks it by
+    c m g (to 1e-12 m) at any stiffness. The Newton iteration's stiffness by central differences
+    (step 1e-7) had reached across the layer's kink at zero overlap from 1e7 N/m on, and its
+    tolerance, relative to the forces at the iterate (nothing at an equilibrium), sat below the
+    round-off of a stiff contact: it failed from 1e7 N/m on."""
+    m = ball_in_bowl(c, 1.0, 0.05, 0.5)
+    eq = ms.analysis.static_equilibrium(m, q=[0.0, 0.0, -0.45, 1.0, 0.0, 0.0, 0.0], contacts=mode)
+    np.testing.assert_allclose(eq["q"][2], -0.45 - c * 1.0 * G, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(eq["q"][:2], 0.0, atol=1e-12)

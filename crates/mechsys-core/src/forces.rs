@@ -223,6 +223,24 @@ fn add_wrench_at(data: &mut Data, b: usize, p: &Vec3, f: &Vec3, n: &Vec3) {
     }
 }
 
+/// The overlaps δ = −g_N (m; negative where open) of the explicit compliant contacts' points at
+/// the last force evaluation (`Data::element_deflection`), contact by contact and point by point:
+/// where their force laws have their kink (δ = 0), for derivatives by differences.
+pub fn compliant_overlaps(model: &Model, data: &Data) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut next = 0;
+    for fe in &model.forces {
+        let o = next;
+        next += fe.outputs(model.nu);
+        if let ForceElement::Contact(c) = fe {
+            out.extend(
+                (0..c.points()).map(|k| data.element_deflection[o + crate::model::compliant::OUTPUTS_PER_POINT * k]),
+            );
+        }
+    }
+    out
+}
+
 /// Power balance of the force elements at one instant.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Powers {

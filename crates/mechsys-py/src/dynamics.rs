@@ -122,6 +122,26 @@ fn nonlinear_effects<'py>(
     Ok(PyArray1::from_slice(py, data.h.as_slice()))
 }
 
+/// The overlaps δ = −g_N (m; negative where open) of the model's explicit compliant contacts'
+/// points at (q, u = 0, t), contact by contact and point by point (where their force laws kink).
+#[pyfunction]
+#[pyo3(signature = (model, q, t = 0.0, callbacks = None))]
+fn compliant_overlaps(
+    model: &PyModel,
+    q: PyReadonlyArray1<'_, f64>,
+    t: f64,
+    callbacks: Option<Vec<PyObject>>,
+) -> PyResult<Vec<f64>> {
+    let m = &model.model;
+    let q = q_checked(model, &q)?;
+    let cb = self::callbacks(model, callbacks)?;
+    let mut data = model.data.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let mut ws = model.ws.lock().map_err(|_| settings("model workspace is poisoned"))?;
+    let zero = vec![0.0; m.nu];
+    dynamics::nonlinear_effects(m, &mut data, &mut ws, t, q, &zero, &cb).map_err(PyMechsysError::from)?;
+    Ok(mechsys_core::forces::compliant_overlaps(m, &data))
+}
+
 /// Linearization at (q, u, t) into M, D, G, K, N (eq. 2.204) in minimal coordinates: a dict of
 /// row-major numpy matrices, the basis `v` (nu × n), the `residual` Vᵀ M u̇ and the `method` the
 /// derivatives were taken by (`method`: "auto" exact where the model allows, "exact", or "fd"
@@ -299,6 +319,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(aba, m)?)?;
     m.add_function(wrap_pyfunction!(rnea, m)?)?;
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
+    m.add_function(wrap_pyfunction!(compliant_overlaps, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
     m.add_function(wrap_pyfunction!(linearize, m)?)?;
     m.add_function(wrap_pyfunction!(state_space, m)?)?;

@@ -23,21 +23,6 @@ use crate::model::Model;
 /// Step of the central differences (positions absolute, velocities relative to `max(1, |u|∞)`).
 pub(super) const STEP: f64 = 1e-5;
 
-/// Where the overlaps δ of the explicit compliant contacts' points are recorded
-/// (`Data::element_deflection`), for [`acceleration_derivatives`]' step.
-fn overlap_slots(model: &Model) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut next = 0;
-    for fe in &model.forces {
-        let o = next;
-        next += fe.outputs(model.nu);
-        if let crate::model::ForceElement::Contact(c) = fe {
-            out.extend((0..c.points()).map(|k| o + crate::model::compliant::OUTPUTS_PER_POINT * k));
-        }
-    }
-    out
-}
-
 /// The position step along a direction from the overlaps at the point (`at`) and at ±`h`: `h`,
 /// or less where a compliant point's overlap changes along it, so that the difference stays a
 /// thousandth of the overlap away from the force law's kink at δ = 0 and the overlap's own
@@ -80,8 +65,7 @@ pub(super) fn acceleration_derivatives(
     };
     let (mut qp, mut up, mut dir) = (vec![0.0; nq], u.to_vec(), vec![0.0; nu]);
     // the compliant contacts' overlaps at the point, and at each difference's ends
-    let slots = overlap_slots(model);
-    let overlaps = |data: &Data| -> Vec<f64> { slots.iter().map(|&i| data.element_deflection[i]).collect() };
+    let overlaps = |data: &Data| -> Vec<f64> { crate::forces::compliant_overlaps(model, data) };
     accel(data, q, u)?;
     let at = overlaps(data);
     let mut ends: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
