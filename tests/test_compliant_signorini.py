@@ -168,7 +168,8 @@ def test_every_step_of_a_drop_on_a_layer_dissipates(zeta, h):
     assert step.min() >= -mass * G**2 * h**2 / 8 * (1 + 1e-9) - 1e-15, step.min()
     assert np.abs(res["energy/dissipated_drift"]).max() == 0.0
     assert np.abs(energy_balance(res)).max() < 1e-12
-    assert step.sum() > 0.5 * mass * G * 0.2 if zeta > 0 else True  # the damped layers take the drop's energy
+    if zeta > 0:  # the damped layers take the drop's energy (undamped, the ball keeps bouncing)
+        assert step.sum() > 0.5 * mass * G * 0.2, step.sum()
 
 
 def test_a_layer_let_go_relaxes_on_its_own_and_its_damper_takes_what_it_held():
@@ -395,9 +396,10 @@ def test_a_ball_rolling_in_a_bowl_on_its_layer_rocks_at_the_rolling_frequency():
     m = ball_in_bowl(c, mass, r, radius)
     q = np.array([0.0, 0.0, -(radius - r) - c * mass * G, 1.0, 0.0, 0.0, 0.0])
     bounce = np.sqrt(1.0 / (c * mass)) / (2 * np.pi)
-    # (central differences, the layer's force being no exact-derivative law: 2.4e-7 and 2.5e-6
-    # measured; the same ball on a rigid bowl's held contact comes out to 1e-11)
-    for mode, rock, tol in (("hold", np.sqrt(G / (radius - r)), 1e-6), ("roll", np.sqrt(5 * G / (7 * (radius - r))), 5e-6)):
+    # (central differences, the layer's force being no exact-derivative law: 8e-9 and 1.4e-8
+    # measured, where the overlap c m g shifts the closed forms by about 1e-8; a curvature bound
+    # of a millionth of the overlap on the differences' step had left 2.5e-6 on the rolling one)
+    for mode, rock, tol in (("hold", np.sqrt(G / (radius - r)), 1e-7), ("roll", np.sqrt(5 * G / (7 * (radius - r))), 1e-7)):
         lin = ms.linear.linearize(m, q=q, u=np.zeros(6), contacts=mode)
         f = np.sort(lin.modes().natural_frequency)
         np.testing.assert_allclose(f[-1], bounce, rtol=1e-6, err_msg=mode)

@@ -127,7 +127,7 @@ def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10,
         return _core.nonlinear_effects(core, qv, zero, t, callbacks)
 
     def overlaps(qv):
-        return np.asarray(_core.compliant_overlaps(core, qv, t, callbacks))
+        return _core.compliant_overlaps(core, qv, t, callbacks)
 
     # the residual's scale: the forces at the start (at an equilibrium h is only the imbalance,
     # and a stiff contact's round-off alone is k eps |q|)
@@ -153,15 +153,7 @@ def static_equilibrium(model: Model, q=None, t: float = 0.0, tol: float = 1e-10,
                 e = np.zeros(nu)
                 e[i] = eps
                 qp, qm = core.integrate(qk, e, 1.0), core.integrate(qk, -e, 1.0)
-                shorter = eps
-                if at.size:
-                    dp, dm = overlaps(qp), overlaps(qm)
-                    rate, curv = np.abs(dp - dm) / (2 * eps), np.abs(dp + dm - 2 * at) / eps**2
-                    live = at != 0.0
-                    with np.errstate(divide="ignore", invalid="ignore"):
-                        cands = np.concatenate([np.where(live & (rate > 0), 1e-3 * np.abs(at) / rate, np.inf),
-                                                np.where(live & (curv > 0), np.sqrt(1e-6 * np.abs(at) / curv), np.inf)])
-                    shorter = max(min(eps, float(cands.min(initial=np.inf))), 1e-13)
+                shorter = _core.difference_step(at, overlaps(qp), overlaps(qm), eps) if at else eps
                 if shorter >= eps:
                     break
                 eps = shorter

@@ -53,6 +53,9 @@ pub struct Data {
     /// forces: the external loads' share of `tau_applied` (joint forces, servos, callbacks and the
     /// elastic coordinates' share of loads at nodes) (nu).
     pub tau_load: Vec<f64>,
+    /// forces: whether the force stage fills `f_load` and `tau_load` (set by the scheme that reads
+    /// them; off, they are left as they are).
+    pub record_loads: bool,
     /// dynamics: spatial force transmitted by the joint into body i, body frame (nbody).
     pub f: Vec<Force>,
     /// crba: composite rigid-body inertias (nbody).
@@ -167,6 +170,7 @@ impl Data {
             tau_applied: vec![0.0; nu],
             f_load: vec![Force::ZERO; nb],
             tau_load: vec![0.0; nu],
+            record_loads: false,
             f: vec![Force::ZERO; nb],
             ic: vec![RigidInertia::default(); nb],
             mass_matrix: DMatrix::zeros(nu, nu),

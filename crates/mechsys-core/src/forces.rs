@@ -209,7 +209,9 @@ fn add_node_load(data: &mut Data, b: usize, p_b: &Vec3, load_i: &Vec3, rotation:
     for kk in 0..ne {
         let g = fields[n * ne + kk].dot(&load_b);
         data.tau_applied[w.iu + kk] += g;
-        data.tau_load[w.iu + kk] += g;
+        if data.record_loads {
+            data.tau_load[w.iu + kk] += g;
+        }
         power += g * w.qd[kk];
     }
     power
@@ -288,8 +290,12 @@ pub fn evaluate(
 ) -> Result<Powers> {
     data.f_ext.iter_mut().for_each(|f| *f = Force::ZERO);
     data.tau_applied.iter_mut().for_each(|x| *x = 0.0);
-    data.f_load.iter_mut().for_each(|f| *f = Force::ZERO);
-    data.tau_load.iter_mut().for_each(|x| *x = 0.0);
+    // (the loads apart only for a scheme that asks: Moreau–Jean's work at its own velocities)
+    let loads = data.record_loads;
+    if loads {
+        data.f_load.iter_mut().for_each(|f| *f = Force::ZERO);
+        data.tau_load.iter_mut().for_each(|x| *x = 0.0);
+    }
     data.contact_energy = 0.0;
     let mut p_diss = 0.0;
     let mut p_ext = 0.0;
@@ -317,7 +323,9 @@ pub fn evaluate(
                 let w = Force::new(x.point_to_parent(&b.ejection_point).cross(&f), f);
                 p_ext += wrench_power(data, i, &w);
                 data.f_ext[i] += w;
-                data.f_load[i] += w;
+                if loads {
+                    data.f_load[i] += w;
+                }
             }
         }
     }
@@ -500,7 +508,9 @@ pub fn evaluate(
                 let w = Force::new(n + point_position(data, *body, point).cross(&f), f);
                 p_ext += wrench_power(data, *body, &w);
                 data.f_ext[*body] += w;
-                data.f_load[*body] += w;
+                if loads {
+                    data.f_load[*body] += w;
+                }
                 p_ext += add_node_force(data, *body, point, &f);
                 p_ext += add_node_torque(data, *body, point, &n);
                 // recorded: the applied force and the torque (about its point), inertial components
@@ -522,7 +532,9 @@ pub fn evaluate(
                 };
                 let tau = gear * tm.clamp(-max_torque, *max_torque);
                 data.tau_applied[j.iu + index] += tau;
-                data.tau_load[j.iu + index] += tau;
+                if loads {
+                    data.tau_load[j.iu + index] += tau;
+                }
                 p_ext += tau * v;
                 data.element_force[o] = tau;
                 data.element_deflection[o] = err;
@@ -532,7 +544,9 @@ pub fn evaluate(
                 let j = &model.joints[*joint];
                 for (k, v) in value.iter().enumerate() {
                     data.tau_applied[j.iu + k] += v * s;
-                    data.tau_load[j.iu + k] += v * s;
+                    if loads {
+                        data.tau_load[j.iu + k] += v * s;
+                    }
                     p_ext += v * s * u[j.iu + k];
                     data.element_force[o + k] = v * s;
                 }
@@ -554,7 +568,9 @@ pub fn evaluate(
                 // recorded: the generalized forces the callback added
                 for i in 0..nu {
                     data.element_force[o + i] = data.tau_applied[i] - data.element_force[o + i];
-                    data.tau_load[i] += data.element_force[o + i];
+                    if loads {
+                        data.tau_load[i] += data.element_force[o + i];
+                    }
                 }
             }
         }

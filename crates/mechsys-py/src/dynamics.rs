@@ -142,6 +142,16 @@ fn compliant_overlaps(
     Ok(mechsys_core::forces::compliant_overlaps(m, &data))
 }
 
+/// The central difference's position step along a direction, from the compliant overlaps at the
+/// point and at ±h (`mechsys_core::linear::difference_step`).
+#[pyfunction]
+fn difference_step(at: Vec<f64>, plus: Vec<f64>, minus: Vec<f64>, h: f64) -> PyResult<f64> {
+    if plus.len() != at.len() || minus.len() != at.len() {
+        return Err(settings("difference_step: the three overlap lists must have one length"));
+    }
+    Ok(mechsys_core::linear::difference_step(&at, &plus, &minus, h))
+}
+
 /// Linearization at (q, u, t) into M, D, G, K, N (eq. 2.204) in minimal coordinates: a dict of
 /// row-major numpy matrices, the basis `v` (nu × n), the `residual` Vᵀ M u̇ and the `method` the
 /// derivatives were taken by (`method`: "auto" exact where the model allows, "exact", or "fd"
@@ -320,6 +330,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea, m)?)?;
     m.add_function(wrap_pyfunction!(nonlinear_effects, m)?)?;
     m.add_function(wrap_pyfunction!(compliant_overlaps, m)?)?;
+    m.add_function(wrap_pyfunction!(difference_step, m)?)?;
     m.add_function(wrap_pyfunction!(energies, m)?)?;
     m.add_function(wrap_pyfunction!(linearize, m)?)?;
     m.add_function(wrap_pyfunction!(state_space, m)?)?;

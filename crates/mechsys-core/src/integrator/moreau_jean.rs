@@ -65,11 +65,6 @@ pub const CONTACT_MARGIN: f64 = 1e-9;
 /// point takes an impulse only where it would otherwise end the step inside its contact.
 pub const HOLD_MARGIN: f64 = 1e-7;
 
-/// How far (m) beyond the activation margin a compliant point is taken into the step's problem
-/// while it approaches at `gd_n` (twice the step's approach at the start velocity): its gap
-/// allowance lets it close, not pass. A compliant layer must not be entered by a whole step's
-/// motion the way a rigid point is (its velocity-level penetration stays as drift): the gap term
-/// would then push that penetration out within a step, an elastic pop at any stiffness.
 /// The share `τ/(h + τ)` of a compliant layer's deflection that is left after a step of `h`
 /// without force (implicit Euler of `k δ + d δ̇ = 0`, `τ = c d`): 0 undamped, 1 infinitely damped.
 #[inline]
@@ -81,6 +76,11 @@ fn relaxed(h: f64, tau: f64) -> f64 {
     }
 }
 
+/// How far (m) beyond the activation margin a compliant point is taken into the step's problem
+/// while it approaches at `gd_n` (twice the step's approach at the start velocity): its gap
+/// allowance lets it close, not pass. A compliant layer must not be entered by a whole step's
+/// motion the way a rigid point is (its velocity-level penetration stays as drift): the gap term
+/// would then push that penetration out within a step, an elastic pop at any stiffness.
 fn speculative(h: f64, gd_n: f64) -> f64 {
     2.0 * h * (-gd_n).max(0.0)
 }
@@ -473,7 +473,10 @@ impl MoreauJean {
                 crate::dynamics::prepare(model, data, ws, tm, &self.q_mid, u, cb)?
             } else {
                 // (the same midpoint positions: only the velocities and forces are redone)
-                let p = crate::dynamics::prepare_rates(model, data, ws, tm, &self.q_mid, &self.u_free, cb)?;
+                data.record_loads = true;
+                let p = crate::dynamics::prepare_rates(model, data, ws, tm, &self.q_mid, &self.u_free, cb);
+                data.record_loads = false;
+                let p = p?;
                 self.external_loads(model, data);
                 p
             };
@@ -580,7 +583,6 @@ impl MoreauJean {
             self.group_stats[gi].pairs = ph.live.len();
         }
         let m = self.act.len();
-        // (stored: the layers' energy at the step's end; start: at the overlaps it starts from)
         // the layers' energy at the step's end (stored), at the start of the points that carry
         // their layer's state from the last step (kept) and of those that join overlapped (new)
         let (mut dw_n, mut dw_t, mut stored, mut kept, mut new) = (0.0, 0.0, 0.0, 0.0, 0.0);

@@ -10,7 +10,7 @@
 //! 1e7 N/m), and a difference across the kink halves its stiffness. The position step is
 //! therefore shortened along each direction that moves a compliant contact's point: to a
 //! thousandth of its overlap over its rate along the direction, and so that the overlap's
-//! curvature along it changes the overlap by less than a millionth.
+//! curvature along it changes the overlap by less than 1e-8 of itself.
 
 use nalgebra::DMatrix;
 
@@ -23,12 +23,14 @@ use crate::model::Model;
 /// Step of the central differences (positions absolute, velocities relative to `max(1, |u|∞)`).
 pub(super) const STEP: f64 = 1e-5;
 
-/// The position step along a direction from the overlaps at the point (`at`) and at ±`h`: `h`,
-/// or less where a compliant point's overlap changes along it, so that the difference stays a
-/// thousandth of the overlap away from the force law's kink at δ = 0 and the overlap's own
-/// curvature along the direction (a ball rocking in a bowl) moves it by less than a millionth
-/// (either gives about 1e-6 relative in the stiffness); not below 1e-13 m.
-fn step_along(at: &[f64], plus: &[f64], minus: &[f64], h: f64) -> f64 {
+/// The position step along a direction from the compliant contacts' overlaps at the point
+/// (`at`) and at ±`h` ([`crate::forces::compliant_overlaps`]): `h`, or less where an overlap
+/// changes along it, so that the difference stays a thousandth of the overlap away from the force
+/// law's kink at δ = 0 (about 1e-7 relative in a Hertz stiffness) and the overlap's own curvature
+/// along the direction (a ball rocking in a bowl) moves it by less than 1e-8 of itself (a
+/// millionth left the rolling ball's rocking frequency 2.5e-6 off; 1e-8 leaves 1e-8); not below
+/// 1e-13 m. Also the static equilibrium's Newton stiffness (`mechsys.analysis`) steps by it.
+pub fn difference_step(at: &[f64], plus: &[f64], minus: &[f64], h: f64) -> f64 {
     let mut step = h;
     for ((d0, dp), dm) in at.iter().zip(plus).zip(minus) {
         if !(d0.is_finite() && *d0 != 0.0) {
@@ -40,7 +42,7 @@ fn step_along(at: &[f64], plus: &[f64], minus: &[f64], h: f64) -> f64 {
         }
         let curvature = (dp + dm - 2.0 * d0).abs() / (h * h);
         if curvature > 0.0 {
-            step = step.min((1e-6 * d0.abs() / curvature).sqrt());
+            step = step.min((1e-8 * d0.abs() / curvature).sqrt());
         }
     }
     step.max(1e-13)
@@ -89,7 +91,7 @@ pub(super) fn acceleration_derivatives(
             }
             // a stiff contact at rest overlaps by less than STEP (a micrometre at 1e7 N/m): a
             // difference across its kink at δ = 0 halves its stiffness, so step again, shorter
-            let shorter = step_along(&at, &ends[0], &ends[1], h);
+            let shorter = difference_step(&at, &ends[0], &ends[1], h);
             if pass == 1 || shorter >= h {
                 break;
             }

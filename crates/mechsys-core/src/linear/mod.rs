@@ -40,6 +40,7 @@ mod differences;
 mod geometric;
 mod motion;
 
+pub use differences::difference_step;
 pub use motion::{state_space, Basis, StateSpace};
 
 use nalgebra::{DMatrix, DVector};
